@@ -1,0 +1,354 @@
+//! A safe command-buffer recorder. Passes record through it; barriers are
+//! crate-private so only the render graph issues them.
+
+use ash::vk;
+
+use super::context::{vk_err, Context};
+use super::heap::PUSH_CONSTANT_BYTES;
+use super::memory::{subresource_range, AccessState, Buffer, Image};
+use super::pipeline::{ComputePipeline, GraphicsPipeline};
+use crate::error::{Error, Result};
+
+/// A buffer transition from one access state to another.
+pub(crate) struct BufferBarrier<'a> {
+    pub buffer: &'a Buffer,
+    pub src: AccessState,
+    pub dst: AccessState,
+}
+
+/// An image transition (and layout change) from one state to another.
+pub(crate) struct ImageBarrier<'a> {
+    pub image: &'a Image,
+    pub src: AccessState,
+    pub dst: AccessState,
+}
+
+/// How a colour attachment starts.
+#[derive(Clone, Copy, Debug)]
+pub enum LoadOp {
+    Clear([f32; 4]),
+    Load,
+    DontCare,
+}
+
+/// Records commands into one command buffer.
+pub struct CommandRecorder {
+    pub(crate) ctx: Context,
+    pub(crate) cmd: vk::CommandBuffer,
+    bound_layout_is_graphics: Option<bool>,
+}
+
+impl CommandRecorder {
+    pub(crate) fn new(ctx: &Context, cmd: vk::CommandBuffer) -> Self {
+        CommandRecorder {
+            ctx: ctx.clone(),
+            cmd,
+            bound_layout_is_graphics: None,
+        }
+    }
+
+    fn device(&self) -> &ash::Device {
+        &self.ctx.shared.device
+    }
+
+    /// One synchronization2 dependency for all the given transitions.
+    pub(crate) fn barriers(&mut self, buffers: &[BufferBarrier<'_>], images: &[ImageBarrier<'_>]) {
+        if buffers.is_empty() && images.is_empty() {
+            return;
+        }
+        let buffer_barriers: Vec<_> = buffers
+            .iter()
+            .map(|b| {
+                vk::BufferMemoryBarrier2::default()
+                    .src_stage_mask(b.src.stages)
+                    .src_access_mask(b.src.access)
+                    .dst_stage_mask(b.dst.stages)
+                    .dst_access_mask(b.dst.access)
+                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                    .buffer(b.buffer.raw)
+                    .offset(0)
+                    .size(vk::WHOLE_SIZE)
+            })
+            .collect();
+        let image_barriers: Vec<_> = images
+            .iter()
+            .map(|b| {
+                vk::ImageMemoryBarrier2::default()
+                    .src_stage_mask(b.src.stages)
+                    .src_access_mask(b.src.access)
+                    .dst_stage_mask(b.dst.stages)
+                    .dst_access_mask(b.dst.access)
+                    .old_layout(b.src.layout)
+                    .new_layout(b.dst.layout)
+                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                    .image(b.image.raw)
+                    .subresource_range(subresource_range(b.image.aspect()))
+            })
+            .collect();
+        let dependency = vk::DependencyInfo::default()
+            .buffer_memory_barriers(&buffer_barriers)
+            .image_memory_barriers(&image_barriers);
+        // SAFETY: the command buffer is recording; the resources are alive until the
+        // frame completes (the graph or caller holds them).
+        unsafe { self.device().cmd_pipeline_barrier2(self.cmd, &dependency) };
+    }
+
+    /// Opens a debug label (RenderDoc, Nsight, validation messages).
+    pub fn begin_label(&mut self, name: &str, color: [f32; 4]) {
+        if let (Some(debug), Ok(name)) = (&self.ctx.shared.debug_device, std::ffi::CString::new(name)) {
+            let label = vk::DebugUtilsLabelEXT::default().label_name(&name).color(color);
+            // SAFETY: recording command buffer; the label string outlives the call.
+            unsafe { debug.cmd_begin_debug_utils_label(self.cmd, &label) };
+        }
+    }
+
+    /// Closes the innermost debug label.
+    pub fn end_label(&mut self) {
+        if let Some(debug) = &self.ctx.shared.debug_device {
+            // SAFETY: paired with `begin_label` by the caller.
+            unsafe { debug.cmd_end_debug_utils_label(self.cmd) };
+        }
+    }
+
+    pub(crate) fn write_timestamp(&mut self, pool: vk::QueryPool, index: u32, stage: vk::PipelineStageFlags2) {
+        // SAFETY: the query was reset in this command buffer before use.
+        unsafe { self.device().cmd_write_timestamp2(self.cmd, stage, pool, index) };
+    }
+
+    pub(crate) fn reset_queries(&mut self, pool: vk::QueryPool, count: u32) {
+        // SAFETY: recording outside a render pass instance.
+        unsafe { self.device().cmd_reset_query_pool(self.cmd, pool, 0, count) };
+    }
+
+    fn bind_heap(&mut self, bind_point: vk::PipelineBindPoint) {
+        let heap = &self.ctx.shared.heap;
+        // SAFETY: the heap set is compatible with the global pipeline layout.
+        unsafe {
+            self.device()
+                .cmd_bind_descriptor_sets(self.cmd, bind_point, heap.pipeline_layout, 0, &[heap.set], &[])
+        };
+    }
+
+    /// Binds a compute pipeline and the descriptor heap.
+    pub fn bind_compute(&mut self, pipeline: &ComputePipeline) {
+        // SAFETY: the pipeline is alive for the frame (callers keep it).
+        unsafe { self.device().cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::COMPUTE, pipeline.raw) };
+        if self.bound_layout_is_graphics != Some(false) {
+            self.bind_heap(vk::PipelineBindPoint::COMPUTE);
+            self.bound_layout_is_graphics = Some(false);
+        }
+    }
+
+    /// Binds a graphics pipeline and the descriptor heap.
+    pub fn bind_graphics(&mut self, pipeline: &GraphicsPipeline) {
+        // SAFETY: as in `bind_compute`.
+        unsafe { self.device().cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.raw) };
+        if self.bound_layout_is_graphics != Some(true) {
+            self.bind_heap(vk::PipelineBindPoint::GRAPHICS);
+            self.bound_layout_is_graphics = Some(true);
+        }
+    }
+
+    /// Sets the push constants (at most 128 bytes) for all stages.
+    pub fn push_constants<T: bytemuck::Pod>(&mut self, data: &T) -> Result<()> {
+        let bytes = bytemuck::bytes_of(data);
+        if bytes.len() > PUSH_CONSTANT_BYTES as usize {
+            return Err(Error::invalid("push constants", format!("{} bytes, at most {PUSH_CONSTANT_BYTES}", bytes.len())));
+        }
+        let layout = self.ctx.shared.heap.pipeline_layout;
+        // SAFETY: the range lies within the layout's push-constant range.
+        unsafe { self.device().cmd_push_constants(self.cmd, layout, vk::ShaderStageFlags::ALL, 0, bytes) };
+        Ok(())
+    }
+
+    /// Dispatches `x·y·z` workgroups.
+    pub fn dispatch(&mut self, x: u32, y: u32, z: u32) {
+        // SAFETY: a compute pipeline is bound by the pass.
+        unsafe { self.device().cmd_dispatch(self.cmd, x, y, z) };
+    }
+
+    /// Starts dynamic rendering into the attachments; viewport and scissor cover
+    /// the first attachment.
+    pub fn begin_rendering(&mut self, colors: &[(&Image, LoadOp)], depth: Option<(&Image, Option<f32>)>) {
+        let (width, height) = colors
+            .first()
+            .map(|(i, _)| (i.desc().width, i.desc().height))
+            .or(depth.map(|(i, _)| (i.desc().width, i.desc().height)))
+            .unwrap_or((1, 1));
+        let color_infos: Vec<_> = colors
+            .iter()
+            .map(|(image, load)| {
+                let (op, clear) = match load {
+                    LoadOp::Clear(c) => (vk::AttachmentLoadOp::CLEAR, *c),
+                    LoadOp::Load => (vk::AttachmentLoadOp::LOAD, [0.0; 4]),
+                    LoadOp::DontCare => (vk::AttachmentLoadOp::DONT_CARE, [0.0; 4]),
+                };
+                vk::RenderingAttachmentInfo::default()
+                    .image_view(image.view)
+                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                    .load_op(op)
+                    .store_op(vk::AttachmentStoreOp::STORE)
+                    .clear_value(vk::ClearValue {
+                        color: vk::ClearColorValue { float32: clear },
+                    })
+            })
+            .collect();
+        let depth_info = depth.map(|(image, clear)| {
+            vk::RenderingAttachmentInfo::default()
+                .image_view(image.view)
+                .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+                .load_op(if clear.is_some() {
+                    vk::AttachmentLoadOp::CLEAR
+                } else {
+                    vk::AttachmentLoadOp::LOAD
+                })
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    depth_stencil: vk::ClearDepthStencilValue {
+                        depth: clear.unwrap_or(1.0),
+                        stencil: 0,
+                    },
+                })
+        });
+        let area = vk::Rect2D {
+            offset: vk::Offset2D { x: 0, y: 0 },
+            extent: vk::Extent2D { width, height },
+        };
+        let mut info = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .color_attachments(&color_infos);
+        if let Some(d) = depth_info.as_ref() {
+            info = info.depth_attachment(d);
+        }
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: width as f32,
+            height: height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        // SAFETY: attachments are in the layouts the graph transitioned them to.
+        unsafe {
+            self.device().cmd_begin_rendering(self.cmd, &info);
+            self.device().cmd_set_viewport(self.cmd, 0, &[viewport]);
+            self.device().cmd_set_scissor(self.cmd, 0, &[area]);
+        }
+    }
+
+    /// Ends dynamic rendering.
+    pub fn end_rendering(&mut self) {
+        // SAFETY: paired with `begin_rendering`.
+        unsafe { self.device().cmd_end_rendering(self.cmd) };
+    }
+
+    /// Binds `buffer` as vertex buffer 0.
+    pub fn bind_vertex_buffer(&mut self, buffer: &Buffer) {
+        // SAFETY: the buffer has VERTEX_BUFFER usage (the graph declared it).
+        unsafe { self.device().cmd_bind_vertex_buffers(self.cmd, 0, &[buffer.raw], &[0]) };
+    }
+
+    /// Binds `buffer` as a 32-bit index buffer.
+    pub fn bind_index_buffer(&mut self, buffer: &Buffer) {
+        // SAFETY: the buffer has INDEX_BUFFER usage.
+        unsafe { self.device().cmd_bind_index_buffer(self.cmd, buffer.raw, 0, vk::IndexType::UINT32) };
+    }
+
+    /// Draws non-indexed vertices.
+    pub fn draw(&mut self, vertices: u32, instances: u32) {
+        // SAFETY: inside a rendering instance with a graphics pipeline bound.
+        unsafe { self.device().cmd_draw(self.cmd, vertices, instances, 0, 0) };
+    }
+
+    /// Draws indexed vertices.
+    pub fn draw_indexed(&mut self, indices: u32, instances: u32) {
+        // SAFETY: as in `draw`, with an index buffer bound.
+        unsafe { self.device().cmd_draw_indexed(self.cmd, indices, instances, 0, 0, 0) };
+    }
+
+    /// Copies `size` bytes from the start of `src` to the start of `dst`.
+    pub fn copy_buffer(&mut self, src: &Buffer, dst: &Buffer, size: u64) {
+        let region = vk::BufferCopy {
+            src_offset: 0,
+            dst_offset: 0,
+            size,
+        };
+        // SAFETY: both buffers are large enough and in transfer states.
+        unsafe { self.device().cmd_copy_buffer(self.cmd, src.raw, dst.raw, &[region]) };
+    }
+
+    fn image_copy_region(image: &Image) -> vk::BufferImageCopy {
+        vk::BufferImageCopy {
+            buffer_offset: 0,
+            buffer_row_length: 0,
+            buffer_image_height: 0,
+            image_subresource: vk::ImageSubresourceLayers {
+                aspect_mask: image.aspect(),
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            },
+            image_offset: vk::Offset3D::default(),
+            image_extent: vk::Extent3D {
+                width: image.desc().width,
+                height: image.desc().height,
+                depth: 1,
+            },
+        }
+    }
+
+    /// Copies the whole image into `dst`, tightly packed (image in TRANSFER_SRC layout).
+    pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) {
+        let region = Self::image_copy_region(src);
+        // SAFETY: the graph put `src` in TRANSFER_SRC_OPTIMAL; `dst` is large enough.
+        unsafe {
+            self.device()
+                .cmd_copy_image_to_buffer(self.cmd, src.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, dst.raw, &[region])
+        };
+    }
+
+    /// Copies tightly packed texels from `src` into the whole image (TRANSFER_DST layout).
+    pub fn copy_buffer_to_image(&mut self, src: &Buffer, dst: &Image) {
+        let region = Self::image_copy_region(dst);
+        // SAFETY: `dst` is in TRANSFER_DST_OPTIMAL; `src` holds enough texels.
+        unsafe {
+            self.device()
+                .cmd_copy_buffer_to_image(self.cmd, src.raw, dst.raw, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &[region])
+        };
+    }
+}
+
+impl Context {
+    /// Records commands with `record`, submits them and waits: for uploads and
+    /// setup work outside the per-frame graph.
+    pub(crate) fn one_shot(&self, record: impl FnOnce(&mut CommandRecorder)) -> Result<()> {
+        let device = &self.shared.device;
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(self.shared.queue_family)
+            .flags(vk::CommandPoolCreateFlags::TRANSIENT);
+        // SAFETY: valid create info on a live device.
+        let pool = unsafe { device.create_command_pool(&pool_info, None) }.map_err(vk_err("vkCreateCommandPool"))?;
+        let result = (|| {
+            let alloc = vk::CommandBufferAllocateInfo::default()
+                .command_pool(pool)
+                .level(vk::CommandBufferLevel::PRIMARY)
+                .command_buffer_count(1);
+            // SAFETY: the pool is live and owned by this thread.
+            let cmd = unsafe { device.allocate_command_buffers(&alloc) }.map_err(vk_err("vkAllocateCommandBuffers"))?[0];
+            let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            // SAFETY: fresh command buffer.
+            unsafe { device.begin_command_buffer(cmd, &begin) }.map_err(vk_err("vkBeginCommandBuffer"))?;
+            record(&mut CommandRecorder::new(self, cmd));
+            // SAFETY: recording.
+            unsafe { device.end_command_buffer(cmd) }.map_err(vk_err("vkEndCommandBuffer"))?;
+            let value = self.submit(cmd)?;
+            self.wait(value)
+        })();
+        // SAFETY: the submission completed (or was never made), so the pool is idle.
+        unsafe { device.destroy_command_pool(pool, None) };
+        result
+    }
+}

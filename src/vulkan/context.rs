@@ -1,0 +1,442 @@
+//! The Vulkan context: instance, validation, device, queue, allocator,
+//! timeline semaphore, deferred destruction and the descriptor heap.
+//!
+//! [`Context`] is a cheap, cloneable handle; the GPU objects it owns are
+//! destroyed when the last handle (and the last resource made from it) drops,
+//! after the GPU is idle.
+
+use std::ffi::{c_char, CStr};
+use std::mem::ManuallyDrop;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+
+use super::device_select::{self, DeviceSelector, REQUIRED_FEATURES};
+use super::heap::DescriptorHeap;
+use super::memory::Garbage;
+use super::validation::{messenger_info, ValidationReport};
+use crate::error::{Error, Result};
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+/// How to create a [`Context`].
+#[derive(Clone, Debug, Default)]
+pub struct ContextOptions {
+    /// Enable the Khronos validation layer with synchronization validation.
+    pub validation: bool,
+    /// Which physical device to use.
+    pub device: DeviceSelector,
+}
+
+/// What the chosen device is and what alpenglow uses of it.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct DeviceInfo {
+    pub name: String,
+    pub device_type: String,
+    pub vendor_id: u32,
+    pub device_id: u32,
+    pub driver_name: String,
+    pub driver_info: String,
+    pub api_version: String,
+    pub index: usize,
+    pub timestamp_period_ns: f32,
+    pub max_image_dimension_2d: u32,
+    pub features: Vec<String>,
+    pub validation: bool,
+}
+
+pub(crate) struct Shared {
+    _entry: ash::Entry,
+    pub instance: ash::Instance,
+    debug_instance: Option<ash::ext::debug_utils::Instance>,
+    messenger: vk::DebugUtilsMessengerEXT,
+    pub debug_device: Option<ash::ext::debug_utils::Device>,
+    pub physical: vk::PhysicalDevice,
+    pub device: ash::Device,
+    queue: Mutex<vk::Queue>,
+    pub queue_family: u32,
+    pub allocator: ManuallyDrop<Mutex<Allocator>>,
+    timeline: vk::Semaphore,
+    last_submitted: AtomicU64,
+    garbage: Mutex<Vec<(u64, Garbage)>>,
+    pub heap: ManuallyDrop<DescriptorHeap>,
+    pub info: DeviceInfo,
+    pub limits: vk::PhysicalDeviceLimits,
+    report: Option<Arc<ValidationReport>>,
+}
+
+/// A Vulkan instance and device with everything alpenglow renders through.
+#[derive(Clone)]
+pub struct Context {
+    pub(crate) shared: Arc<Shared>,
+}
+
+impl std::fmt::Debug for Context {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Context").field("device", &self.shared.info.name).finish()
+    }
+}
+
+pub(crate) fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> Error {
+    move |result| Error::Vulkan { call, result }
+}
+
+impl Context {
+    /// Creates the instance (with validation when asked) and the device.
+    pub fn new(options: &ContextOptions) -> Result<Self> {
+        // SAFETY: loading libvulkan.so.1 runs its initialisers; the loader is a
+        // well-behaved shared library.
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::Loader(e.to_string()))?;
+        let report = options.validation.then(|| Arc::new(ValidationReport::default()));
+
+        // SAFETY: plain queries with no external state.
+        let layers = unsafe { entry.enumerate_instance_layer_properties() }
+            .map_err(vk_err("vkEnumerateInstanceLayerProperties"))?;
+        let has_layer = |name: &CStr| layers.iter().any(|l| l.layer_name_as_c_str().ok() == Some(name));
+        // SAFETY: as above.
+        let extensions = unsafe { entry.enumerate_instance_extension_properties(None) }
+            .map_err(vk_err("vkEnumerateInstanceExtensionProperties"))?;
+        let has_debug_utils = extensions
+            .iter()
+            .any(|e| e.extension_name_as_c_str().ok() == Some(ash::ext::debug_utils::NAME));
+
+        let mut layer_names: Vec<*const c_char> = Vec::new();
+        let mut extension_names: Vec<*const c_char> = Vec::new();
+        if options.validation {
+            if !has_layer(VALIDATION_LAYER) {
+                return Err(Error::Device(
+                    "validation requested but VK_LAYER_KHRONOS_validation is not installed \
+                     (apt install vulkan-validationlayers, or run tools/install-vulkan-runtime.sh)"
+                        .into(),
+                ));
+            }
+            layer_names.push(VALIDATION_LAYER.as_ptr());
+            extension_names.push(ash::ext::validation_features::NAME.as_ptr());
+        }
+        let debug_utils = has_debug_utils || options.validation;
+        if debug_utils {
+            extension_names.push(ash::ext::debug_utils::NAME.as_ptr());
+        }
+
+        let app = vk::ApplicationInfo::default()
+            .application_name(c"alpenglow")
+            .engine_name(c"alpenglow")
+            .api_version(vk::API_VERSION_1_3);
+        let enabled_validation = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut validation_features =
+            vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_validation);
+        let mut messenger_create = report.as_deref().map(messenger_info);
+        let mut instance_info = vk::InstanceCreateInfo::default()
+            .application_info(&app)
+            .enabled_layer_names(&layer_names)
+            .enabled_extension_names(&extension_names);
+        if let Some(messenger_create) = messenger_create.as_mut() {
+            instance_info = instance_info.push_next(messenger_create).push_next(&mut validation_features);
+        }
+        // SAFETY: every pointer in the create info refers to locals that outlive the call.
+        let instance = unsafe { entry.create_instance(&instance_info, None) }.map_err(|e| match e {
+            vk::Result::ERROR_INCOMPATIBLE_DRIVER => {
+                Error::Device("no Vulkan 1.3 driver found (run tools/install-vulkan-runtime.sh)".into())
+            }
+            other => Error::Vulkan {
+                call: "vkCreateInstance",
+                result: other,
+            },
+        })?;
+
+        let debug_instance = debug_utils.then(|| ash::ext::debug_utils::Instance::new(&entry, &instance));
+        let messenger = match (&debug_instance, report.as_deref()) {
+            (Some(debug), Some(report)) => {
+                // SAFETY: the report outlives the messenger (Shared keeps the Arc).
+                unsafe { debug.create_debug_utils_messenger(&messenger_info(report), None) }
+                    .map_err(vk_err("vkCreateDebugUtilsMessengerEXT"))?
+            }
+            _ => vk::DebugUtilsMessengerEXT::null(),
+        };
+
+        let result = Self::create_device(entry, instance, debug_instance, messenger, report, options);
+        result
+    }
+
+    fn create_device(
+        entry: ash::Entry,
+        instance: ash::Instance,
+        debug_instance: Option<ash::ext::debug_utils::Instance>,
+        messenger: vk::DebugUtilsMessengerEXT,
+        report: Option<Arc<ValidationReport>>,
+        options: &ContextOptions,
+    ) -> Result<Self> {
+        let destroy_instance = |instance: &ash::Instance| {
+            // SAFETY: nothing else was created from the instance yet but the messenger.
+            unsafe {
+                if let Some(debug) = &debug_instance {
+                    if messenger != vk::DebugUtilsMessengerEXT::null() {
+                        debug.destroy_debug_utils_messenger(messenger, None);
+                    }
+                }
+                instance.destroy_instance(None);
+            }
+        };
+        // SAFETY: plain query on a live instance.
+        let physicals = match unsafe { instance.enumerate_physical_devices() } {
+            Ok(p) => p,
+            Err(e) => {
+                destroy_instance(&instance);
+                return Err(Error::Vulkan {
+                    call: "vkEnumeratePhysicalDevices",
+                    result: e,
+                });
+            }
+        };
+        let candidates = physicals
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| device_select::inspect(&instance, p, i))
+            .collect();
+        let candidate = match device_select::choose(candidates, &options.device) {
+            Ok(c) => c,
+            Err(e) => {
+                destroy_instance(&instance);
+                return Err(e);
+            }
+        };
+        let queue_family = candidate.queue_family.unwrap_or(0);
+
+        let priorities = [1.0f32];
+        let queue_infos = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
+        let mut v12 = vk::PhysicalDeviceVulkan12Features::default()
+            .timeline_semaphore(true)
+            .descriptor_indexing(true)
+            .runtime_descriptor_array(true)
+            .descriptor_binding_partially_bound(true)
+            .descriptor_binding_sampled_image_update_after_bind(true)
+            .descriptor_binding_storage_image_update_after_bind(true)
+            .descriptor_binding_storage_buffer_update_after_bind(true)
+            .shader_sampled_image_array_non_uniform_indexing(true)
+            .shader_storage_image_array_non_uniform_indexing(true)
+            .shader_storage_buffer_array_non_uniform_indexing(true);
+        let mut v13 = vk::PhysicalDeviceVulkan13Features::default()
+            .dynamic_rendering(true)
+            .synchronization2(true)
+            .maintenance4(true);
+        let base = vk::PhysicalDeviceFeatures::default();
+        let device_info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_infos)
+            .enabled_features(&base)
+            .push_next(&mut v12)
+            .push_next(&mut v13);
+        // SAFETY: the features were checked as supported by `inspect`; pointers are to locals.
+        let device = match unsafe { instance.create_device(candidate.physical, &device_info, None) } {
+            Ok(d) => d,
+            Err(e) => {
+                destroy_instance(&instance);
+                return Err(Error::Vulkan {
+                    call: "vkCreateDevice",
+                    result: e,
+                });
+            }
+        };
+        // SAFETY: the queue family and index were requested at device creation.
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        let debug_device = debug_instance
+            .as_ref()
+            .map(|_| ash::ext::debug_utils::Device::new(&instance, &device));
+
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device: candidate.physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })
+        .map_err(|e| Error::Allocation {
+            what: "allocator".into(),
+            message: e.to_string(),
+        })?;
+
+        let mut timeline_type =
+            vk::SemaphoreTypeCreateInfo::default().semaphore_type(vk::SemaphoreType::TIMELINE).initial_value(0);
+        let semaphore_info = vk::SemaphoreCreateInfo::default().push_next(&mut timeline_type);
+        // SAFETY: valid device; timeline semaphores were enabled.
+        let timeline = unsafe { device.create_semaphore(&semaphore_info, None) }.map_err(vk_err("vkCreateSemaphore"))?;
+        let heap = DescriptorHeap::new(&device, &candidate.properties.limits)?;
+
+        let props = &candidate.properties;
+        let info = DeviceInfo {
+            name: candidate.name.clone(),
+            device_type: device_select::device_type_name(candidate.device_type).into(),
+            vendor_id: props.vendor_id,
+            device_id: props.device_id,
+            driver_name: candidate.driver_name.clone(),
+            driver_info: candidate.driver_info.clone(),
+            api_version: format!(
+                "{}.{}.{}",
+                vk::api_version_major(props.api_version),
+                vk::api_version_minor(props.api_version),
+                vk::api_version_patch(props.api_version)
+            ),
+            index: candidate.index,
+            timestamp_period_ns: props.limits.timestamp_period,
+            max_image_dimension_2d: props.limits.max_image_dimension2_d,
+            features: REQUIRED_FEATURES.iter().map(|s| s.to_string()).collect(),
+            validation: report.is_some(),
+        };
+        let shared = Shared {
+            _entry: entry,
+            instance,
+            debug_instance,
+            messenger,
+            debug_device,
+            physical: candidate.physical,
+            device,
+            queue: Mutex::new(queue),
+            queue_family,
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            timeline,
+            last_submitted: AtomicU64::new(0),
+            garbage: Mutex::new(Vec::new()),
+            heap: ManuallyDrop::new(heap),
+            info,
+            limits: props.limits,
+            report,
+        };
+        log::info!("device: {} ({})", shared.info.name, shared.info.driver_info);
+        Ok(Context {
+            shared: Arc::new(shared),
+        })
+    }
+
+    /// The chosen device and the features in use.
+    pub fn info(&self) -> &DeviceInfo {
+        &self.shared.info
+    }
+
+    /// The validation report of this instance (None without validation).
+    pub fn validation_report(&self) -> Option<Arc<ValidationReport>> {
+        self.shared.report.clone()
+    }
+
+    /// The largest 2-D image side the device accepts.
+    pub fn max_image_dimension(&self) -> u32 {
+        self.shared.limits.max_image_dimension2_d
+    }
+
+    /// Submits `command_buffer`, signalling the timeline; returns the value
+    /// that marks its completion.
+    pub(crate) fn submit(&self, command_buffer: vk::CommandBuffer) -> Result<u64> {
+        let queue = self.shared.queue.lock().map_err(|_| Error::Device("queue lock poisoned".into()))?;
+        let value = self.shared.last_submitted.load(Ordering::SeqCst) + 1;
+        let signal = [vk::SemaphoreSubmitInfo::default()
+            .semaphore(self.shared.timeline)
+            .value(value)
+            .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
+        let buffers = [vk::CommandBufferSubmitInfo::default().command_buffer(command_buffer)];
+        let submit = vk::SubmitInfo2::default()
+            .command_buffer_infos(&buffers)
+            .signal_semaphore_infos(&signal);
+        // SAFETY: the queue is externally synchronised by the mutex; the command
+        // buffer is fully recorded and not in use by another submission.
+        unsafe { self.shared.device.queue_submit2(*queue, &[submit], vk::Fence::null()) }
+            .map_err(vk_err("vkQueueSubmit2"))?;
+        self.shared.last_submitted.store(value, Ordering::SeqCst);
+        Ok(value)
+    }
+
+    /// The timeline value of the last submission.
+    pub(crate) fn last_submitted(&self) -> u64 {
+        self.shared.last_submitted.load(Ordering::SeqCst)
+    }
+
+    /// The timeline value the GPU has completed.
+    pub(crate) fn completed(&self) -> Result<u64> {
+        // SAFETY: the semaphore is a live timeline semaphore of this device.
+        unsafe { self.shared.device.get_semaphore_counter_value(self.shared.timeline) }
+            .map_err(vk_err("vkGetSemaphoreCounterValue"))
+    }
+
+    /// Blocks until the GPU has completed timeline value `value`, then frees
+    /// what was waiting on it.
+    pub(crate) fn wait(&self, value: u64) -> Result<()> {
+        if value > 0 {
+            let semaphores = [self.shared.timeline];
+            let values = [value];
+            let info = vk::SemaphoreWaitInfo::default().semaphores(&semaphores).values(&values);
+            // SAFETY: waiting on a live timeline semaphore with a value that was submitted.
+            unsafe { self.shared.device.wait_semaphores(&info, u64::MAX) }.map_err(vk_err("vkWaitSemaphores"))?;
+        }
+        self.collect_garbage()
+    }
+
+    /// Blocks until every submission so far has completed.
+    pub fn wait_idle(&self) -> Result<()> {
+        self.wait(self.last_submitted())
+    }
+
+    /// Queues an object for destruction once the GPU has finished every
+    /// submission made so far.
+    pub(crate) fn defer_destroy(&self, garbage: Garbage) {
+        let value = self.last_submitted();
+        if let Ok(mut list) = self.shared.garbage.lock() {
+            list.push((value, garbage));
+        }
+    }
+
+    /// Destroys deferred objects whose last possible use has completed, and
+    /// releases descriptor handles likewise.
+    pub(crate) fn collect_garbage(&self) -> Result<()> {
+        let done = self.completed()?;
+        let ready: Vec<Garbage> = {
+            let mut list = self.shared.garbage.lock().map_err(|_| Error::Device("garbage lock poisoned".into()))?;
+            let (ready, waiting): (Vec<_>, Vec<_>) = list.drain(..).partition(|(v, _)| *v <= done);
+            *list = waiting;
+            ready.into_iter().map(|(_, g)| g).collect()
+        };
+        for garbage in ready {
+            garbage.destroy(&self.shared);
+        }
+        self.shared.heap.recycle(done);
+        Ok(())
+    }
+
+    /// Names a Vulkan object for RenderDoc, Nsight and validation messages.
+    pub(crate) fn name_object<H: vk::Handle>(&self, handle: H, name: &str) {
+        if let Some(debug) = &self.shared.debug_device {
+            if let Ok(name) = std::ffi::CString::new(name) {
+                let info = vk::DebugUtilsObjectNameInfoEXT::default().object_handle(handle).object_name(&name);
+                // SAFETY: the handle belongs to this device; the name outlives the call.
+                let _ = unsafe { debug.set_debug_utils_object_name(&info) };
+            }
+        }
+    }
+}
+
+impl Drop for Shared {
+    fn drop(&mut self) {
+        // SAFETY: this is the last reference to the device: every resource made
+        // from it has been dropped (they hold the Arc). We wait for the GPU, then
+        // destroy children before parents: garbage, heap, allocator, semaphore,
+        // device, messenger, instance.
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            let garbage: Vec<_> = self.garbage.get_mut().map(|g| g.drain(..).collect()).unwrap_or_default();
+            for (_, g) in garbage {
+                g.destroy(self);
+            }
+            ManuallyDrop::take(&mut self.heap).destroy(&self.device);
+            ManuallyDrop::drop(&mut self.allocator);
+            self.device.destroy_semaphore(self.timeline, None);
+            self.device.destroy_device(None);
+            if let Some(debug) = &self.debug_instance {
+                if self.messenger != vk::DebugUtilsMessengerEXT::null() {
+                    debug.destroy_debug_utils_messenger(self.messenger, None);
+                }
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}

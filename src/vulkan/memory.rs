@@ -1,0 +1,449 @@
+//! Typed GPU buffers and images on gpu-allocator, with staging uploads,
+//! readback and destruction deferred until the GPU is done with them.
+
+use std::sync::Mutex;
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+pub use gpu_allocator::MemoryLocation;
+
+use super::context::{vk_err, Context, Shared};
+use super::heap::HeapKind;
+use crate::error::{Error, Result};
+
+/// Where a resource was last used and how: the state the render graph
+/// synchronises from when it imports the resource next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AccessState {
+    pub stages: vk::PipelineStageFlags2,
+    pub access: vk::AccessFlags2,
+    pub layout: vk::ImageLayout,
+}
+
+impl AccessState {
+    /// Never used: no stages to wait for, contents undefined.
+    pub const UNUSED: AccessState = AccessState {
+        stages: vk::PipelineStageFlags2::NONE,
+        access: vk::AccessFlags2::NONE,
+        layout: vk::ImageLayout::UNDEFINED,
+    };
+}
+
+/// An object waiting for the GPU to finish before it is destroyed.
+pub(crate) enum Garbage {
+    Buffer(vk::Buffer, Allocation),
+    Image(vk::Image, vk::ImageView, Allocation),
+    Pipeline(vk::Pipeline),
+    CommandPool(vk::CommandPool),
+    QueryPool(vk::QueryPool),
+}
+
+impl Garbage {
+    pub(crate) fn destroy(self, shared: &Shared) {
+        let device = &shared.device;
+        // SAFETY: the object's last use has completed on the GPU (the caller checked
+        // the timeline, or the device is idle) and nothing refers to it any more.
+        unsafe {
+            match self {
+                Garbage::Buffer(buffer, allocation) => {
+                    device.destroy_buffer(buffer, None);
+                    free(shared, allocation);
+                }
+                Garbage::Image(image, view, allocation) => {
+                    device.destroy_image_view(view, None);
+                    device.destroy_image(image, None);
+                    free(shared, allocation);
+                }
+                Garbage::Pipeline(p) => device.destroy_pipeline(p, None),
+                Garbage::CommandPool(p) => device.destroy_command_pool(p, None),
+                Garbage::QueryPool(p) => device.destroy_query_pool(p, None),
+            }
+        }
+    }
+}
+
+fn free(shared: &Shared, allocation: Allocation) {
+    if let Ok(mut allocator) = shared.allocator.lock() {
+        if let Err(e) = allocator.free(allocation) {
+            log::error!("freeing GPU memory: {e}");
+        }
+    }
+}
+
+/// What a buffer is for.
+#[derive(Clone, Debug)]
+pub struct BufferDesc {
+    pub name: String,
+    pub size: u64,
+    pub usage: vk::BufferUsageFlags,
+    pub location: MemoryLocation,
+}
+
+/// A GPU buffer. Storage buffers get a descriptor-heap handle.
+pub struct Buffer {
+    ctx: Context,
+    pub(crate) raw: vk::Buffer,
+    allocation: Option<Allocation>,
+    desc: BufferDesc,
+    storage_handle: Option<u32>,
+    pub(crate) state: Mutex<AccessState>,
+}
+
+impl std::fmt::Debug for Buffer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Buffer").field("name", &self.desc.name).field("size", &self.desc.size).finish()
+    }
+}
+
+impl Buffer {
+    /// Creates a buffer; storage buffers are registered in the descriptor heap.
+    pub fn new(ctx: &Context, desc: BufferDesc) -> Result<Buffer> {
+        if desc.size == 0 {
+            return Err(Error::invalid("buffer size", format!("buffer '{}' has size 0", desc.name)));
+        }
+        let device = &ctx.shared.device;
+        let info = vk::BufferCreateInfo::default()
+            .size(desc.size)
+            .usage(desc.usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: valid create info on a live device.
+        let raw = unsafe { device.create_buffer(&info, None) }.map_err(vk_err("vkCreateBuffer"))?;
+        // SAFETY: `raw` was just created on this device.
+        let requirements = unsafe { device.get_buffer_memory_requirements(raw) };
+        let allocation = allocate(ctx, &desc.name, requirements, desc.location, true);
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: the buffer was never used.
+                unsafe { device.destroy_buffer(raw, None) };
+                return Err(e);
+            }
+        };
+        // SAFETY: the allocation satisfies the buffer's requirements and is unbound.
+        let bound = unsafe { device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) };
+        if let Err(e) = bound {
+            ctx.defer_destroy(Garbage::Buffer(raw, allocation));
+            return Err(vk_err("vkBindBufferMemory")(e));
+        }
+        ctx.name_object(raw, &desc.name);
+        let storage_handle = if desc.usage.contains(vk::BufferUsageFlags::STORAGE_BUFFER) {
+            Some(ctx.shared.heap.register_buffer(device, raw, desc.size)?)
+        } else {
+            None
+        };
+        Ok(Buffer {
+            ctx: ctx.clone(),
+            raw,
+            allocation: Some(allocation),
+            desc,
+            storage_handle,
+            state: Mutex::new(AccessState::UNUSED),
+        })
+    }
+
+    /// Creates a device-local buffer filled with `data` through a staging copy.
+    pub fn with_data(ctx: &Context, name: &str, usage: vk::BufferUsageFlags, data: &[u8]) -> Result<Buffer> {
+        let buffer = Buffer::new(
+            ctx,
+            BufferDesc {
+                name: name.into(),
+                size: data.len() as u64,
+                usage: usage | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            },
+        )?;
+        let staging = Buffer::staging(ctx, name, data)?;
+        ctx.one_shot(|rec| rec.copy_buffer(&staging, &buffer, data.len() as u64))?;
+        buffer.set_state(AccessState {
+            stages: vk::PipelineStageFlags2::COPY,
+            access: vk::AccessFlags2::TRANSFER_WRITE,
+            layout: vk::ImageLayout::UNDEFINED,
+        });
+        Ok(buffer)
+    }
+
+    /// A host-visible buffer holding `data`, as a transfer source.
+    pub fn staging(ctx: &Context, name: &str, data: &[u8]) -> Result<Buffer> {
+        let staging = Buffer::new(
+            ctx,
+            BufferDesc {
+                name: format!("{name} (staging)"),
+                size: data.len().max(1) as u64,
+                usage: vk::BufferUsageFlags::TRANSFER_SRC,
+                location: MemoryLocation::CpuToGpu,
+            },
+        )?;
+        staging.write(0, data)?;
+        Ok(staging)
+    }
+
+    /// The buffer's description.
+    pub fn desc(&self) -> &BufferDesc {
+        &self.desc
+    }
+
+    /// Size in bytes.
+    pub fn size(&self) -> u64 {
+        self.desc.size
+    }
+
+    /// The descriptor-heap index of this storage buffer.
+    pub fn storage_handle(&self) -> Option<u32> {
+        self.storage_handle
+    }
+
+    /// Copies `data` into a host-visible buffer at `offset`.
+    pub fn write(&self, offset: u64, data: &[u8]) -> Result<()> {
+        let mapped = self.mapped()?;
+        let end = offset as usize + data.len();
+        if end > mapped.len() {
+            return Err(Error::invalid("buffer write", format!("{} bytes past the end of '{}'", end - mapped.len(), self.desc.name)));
+        }
+        // SAFETY: the range is inside the mapping; the CPU writes only to host-visible
+        // memory the GPU is not using (callers write before submitting work on it).
+        unsafe {
+            std::ptr::copy_nonoverlapping(data.as_ptr(), mapped.as_ptr().add(offset as usize) as *mut u8, data.len());
+        }
+        Ok(())
+    }
+
+    /// The contents of a host-visible buffer (call after the GPU wrote it and the
+    /// frame that wrote it has completed).
+    pub fn mapped(&self) -> Result<&[u8]> {
+        self.allocation
+            .as_ref()
+            .and_then(|a| a.mapped_slice())
+            .map(|s| &s[..self.desc.size as usize])
+            .ok_or_else(|| Error::invalid("buffer mapping", format!("buffer '{}' is not host-visible", self.desc.name)))
+    }
+
+    pub(crate) fn state(&self) -> AccessState {
+        self.state.lock().map(|s| *s).unwrap_or(AccessState::UNUSED)
+    }
+
+    pub(crate) fn set_state(&self, state: AccessState) {
+        if let Ok(mut s) = self.state.lock() {
+            *s = state;
+        }
+    }
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        if let Some(handle) = self.storage_handle {
+            self.ctx.shared.heap.release(HeapKind::StorageBuffer, handle, self.ctx.last_submitted());
+        }
+        if let Some(allocation) = self.allocation.take() {
+            self.ctx.defer_destroy(Garbage::Buffer(self.raw, allocation));
+        }
+    }
+}
+
+/// What a 2-D image is for.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ImageDesc {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub format: vk::Format,
+    pub usage: vk::ImageUsageFlags,
+}
+
+/// Whether `format` holds depth.
+pub fn is_depth_format(format: vk::Format) -> bool {
+    matches!(
+        format,
+        vk::Format::D16_UNORM | vk::Format::D32_SFLOAT | vk::Format::D24_UNORM_S8_UINT | vk::Format::D32_SFLOAT_S8_UINT
+    )
+}
+
+/// A 2-D GPU image with one view. Sampled and storage images get
+/// descriptor-heap handles.
+pub struct Image {
+    ctx: Context,
+    pub(crate) raw: vk::Image,
+    pub(crate) view: vk::ImageView,
+    allocation: Option<Allocation>,
+    desc: ImageDesc,
+    sampled_handle: Option<u32>,
+    storage_handle: Option<u32>,
+    pub(crate) state: Mutex<AccessState>,
+}
+
+impl std::fmt::Debug for Image {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Image").field("name", &self.desc.name).finish()
+    }
+}
+
+impl Image {
+    /// Creates a device-local image and its view, registered in the heap.
+    pub fn new(ctx: &Context, desc: ImageDesc) -> Result<Image> {
+        let max = ctx.max_image_dimension();
+        if desc.width == 0 || desc.height == 0 || desc.width > max || desc.height > max {
+            return Err(Error::invalid(
+                "image size",
+                format!("'{}' is {}x{}; each side must be in 1..={max}", desc.name, desc.width, desc.height),
+            ));
+        }
+        let device = &ctx.shared.device;
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(desc.format)
+            .extent(vk::Extent3D {
+                width: desc.width,
+                height: desc.height,
+                depth: 1,
+            })
+            .mip_levels(1)
+            .array_layers(1)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(desc.usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        // SAFETY: valid create info on a live device.
+        let raw = unsafe { device.create_image(&info, None) }.map_err(vk_err("vkCreateImage"))?;
+        // SAFETY: `raw` was just created on this device.
+        let requirements = unsafe { device.get_image_memory_requirements(raw) };
+        let allocation = match allocate(ctx, &desc.name, requirements, MemoryLocation::GpuOnly, false) {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: the image was never used.
+                unsafe { device.destroy_image(raw, None) };
+                return Err(e);
+            }
+        };
+        // SAFETY: the allocation satisfies the image's requirements and is unbound.
+        let bound = unsafe { device.bind_image_memory(raw, allocation.memory(), allocation.offset()) };
+        let aspect = if is_depth_format(desc.format) {
+            vk::ImageAspectFlags::DEPTH
+        } else {
+            vk::ImageAspectFlags::COLOR
+        };
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(raw)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(desc.format)
+            .subresource_range(subresource_range(aspect));
+        let view = bound.map_err(vk_err("vkBindImageMemory")).and_then(|_| {
+            // SAFETY: the image is bound to memory; the view matches its format.
+            unsafe { device.create_image_view(&view_info, None) }.map_err(vk_err("vkCreateImageView"))
+        });
+        let view = match view {
+            Ok(v) => v,
+            Err(e) => {
+                ctx.defer_destroy(Garbage::Image(raw, vk::ImageView::null(), allocation));
+                return Err(e);
+            }
+        };
+        ctx.name_object(raw, &desc.name);
+        ctx.name_object(view, &desc.name);
+        let heap = &ctx.shared.heap;
+        let sampled_handle = if desc.usage.contains(vk::ImageUsageFlags::SAMPLED) {
+            Some(heap.register_image(device, HeapKind::SampledImage, view)?)
+        } else {
+            None
+        };
+        let storage_handle = if desc.usage.contains(vk::ImageUsageFlags::STORAGE) {
+            Some(heap.register_image(device, HeapKind::StorageImage, view)?)
+        } else {
+            None
+        };
+        Ok(Image {
+            ctx: ctx.clone(),
+            raw,
+            view,
+            allocation: Some(allocation),
+            desc,
+            sampled_handle,
+            storage_handle,
+            state: Mutex::new(AccessState::UNUSED),
+        })
+    }
+
+    /// The image's description.
+    pub fn desc(&self) -> &ImageDesc {
+        &self.desc
+    }
+
+    /// Heap index for sampling (layout SHADER_READ_ONLY_OPTIMAL).
+    pub fn sampled_handle(&self) -> Option<u32> {
+        self.sampled_handle
+    }
+
+    /// Heap index for storage access (layout GENERAL).
+    pub fn storage_handle(&self) -> Option<u32> {
+        self.storage_handle
+    }
+
+    pub(crate) fn aspect(&self) -> vk::ImageAspectFlags {
+        if is_depth_format(self.desc.format) {
+            vk::ImageAspectFlags::DEPTH
+        } else {
+            vk::ImageAspectFlags::COLOR
+        }
+    }
+
+    pub(crate) fn state(&self) -> AccessState {
+        self.state.lock().map(|s| *s).unwrap_or(AccessState::UNUSED)
+    }
+
+    pub(crate) fn set_state(&self, state: AccessState) {
+        if let Ok(mut s) = self.state.lock() {
+            *s = state;
+        }
+    }
+}
+
+impl Drop for Image {
+    fn drop(&mut self) {
+        let heap = &self.ctx.shared.heap;
+        let last = self.ctx.last_submitted();
+        if let Some(handle) = self.sampled_handle {
+            heap.release(HeapKind::SampledImage, handle, last);
+        }
+        if let Some(handle) = self.storage_handle {
+            heap.release(HeapKind::StorageImage, handle, last);
+        }
+        if let Some(allocation) = self.allocation.take() {
+            self.ctx.defer_destroy(Garbage::Image(self.raw, self.view, allocation));
+        }
+    }
+}
+
+pub(crate) fn subresource_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange {
+        aspect_mask: aspect,
+        base_mip_level: 0,
+        level_count: 1,
+        base_array_layer: 0,
+        layer_count: 1,
+    }
+}
+
+fn allocate(
+    ctx: &Context,
+    name: &str,
+    requirements: vk::MemoryRequirements,
+    location: MemoryLocation,
+    linear: bool,
+) -> Result<Allocation> {
+    let mut allocator = ctx
+        .shared
+        .allocator
+        .lock()
+        .map_err(|_| Error::Device("allocator lock poisoned".into()))?;
+    allocator
+        .allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location,
+            linear,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        })
+        .map_err(|e| Error::Allocation {
+            what: name.to_string(),
+            message: e.to_string(),
+        })
+}
