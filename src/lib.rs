@@ -6,6 +6,13 @@
 //! outputs) used by the CLI.
 
 pub mod error;
+pub mod graph;
+pub mod io;
+pub mod lighting;
+pub mod profile;
+pub mod renderer;
+pub mod shaders;
+pub mod terrain;
 pub mod vulkan;
 
 pub use error::{Error, Result};

@@ -5,23 +5,10 @@ use ash::vk;
 
 use super::context::{vk_err, Context};
 use super::heap::PUSH_CONSTANT_BYTES;
-use super::memory::{subresource_range, AccessState, Buffer, Image};
+use super::memory::{subresource_range, Barrier, Buffer, Image};
 use super::pipeline::{ComputePipeline, GraphicsPipeline};
 use crate::error::{Error, Result};
 
-/// A buffer transition from one access state to another.
-pub(crate) struct BufferBarrier<'a> {
-    pub buffer: &'a Buffer,
-    pub src: AccessState,
-    pub dst: AccessState,
-}
-
-/// An image transition (and layout change) from one state to another.
-pub(crate) struct ImageBarrier<'a> {
-    pub image: &'a Image,
-    pub src: AccessState,
-    pub dst: AccessState,
-}
 
 /// How a colour attachment starts.
 #[derive(Clone, Copy, Debug)]
@@ -52,39 +39,39 @@ impl CommandRecorder {
     }
 
     /// One synchronization2 dependency for all the given transitions.
-    pub(crate) fn barriers(&mut self, buffers: &[BufferBarrier<'_>], images: &[ImageBarrier<'_>]) {
+    pub(crate) fn barriers(&mut self, buffers: &[(&Buffer, Barrier)], images: &[(&Image, Barrier)]) {
         if buffers.is_empty() && images.is_empty() {
             return;
         }
         let buffer_barriers: Vec<_> = buffers
             .iter()
-            .map(|b| {
+            .map(|(buffer, b)| {
                 vk::BufferMemoryBarrier2::default()
-                    .src_stage_mask(b.src.stages)
-                    .src_access_mask(b.src.access)
-                    .dst_stage_mask(b.dst.stages)
-                    .dst_access_mask(b.dst.access)
+                    .src_stage_mask(b.src_stages)
+                    .src_access_mask(b.src_access)
+                    .dst_stage_mask(b.dst_stages)
+                    .dst_access_mask(b.dst_access)
                     .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
                     .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .buffer(b.buffer.raw)
+                    .buffer(buffer.raw)
                     .offset(0)
                     .size(vk::WHOLE_SIZE)
             })
             .collect();
         let image_barriers: Vec<_> = images
             .iter()
-            .map(|b| {
+            .map(|(image, b)| {
                 vk::ImageMemoryBarrier2::default()
-                    .src_stage_mask(b.src.stages)
-                    .src_access_mask(b.src.access)
-                    .dst_stage_mask(b.dst.stages)
-                    .dst_access_mask(b.dst.access)
-                    .old_layout(b.src.layout)
-                    .new_layout(b.dst.layout)
+                    .src_stage_mask(b.src_stages)
+                    .src_access_mask(b.src_access)
+                    .dst_stage_mask(b.dst_stages)
+                    .dst_access_mask(b.dst_access)
+                    .old_layout(b.old_layout)
+                    .new_layout(b.new_layout)
                     .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
                     .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .image(b.image.raw)
-                    .subresource_range(subresource_range(b.image.aspect()))
+                    .image(image.raw)
+                    .subresource_range(subresource_range(image.aspect()))
             })
             .collect();
         let dependency = vk::DependencyInfo::default()

@@ -89,11 +89,17 @@ impl Context {
         // SAFETY: loading libvulkan.so.1 runs its initialisers; the loader is a
         // well-behaved shared library.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::Loader(e.to_string()))?;
-        let report = options.validation.then(|| Arc::new(ValidationReport::default()));
-
         // SAFETY: plain queries with no external state.
         let layers = unsafe { entry.enumerate_instance_layer_properties() }
             .map_err(vk_err("vkEnumerateInstanceLayerProperties"))?;
+        let layer_version = layers
+            .iter()
+            .find(|l| l.layer_name_as_c_str().ok() == Some(VALIDATION_LAYER))
+            .map(|l| l.spec_version)
+            .unwrap_or(0);
+        let report = options
+            .validation
+            .then(|| Arc::new(ValidationReport::for_layer(layer_version)));
         let has_layer = |name: &CStr| layers.iter().any(|l| l.layer_name_as_c_str().ok() == Some(name));
         // SAFETY: as above.
         let extensions = unsafe { entry.enumerate_instance_extension_properties(None) }
@@ -370,6 +376,11 @@ impl Context {
             unsafe { self.shared.device.wait_semaphores(&info, u64::MAX) }.map_err(vk_err("vkWaitSemaphores"))?;
         }
         self.collect_garbage()
+    }
+
+    /// Blocks until the GPU has completed timeline value `value`.
+    pub fn wait_timeline(&self, value: u64) -> Result<()> {
+        self.wait(value)
     }
 
     /// Blocks until every submission so far has completed.

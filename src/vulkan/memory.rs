@@ -11,22 +11,57 @@ use super::context::{vk_err, Context, Shared};
 use super::heap::HeapKind;
 use crate::error::{Error, Result};
 
-/// Where a resource was last used and how: the state the render graph
-/// synchronises from when it imports the resource next.
+/// What the GPU last did with a resource, as the render graph tracks it
+/// across passes and frames: the last write, who has read since, to which
+/// stages and accesses that write has been made visible, and the layout.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct AccessState {
-    pub stages: vk::PipelineStageFlags2,
-    pub access: vk::AccessFlags2,
+    /// Stages and accesses of the last write (a layout transition counts as one).
+    pub write_stages: vk::PipelineStageFlags2,
+    pub write_access: vk::AccessFlags2,
+    /// Stages that read the resource since the last write.
+    pub read_stages: vk::PipelineStageFlags2,
+    /// Stages and accesses the last write has been made visible to.
+    pub visible_stages: vk::PipelineStageFlags2,
+    pub visible_access: vk::AccessFlags2,
+    /// Current image layout (UNDEFINED for buffers).
     pub layout: vk::ImageLayout,
 }
 
 impl AccessState {
-    /// Never used: no stages to wait for, contents undefined.
+    /// Never used: nothing to wait for, contents undefined.
     pub const UNUSED: AccessState = AccessState {
-        stages: vk::PipelineStageFlags2::NONE,
-        access: vk::AccessFlags2::NONE,
+        write_stages: vk::PipelineStageFlags2::NONE,
+        write_access: vk::AccessFlags2::NONE,
+        read_stages: vk::PipelineStageFlags2::NONE,
+        visible_stages: vk::PipelineStageFlags2::NONE,
+        visible_access: vk::AccessFlags2::NONE,
         layout: vk::ImageLayout::UNDEFINED,
     };
+
+    /// Just written by `stages`/`access`, leaving `layout`.
+    pub const fn written(stages: vk::PipelineStageFlags2, access: vk::AccessFlags2, layout: vk::ImageLayout) -> Self {
+        AccessState {
+            write_stages: stages,
+            write_access: access,
+            read_stages: vk::PipelineStageFlags2::NONE,
+            visible_stages: vk::PipelineStageFlags2::NONE,
+            visible_access: vk::AccessFlags2::NONE,
+            layout,
+        }
+    }
+}
+
+/// One pipeline barrier: wait for `src_*`, make it visible to `dst_*`, and
+/// change the layout from `old_layout` to `new_layout` (images).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Barrier {
+    pub src_stages: vk::PipelineStageFlags2,
+    pub src_access: vk::AccessFlags2,
+    pub dst_stages: vk::PipelineStageFlags2,
+    pub dst_access: vk::AccessFlags2,
+    pub old_layout: vk::ImageLayout,
+    pub new_layout: vk::ImageLayout,
 }
 
 /// An object waiting for the GPU to finish before it is destroyed.
@@ -154,11 +189,11 @@ impl Buffer {
         )?;
         let staging = Buffer::staging(ctx, name, data)?;
         ctx.one_shot(|rec| rec.copy_buffer(&staging, &buffer, data.len() as u64))?;
-        buffer.set_state(AccessState {
-            stages: vk::PipelineStageFlags2::COPY,
-            access: vk::AccessFlags2::TRANSFER_WRITE,
-            layout: vk::ImageLayout::UNDEFINED,
-        });
+        buffer.set_state(AccessState::written(
+            vk::PipelineStageFlags2::ALL_TRANSFER,
+            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::ImageLayout::UNDEFINED,
+        ));
         Ok(buffer)
     }
 
@@ -217,11 +252,11 @@ impl Buffer {
             .ok_or_else(|| Error::invalid("buffer mapping", format!("buffer '{}' is not host-visible", self.desc.name)))
     }
 
-    pub(crate) fn state(&self) -> AccessState {
+    pub fn state(&self) -> AccessState {
         self.state.lock().map(|s| *s).unwrap_or(AccessState::UNUSED)
     }
 
-    pub(crate) fn set_state(&self, state: AccessState) {
+    pub fn set_state(&self, state: AccessState) {
         if let Ok(mut s) = self.state.lock() {
             *s = state;
         }
@@ -385,11 +420,11 @@ impl Image {
         }
     }
 
-    pub(crate) fn state(&self) -> AccessState {
+    pub fn state(&self) -> AccessState {
         self.state.lock().map(|s| *s).unwrap_or(AccessState::UNUSED)
     }
 
-    pub(crate) fn set_state(&self, state: AccessState) {
+    pub fn set_state(&self, state: AccessState) {
         if let Ok(mut s) = self.state.lock() {
             *s = state;
         }
@@ -446,4 +481,33 @@ fn allocate(
             what: name.to_string(),
             message: e.to_string(),
         })
+}
+
+impl Image {
+    /// Creates a device-local image (with TRANSFER_DST added to `desc.usage`)
+    /// holding `texels`, tightly packed rows, through a staging copy.
+    pub fn with_data(ctx: &Context, mut desc: ImageDesc, texels: &[u8]) -> Result<Image> {
+        desc.usage |= vk::ImageUsageFlags::TRANSFER_DST;
+        let name = desc.name.clone();
+        let image = Image::new(ctx, desc)?;
+        let staging = Buffer::staging(ctx, &name, texels)?;
+        let to_transfer = Barrier {
+            src_stages: vk::PipelineStageFlags2::NONE,
+            src_access: vk::AccessFlags2::NONE,
+            dst_stages: vk::PipelineStageFlags2::ALL_TRANSFER,
+            dst_access: vk::AccessFlags2::TRANSFER_WRITE,
+            old_layout: vk::ImageLayout::UNDEFINED,
+            new_layout: vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+        };
+        ctx.one_shot(|rec| {
+            rec.barriers(&[], &[(&image, to_transfer)]);
+            rec.copy_buffer_to_image(&staging, &image);
+        })?;
+        image.set_state(AccessState::written(
+            vk::PipelineStageFlags2::ALL_TRANSFER,
+            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+        ));
+        Ok(image)
+    }
 }

@@ -12,11 +12,10 @@ mod validation;
 
 pub use ash::vk::{BufferUsageFlags, Format, ImageLayout, ImageUsageFlags, PipelineStageFlags2, AccessFlags2, CompareOp, PrimitiveTopology};
 pub use commands::{CommandRecorder, LoadOp};
-pub(crate) use commands::{BufferBarrier, ImageBarrier};
 pub use context::{Context, ContextOptions, DeviceInfo};
 pub use device_select::{DeviceSelector, REQUIRED_FEATURES};
 pub use frames::{CompletedFrame, FrameRing, RecordingFrame, FRAMES_IN_FLIGHT};
 pub use heap::{SamplerKind, PUSH_CONSTANT_BYTES};
-pub use memory::{is_depth_format, AccessState, Buffer, BufferDesc, Image, ImageDesc, MemoryLocation};
+pub use memory::{is_depth_format, AccessState, Barrier, Buffer, BufferDesc, Image, ImageDesc, MemoryLocation};
 pub use pipeline::{Blend, ComputePipeline, GraphicsPipeline, GraphicsPipelineDesc, SpirV, VertexAttribute};
 pub use validation::ValidationReport;

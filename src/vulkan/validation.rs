@@ -14,10 +14,42 @@ use ash::vk;
 pub struct ValidationReport {
     errors: AtomicU64,
     warnings: AtomicU64,
+    set_aside: AtomicU64,
+    /// Set aside synchronization-validation reports on descriptors of runtime
+    /// descriptor arrays (see [`ValidationReport::for_layer`]).
+    set_aside_bindless_hazards: bool,
     messages: Mutex<Vec<String>>,
 }
 
+/// The first Khronos validation layer release (SDK 1.3.268) that no longer
+/// reports hazards for every element of a runtime descriptor array a shader
+/// could index (KhronosGroup/Vulkan-ValidationLayers#3450, fixed by #6605).
+pub const BINDLESS_SYNCVAL_FIX: u32 = ash::vk::make_api_version(0, 1, 3, 268);
+
 impl ValidationReport {
+    /// A report for a validation layer whose spec version is `layer_version`.
+    ///
+    /// Layers before [`BINDLESS_SYNCVAL_FIX`] treat every descriptor of a bound
+    /// runtime array as accessed by every draw and dispatch, so a bindless heap
+    /// produces hazards on resources the shader never touches. Those reports
+    /// (and only those: they name a descriptor binding and index) are counted
+    /// in [`ValidationReport::set_aside`] instead of as errors, which is what
+    /// newer layers do by not reporting them. Attachment, vertex, index, copy
+    /// and layout-transition hazards are still errors; the graph's barrier
+    /// derivation is unit-tested independently (src/graph/access.rs).
+    pub fn for_layer(layer_version: u32) -> Self {
+        ValidationReport {
+            set_aside_bindless_hazards: layer_version < BINDLESS_SYNCVAL_FIX,
+            ..Default::default()
+        }
+    }
+
+    /// Synchronization reports on bindless descriptor-array elements that were
+    /// set aside as known false positives of old layers.
+    pub fn set_aside(&self) -> u64 {
+        self.set_aside.load(Ordering::SeqCst)
+    }
+
     /// Validation errors reported so far.
     pub fn errors(&self) -> u64 {
         self.errors.load(Ordering::SeqCst)
@@ -39,6 +71,11 @@ impl ValidationReport {
     }
 
     fn record(&self, severity: vk::DebugUtilsMessageSeverityFlagsEXT, text: String) {
+        if self.set_aside_bindless_hazards && is_descriptor_array_hazard(&text) {
+            self.set_aside.fetch_add(1, Ordering::SeqCst);
+            log::debug!("validation (set aside, layer bug #3450): {text}");
+            return;
+        }
         if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
             self.errors.fetch_add(1, Ordering::SeqCst);
             log::error!("validation: {text}");
@@ -53,6 +90,13 @@ impl ValidationReport {
             messages.push(text);
         }
     }
+}
+
+/// Whether `text` is a synchronization hazard reported on an element of a
+/// descriptor array (the layer names the descriptor type, binding and index).
+fn is_descriptor_array_hazard(text: &str) -> bool {
+    text.contains("SYNC-HAZARD") && text.contains("VkDescriptorSet") && text.contains(", type: VK_DESCRIPTOR_TYPE_")
+        && text.contains("binding #")
 }
 
 /// The messenger create-info that reports into `report`. The report must
@@ -95,4 +139,33 @@ unsafe extern "system" fn debug_callback(
         report.record(severity, text);
     }
     vk::FALSE
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const BINDLESS: &str = "Validation Error: [ SYNC-HAZARD-WRITE-AFTER-WRITE ] Object 0: handle = 0x26, \
+        name = hdr radiance, type = VK_OBJECT_TYPE_IMAGE_VIEW; | vkCmdDispatch: Hazard WRITE_AFTER_WRITE for \
+        VkImageView 0x26[hdr radiance], in VkCommandBuffer 0x5[frame slot 0], and VkPipeline 0x1d[post/tonemap.comp], \
+        VkDescriptorSet 0x5[], type: VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, imageLayout: VK_IMAGE_LAYOUT_GENERAL, binding #1, index 0.";
+    const ATTACHMENT: &str = "Validation Error: [ SYNC-HAZARD-WRITE-AFTER-WRITE ] vkCmdBeginRendering: Hazard \
+        WRITE_AFTER_WRITE vs. layout transition in subpass 0 for attachment 0 color aspect";
+
+    #[test]
+    fn old_layers_set_aside_only_descriptor_array_hazards() {
+        let report = ValidationReport::for_layer(vk::make_api_version(0, 1, 3, 239));
+        report.record(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR, BINDLESS.into());
+        assert_eq!((report.errors(), report.set_aside()), (0, 1));
+        report.record(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR, ATTACHMENT.into());
+        assert_eq!((report.errors(), report.set_aside()), (1, 1));
+    }
+
+    #[test]
+    fn fixed_layers_count_everything() {
+        let report = ValidationReport::for_layer(BINDLESS_SYNCVAL_FIX);
+        report.record(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR, BINDLESS.into());
+        report.record(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING, "a warning".into());
+        assert_eq!((report.errors(), report.warnings(), report.set_aside()), (1, 1, 0));
+    }
 }

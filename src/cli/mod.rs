@@ -1,0 +1,249 @@
+//! Subcommands of the `alpenglow` binary.
+
+mod args;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{anyhow, bail, Result};
+use clap::Parser;
+use glam::DVec2;
+
+use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
+use alpenglow::io::image_out::{write_exr, write_png_rgba8};
+use alpenglow::profile::{summarize, write_chrome_trace, write_profile_json, FrameProfile};
+use alpenglow::renderer::{validate_size, Camera, RenderSettings, Renderer, Scene};
+use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector, ValidationReport};
+use args::{BenchArgs, Cli, Command, DeviceArgs, RenderArgs, SceneArgs};
+
+/// Parses the command line and runs the subcommand.
+pub fn run() -> Result<ExitCode> {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+                e.print()?;
+                return Ok(ExitCode::SUCCESS);
+            }
+            // clap's message is multi-line; keep its first line.
+            let text = e.to_string();
+            let first = text.lines().next().unwrap_or("invalid arguments").trim_start_matches("error: ");
+            bail!("{first} (see alpenglow --help)");
+        }
+    };
+    match cli.command {
+        Command::Render(args) => render(args),
+        Command::Bench(args) => bench(args),
+        Command::Info(args) => info(args),
+    }
+}
+
+fn context(args: &DeviceArgs) -> Result<Context> {
+    let device = match &args.device {
+        Some(d) => d.parse::<DeviceSelector>()?,
+        None => DeviceSelector::Best,
+    };
+    Ok(Context::new(&ContextOptions {
+        validation: args.validation,
+        device,
+    })?)
+}
+
+/// Fails when validation reported anything (call after everything Vulkan was dropped).
+fn check_validation(report: Option<std::sync::Arc<ValidationReport>>) -> Result<()> {
+    if let Some(report) = report {
+        if report.set_aside() > 0 {
+            log::info!(
+                "{} synchronization-validation reports on bindless descriptor-array elements set aside \
+                 (false positives of validation layers before 1.3.268, KhronosGroup/Vulkan-ValidationLayers#3450)",
+                report.set_aside()
+            );
+        }
+        if report.total() > 0 {
+            let first = report.messages().into_iter().next().unwrap_or_default();
+            bail!(
+                "validation reported {} error(s) and {} warning(s); first: {}",
+                report.errors(),
+                report.warnings(),
+                first.lines().next().unwrap_or("")
+            );
+        }
+    }
+    Ok(())
+}
+
+fn check_output_path(path: &Option<PathBuf>, what: &str) -> Result<()> {
+    if let Some(path) = path {
+        let parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        if !parent.is_dir() {
+            bail!("cannot write {what} {}: directory {} does not exist", path.display(), parent.display());
+        }
+    }
+    Ok(())
+}
+
+fn load_scene(args: &SceneArgs) -> Result<Scene> {
+    validate_size(args.width, args.height)?;
+    match &args.heightmap {
+        Some(path) => {
+            let field = load_heightmap(
+                path,
+                &HeightmapOptions {
+                    scale: args.height_scale,
+                    offset: args.height_offset,
+                    spacing: DVec2::new(args.spacing.0, args.spacing.1),
+                },
+            )?;
+            Ok(Scene::new(field))
+        }
+        None => Ok(Scene::default_procedural()?),
+    }
+}
+
+fn camera(args: &SceneArgs, scene: &Scene) -> Result<Camera> {
+    let mut camera = scene.default_camera();
+    if let Some(eye) = args.eye {
+        camera.eye = eye;
+    }
+    if let Some(target) = args.target {
+        camera.target = target;
+    }
+    camera.up = args.up;
+    camera.fov_y_deg = args.fov_y;
+    if let Some(near) = args.near {
+        camera.near = near;
+    }
+    if let Some(far) = args.far {
+        camera.far = far;
+    }
+    camera.validate()?;
+    Ok(camera)
+}
+
+fn print_profile(device: &str, frame: &FrameProfile) {
+    let passes: Vec<String> = frame
+        .passes
+        .iter()
+        .map(|p| format!("{} {:.2}", p.name, p.gpu_ms))
+        .collect();
+    println!("{device}: frame {:.2} ms GPU, {:.2} ms CPU ({})", frame.gpu_ms, frame.cpu_ms, passes.join(", "));
+}
+
+fn render(args: RenderArgs) -> Result<ExitCode> {
+    check_output_path(&args.out, "PNG")?;
+    check_output_path(&args.exr, "EXR")?;
+    check_output_path(&args.profile, "profile")?;
+    check_output_path(&args.trace, "trace")?;
+    let scene = load_scene(&args.scene)?;
+    let camera = camera(&args.scene, &scene)?;
+    let ctx = context(&args.scene.device)?;
+    let report = ctx.validation_report();
+    let device = ctx.info().name.clone();
+    let (images, profiles) = {
+        let settings = RenderSettings {
+            width: args.scene.width,
+            height: args.scene.height,
+            readback: true,
+        };
+        let mut renderer = Renderer::new(&ctx, &scene, settings)?;
+        let frame = renderer.render(&camera)?;
+        let images = renderer.read(&frame)?;
+        let profiles = renderer.finish()?;
+        (images, profiles)
+    };
+    drop(ctx);
+    check_validation(report)?;
+    if let Some(path) = &args.out {
+        write_png_rgba8(path, &images.rgba8, images.width, images.height)?;
+    }
+    if let Some(path) = &args.exr {
+        write_exr(path, images.width, images.height, &images.hdr, &images.depth, &[])?;
+    }
+    if let Some(path) = &args.profile {
+        write_profile_json(path, &device, &profiles)?;
+    }
+    if let Some(path) = &args.trace {
+        write_chrome_trace(path, &device, &profiles)?;
+    }
+    if let Some(frame) = profiles.last() {
+        print_profile(&device, frame);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn bench(args: BenchArgs) -> Result<ExitCode> {
+    check_output_path(&args.json, "JSON")?;
+    check_output_path(&args.trace, "trace")?;
+    if args.frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    let scene = load_scene(&args.scene)?;
+    let camera = camera(&args.scene, &scene)?;
+    let ctx = context(&args.scene.device)?;
+    let report = ctx.validation_report();
+    let device = ctx.info().clone();
+    let profiles = {
+        let settings = RenderSettings {
+            width: args.scene.width,
+            height: args.scene.height,
+            readback: false,
+        };
+        let mut renderer = Renderer::new(&ctx, &scene, settings)?;
+        for _ in 0..args.warmup + args.frames {
+            renderer.render(&camera)?;
+        }
+        renderer.finish()?
+    };
+    drop(ctx);
+    check_validation(report)?;
+    let timed: Vec<FrameProfile> = profiles.into_iter().skip(args.warmup as usize).collect();
+    if timed.is_empty() {
+        return Err(anyhow!("no frame timings were collected"));
+    }
+    let (passes, frame) = summarize(&timed);
+    println!(
+        "{} ({}, {}), {}x{}, {} frames: median frame {:.3} ms GPU, {:.3} ms CPU",
+        device.name, device.device_type, device.driver_info, args.scene.width, args.scene.height,
+        frame.frames, frame.median_gpu_ms, frame.median_cpu_ms
+    );
+    for p in &passes {
+        println!(
+            "  {:<16} median {:>8.3} ms GPU (min {:.3}, max {:.3}), {:.3} ms CPU",
+            p.name, p.median_gpu_ms, p.min_gpu_ms, p.max_gpu_ms, p.median_cpu_ms
+        );
+    }
+    if let Some(path) = &args.json {
+        let value = serde_json::json!({
+            "device": device,
+            "width": args.scene.width,
+            "height": args.scene.height,
+            "frames": frame.frames,
+            "median_frame_gpu_ms": frame.median_gpu_ms,
+            "median_frame_cpu_ms": frame.median_cpu_ms,
+            "passes": passes,
+        });
+        alpenglow::io::atomic::write_bytes_atomically(path, serde_json::to_string_pretty(&value)?.as_bytes())?;
+    }
+    if let Some(path) = &args.trace {
+        write_chrome_trace(path, &device.name, &timed)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn info(args: DeviceArgs) -> Result<ExitCode> {
+    let ctx = context(&args)?;
+    let report = ctx.validation_report();
+    let i = ctx.info().clone();
+    drop(ctx);
+    check_validation(report)?;
+    println!("device:      {} (#{}, {})", i.name, i.index, i.device_type);
+    println!("driver:      {} ({})", i.driver_name, i.driver_info);
+    println!("vulkan:      {}", i.api_version);
+    println!("vendor/id:   {:#06x}/{:#06x}", i.vendor_id, i.device_id);
+    println!("timestamps:  {} ns per tick", i.timestamp_period_ns);
+    println!("max image:   {} px per side", i.max_image_dimension_2d);
+    println!("validation:  {}", if i.validation { "on (with synchronization validation)" } else { "off" });
+    println!("features:    {}", i.features.join(", "));
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,287 @@
+//! Baking: validate the declarations, cull passes whose outputs nobody uses,
+//! fix the execution order, derive usage flags and create the transient
+//! resources (once; they are reused by every frame).
+
+use std::collections::VecDeque;
+use std::sync::Arc;
+use std::time::Instant;
+
+use super::{Access, PassDecl, PassKind, RenderGraph, ResourceDecl, ResourceId};
+use crate::error::{Error, Result};
+use crate::profile::FrameProfile;
+use crate::vulkan::{AccessState, Buffer, BufferDesc, BufferUsageFlags, Context, Image, ImageDesc, ImageUsageFlags};
+
+/// The physical resource(s) behind a graph resource.
+pub(crate) enum Physical {
+    Image(Vec<Arc<Image>>),
+    Buffer(Vec<Arc<Buffer>>),
+    /// A transient nobody uses after culling.
+    Unused,
+}
+
+pub(crate) struct BakedPass<P> {
+    pub name: String,
+    pub kind: PassKind,
+    pub uses: Vec<(ResourceId, Access)>,
+    pub record: super::RecordFn<P>,
+}
+
+pub(crate) struct PendingFrame {
+    pub frame: u64,
+    pub cpu_start_ms: f64,
+    pub cpu_ms: f64,
+    /// Per pass: CPU start (ms from frame start) and CPU recording time.
+    pub cpu_passes: Vec<(f64, f64)>,
+}
+
+/// A baked render graph: passes in execution order with their resources,
+/// ready to record frame after frame ([`BakedGraph::execute`]).
+pub struct BakedGraph<P> {
+    pub(crate) ctx: Context,
+    pub(crate) passes: Vec<BakedPass<P>>,
+    pub(crate) physical: Vec<Physical>,
+    pub(crate) imported: Vec<bool>,
+    pub(crate) names: Vec<String>,
+    /// Tracked state of each transient across frames.
+    pub(crate) transient_states: Vec<AccessState>,
+    pub(crate) final_accesses: Vec<(ResourceId, Access)>,
+    pub(crate) culled: Vec<String>,
+    pub(crate) pending: VecDeque<PendingFrame>,
+    pub(crate) profiles: Vec<FrameProfile>,
+    pub(crate) epoch: Instant,
+}
+
+impl<P> BakedGraph<P> {
+    /// Names of the passes in execution order.
+    pub fn pass_names(&self) -> Vec<String> {
+        self.passes.iter().map(|p| p.name.clone()).collect()
+    }
+
+    /// Names of the passes that were culled because nothing used their output.
+    pub fn culled_passes(&self) -> &[String] {
+        &self.culled
+    }
+
+    /// The physical image behind a transient or imported image (slot 0).
+    pub fn image(&self, id: ResourceId) -> Option<&Arc<Image>> {
+        match self.physical.get(id.0) {
+            Some(Physical::Image(images)) => images.first(),
+            _ => None,
+        }
+    }
+}
+
+/// Which passes must run: those that write an imported or output resource,
+/// and, transitively, the last writer of everything a live pass reads.
+pub(crate) fn live_passes<P>(graph: &RenderGraph<P>) -> Vec<bool> {
+    let n = graph.passes.len();
+    let mut live = vec![false; n];
+    let is_root_resource = |r: ResourceId| {
+        graph.resources[r.0].is_imported() || graph.outputs.iter().any(|(o, _)| *o == r)
+    };
+    let mut work: Vec<usize> = Vec::new();
+    for (i, pass) in graph.passes.iter().enumerate() {
+        if pass.uses.iter().any(|(r, a)| a.writes() && is_root_resource(*r)) {
+            live[i] = true;
+            work.push(i);
+        }
+    }
+    while let Some(i) = work.pop() {
+        for (r, a) in &graph.passes[i].uses {
+            if !a.reads() {
+                continue;
+            }
+            // The last earlier pass writing `r` produces what pass i reads.
+            let producer = (0..i)
+                .rev()
+                .find(|&j| graph.passes[j].uses.iter().any(|(r2, a2)| r2 == r && a2.writes()));
+            if let Some(j) = producer {
+                if !live[j] {
+                    live[j] = true;
+                    work.push(j);
+                }
+            }
+        }
+    }
+    live
+}
+
+fn validate<P>(graph: &RenderGraph<P>) -> Result<()> {
+    for pass in &graph.passes {
+        for (r, a) in &pass.uses {
+            let decl = graph
+                .resources
+                .get(r.0)
+                .ok_or_else(|| Error::Graph(format!("pass '{}' uses an unknown resource #{}", pass.name, r.0)))?;
+            let fits = if decl.is_image() { a.is_image() } else { a.is_buffer() };
+            if !fits {
+                return Err(Error::Graph(format!(
+                    "pass '{}' declares {a:?} on '{}', which is {}",
+                    pass.name,
+                    decl.name(),
+                    if decl.is_image() { "an image" } else { "a buffer" }
+                )));
+            }
+        }
+        if pass.record.is_none() {
+            return Err(Error::Graph(format!("pass '{}' has no recording closure", pass.name)));
+        }
+    }
+    for (r, a) in &graph.outputs {
+        if r.0 >= graph.resources.len() {
+            return Err(Error::Graph(format!("output #{} is not a resource of this graph", r.0)));
+        }
+        if a.is_some() && graph.resources[r.0].is_image() {
+            return Err(Error::Graph(format!("'{}': only buffers can be read back", graph.resources[r.0].name())));
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<BakedGraph<P>> {
+    validate(&graph)?;
+    let live = live_passes(&graph);
+    let mut image_usage = vec![ImageUsageFlags::empty(); graph.resources.len()];
+    let mut buffer_usage = vec![BufferUsageFlags::empty(); graph.resources.len()];
+    for (pass, _) in graph.passes.iter().zip(&live).filter(|(_, l)| **l) {
+        for (r, a) in &pass.uses {
+            image_usage[r.0] |= a.image_usage();
+            buffer_usage[r.0] |= a.buffer_usage();
+        }
+    }
+    let mut physical = Vec::with_capacity(graph.resources.len());
+    let mut names = Vec::with_capacity(graph.resources.len());
+    let mut imported = Vec::with_capacity(graph.resources.len());
+    for (i, decl) in graph.resources.into_iter().enumerate() {
+        names.push(decl.name());
+        imported.push(decl.is_imported());
+        let p = match decl {
+            ResourceDecl::TransientImage { name, info } => {
+                if image_usage[i].is_empty() {
+                    Physical::Unused
+                } else {
+                    let image = Image::new(
+                        ctx,
+                        ImageDesc {
+                            name,
+                            width: info.width,
+                            height: info.height,
+                            format: info.format,
+                            usage: image_usage[i],
+                        },
+                    )?;
+                    Physical::Image(vec![Arc::new(image)])
+                }
+            }
+            ResourceDecl::TransientBuffer { name, info } => {
+                if buffer_usage[i].is_empty() {
+                    Physical::Unused
+                } else {
+                    let buffer = Buffer::new(
+                        ctx,
+                        BufferDesc {
+                            name,
+                            size: info.size,
+                            usage: buffer_usage[i],
+                            location: info.location,
+                        },
+                    )?;
+                    Physical::Buffer(vec![Arc::new(buffer)])
+                }
+            }
+            ResourceDecl::ImportedImages(images) => {
+                for image in &images {
+                    if !image.desc().usage.contains(image_usage[i]) {
+                        return Err(Error::Graph(format!(
+                            "imported image '{}' lacks usage {:?}",
+                            image.desc().name,
+                            image_usage[i] & !image.desc().usage
+                        )));
+                    }
+                }
+                Physical::Image(images)
+            }
+            ResourceDecl::ImportedBuffers(buffers) => {
+                for buffer in &buffers {
+                    if !buffer.desc().usage.contains(buffer_usage[i]) {
+                        return Err(Error::Graph(format!(
+                            "imported buffer '{}' lacks usage {:?}",
+                            buffer.desc().name,
+                            buffer_usage[i] & !buffer.desc().usage
+                        )));
+                    }
+                }
+                Physical::Buffer(buffers)
+            }
+        };
+        physical.push(p);
+    }
+    let mut passes = Vec::new();
+    let mut culled = Vec::new();
+    for (decl, alive) in graph.passes.into_iter().zip(live) {
+        let PassDecl { name, kind, uses, record } = decl;
+        match (alive, record) {
+            (true, Some(record)) => passes.push(BakedPass { name, kind, uses, record }),
+            _ => culled.push(name),
+        }
+    }
+    if !culled.is_empty() {
+        log::debug!("render graph: culled passes {culled:?}");
+    }
+    let final_accesses = graph.outputs.iter().filter_map(|(r, a)| a.map(|a| (*r, a))).collect();
+    Ok(BakedGraph {
+        ctx: ctx.clone(),
+        passes,
+        transient_states: vec![AccessState::UNUSED; physical.len()],
+        physical,
+        imported,
+        names,
+        final_accesses,
+        culled,
+        pending: VecDeque::new(),
+        profiles: Vec::new(),
+        epoch: Instant::now(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::graph::{ImageInfo, Stage};
+    use crate::vulkan::Format;
+
+    #[test]
+    fn passes_without_used_outputs_are_culled() {
+        let mut g: RenderGraph<()> = RenderGraph::new();
+        let a = g.create_image("a", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
+        let b = g.create_image("b", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
+        let unused = g.create_image("unused", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
+        g.pass("write a").write(a, Access::StorageImageWrite(Stage::Compute)).record(|_, _| Ok(()));
+        g.pass("write unused")
+            .read(a, Access::SampledImage(Stage::Compute))
+            .write(unused, Access::StorageImageWrite(Stage::Compute))
+            .record(|_, _| Ok(()));
+        g.pass("a to b")
+            .read(a, Access::SampledImage(Stage::Compute))
+            .write(b, Access::StorageImageWrite(Stage::Compute))
+            .record(|_, _| Ok(()));
+        g.keep(b);
+        assert_eq!(live_passes(&g), vec![true, false, true]);
+    }
+
+    #[test]
+    fn only_the_last_writer_before_a_read_is_its_producer() {
+        let mut g: RenderGraph<()> = RenderGraph::new();
+        let a = g.create_image("a", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
+        let out = g.create_image("out", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
+        g.pass("overwritten").write(a, Access::StorageImageWrite(Stage::Compute)).record(|_, _| Ok(()));
+        g.pass("rewrite").write(a, Access::StorageImageWrite(Stage::Compute)).record(|_, _| Ok(()));
+        g.pass("accumulate").write(a, Access::StorageImageReadWrite(Stage::Compute)).record(|_, _| Ok(()));
+        g.pass("use")
+            .read(a, Access::SampledImage(Stage::Fragment))
+            .write(out, Access::ColorAttachmentWrite)
+            .record(|_, _| Ok(()));
+        g.keep(out);
+        assert_eq!(live_passes(&g), vec![false, true, true, true]);
+    }
+}

@@ -1,0 +1,257 @@
+//! Executing a baked graph: per pass, a debug label, a begin timestamp, the
+//! barriers derived from the declared accesses and the tracked state of each
+//! resource, the pass's commands, and an end timestamp.
+
+use std::time::Instant;
+
+use super::access::derive_barrier;
+use super::bake::{BakedGraph, PendingFrame, Physical};
+use super::{PassKind, ResourceId};
+use crate::error::{Error, Result};
+use crate::profile::{FrameProfile, PassTiming};
+use crate::vulkan::{AccessState, Barrier, Buffer, CommandRecorder, CompletedFrame, FrameRing, Image,
+    PipelineStageFlags2};
+
+/// What a pass's recording closure gets: the command recorder and the
+/// physical resources of this frame.
+pub struct PassContext<'a> {
+    cmd: &'a mut CommandRecorder,
+    physical: &'a [Physical],
+    frame: u64,
+}
+
+impl<'a> PassContext<'a> {
+    /// The command recorder.
+    pub fn cmd(&mut self) -> &mut CommandRecorder {
+        &mut *self.cmd
+    }
+
+    /// The image behind `id` this frame.
+    pub fn image(&self, id: ResourceId) -> Result<&'a Image> {
+        match self.physical.get(id.0) {
+            Some(Physical::Image(images)) if !images.is_empty() => Ok(&images[(self.frame as usize) % images.len()]),
+            _ => Err(Error::Graph(format!("resource #{} is not an image of this graph", id.0))),
+        }
+    }
+
+    /// The buffer behind `id` this frame.
+    pub fn buffer(&self, id: ResourceId) -> Result<&'a Buffer> {
+        match self.physical.get(id.0) {
+            Some(Physical::Buffer(buffers)) if !buffers.is_empty() => {
+                Ok(&buffers[(self.frame as usize) % buffers.len()])
+            }
+            _ => Err(Error::Graph(format!("resource #{} is not a buffer of this graph", id.0))),
+        }
+    }
+
+    /// Heap handle for sampling the image `id`.
+    pub fn sampled(&self, id: ResourceId) -> Result<u32> {
+        self.image(id)?
+            .sampled_handle()
+            .ok_or_else(|| Error::Graph(format!("resource #{} is not sampled", id.0)))
+    }
+
+    /// Heap handle of the storage image `id`.
+    pub fn storage_image(&self, id: ResourceId) -> Result<u32> {
+        self.image(id)?
+            .storage_handle()
+            .ok_or_else(|| Error::Graph(format!("resource #{} is not a storage image", id.0)))
+    }
+
+    /// Heap handle of the storage buffer `id`.
+    pub fn storage_buffer(&self, id: ResourceId) -> Result<u32> {
+        self.buffer(id)?
+            .storage_handle()
+            .ok_or_else(|| Error::Graph(format!("resource #{} is not a storage buffer", id.0)))
+    }
+}
+
+/// What executing one frame produced.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameOutcome {
+    /// Frame number (0, 1, ...).
+    pub frame: u64,
+    /// Timeline value that marks the frame's completion.
+    pub timeline: u64,
+    /// Which physical copy of per-frame imported resources this frame used.
+    pub slot: usize,
+}
+
+fn label_color(kind: PassKind) -> [f32; 4] {
+    match kind {
+        PassKind::Compute => [0.30, 0.55, 0.95, 1.0],
+        PassKind::Graphics => [0.95, 0.55, 0.25, 1.0],
+        PassKind::Transfer => [0.50, 0.80, 0.40, 1.0],
+    }
+}
+
+impl<P> BakedGraph<P> {
+    fn state_of(&self, r: ResourceId, frame: u64) -> AccessState {
+        match &self.physical[r.0] {
+            _ if !self.imported[r.0] => self.transient_states[r.0],
+            Physical::Image(v) => v[(frame as usize) % v.len()].state(),
+            Physical::Buffer(v) => v[(frame as usize) % v.len()].state(),
+            Physical::Unused => AccessState::UNUSED,
+        }
+    }
+
+    fn set_state_of(&mut self, r: ResourceId, frame: u64, state: AccessState) {
+        if !self.imported[r.0] {
+            self.transient_states[r.0] = state;
+            return;
+        }
+        match &self.physical[r.0] {
+            Physical::Image(v) => v[(frame as usize) % v.len()].set_state(state),
+            Physical::Buffer(v) => v[(frame as usize) % v.len()].set_state(state),
+            Physical::Unused => {}
+        }
+    }
+
+    /// Derives and records the barriers before `uses`, updating tracked states.
+    fn emit_barriers(
+        &mut self,
+        cmd: &mut CommandRecorder,
+        uses: &[(ResourceId, super::Access)],
+        frame: u64,
+        touched: &mut [bool],
+    ) {
+        let mut image_barriers: Vec<(usize, Barrier)> = Vec::new();
+        let mut buffer_barriers: Vec<(usize, Barrier)> = Vec::new();
+        for &(r, access) in uses {
+            let mut state = self.state_of(r, frame);
+            let discard = !self.imported[r.0] && !touched[r.0];
+            touched[r.0] = true;
+            if let Some(b) = derive_barrier(&mut state, access, discard) {
+                if access.is_image() && matches!(self.physical[r.0], Physical::Image(_)) {
+                    image_barriers.push((r.0, b));
+                } else {
+                    buffer_barriers.push((r.0, b));
+                }
+            }
+            self.set_state_of(r, frame, state);
+        }
+        let slot = frame as usize;
+        let images: Vec<(&Image, Barrier)> = image_barriers
+            .iter()
+            .filter_map(|(r, b)| match &self.physical[*r] {
+                Physical::Image(v) => Some((&*v[slot % v.len()], *b)),
+                _ => None,
+            })
+            .collect();
+        let buffers: Vec<(&Buffer, Barrier)> = buffer_barriers
+            .iter()
+            .filter_map(|(r, b)| match &self.physical[*r] {
+                Physical::Buffer(v) => Some((&*v[slot % v.len()], *b)),
+                _ => None,
+            })
+            .collect();
+        cmd.barriers(&buffers, &images);
+    }
+
+    /// Records and submits one frame. Returns once the frame is submitted; its
+    /// GPU timings arrive in [`BakedGraph::take_profiles`] when the GPU is done.
+    pub fn execute(&mut self, frames: &mut FrameRing, params: &P) -> Result<FrameOutcome> {
+        let frame_start = Instant::now();
+        let query_count = 2 * self.passes.len() as u32;
+        let (mut recording, completed) = frames.begin(query_count)?;
+        if let Some(c) = completed {
+            self.complete(c);
+        }
+        let frame = recording.frame;
+        let pool = recording.query_pool();
+        let mut touched = vec![false; self.physical.len()];
+        let mut cpu_passes = Vec::with_capacity(self.passes.len());
+        let mut passes = std::mem::take(&mut self.passes);
+        let mut result = Ok(());
+        for (i, pass) in passes.iter_mut().enumerate() {
+            let pass_start = Instant::now();
+            let cmd = &mut recording.recorder;
+            cmd.begin_label(&pass.name, label_color(pass.kind));
+            cmd.write_timestamp(pool, 2 * i as u32, PipelineStageFlags2::TOP_OF_PIPE);
+            self.emit_barriers(cmd, &pass.uses, frame, &mut touched);
+            let mut ctx = PassContext {
+                cmd,
+                physical: &self.physical,
+                frame,
+            };
+            if let Err(e) = (pass.record)(&mut ctx, params) {
+                result = Err(Error::Graph(format!("pass '{}': {e}", pass.name)));
+            }
+            let cmd = &mut recording.recorder;
+            cmd.write_timestamp(pool, 2 * i as u32 + 1, PipelineStageFlags2::ALL_COMMANDS);
+            cmd.end_label();
+            cpu_passes.push((
+                (pass_start - frame_start).as_secs_f64() * 1e3,
+                pass_start.elapsed().as_secs_f64() * 1e3,
+            ));
+            if result.is_err() {
+                break;
+            }
+        }
+        self.passes = passes;
+        let finals = self.final_accesses.clone();
+        self.emit_barriers(&mut recording.recorder, &finals, frame, &mut touched);
+        // Submit even after a failed pass so the frame slot stays consistent.
+        let timeline = recording.submit()?;
+        result?;
+        self.pending.push_back(PendingFrame {
+            frame,
+            cpu_start_ms: (frame_start - self.epoch).as_secs_f64() * 1e3,
+            cpu_ms: frame_start.elapsed().as_secs_f64() * 1e3,
+            cpu_passes,
+        });
+        Ok(FrameOutcome {
+            frame,
+            timeline,
+            slot: frame as usize,
+        })
+    }
+
+    fn complete(&mut self, completed: CompletedFrame) {
+        while let Some(p) = self.pending.front() {
+            if p.frame > completed.frame {
+                return;
+            }
+            let p = self.pending.pop_front().expect("front exists");
+            if p.frame < completed.frame {
+                continue;
+            }
+            let ts = &completed.timestamps_ns;
+            let mut passes = Vec::with_capacity(self.passes.len());
+            for (i, pass) in self.passes.iter().enumerate() {
+                let (begin, end) = (ts.get(2 * i).copied().unwrap_or(0.0), ts.get(2 * i + 1).copied().unwrap_or(0.0));
+                let (cpu_start_ms, cpu_ms) = p.cpu_passes.get(i).copied().unwrap_or((0.0, 0.0));
+                passes.push(PassTiming {
+                    name: pass.name.clone(),
+                    gpu_ms: (end - begin).max(0.0) / 1e6,
+                    cpu_ms,
+                    gpu_start_ms: begin / 1e6,
+                    cpu_start_ms,
+                });
+            }
+            let first = ts.iter().copied().fold(f64::INFINITY, f64::min);
+            let last = ts.iter().copied().fold(0.0, f64::max);
+            self.profiles.push(FrameProfile {
+                frame: p.frame,
+                passes,
+                gpu_ms: if first.is_finite() { (last - first) / 1e6 } else { 0.0 },
+                cpu_ms: p.cpu_ms,
+                cpu_start_ms: p.cpu_start_ms,
+            });
+            return;
+        }
+    }
+
+    /// Waits for every frame in flight and collects its timings.
+    pub fn finish(&mut self, frames: &mut FrameRing) -> Result<()> {
+        for c in frames.finish()? {
+            self.complete(c);
+        }
+        Ok(())
+    }
+
+    /// Timings of the frames completed so far (oldest first), removing them.
+    pub fn take_profiles(&mut self) -> Vec<FrameProfile> {
+        std::mem::take(&mut self.profiles)
+    }
+}

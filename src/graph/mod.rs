@@ -1,0 +1,242 @@
+//! The render graph. Passes declare what they read and write; [`RenderGraph::bake`]
+//! orders them, culls the ones nobody needs, creates the transient resources
+//! and returns a [`BakedGraph`] that records and times every frame, deriving
+//! each barrier and layout transition from the declared accesses.
+//!
+//! ```ignore
+//! let mut graph = RenderGraph::new();
+//! let vertices = graph.import_buffer(vertex_buffer);
+//! let hdr = graph.create_image("hdr", ImageInfo::new(w, h, Format::R32G32B32A32_SFLOAT));
+//! graph.pass("terrain.grid")
+//!     .write(vertices, Access::StorageBufferWrite(Stage::Compute))
+//!     .record(move |pass, params: &FrameParams| { /* bind, push, dispatch */ Ok(()) });
+//! graph.pass("terrain.draw")
+//!     .read(vertices, Access::VertexBuffer)
+//!     .write(hdr, Access::ColorAttachmentWrite)
+//!     .record(move |pass, params| { /* begin_rendering, draw */ Ok(()) });
+//! let mut baked = graph.bake(&ctx)?;
+//! baked.execute(&mut frames, &params)?;
+//! ```
+
+pub mod access;
+mod bake;
+mod execute;
+
+use std::sync::Arc;
+
+pub use access::{derive_barrier, Access, Stage};
+pub use bake::BakedGraph;
+pub use execute::{FrameOutcome, PassContext};
+
+use crate::error::Result;
+use crate::vulkan::{Buffer, Format, Image, MemoryLocation};
+
+/// A resource of the graph (transient or imported), by index.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ResourceId(pub(crate) usize);
+
+/// Size and format of a transient image; usage is derived from the accesses.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ImageInfo {
+    pub width: u32,
+    pub height: u32,
+    pub format: Format,
+}
+
+impl ImageInfo {
+    /// A `width`×`height` image of `format`.
+    pub fn new(width: u32, height: u32, format: Format) -> Self {
+        ImageInfo { width, height, format }
+    }
+}
+
+/// Size and memory of a transient buffer; usage is derived from the accesses.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BufferInfo {
+    pub size: u64,
+    pub location: MemoryLocation,
+}
+
+pub(crate) enum ResourceDecl {
+    TransientImage { name: String, info: ImageInfo },
+    TransientBuffer { name: String, info: BufferInfo },
+    /// One physical image per frame slot (or one shared by all).
+    ImportedImages(Vec<Arc<Image>>),
+    ImportedBuffers(Vec<Arc<Buffer>>),
+}
+
+impl ResourceDecl {
+    pub(crate) fn is_imported(&self) -> bool {
+        matches!(self, ResourceDecl::ImportedImages(_) | ResourceDecl::ImportedBuffers(_))
+    }
+
+    pub(crate) fn is_image(&self) -> bool {
+        matches!(self, ResourceDecl::TransientImage { .. } | ResourceDecl::ImportedImages(_))
+    }
+
+    pub(crate) fn name(&self) -> String {
+        match self {
+            ResourceDecl::TransientImage { name, .. } | ResourceDecl::TransientBuffer { name, .. } => name.clone(),
+            ResourceDecl::ImportedImages(i) => i.first().map(|i| i.desc().name.clone()).unwrap_or_default(),
+            ResourceDecl::ImportedBuffers(b) => b.first().map(|b| b.desc().name.clone()).unwrap_or_default(),
+        }
+    }
+}
+
+/// The recording closure of a pass: gets the pass context and the frame's
+/// parameters.
+pub type RecordFn<P> = Box<dyn FnMut(&mut PassContext<'_>, &P) -> Result<()>>;
+
+/// What kind of queue work a pass records (for labels and timestamps).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PassKind {
+    Compute,
+    Graphics,
+    Transfer,
+}
+
+pub(crate) struct PassDecl<P> {
+    pub name: String,
+    pub kind: PassKind,
+    pub uses: Vec<(ResourceId, Access)>,
+    pub record: Option<RecordFn<P>>,
+}
+
+/// A render graph being declared. `P` is the per-frame parameter type every
+/// pass's recording closure receives (camera, time, ...).
+pub struct RenderGraph<P> {
+    pub(crate) resources: Vec<ResourceDecl>,
+    pub(crate) passes: Vec<PassDecl<P>>,
+    /// Resources whose final contents are wanted after the frame.
+    pub(crate) outputs: Vec<(ResourceId, Option<Access>)>,
+}
+
+impl<P> Default for RenderGraph<P> {
+    fn default() -> Self {
+        RenderGraph {
+            resources: Vec::new(),
+            passes: Vec::new(),
+            outputs: Vec::new(),
+        }
+    }
+}
+
+impl<P: 'static> RenderGraph<P> {
+    /// An empty graph.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// A transient image, created at bake time and reused every frame.
+    pub fn create_image(&mut self, name: &str, info: ImageInfo) -> ResourceId {
+        self.resources.push(ResourceDecl::TransientImage {
+            name: name.into(),
+            info,
+        });
+        ResourceId(self.resources.len() - 1)
+    }
+
+    /// A transient buffer, created at bake time and reused every frame.
+    pub fn create_buffer(&mut self, name: &str, info: BufferInfo) -> ResourceId {
+        self.resources.push(ResourceDecl::TransientBuffer {
+            name: name.into(),
+            info,
+        });
+        ResourceId(self.resources.len() - 1)
+    }
+
+    /// A persistent image owned outside the graph; its state is tracked across
+    /// frames (and across graphs).
+    pub fn import_image(&mut self, image: Arc<Image>) -> ResourceId {
+        self.import_images_per_frame(vec![image])
+    }
+
+    /// One persistent image per frame in flight, used round-robin.
+    pub fn import_images_per_frame(&mut self, images: Vec<Arc<Image>>) -> ResourceId {
+        self.resources.push(ResourceDecl::ImportedImages(images));
+        ResourceId(self.resources.len() - 1)
+    }
+
+    /// A persistent buffer owned outside the graph (vertex buffers, atlases).
+    pub fn import_buffer(&mut self, buffer: Arc<Buffer>) -> ResourceId {
+        self.import_buffers_per_frame(vec![buffer])
+    }
+
+    /// One persistent buffer per frame in flight (readback targets).
+    pub fn import_buffers_per_frame(&mut self, buffers: Vec<Arc<Buffer>>) -> ResourceId {
+        self.resources.push(ResourceDecl::ImportedBuffers(buffers));
+        ResourceId(self.resources.len() - 1)
+    }
+
+    /// Keeps the passes that produce `resource` even if no pass reads it.
+    pub fn keep(&mut self, resource: ResourceId) {
+        self.outputs.push((resource, None));
+    }
+
+    /// The host reads `resource` after the frame: a final barrier makes the
+    /// GPU's writes visible to the host.
+    pub fn read_back(&mut self, resource: ResourceId) {
+        self.outputs.push((resource, Some(Access::HostRead)));
+    }
+
+    /// Starts declaring a compute pass.
+    pub fn pass(&mut self, name: &str) -> PassBuilder<'_, P> {
+        self.begin_pass(name, PassKind::Compute)
+    }
+
+    /// Starts declaring a pass of the given kind.
+    pub fn begin_pass(&mut self, name: &str, kind: PassKind) -> PassBuilder<'_, P> {
+        PassBuilder {
+            graph: self,
+            decl: PassDecl {
+                name: name.into(),
+                kind,
+                uses: Vec::new(),
+                record: None,
+            },
+        }
+    }
+
+    /// Orders, culls, creates transients; see [`BakedGraph`].
+    pub fn bake(self, ctx: &crate::vulkan::Context) -> Result<BakedGraph<P>> {
+        bake::bake(self, ctx)
+    }
+}
+
+/// Declares one pass: `graph.pass("name").read(..).write(..).record(..)`.
+pub struct PassBuilder<'g, P> {
+    graph: &'g mut RenderGraph<P>,
+    decl: PassDecl<P>,
+}
+
+impl<P: 'static> PassBuilder<'_, P> {
+    /// Marks the pass as graphics (draws into attachments).
+    pub fn graphics(mut self) -> Self {
+        self.decl.kind = PassKind::Graphics;
+        self
+    }
+
+    /// Marks the pass as transfer (copies).
+    pub fn transfer(mut self) -> Self {
+        self.decl.kind = PassKind::Transfer;
+        self
+    }
+
+    /// Declares a read of `resource`.
+    pub fn read(mut self, resource: ResourceId, access: Access) -> Self {
+        self.decl.uses.push((resource, access));
+        self
+    }
+
+    /// Declares a write (or read-write) of `resource`.
+    pub fn write(mut self, resource: ResourceId, access: Access) -> Self {
+        self.decl.uses.push((resource, access));
+        self
+    }
+
+    /// Finishes the pass with the closure that records its commands.
+    pub fn record(mut self, record: impl FnMut(&mut PassContext<'_>, &P) -> Result<()> + 'static) {
+        self.decl.record = Some(Box::new(record));
+        self.graph.passes.push(self.decl);
+    }
+}

@@ -1,0 +1,200 @@
+//! All-or-nothing file writes.
+//!
+//! [`write_atomically`] lets a writer fill a temporary file beside the target
+//! and renames it into place only when the writer succeeded. Readers of the
+//! target therefore see either the old file or the complete new one, never a
+//! partial file, and a failed write leaves nothing behind.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use crate::error::{Error, Result};
+
+/// Distinguishes temporary files of concurrent writes within one process.
+static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// Removes the temporary file on drop unless disarmed (covers early returns
+/// and panics inside the writer).
+struct TempGuard {
+    path: PathBuf,
+    armed: bool,
+}
+
+impl Drop for TempGuard {
+    fn drop(&mut self) {
+        if self.armed {
+            // Best effort: the file may never have been created.
+            let _ = std::fs::remove_file(&self.path);
+        }
+    }
+}
+
+/// The temporary path used while writing `path`:
+/// `.{file name}.tmp-{process id}-{counter}` in the same directory.
+fn temp_path(dir: &Path, file_name: &std::ffi::OsStr) -> PathBuf {
+    let mut name = std::ffi::OsString::from(".");
+    name.push(file_name);
+    name.push(format!(
+        ".tmp-{}-{}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    dir.join(name)
+}
+
+/// Writes `path` atomically.
+///
+/// Calls `write` with a temporary path in the same directory as `path`
+/// (named `.{file name}.tmp-{pid}-{n}`, hidden on Unix), then renames the
+/// temporary file onto `path`. Because the rename happens within one
+/// directory (one file system), it replaces any existing file in one step.
+///
+/// On failure — the writer returns an error, the writer panics, or the
+/// rename fails — the temporary file is removed and `path` is untouched.
+///
+/// Errors (one line, naming `path`): `path` has no file name, its parent
+/// directory does not exist or is not a directory, `path` is an existing
+/// directory, the writer did not create the temporary file, or the rename
+/// failed. Errors returned by `write` are passed through unchanged, so
+/// writers should name `path` (not the temporary path) in their messages.
+pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    let file_name = path
+        .file_name()
+        .ok_or_else(|| Error::output(path, "the path does not name a file"))?;
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !dir.exists() {
+        return Err(Error::output(
+            path,
+            format!("directory {} does not exist", dir.display()),
+        ));
+    }
+    if !dir.is_dir() {
+        return Err(Error::output(
+            path,
+            format!("{} is not a directory", dir.display()),
+        ));
+    }
+    if path.is_dir() {
+        return Err(Error::output(path, "a directory of that name exists"));
+    }
+
+    let mut guard = TempGuard {
+        path: temp_path(dir, file_name),
+        armed: true,
+    };
+    write(&guard.path)?;
+    if !guard.path.is_file() {
+        return Err(Error::output(
+            path,
+            "internal error: the writer did not create the temporary file",
+        ));
+    }
+    std::fs::rename(&guard.path, path).map_err(|e| {
+        Error::output(
+            path,
+            format!(
+                "cannot rename {} into place: {}",
+                guard.path.display(),
+                super::one_line(e)
+            ),
+        )
+    })?;
+    guard.armed = false;
+    Ok(())
+}
+
+/// Writes `bytes` to `path` atomically (see [`write_atomically`]).
+pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomically(path, |tmp| {
+        std::fs::write(tmp, bytes).map_err(|e| Error::output(path, super::one_line(e)))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch_dir(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!(
+            "alpenglow-atomic-{}-{}",
+            std::process::id(),
+            name
+        ));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn entries(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn success_replaces_file_and_leaves_no_temp() {
+        let dir = scratch_dir("ok");
+        let target = dir.join("a.txt");
+        std::fs::write(&target, b"old").unwrap();
+        write_bytes_atomically(&target, b"new").unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"new");
+        assert_eq!(entries(&dir), vec!["a.txt".to_string()]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn failure_keeps_old_file_and_removes_temp() {
+        let dir = scratch_dir("fail");
+        let target = dir.join("a.txt");
+        std::fs::write(&target, b"old").unwrap();
+        let err = write_atomically(&target, |tmp| {
+            std::fs::write(tmp, b"partial").unwrap();
+            Err(Error::output(&target, "simulated failure"))
+        })
+        .unwrap_err();
+        assert!(err.to_string().contains("simulated failure"));
+        assert_eq!(std::fs::read(&target).unwrap(), b"old");
+        assert_eq!(entries(&dir), vec!["a.txt".to_string()]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn panic_in_writer_removes_temp() {
+        let dir = scratch_dir("panic");
+        let target = dir.join("b.bin");
+        let result = std::panic::catch_unwind(|| {
+            let _ = write_atomically(&target, |tmp| {
+                std::fs::write(tmp, b"partial").unwrap();
+                panic!("writer panicked");
+            });
+        });
+        assert!(result.is_err());
+        assert!(entries(&dir).is_empty());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn missing_directory_is_a_clear_error() {
+        let dir = scratch_dir("missing");
+        let target = dir.join("nope").join("x.png");
+        let err = write_bytes_atomically(&target, b"x").unwrap_err().to_string();
+        assert!(err.contains("does not exist"), "{err}");
+        assert!(err.contains("x.png"), "{err}");
+        assert!(!dir.join("nope").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn writer_that_creates_nothing_is_an_error() {
+        let dir = scratch_dir("nothing");
+        let err = write_atomically(&dir.join("y"), |_| Ok(())).unwrap_err();
+        assert!(err.to_string().contains("temporary file"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,221 @@
+//! Image output: 8-bit sRGB PNG screenshots and 32-bit float OpenEXR layers.
+//!
+//! Both writers go through [`write_atomically`], so a failed write leaves no
+//! file behind. Pixel data is row-major with row 0 at the top of the image.
+
+use std::collections::BTreeSet;
+use std::io::{BufWriter, Cursor, Write};
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::io::atomic::{write_atomically, write_bytes_atomically};
+use crate::io::one_line;
+
+/// Number of pixels of a `width`×`height` image, rejecting empty images and
+/// sizes that overflow `usize`.
+fn pixel_count(what: &str, width: u32, height: u32) -> Result<usize> {
+    if width == 0 || height == 0 {
+        return Err(Error::invalid(
+            what,
+            format!("image size {width}×{height} is empty"),
+        ));
+    }
+    (width as usize)
+        .checked_mul(height as usize)
+        .ok_or_else(|| Error::invalid(what, format!("image size {width}×{height} is too large")))
+}
+
+/// Writes an 8-bit RGBA PNG.
+///
+/// `rgba` holds 4 bytes per pixel, row-major, row 0 at the top, already
+/// encoded for display (sRGB transfer function, e.g. tone-mapped by the
+/// GPU). The encoder settings are fixed and the file carries no timestamp,
+/// so identical input gives a byte-identical file.
+///
+/// Errors: empty size, `rgba.len() != 4·width·height`, encoder or I/O
+/// failure (the message names `path`).
+pub fn write_png_rgba8(path: &Path, rgba: &[u8], width: u32, height: u32) -> Result<()> {
+    let pixels = pixel_count("PNG image size", width, height)?;
+    if Some(rgba.len()) != pixels.checked_mul(4) {
+        return Err(Error::invalid(
+            "PNG pixel data",
+            format!(
+                "{} bytes for a {width}×{height} RGBA image (expected {})",
+                rgba.len(),
+                pixels.saturating_mul(4)
+            ),
+        ));
+    }
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    use image::{ExtendedColorType, ImageEncoder};
+    let mut bytes = Vec::new();
+    PngEncoder::new_with_quality(&mut bytes, CompressionType::Default, FilterType::Adaptive)
+        .write_image(rgba, width, height, ExtendedColorType::Rgba8)
+        .map_err(|e| Error::output(path, format!("PNG encoding failed: {}", one_line(e))))?;
+    write_bytes_atomically(path, &bytes)
+}
+
+/// Writes a 32-bit float OpenEXR file with channels R, G, B, A, Z and any
+/// `extra` channels.
+///
+/// * `rgba`: 4 linear values per pixel (R, G, B, A), row-major, row 0 at the
+///   top (the EXR data window starts at (0, 0) and lines are stored in
+///   increasing y, i.e. top to bottom).
+/// * `depth`: one view-space depth per pixel, `+inf` where nothing was hit;
+///   stored unchanged in channel `Z`.
+/// * `extra`: further named channels, one value per pixel each.
+///
+/// Channels are stored in alphabetical order as the format requires; ZIP
+/// compression (lossless) in 16-line blocks.
+///
+/// Errors: empty size, wrong slice lengths, empty, duplicate or reserved
+/// extra channel names, encoder or I/O failure.
+pub fn write_exr(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgba: &[f32],
+    depth: &[f32],
+    extra: &[(&str, &[f32])],
+) -> Result<()> {
+    use exr::prelude::{
+        AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image, Layer,
+        LayerAttributes, LineOrder, SmallVec, WritableImage,
+    };
+
+    let pixels = pixel_count("EXR image size", width, height)?;
+    let check_len = |what: &str, len: usize, per_pixel: usize| -> Result<()> {
+        if Some(len) == pixels.checked_mul(per_pixel) {
+            Ok(())
+        } else {
+            Err(Error::invalid(
+                format!("EXR {what}"),
+                format!(
+                    "{len} values for a {width}×{height} image (expected {})",
+                    pixels.saturating_mul(per_pixel)
+                ),
+            ))
+        }
+    };
+    check_len("RGBA data", rgba.len(), 4)?;
+    check_len("depth data", depth.len(), 1)?;
+    let mut names: BTreeSet<&str> = ["R", "G", "B", "A", "Z"].into_iter().collect();
+    for (name, data) in extra {
+        if name.is_empty() || !name.is_ascii() || name.chars().any(|c| c.is_ascii_control()) {
+            return Err(Error::invalid(
+                "EXR channel name",
+                format!("{name:?} must be non-empty printable ASCII"),
+            ));
+        }
+        if !names.insert(name) {
+            return Err(Error::invalid(
+                "EXR channel name",
+                format!("{name:?} is used twice"),
+            ));
+        }
+        check_len(&format!("channel {name}"), data.len(), 1)?;
+    }
+
+    let component = |k: usize| -> Vec<f32> { rgba.iter().skip(k).step_by(4).copied().collect() };
+    let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+    for (k, name) in ["R", "G", "B", "A"].iter().enumerate() {
+        list.push(AnyChannel::new(*name, FlatSamples::F32(component(k))));
+    }
+    list.push(AnyChannel::new("Z", FlatSamples::F32(depth.to_vec())));
+    for (name, data) in extra {
+        list.push(AnyChannel::new(*name, FlatSamples::F32(data.to_vec())));
+    }
+    let encoding = Encoding {
+        compression: Compression::ZIP16,
+        blocks: Blocks::ScanLines,
+        line_order: LineOrder::Increasing,
+    };
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        LayerAttributes::default(),
+        encoding,
+        AnyChannels::sort(list),
+    );
+    let image = Image::from_layer(layer);
+
+    write_atomically(path, |tmp| {
+        let file = std::fs::File::create(tmp).map_err(|e| Error::output(path, one_line(e)))?;
+        let mut writer = BufWriter::new(file);
+        image
+            .write()
+            .to_buffered(&mut writer)
+            .map_err(|e| Error::output(path, format!("EXR encoding failed: {}", one_line(e))))?;
+        writer
+            .flush()
+            .map_err(|e| Error::output(path, one_line(e)))
+    })
+}
+
+/// Channels of an EXR image as `(width, height, [(name, samples)])`, samples
+/// row-major from the top, converted to `f32`, channels in file
+/// (alphabetical) order. Reads the first valid layer at full resolution.
+pub(crate) fn decode_exr_channels(
+    path: &Path,
+    bytes: &[u8],
+) -> Result<(u32, u32, Vec<(String, Vec<f32>)>)> {
+    use exr::prelude::{read, ReadChannels, ReadLayers};
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(|e| Error::input(path, format!("invalid OpenEXR file: {}", one_line(e))))?;
+    let layer = image.layer_data;
+    let (w, h) = (layer.size.width(), layer.size.height());
+    let width = u32::try_from(w).map_err(|_| Error::input(path, "image too wide"))?;
+    let height = u32::try_from(h).map_err(|_| Error::input(path, "image too tall"))?;
+    let channels = layer
+        .channel_data
+        .list
+        .iter()
+        .map(|c| {
+            (
+                c.name.to_string(),
+                c.sample_data.values_as_f32().collect::<Vec<f32>>(),
+            )
+        })
+        .collect::<Vec<_>>();
+    if let Some((name, _)) = channels.iter().find(|(_, s)| s.len() != w * h) {
+        return Err(Error::input(
+            path,
+            format!("channel {name} is subsampled, which is not supported"),
+        ));
+    }
+    Ok((width, height, channels))
+}
+
+/// Reads every channel of an OpenEXR file (first layer, full resolution) as
+/// `(width, height, [(name, samples)])`; samples are row-major with row 0 at
+/// the top, converted to `f32`; channels in alphabetical order. Meant for
+/// tests and tools that check what [`write_exr`] produced.
+pub fn read_exr_channels(path: &Path) -> Result<(u32, u32, Vec<(String, Vec<f32>)>)> {
+    let bytes = crate::io::read_input(path)?;
+    decode_exr_channels(path, &bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_wrong_lengths_and_names() {
+        let p = std::env::temp_dir().join("alpenglow-never-written.exr");
+        let rgba = vec![0.0; 4 * 6];
+        let z = vec![0.0; 6];
+        assert!(write_exr(&p, 3, 2, &rgba[1..], &z, &[]).is_err());
+        assert!(write_exr(&p, 3, 2, &rgba, &z[1..], &[]).is_err());
+        assert!(write_exr(&p, 3, 2, &rgba, &z, &[("Z", &z)]).is_err());
+        assert!(write_exr(&p, 3, 2, &rgba, &z, &[("", &z)]).is_err());
+        assert!(write_exr(&p, 3, 2, &rgba, &z, &[("W", &z[1..])]).is_err());
+        assert!(write_exr(&p, 0, 2, &[], &[], &[]).is_err());
+        assert!(write_png_rgba8(&p, &[0; 7], 1, 2).is_err());
+        assert!(!p.exists());
+    }
+}

@@ -1,0 +1,129 @@
+//! The pinhole camera of the CLI contract: world right-handed, +Z up,
+//! vertical field of view, image row 0 at the top.
+
+use glam::{DMat4, DVec3, Mat4, Vec3};
+
+use crate::error::{Error, Result};
+
+/// A pinhole camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: DVec3,
+    pub target: DVec3,
+    pub up: DVec3,
+    /// Vertical field of view in degrees.
+    pub fov_y_deg: f64,
+    pub near: f64,
+    pub far: f64,
+}
+
+impl Camera {
+    /// Checks that the camera describes a view: finite values, eye ≠ target,
+    /// up not parallel to the view direction, 0 < fov < 180, 0 < near < far.
+    pub fn validate(&self) -> Result<()> {
+        let finite = |v: DVec3| v.is_finite();
+        if !finite(self.eye) || !finite(self.target) || !finite(self.up) {
+            return Err(Error::invalid("camera", "eye, target and up must be finite numbers"));
+        }
+        let dir = self.target - self.eye;
+        if dir.length() <= 1e-9 * self.eye.length().max(1.0) {
+            return Err(Error::invalid("camera", "eye equals target; there is no view direction"));
+        }
+        if self.up.length() == 0.0 || dir.normalize().cross(self.up.normalize()).length() < 1e-6 {
+            return Err(Error::invalid("camera", "up is zero or parallel to the view direction"));
+        }
+        if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
+            return Err(Error::invalid("--fov-y", format!("{} degrees; must be in (0, 180)", self.fov_y_deg)));
+        }
+        if !(self.near > 0.0 && self.near.is_finite() && self.far > self.near && self.far.is_finite()) {
+            return Err(Error::invalid(
+                "--near/--far",
+                format!("near {} and far {}; need 0 < near < far, both finite", self.near, self.far),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Unit forward axis (view-space depth is measured along it).
+    pub fn forward(&self) -> DVec3 {
+        (self.target - self.eye).normalize()
+    }
+
+    /// Unit right axis.
+    pub fn right(&self) -> DVec3 {
+        self.forward().cross(self.up).normalize()
+    }
+
+    /// Unit up axis of the image (orthogonal to forward).
+    pub fn image_up(&self) -> DVec3 {
+        self.right().cross(self.forward())
+    }
+
+    /// World → clip transform for Vulkan (depth 0..1, y flipped so image row 0
+    /// is the top). Computed in f64, rounded once.
+    pub fn view_proj(&self, aspect: f64) -> Mat4 {
+        let view = DMat4::look_at_rh(self.eye, self.target, self.up);
+        let mut proj = DMat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, self.near, self.far);
+        proj.y_axis.y = -proj.y_axis.y;
+        (proj * view).as_mat4()
+    }
+
+    /// Right and up axes scaled by the half-extents of the image plane at
+    /// distance 1 (for reconstructing view rays).
+    pub fn ray_basis(&self, aspect: f64) -> (Vec3, Vec3, Vec3) {
+        let tan_y = (self.fov_y_deg.to_radians() * 0.5).tan();
+        (
+            (self.right() * tan_y * aspect).as_vec3(),
+            (self.image_up() * tan_y).as_vec3(),
+            self.forward().as_vec3(),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera() -> Camera {
+        Camera {
+            eye: DVec3::new(0.0, 0.0, 10.0),
+            target: DVec3::new(100.0, 0.0, 10.0),
+            up: DVec3::Z,
+            fov_y_deg: 60.0,
+            near: 1.0,
+            far: 1000.0,
+        }
+    }
+
+    #[test]
+    fn bad_cameras_are_rejected() {
+        assert!(camera().validate().is_ok());
+        let mut c = camera();
+        c.target = c.eye;
+        assert!(c.validate().unwrap_err().to_string().contains("eye equals target"));
+        let mut c = camera();
+        c.up = DVec3::X;
+        assert!(c.validate().is_err());
+        let mut c = camera();
+        c.fov_y_deg = 180.0;
+        assert!(c.validate().is_err());
+        let mut c = camera();
+        c.near = 0.0;
+        assert!(c.validate().is_err());
+        let mut c = camera();
+        c.eye.x = f64::NAN;
+        assert!(c.validate().is_err());
+    }
+
+    #[test]
+    fn up_in_the_world_is_up_in_the_image() {
+        let c = camera();
+        let vp = c.view_proj(1.0);
+        let above = vp * glam::Vec4::new(100.0, 0.0, 30.0, 1.0);
+        let below = vp * glam::Vec4::new(100.0, 0.0, -10.0, 1.0);
+        // Vulkan NDC y grows downwards: a point above the horizon has smaller y.
+        assert!(above.y / above.w < 0.0 && below.y / below.w > 0.0);
+        let right = vp * glam::Vec4::new(100.0, -20.0, 10.0, 1.0);
+        assert!(right.x / right.w > 0.0, "-Y is to the right when looking along +X with +Z up");
+    }
+}

@@ -1,0 +1,28 @@
+//! The compiled SPIR-V modules in `spirv/`, embedded into the library so the
+//! renderer runs from any working directory. `spirv/` is produced from
+//! `glsl/` by `cargo run -p alpenglow-tools --bin compile-shaders`; a test in
+//! the tools crate fails when it is stale.
+
+use crate::vulkan::SpirV;
+
+macro_rules! spirv {
+    ($path:literal) => {
+        SpirV {
+            name: $path,
+            bytes: include_bytes!(concat!("../spirv/", $path, ".spv")),
+        }
+    };
+}
+
+/// terrain.grid: height field → vertex buffer (compute).
+pub const TERRAIN_GRID: SpirV = spirv!("terrain/grid.comp");
+/// terrain.draw: vertex stage.
+pub const TERRAIN_DRAW_VERT: SpirV = spirv!("terrain/draw.vert");
+/// terrain.draw: fragment stage.
+pub const TERRAIN_DRAW_FRAG: SpirV = spirv!("terrain/draw.frag");
+/// sky: full-screen triangle.
+pub const SKY_VERT: SpirV = spirv!("lighting/sky.vert");
+/// sky: analytic sky radiance.
+pub const SKY_FRAG: SpirV = spirv!("lighting/sky.frag");
+/// tonemap: HDR → sRGB8.
+pub const TONEMAP: SpirV = spirv!("post/tonemap.comp");
