@@ -25,8 +25,8 @@ vec3 sky_radiance(vec3 dir, vec3 sun) {
 // Haze over distance `dist` (metres) towards `dir`: exponential extinction and
 // in-scattered horizon light.
 vec3 apply_haze(vec3 color, float dist, vec3 dir, vec3 sun) {
-    float extinction = exp(-dist * 2.5e-5);
-    vec3 inscatter = sky_radiance(normalize(vec3(dir.xy, max(dir.z, 0.02))), sun) * 0.9;
+    float extinction = exp(-dist * 1.2e-5);
+    vec3 inscatter = sky_radiance(normalize(vec3(dir.xy, max(dir.z, 0.02))), sun) * 0.75;
     return color * extinction + inscatter * (1.0 - extinction);
 }
 

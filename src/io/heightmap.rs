@@ -16,7 +16,7 @@ use std::path::Path;
 use glam::DVec2;
 
 use crate::error::{Error, Result};
-use crate::io::one_line;
+use crate::io::{one_line, MAX_DECODE_BYTES};
 
 /// A regular grid of heights in metres.
 #[derive(Clone, Debug, PartialEq)]
@@ -142,8 +142,6 @@ impl Default for HeightmapOptions {
 
 const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
 const EXR_MAGIC: &[u8] = &[0x76, 0x2f, 0x31, 0x01];
-/// Decoder allocation cap: 4 GiB (a 32768² 16-bit map is 2 GiB).
-const MAX_DECODE_BYTES: u64 = 4 << 30;
 
 /// Loads a height map: `height = raw · scale + offset` in metres.
 ///

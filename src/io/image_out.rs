@@ -139,7 +139,9 @@ pub fn write_exr(
     let image = Image::from_layer(layer);
 
     write_atomically(path, |tmp| {
-        let file = std::fs::File::create(tmp).map_err(|e| Error::output(path, one_line(e)))?;
+        let file = std::fs::File::create(tmp).map_err(|e| {
+            Error::output(path, format!("creating the temporary file failed: {}", one_line(e)))
+        })?;
         let mut writer = BufWriter::new(file);
         image
             .write()
@@ -159,6 +161,33 @@ pub(crate) fn decode_exr_channels(
     bytes: &[u8],
 ) -> Result<(u32, u32, Vec<(String, Vec<f32>)>)> {
     use exr::prelude::{read, ReadChannels, ReadLayers};
+    let invalid = |e: exr::error::Error| {
+        Error::input(path, format!("invalid OpenEXR file: {}", one_line(e)))
+    };
+    // Check the claimed size before decoding: a corrupt header must not make
+    // the decoder attempt a huge allocation (which aborts the process).
+    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(invalid)?;
+    for header in &meta.headers {
+        let size = header.layer_size;
+        let per_pixel = header.channels.list.len() as u64 * 4;
+        let decoded = (size.width() as u64)
+            .checked_mul(size.height() as u64)
+            .and_then(|n| n.checked_mul(per_pixel));
+        if decoded.map_or(true, |n| n > crate::io::MAX_DECODE_BYTES) {
+            return Err(Error::input(
+                path,
+                format!(
+                    "image of {}×{} pixels with {} channels is too large (corrupt header?)",
+                    size.width(),
+                    size.height(),
+                    header.channels.list.len()
+                ),
+            ));
+        }
+        if header.chunk_count > bytes.len() / 8 {
+            return Err(Error::input(path, "file is truncated or corrupt (too few bytes for its blocks)"));
+        }
+    }
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -166,7 +195,7 @@ pub(crate) fn decode_exr_channels(
         .first_valid_layer()
         .all_attributes()
         .from_buffered(Cursor::new(bytes))
-        .map_err(|e| Error::input(path, format!("invalid OpenEXR file: {}", one_line(e))))?;
+        .map_err(invalid)?;
     let layer = image.layer_data;
     let (w, h) = (layer.size.width(), layer.size.height());
     let width = u32::try_from(w).map_err(|_| Error::input(path, "image too wide"))?;

@@ -7,6 +7,11 @@ pub mod atomic;
 pub mod heightmap;
 pub mod image_out;
 
+/// Most memory a decoder may claim for one input image (4 GiB; a 32768²
+/// 16-bit height map needs 2 GiB). Corrupt headers that claim more are
+/// rejected instead of aborting the process on a failed allocation.
+pub(crate) const MAX_DECODE_BYTES: u64 = 4 << 30;
+
 /// Collapses an error message from a dependency onto one line.
 pub(crate) fn one_line(message: impl std::fmt::Display) -> String {
     let text = message.to_string();

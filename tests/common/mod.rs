@@ -1,0 +1,59 @@
+//! Shared helpers of the Vulkan integration tests: every test device runs
+//! with the Khronos validation layers and synchronization validation, and
+//! every test ends by asserting that nothing was reported.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector, ValidationReport};
+
+/// A context with validation and synchronization validation on.
+pub fn validated_context() -> (Context, Arc<ValidationReport>) {
+    let ctx = Context::new(&ContextOptions {
+        validation: true,
+        device: std::env::var("ALPENGLOW_DEVICE")
+            .ok()
+            .and_then(|d| d.parse().ok())
+            .unwrap_or(DeviceSelector::Best),
+    })
+    .unwrap_or_else(|e| panic!("cannot create a validated Vulkan context: {e}"));
+    let report = ctx.validation_report().expect("validation was requested");
+    (ctx, report)
+}
+
+/// Fails the test if validation reported any error or warning. Call after
+/// every Vulkan object (and the context) was dropped, so leak reports count.
+pub fn assert_validation_clean(report: &ValidationReport) {
+    let messages = report.messages();
+    assert!(
+        report.total() == 0,
+        "validation reported {} error(s) and {} warning(s):\n{}",
+        report.errors(),
+        report.warnings(),
+        messages.join("\n")
+    );
+}
+
+/// The directory holding golden images.
+pub fn golden_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden")
+}
+
+/// Where failing image tests leave their output for inspection.
+pub fn failure_dir() -> PathBuf {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/golden-failures");
+    let _ = std::fs::create_dir_all(&dir);
+    dir
+}
+
+/// Mean FLIP error between two sRGB RGBA8 images of the same size (alpha ignored).
+pub fn mean_flip(reference_rgba: &[u8], test_rgba: &[u8], width: u32, height: u32) -> (f32, Vec<u8>) {
+    let rgb = |rgba: &[u8]| -> Vec<u8> { rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect() };
+    let reference = nv_flip::FlipImageRgb8::with_data(width, height, &rgb(reference_rgba));
+    let test = nv_flip::FlipImageRgb8::with_data(width, height, &rgb(test_rgba));
+    let error = nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    let heatmap = error.apply_color_lut(&nv_flip::magma_lut()).to_vec();
+    let mean = nv_flip::FlipPool::from_image(&error).mean();
+    (mean, heatmap)
+}
