@@ -134,8 +134,8 @@ pub fn summarize(frames: &[FrameProfile]) -> (Vec<PassSummary>, FrameSummary) {
 
 /// Serialises `value` and writes it atomically to `path`.
 fn write_json(path: &Path, value: &Value) -> Result<()> {
-    let mut text = serde_json::to_string_pretty(value)
-        .map_err(|e| Error::output(path, format!("JSON encoding failed: {e}")))?;
+    let mut text =
+        serde_json::to_string_pretty(value).map_err(|e| Error::output(path, format!("JSON encoding failed: {e}")))?;
     text.push('\n');
     write_bytes_atomically(path, text.as_bytes())
 }
@@ -214,7 +214,7 @@ fn push_track(
 /// Writes a Chrome Trace Event Format file:
 /// `{"traceEvents": [...], "displayTimeUnit": "ms"}` with complete events
 /// (`ph: "X"`, `ts`/`dur` in microseconds) in process 1 "alpenglow", thread
-/// 1 "CPU (record)" and thread 2 "GPU (<device>)", named by `M` metadata
+/// 1 "CPU (record)" and thread 2 "GPU (`device_name`)", named by `M` metadata
 /// events. Each track has one "frame N" event per frame enclosing one event
 /// per pass.
 ///
@@ -222,9 +222,8 @@ fn push_track(
 /// is placed at its frame's CPU start, or right after the previous GPU frame
 /// if that is later, so the GPU track never overlaps itself.
 pub fn write_chrome_trace(path: &Path, device_name: &str, frames: &[FrameProfile]) -> Result<()> {
-    let meta = |name: &str, tid: u32, args: Value| {
-        json!({ "name": name, "ph": "M", "pid": PID, "tid": tid, "args": args })
-    };
+    let meta =
+        |name: &str, tid: u32, args: Value| json!({ "name": name, "ph": "M", "pid": PID, "tid": tid, "args": args });
     let mut events = vec![
         meta("process_name", 0, json!({ "name": "alpenglow" })),
         meta("thread_name", CPU_TID, json!({ "name": "CPU (record)" })),
@@ -245,33 +244,16 @@ pub fn write_chrome_trace(path: &Path, device_name: &str, frames: &[FrameProfile
             .iter()
             .map(|p| (p, ns(p.cpu_start_ms), ns(p.cpu_ms)))
             .collect();
-        cpu_end = push_track(
-            &mut events,
-            CPU_TID,
-            frame,
-            cpu_start,
-            ns(frame.cpu_ms),
-            cpu_spans,
-        );
+        cpu_end = push_track(&mut events, CPU_TID, frame, cpu_start, ns(frame.cpu_ms), cpu_spans);
         let gpu_start = cpu_start.max(gpu_end);
         let gpu_spans = frame
             .passes
             .iter()
             .map(|p| (p, ns(p.gpu_start_ms), ns(p.gpu_ms)))
             .collect();
-        gpu_end = push_track(
-            &mut events,
-            GPU_TID,
-            frame,
-            gpu_start,
-            ns(frame.gpu_ms),
-            gpu_spans,
-        );
+        gpu_end = push_track(&mut events, GPU_TID, frame, gpu_start, ns(frame.gpu_ms), gpu_spans);
     }
-    write_json(
-        path,
-        &json!({ "traceEvents": events, "displayTimeUnit": "ms" }),
-    )
+    write_json(path, &json!({ "traceEvents": events, "displayTimeUnit": "ms" }))
 }
 
 #[cfg(test)]

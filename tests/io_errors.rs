@@ -8,9 +8,7 @@ use alpenglow::io::image_out::{read_exr_channels, write_exr, write_png_rgba8};
 use glam::DVec2;
 
 fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
 }
 
 /// A fresh, empty scratch directory for one test.
@@ -192,11 +190,17 @@ fn writes_into_a_missing_directory_fail_and_create_nothing() {
     assert!(listing(&dir).is_empty());
 }
 
-/// Regenerates the small fixtures in tests/data (run with `--ignored` after
-/// changing them; the committed files are what the other tests read).
+/// Regenerates the small fixtures in tests/data (the committed files are
+/// what the other tests read). Runs only when asked twice, so that a plain
+/// `--ignored` run never rewrites source files:
+/// `ALPENGLOW_REGENERATE_FIXTURES=1 cargo test --test io_errors -- --ignored regenerate_fixtures`.
 #[test]
 #[ignore = "rewrites tests/data fixtures"]
 fn regenerate_fixtures() {
+    if std::env::var_os("ALPENGLOW_REGENERATE_FIXTURES").is_none() {
+        eprintln!("set ALPENGLOW_REGENERATE_FIXTURES=1 to rewrite tests/data fixtures");
+        return;
+    }
     let dem = std::fs::read(data("jacksboro-fault.png")).unwrap();
     std::fs::write(data("truncated.png"), &dem[..1000]).unwrap();
     std::fs::write(data("empty.png"), b"").unwrap();
@@ -218,14 +222,6 @@ fn regenerate_fixtures() {
     let mut list = SmallVec::new();
     list.push(AnyChannel::new("Y", FlatSamples::F32(y)));
     let channels = AnyChannels::sort(list);
-    let layer = Layer::new(
-        (4, 3),
-        LayerAttributes::default(),
-        Encoding::UNCOMPRESSED,
-        channels,
-    );
-    Image::from_layer(layer)
-        .write()
-        .to_file(data("nan.exr"))
-        .unwrap();
+    let layer = Layer::new((4, 3), LayerAttributes::default(), Encoding::UNCOMPRESSED, channels);
+    Image::from_layer(layer).write().to_file(data("nan.exr")).unwrap();
 }

@@ -10,8 +10,7 @@ use alpenglow::graph::{Access, BufferInfo, ImageInfo, RenderGraph, Stage};
 use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
 use alpenglow::terrain::procedural::ProceduralTerrain;
 use alpenglow::vulkan::{
-    Buffer, BufferDesc, BufferUsageFlags, Context, ContextOptions, DeviceSelector, Format, FrameRing,
-    MemoryLocation,
+    Buffer, BufferDesc, BufferUsageFlags, Context, ContextOptions, DeviceSelector, Format, FrameRing, MemoryLocation,
 };
 use common::{assert_validation_clean, validated_context};
 use glam::{DVec2, DVec3};
@@ -52,7 +51,10 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
         // Bottom centre sees terrain drawn from the compute-written vertex buffer;
         // the top row sees sky.
         let bottom = ((63 * 96) + 48) as usize;
-        assert!(images.depth[bottom].is_finite() && images.depth[bottom] > 0.0, "terrain at the bottom");
+        assert!(
+            images.depth[bottom].is_finite() && images.depth[bottom] > 0.0,
+            "terrain at the bottom"
+        );
         assert!(images.depth[48].is_infinite(), "sky at the top");
         let profiles = renderer.finish().expect("timings");
         assert_eq!(profiles.len(), 4, "every frame's timestamps come back");
@@ -169,10 +171,18 @@ fn heap_handles_are_reused_only_after_the_gpu_is_done() {
         let handle = first.storage_handle().expect("storage buffers get a heap handle");
         drop(first);
         let second = storage("second");
-        assert_ne!(second.storage_handle(), Some(handle), "released handle reused before the GPU finished");
+        assert_ne!(
+            second.storage_handle(),
+            Some(handle),
+            "released handle reused before the GPU finished"
+        );
         ctx.wait_idle().unwrap();
         let third = storage("third");
-        assert_eq!(third.storage_handle(), Some(handle), "released handle recycled once the GPU is done");
+        assert_eq!(
+            third.storage_handle(),
+            Some(handle),
+            "released handle recycled once the GPU is done"
+        );
     }
     drop(ctx);
     assert_validation_clean(&report);
@@ -180,7 +190,10 @@ fn heap_handles_are_reused_only_after_the_gpu_is_done() {
 
 #[test]
 fn missing_devices_and_bad_cameras_are_clear_errors() {
-    for selector in [DeviceSelector::Name("no-such-gpu-xyz".into()), DeviceSelector::Index(99)] {
+    for selector in [
+        DeviceSelector::Name("no-such-gpu-xyz".into()),
+        DeviceSelector::Index(99),
+    ] {
         let err = Context::new(&ContextOptions {
             validation: true,
             device: selector,
@@ -208,7 +221,11 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
             target: DVec3::ONE,
             ..scene.default_camera()
         };
-        assert!(renderer.render(&bad).unwrap_err().to_string().contains("eye equals target"));
+        assert!(renderer
+            .render(&bad)
+            .unwrap_err()
+            .to_string()
+            .contains("eye equals target"));
         assert!(Renderer::new(
             &ctx,
             &scene,

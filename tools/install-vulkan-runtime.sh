@@ -28,8 +28,15 @@ lavapipe_recent() {
   [ "$major" -ge 23 ] 2>/dev/null
 }
 
+# A Rust toolchain (rustup's stable), when cargo is missing.
+if ! command -v cargo >/dev/null 2>&1 && [ ! -x "$HOME/.cargo/bin/cargo" ]; then
+  echo "install-vulkan-runtime: installing Rust (rustup, stable)" >&2
+  command -v curl >/dev/null 2>&1 || { $SUDO apt-get update -qq && $SUDO apt-get install -y -qq curl ca-certificates build-essential >/dev/null; }
+  curl -sSf https://sh.rustup.rs | sh -s -- -y --profile minimal --component rustfmt,clippy >/dev/null
+fi
+
 need=()
-for p in libvulkan1 vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools pkg-config; do
+for p in libvulkan1 vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools pkg-config gcc g++; do
   have_pkg "$p" || need+=("$p")
 done
 if ! lavapipe_recent; then need+=("mesa-vulkan-drivers(backports)"); fi
@@ -52,6 +59,6 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends \
-  libvulkan1 vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools pkg-config >/dev/null
+  libvulkan1 vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools pkg-config gcc g++ >/dev/null
 $SUDO apt-get install -y -qq --no-install-recommends -t bookworm-backports mesa-vulkan-drivers >/dev/null
 lavapipe_recent || { echo "install-vulkan-runtime: mesa-vulkan-drivers from bookworm-backports did not install" >&2; exit 1; }

@@ -28,7 +28,11 @@ pub fn run() -> Result<ExitCode> {
             }
             // clap's message is multi-line; keep its first line.
             let text = e.to_string();
-            let first = text.lines().next().unwrap_or("invalid arguments").trim_start_matches("error: ");
+            let first = text
+                .lines()
+                .next()
+                .unwrap_or("invalid arguments")
+                .trim_start_matches("error: ");
             bail!("{first} (see alpenglow --help)");
         }
     };
@@ -73,11 +77,54 @@ fn check_validation(report: Option<std::sync::Arc<ValidationReport>>) -> Result<
     Ok(())
 }
 
+/// The output files of one command: either all of them are written, or, when
+/// one write fails, those already written are removed again.
+#[derive(Default)]
+struct OutputSet {
+    written: Vec<PathBuf>,
+}
+
+impl OutputSet {
+    fn write(
+        &mut self,
+        path: &Option<PathBuf>,
+        write: impl FnOnce(&Path) -> alpenglow::Result<()>,
+    ) -> alpenglow::Result<()> {
+        let Some(path) = path else { return Ok(()) };
+        write(path)?;
+        self.written.push(path.clone());
+        Ok(())
+    }
+
+    /// Keeps the files written so far.
+    fn commit(mut self) {
+        self.written.clear();
+    }
+}
+
+impl Drop for OutputSet {
+    fn drop(&mut self) {
+        for path in &self.written {
+            let _ = std::fs::remove_file(path);
+        }
+    }
+}
+
 fn check_output_path(path: &Option<PathBuf>, what: &str) -> Result<()> {
     if let Some(path) = path {
-        let parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        if path.is_dir() {
+            bail!("cannot write {what} {}: it is a directory", path.display());
+        }
+        let parent = path
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
         if !parent.is_dir() {
-            bail!("cannot write {what} {}: directory {} does not exist", path.display(), parent.display());
+            bail!(
+                "cannot write {what} {}: directory {} does not exist",
+                path.display(),
+                parent.display()
+            );
         }
     }
     Ok(())
@@ -127,7 +174,12 @@ fn print_profile(device: &str, frame: &FrameProfile) {
         .iter()
         .map(|p| format!("{} {:.2}", p.name, p.gpu_ms))
         .collect();
-    println!("{device}: frame {:.2} ms GPU, {:.2} ms CPU ({})", frame.gpu_ms, frame.cpu_ms, passes.join(", "));
+    println!(
+        "{device}: frame {:.2} ms GPU, {:.2} ms CPU ({})",
+        frame.gpu_ms,
+        frame.cpu_ms,
+        passes.join(", ")
+    );
 }
 
 fn render(args: RenderArgs) -> Result<ExitCode> {
@@ -154,18 +206,16 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
     };
     drop(ctx);
     check_validation(report)?;
-    if let Some(path) = &args.out {
-        write_png_rgba8(path, &images.rgba8, images.width, images.height)?;
-    }
-    if let Some(path) = &args.exr {
-        write_exr(path, images.width, images.height, &images.hdr, &images.depth, &[])?;
-    }
-    if let Some(path) = &args.profile {
-        write_profile_json(path, &device, &profiles)?;
-    }
-    if let Some(path) = &args.trace {
-        write_chrome_trace(path, &device, &profiles)?;
-    }
+    let mut outputs = OutputSet::default();
+    outputs.write(&args.out, |p| {
+        write_png_rgba8(p, &images.rgba8, images.width, images.height)
+    })?;
+    outputs.write(&args.exr, |p| {
+        write_exr(p, images.width, images.height, &images.hdr, &images.depth, &[])
+    })?;
+    outputs.write(&args.profile, |p| write_profile_json(p, &device, &profiles))?;
+    outputs.write(&args.trace, |p| write_chrome_trace(p, &device, &profiles))?;
+    outputs.commit();
     if let Some(frame) = profiles.last() {
         print_profile(&device, frame);
     }
@@ -204,8 +254,14 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     let (passes, frame) = summarize(&timed);
     println!(
         "{} ({}, {}), {}x{}, {} frames: median frame {:.3} ms GPU, {:.3} ms CPU",
-        device.name, device.device_type, device.driver_info, args.scene.width, args.scene.height,
-        frame.frames, frame.median_gpu_ms, frame.median_cpu_ms
+        device.name,
+        device.device_type,
+        device.driver_info,
+        args.scene.width,
+        args.scene.height,
+        frame.frames,
+        frame.median_gpu_ms,
+        frame.median_cpu_ms
     );
     for p in &passes {
         println!(
@@ -213,7 +269,8 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
             p.name, p.median_gpu_ms, p.min_gpu_ms, p.max_gpu_ms, p.median_cpu_ms
         );
     }
-    if let Some(path) = &args.json {
+    let mut outputs = OutputSet::default();
+    if args.json.is_some() {
         let value = serde_json::json!({
             "device": device,
             "width": args.scene.width,
@@ -223,11 +280,13 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
             "median_frame_cpu_ms": frame.median_cpu_ms,
             "passes": passes,
         });
-        alpenglow::io::atomic::write_bytes_atomically(path, serde_json::to_string_pretty(&value)?.as_bytes())?;
+        let text = serde_json::to_string_pretty(&value)?;
+        outputs.write(&args.json, |p| {
+            alpenglow::io::atomic::write_bytes_atomically(p, text.as_bytes())
+        })?;
     }
-    if let Some(path) = &args.trace {
-        write_chrome_trace(path, &device.name, &timed)?;
-    }
+    outputs.write(&args.trace, |p| write_chrome_trace(p, &device.name, &timed))?;
+    outputs.commit();
     Ok(ExitCode::SUCCESS)
 }
 
@@ -243,7 +302,14 @@ fn info(args: DeviceArgs) -> Result<ExitCode> {
     println!("vendor/id:   {:#06x}/{:#06x}", i.vendor_id, i.device_id);
     println!("timestamps:  {} ns per tick", i.timestamp_period_ns);
     println!("max image:   {} px per side", i.max_image_dimension_2d);
-    println!("validation:  {}", if i.validation { "on (with synchronization validation)" } else { "off" });
+    println!(
+        "validation:  {}",
+        if i.validation {
+            "on (with synchronization validation)"
+        } else {
+            "off"
+        }
+    );
     println!("features:    {}", i.features.join(", "));
     Ok(ExitCode::SUCCESS)
 }

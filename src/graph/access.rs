@@ -2,8 +2,10 @@
 //! synchronization2 barrier between what happened to a resource before and
 //! what a pass does next. No device needed: unit-tested below.
 
-use crate::vulkan::{AccessFlags2 as A, AccessState, Barrier, BufferUsageFlags, ImageLayout as L, ImageUsageFlags,
-    PipelineStageFlags2 as S};
+use crate::vulkan::{
+    AccessFlags2 as A, AccessState, Barrier, BufferUsageFlags, ImageLayout as L, ImageUsageFlags,
+    PipelineStageFlags2 as S,
+};
 
 /// Shader stages an access happens in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -74,7 +76,11 @@ impl Access {
             StorageImageRead(s) => (s.flags(), A::SHADER_STORAGE_READ, L::GENERAL),
             StorageImageWrite(s) => (s.flags(), A::SHADER_STORAGE_WRITE, L::GENERAL),
             StorageImageReadWrite(s) => (s.flags(), A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE, L::GENERAL),
-            ColorAttachmentWrite => (S::COLOR_ATTACHMENT_OUTPUT, A::COLOR_ATTACHMENT_WRITE, L::COLOR_ATTACHMENT_OPTIMAL),
+            ColorAttachmentWrite => (
+                S::COLOR_ATTACHMENT_OUTPUT,
+                A::COLOR_ATTACHMENT_WRITE,
+                L::COLOR_ATTACHMENT_OPTIMAL,
+            ),
             ColorAttachmentReadWrite => (
                 S::COLOR_ATTACHMENT_OUTPUT,
                 A::COLOR_ATTACHMENT_READ | A::COLOR_ATTACHMENT_WRITE,
@@ -92,7 +98,11 @@ impl Access {
             ),
             StorageBufferRead(s) => (s.flags(), A::SHADER_STORAGE_READ, L::UNDEFINED),
             StorageBufferWrite(s) => (s.flags(), A::SHADER_STORAGE_WRITE, L::UNDEFINED),
-            StorageBufferReadWrite(s) => (s.flags(), A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE, L::UNDEFINED),
+            StorageBufferReadWrite(s) => (
+                s.flags(),
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+                L::UNDEFINED,
+            ),
             VertexBuffer => (S::VERTEX_ATTRIBUTE_INPUT, A::VERTEX_ATTRIBUTE_READ, L::UNDEFINED),
             IndexBuffer => (S::INDEX_INPUT, A::INDEX_READ, L::UNDEFINED),
             IndirectBuffer => (S::DRAW_INDIRECT, A::INDIRECT_COMMAND_READ, L::UNDEFINED),
@@ -121,7 +131,10 @@ impl Access {
     /// Whether the access reads.
     pub fn reads(self) -> bool {
         use Access::*;
-        !matches!(self, StorageImageWrite(_) | ColorAttachmentWrite | StorageBufferWrite(_) | TransferDst)
+        !matches!(
+            self,
+            StorageImageWrite(_) | ColorAttachmentWrite | StorageBufferWrite(_) | TransferDst
+        )
     }
 
     /// Whether this access applies to images (else buffers).
@@ -176,7 +189,9 @@ impl Access {
     pub fn buffer_usage(self) -> BufferUsageFlags {
         use Access::*;
         match self {
-            StorageBufferRead(_) | StorageBufferWrite(_) | StorageBufferReadWrite(_) => BufferUsageFlags::STORAGE_BUFFER,
+            StorageBufferRead(_) | StorageBufferWrite(_) | StorageBufferReadWrite(_) => {
+                BufferUsageFlags::STORAGE_BUFFER
+            }
             VertexBuffer => BufferUsageFlags::VERTEX_BUFFER,
             IndexBuffer => BufferUsageFlags::INDEX_BUFFER,
             IndirectBuffer => BufferUsageFlags::INDIRECT_BUFFER,
@@ -202,7 +217,11 @@ pub fn derive_barrier(state: &mut AccessState, access: Access, discard: bool) ->
     let (stages, accesses, layout) = access.state();
     let layout = if access.is_image() { layout } else { L::UNDEFINED };
     let layout_change = layout != state.layout && layout != L::UNDEFINED;
-    let old_layout = if discard && !access.reads() { L::UNDEFINED } else { state.layout };
+    let old_layout = if discard && !access.reads() {
+        L::UNDEFINED
+    } else {
+        state.layout
+    };
     let read_access = accesses & !write_bits();
     let barrier;
     if access.writes() || layout_change {
@@ -278,7 +297,10 @@ mod tests {
     #[test]
     fn first_write_to_a_fresh_buffer_needs_no_barrier() {
         let mut s = fresh();
-        assert_eq!(derive_barrier(&mut s, Access::StorageBufferWrite(Stage::Compute), true), None);
+        assert_eq!(
+            derive_barrier(&mut s, Access::StorageBufferWrite(Stage::Compute), true),
+            None
+        );
         assert_eq!(s.write_stages, S::COMPUTE_SHADER);
         assert_eq!(s.write_access, A::SHADER_STORAGE_WRITE);
     }
@@ -331,7 +353,10 @@ mod tests {
         let b = derive_barrier(&mut s, Access::TransferSrc, false).expect("layout change");
         assert_eq!(b.old_layout, L::GENERAL);
         assert_eq!(b.new_layout, L::TRANSFER_SRC_OPTIMAL);
-        assert!(b.src_stages.contains(S::COMPUTE_SHADER), "waits for the compute read (WAR on layout)");
+        assert!(
+            b.src_stages.contains(S::COMPUTE_SHADER),
+            "waits for the compute read (WAR on layout)"
+        );
     }
 
     #[test]
@@ -341,7 +366,10 @@ mod tests {
         let first = derive_barrier(&mut s, Access::SampledImage(Stage::Fragment), false).expect("transition");
         assert_eq!(first.new_layout, L::SHADER_READ_ONLY_OPTIMAL);
         // Same stage again: already visible.
-        assert_eq!(derive_barrier(&mut s, Access::SampledImage(Stage::Fragment), false), None);
+        assert_eq!(
+            derive_barrier(&mut s, Access::SampledImage(Stage::Fragment), false),
+            None
+        );
         // Vertex stage: must wait for the transition, which completed before FRAGMENT.
         let b = derive_barrier(&mut s, Access::SampledImage(Stage::Vertex), false).expect("new stage");
         assert!(b.src_stages.contains(S::FRAGMENT_SHADER));
@@ -378,8 +406,12 @@ mod tests {
 
     #[test]
     fn usage_flags_cover_accesses() {
-        assert!(Access::VertexBuffer.buffer_usage().contains(BufferUsageFlags::VERTEX_BUFFER));
-        assert!(Access::SampledImage(Stage::Fragment).image_usage().contains(ImageUsageFlags::SAMPLED));
+        assert!(Access::VertexBuffer
+            .buffer_usage()
+            .contains(BufferUsageFlags::VERTEX_BUFFER));
+        assert!(Access::SampledImage(Stage::Fragment)
+            .image_usage()
+            .contains(ImageUsageFlags::SAMPLED));
         assert!(Access::DepthAttachmentWrite.is_image() && !Access::DepthAttachmentWrite.is_buffer());
         assert!(Access::TransferSrc.is_image() && Access::TransferSrc.is_buffer());
     }

@@ -37,11 +37,9 @@ pub(crate) struct PendingFrame {
 /// A baked render graph: passes in execution order with their resources,
 /// ready to record frame after frame ([`BakedGraph::execute`]).
 pub struct BakedGraph<P> {
-    pub(crate) ctx: Context,
     pub(crate) passes: Vec<BakedPass<P>>,
     pub(crate) physical: Vec<Physical>,
     pub(crate) imported: Vec<bool>,
-    pub(crate) names: Vec<String>,
     /// Tracked state of each transient across frames.
     pub(crate) transient_states: Vec<AccessState>,
     pub(crate) final_accesses: Vec<(ResourceId, Access)>,
@@ -76,9 +74,8 @@ impl<P> BakedGraph<P> {
 pub(crate) fn live_passes<P>(graph: &RenderGraph<P>) -> Vec<bool> {
     let n = graph.passes.len();
     let mut live = vec![false; n];
-    let is_root_resource = |r: ResourceId| {
-        graph.resources[r.0].is_imported() || graph.outputs.iter().any(|(o, _)| *o == r)
-    };
+    let is_root_resource =
+        |r: ResourceId| graph.resources[r.0].is_imported() || graph.outputs.iter().any(|(o, _)| *o == r);
     let mut work: Vec<usize> = Vec::new();
     for (i, pass) in graph.passes.iter().enumerate() {
         if pass.uses.iter().any(|(r, a)| a.writes() && is_root_resource(*r)) {
@@ -132,7 +129,10 @@ fn validate<P>(graph: &RenderGraph<P>) -> Result<()> {
             return Err(Error::Graph(format!("output #{} is not a resource of this graph", r.0)));
         }
         if a.is_some() && graph.resources[r.0].is_image() {
-            return Err(Error::Graph(format!("'{}': only buffers can be read back", graph.resources[r.0].name())));
+            return Err(Error::Graph(format!(
+                "'{}': only buffers can be read back",
+                graph.resources[r.0].name()
+            )));
         }
     }
     Ok(())
@@ -150,10 +150,8 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
         }
     }
     let mut physical = Vec::with_capacity(graph.resources.len());
-    let mut names = Vec::with_capacity(graph.resources.len());
     let mut imported = Vec::with_capacity(graph.resources.len());
     for (i, decl) in graph.resources.into_iter().enumerate() {
-        names.push(decl.name());
         imported.push(decl.is_imported());
         let p = match decl {
             ResourceDecl::TransientImage { name, info } => {
@@ -219,9 +217,19 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
     let mut passes = Vec::new();
     let mut culled = Vec::new();
     for (decl, alive) in graph.passes.into_iter().zip(live) {
-        let PassDecl { name, kind, uses, record } = decl;
+        let PassDecl {
+            name,
+            kind,
+            uses,
+            record,
+        } = decl;
         match (alive, record) {
-            (true, Some(record)) => passes.push(BakedPass { name, kind, uses, record }),
+            (true, Some(record)) => passes.push(BakedPass {
+                name,
+                kind,
+                uses,
+                record,
+            }),
             _ => culled.push(name),
         }
     }
@@ -230,12 +238,10 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
     }
     let final_accesses = graph.outputs.iter().filter_map(|(r, a)| a.map(|a| (*r, a))).collect();
     Ok(BakedGraph {
-        ctx: ctx.clone(),
         passes,
         transient_states: vec![AccessState::UNUSED; physical.len()],
         physical,
         imported,
-        names,
         final_accesses,
         culled,
         pending: VecDeque::new(),
@@ -256,7 +262,9 @@ mod tests {
         let a = g.create_image("a", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
         let b = g.create_image("b", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
         let unused = g.create_image("unused", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
-        g.pass("write a").write(a, Access::StorageImageWrite(Stage::Compute)).record(|_, _| Ok(()));
+        g.pass("write a")
+            .write(a, Access::StorageImageWrite(Stage::Compute))
+            .record(|_, _| Ok(()));
         g.pass("write unused")
             .read(a, Access::SampledImage(Stage::Compute))
             .write(unused, Access::StorageImageWrite(Stage::Compute))
@@ -274,9 +282,15 @@ mod tests {
         let mut g: RenderGraph<()> = RenderGraph::new();
         let a = g.create_image("a", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
         let out = g.create_image("out", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
-        g.pass("overwritten").write(a, Access::StorageImageWrite(Stage::Compute)).record(|_, _| Ok(()));
-        g.pass("rewrite").write(a, Access::StorageImageWrite(Stage::Compute)).record(|_, _| Ok(()));
-        g.pass("accumulate").write(a, Access::StorageImageReadWrite(Stage::Compute)).record(|_, _| Ok(()));
+        g.pass("overwritten")
+            .write(a, Access::StorageImageWrite(Stage::Compute))
+            .record(|_, _| Ok(()));
+        g.pass("rewrite")
+            .write(a, Access::StorageImageWrite(Stage::Compute))
+            .record(|_, _| Ok(()));
+        g.pass("accumulate")
+            .write(a, Access::StorageImageReadWrite(Stage::Compute))
+            .record(|_, _| Ok(()));
         g.pass("use")
             .read(a, Access::SampledImage(Stage::Fragment))
             .write(out, Access::ColorAttachmentWrite)

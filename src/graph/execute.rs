@@ -9,8 +9,9 @@ use super::bake::{BakedGraph, PendingFrame, Physical};
 use super::{PassKind, ResourceId};
 use crate::error::{Error, Result};
 use crate::profile::{FrameProfile, PassTiming};
-use crate::vulkan::{AccessState, Barrier, Buffer, CommandRecorder, CompletedFrame, FrameRing, Image,
-    PipelineStageFlags2};
+use crate::vulkan::{
+    AccessState, Barrier, Buffer, CommandRecorder, CompletedFrame, FrameRing, Image, PipelineStageFlags2,
+};
 
 /// What a pass's recording closure gets: the command recorder and the
 /// physical resources of this frame.
@@ -30,7 +31,10 @@ impl<'a> PassContext<'a> {
     pub fn image(&self, id: ResourceId) -> Result<&'a Image> {
         match self.physical.get(id.0) {
             Some(Physical::Image(images)) if !images.is_empty() => Ok(&images[(self.frame as usize) % images.len()]),
-            _ => Err(Error::Graph(format!("resource #{} is not an image of this graph", id.0))),
+            _ => Err(Error::Graph(format!(
+                "resource #{} is not an image of this graph",
+                id.0
+            ))),
         }
     }
 
@@ -40,7 +44,10 @@ impl<'a> PassContext<'a> {
             Some(Physical::Buffer(buffers)) if !buffers.is_empty() => {
                 Ok(&buffers[(self.frame as usize) % buffers.len()])
             }
-            _ => Err(Error::Graph(format!("resource #{} is not a buffer of this graph", id.0))),
+            _ => Err(Error::Graph(format!(
+                "resource #{} is not a buffer of this graph",
+                id.0
+            ))),
         }
     }
 
@@ -219,7 +226,10 @@ impl<P> BakedGraph<P> {
             let ts = &completed.timestamps_ns;
             let mut passes = Vec::with_capacity(self.passes.len());
             for (i, pass) in self.passes.iter().enumerate() {
-                let (begin, end) = (ts.get(2 * i).copied().unwrap_or(0.0), ts.get(2 * i + 1).copied().unwrap_or(0.0));
+                let (begin, end) = (
+                    ts.get(2 * i).copied().unwrap_or(0.0),
+                    ts.get(2 * i + 1).copied().unwrap_or(0.0),
+                );
                 let (cpu_start_ms, cpu_ms) = p.cpu_passes.get(i).copied().unwrap_or((0.0, 0.0));
                 passes.push(PassTiming {
                     name: pass.name.clone(),

@@ -58,8 +58,14 @@ pub struct BufferInfo {
 }
 
 pub(crate) enum ResourceDecl {
-    TransientImage { name: String, info: ImageInfo },
-    TransientBuffer { name: String, info: BufferInfo },
+    TransientImage {
+        name: String,
+        info: ImageInfo,
+    },
+    TransientBuffer {
+        name: String,
+        info: BufferInfo,
+    },
     /// One physical image per frame slot (or one shared by all).
     ImportedImages(Vec<Arc<Image>>),
     ImportedBuffers(Vec<Arc<Buffer>>),
@@ -71,7 +77,10 @@ impl ResourceDecl {
     }
 
     pub(crate) fn is_image(&self) -> bool {
-        matches!(self, ResourceDecl::TransientImage { .. } | ResourceDecl::ImportedImages(_))
+        matches!(
+            self,
+            ResourceDecl::TransientImage { .. } | ResourceDecl::ImportedImages(_)
+        )
     }
 
     pub(crate) fn name(&self) -> String {

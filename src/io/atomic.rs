@@ -72,10 +72,7 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) ->
         ));
     }
     if !dir.is_dir() {
-        return Err(Error::output(
-            path,
-            format!("{} is not a directory", dir.display()),
-        ));
+        return Err(Error::output(path, format!("{} is not a directory", dir.display())));
     }
     if path.is_dir() {
         return Err(Error::output(path, "a directory of that name exists"));
@@ -110,7 +107,10 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) ->
 pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     write_atomically(path, |tmp| {
         std::fs::write(tmp, bytes).map_err(|e| {
-            Error::output(path, format!("writing the temporary file failed: {}", super::one_line(e)))
+            Error::output(
+                path,
+                format!("writing the temporary file failed: {}", super::one_line(e)),
+            )
         })
     })
 }
@@ -120,11 +120,7 @@ mod tests {
     use super::*;
 
     fn scratch_dir(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!(
-            "alpenglow-atomic-{}-{}",
-            std::process::id(),
-            name
-        ));
+        let dir = std::env::temp_dir().join(format!("alpenglow-atomic-{}-{}", std::process::id(), name));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         dir

@@ -176,8 +176,7 @@ pub fn load_heightmap(path: &Path, opts: &HeightmapOptions) -> Result<HeightFiel
             format!("{} for {name}: must be finite", opts.offset),
         ));
     }
-    check_spacing(opts.spacing)
-        .map_err(|m| Error::invalid("height-map spacing", format!("{m} (for {name})")))?;
+    check_spacing(opts.spacing).map_err(|m| Error::invalid("height-map spacing", format!("{m} (for {name})")))?;
 
     let bytes = crate::io::read_input(path)?;
     if bytes.is_empty() {
@@ -188,9 +187,7 @@ pub fn load_heightmap(path: &Path, opts: &HeightmapOptions) -> Result<HeightFiel
     } else if bytes.starts_with(EXR_MAGIC) {
         decode_exr(path, &bytes)?
     } else {
-        let ext = path
-            .extension()
-            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
         let msg = match ext.as_deref() {
             Some("png") => "not a PNG file (bad signature)",
             Some("exr") => "not an OpenEXR file (bad signature)",
@@ -248,14 +245,11 @@ fn decode_png(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<f32>)> {
         other => {
             return Err(Error::input(
                 path,
-                format!(
-                    "PNG is a colour image ({other:?}); height maps must be greyscale (16-bit)"
-                ),
+                format!("PNG is a colour image ({other:?}); height maps must be greyscale (16-bit)"),
             ))
         }
     };
-    let total = usize::try_from(decoder.total_bytes())
-        .map_err(|_| Error::input(path, "image too large"))?;
+    let total = usize::try_from(decoder.total_bytes()).map_err(|_| Error::input(path, "image too large"))?;
     let mut buf = vec![0u8; total];
     decoder.read_image(&mut buf).map_err(corrupt)?;
     let raw = if bytes_per_sample == 2 {
@@ -335,10 +329,22 @@ mod tests {
     fn bad_options_are_rejected_before_reading() {
         let p = Path::new("does-not-matter.png");
         for opts in [
-            HeightmapOptions { scale: 0.0, ..Default::default() },
-            HeightmapOptions { scale: f32::NAN, ..Default::default() },
-            HeightmapOptions { offset: f32::INFINITY, ..Default::default() },
-            HeightmapOptions { spacing: DVec2::new(1.0, -1.0), ..Default::default() },
+            HeightmapOptions {
+                scale: 0.0,
+                ..Default::default()
+            },
+            HeightmapOptions {
+                scale: f32::NAN,
+                ..Default::default()
+            },
+            HeightmapOptions {
+                offset: f32::INFINITY,
+                ..Default::default()
+            },
+            HeightmapOptions {
+                spacing: DVec2::new(1.0, -1.0),
+                ..Default::default()
+            },
         ] {
             let e = load_heightmap(p, &opts).unwrap_err().to_string();
             assert!(e.contains("does-not-matter.png"), "{e}");

@@ -11,14 +11,14 @@ use crate::error::{Error, Result};
 use crate::io::atomic::{write_atomically, write_bytes_atomically};
 use crate::io::one_line;
 
+/// Named channels of an EXR image: `(name, samples)` per channel.
+pub type ExrChannels = Vec<(String, Vec<f32>)>;
+
 /// Number of pixels of a `width`×`height` image, rejecting empty images and
 /// sizes that overflow `usize`.
 fn pixel_count(what: &str, width: u32, height: u32) -> Result<usize> {
     if width == 0 || height == 0 {
-        return Err(Error::invalid(
-            what,
-            format!("image size {width}×{height} is empty"),
-        ));
+        return Err(Error::invalid(what, format!("image size {width}×{height} is empty")));
     }
     (width as usize)
         .checked_mul(height as usize)
@@ -79,8 +79,8 @@ pub fn write_exr(
     extra: &[(&str, &[f32])],
 ) -> Result<()> {
     use exr::prelude::{
-        AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image, Layer,
-        LayerAttributes, LineOrder, SmallVec, WritableImage,
+        AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image, Layer, LayerAttributes, LineOrder,
+        SmallVec, WritableImage,
     };
 
     let pixels = pixel_count("EXR image size", width, height)?;
@@ -108,10 +108,7 @@ pub fn write_exr(
             ));
         }
         if !names.insert(name) {
-            return Err(Error::invalid(
-                "EXR channel name",
-                format!("{name:?} is used twice"),
-            ));
+            return Err(Error::invalid("EXR channel name", format!("{name:?} is used twice")));
         }
         check_len(&format!("channel {name}"), data.len(), 1)?;
     }
@@ -139,31 +136,23 @@ pub fn write_exr(
     let image = Image::from_layer(layer);
 
     write_atomically(path, |tmp| {
-        let file = std::fs::File::create(tmp).map_err(|e| {
-            Error::output(path, format!("creating the temporary file failed: {}", one_line(e)))
-        })?;
+        let file = std::fs::File::create(tmp)
+            .map_err(|e| Error::output(path, format!("creating the temporary file failed: {}", one_line(e))))?;
         let mut writer = BufWriter::new(file);
         image
             .write()
             .to_buffered(&mut writer)
             .map_err(|e| Error::output(path, format!("EXR encoding failed: {}", one_line(e))))?;
-        writer
-            .flush()
-            .map_err(|e| Error::output(path, one_line(e)))
+        writer.flush().map_err(|e| Error::output(path, one_line(e)))
     })
 }
 
 /// Channels of an EXR image as `(width, height, [(name, samples)])`, samples
 /// row-major from the top, converted to `f32`, channels in file
 /// (alphabetical) order. Reads the first valid layer at full resolution.
-pub(crate) fn decode_exr_channels(
-    path: &Path,
-    bytes: &[u8],
-) -> Result<(u32, u32, Vec<(String, Vec<f32>)>)> {
+pub(crate) fn decode_exr_channels(path: &Path, bytes: &[u8]) -> Result<(u32, u32, ExrChannels)> {
     use exr::prelude::{read, ReadChannels, ReadLayers};
-    let invalid = |e: exr::error::Error| {
-        Error::input(path, format!("invalid OpenEXR file: {}", one_line(e)))
-    };
+    let invalid = |e: exr::error::Error| Error::input(path, format!("invalid OpenEXR file: {}", one_line(e)));
     // Check the claimed size before decoding: a corrupt header must not make
     // the decoder attempt a huge allocation (which aborts the process).
     let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(invalid)?;
@@ -185,7 +174,10 @@ pub(crate) fn decode_exr_channels(
             ));
         }
         if header.chunk_count > bytes.len() / 8 {
-            return Err(Error::input(path, "file is truncated or corrupt (too few bytes for its blocks)"));
+            return Err(Error::input(
+                path,
+                "file is truncated or corrupt (too few bytes for its blocks)",
+            ));
         }
     }
     let image = read()
@@ -204,12 +196,7 @@ pub(crate) fn decode_exr_channels(
         .channel_data
         .list
         .iter()
-        .map(|c| {
-            (
-                c.name.to_string(),
-                c.sample_data.values_as_f32().collect::<Vec<f32>>(),
-            )
-        })
+        .map(|c| (c.name.to_string(), c.sample_data.values_as_f32().collect::<Vec<f32>>()))
         .collect::<Vec<_>>();
     if let Some((name, _)) = channels.iter().find(|(_, s)| s.len() != w * h) {
         return Err(Error::input(
@@ -224,7 +211,7 @@ pub(crate) fn decode_exr_channels(
 /// `(width, height, [(name, samples)])`; samples are row-major with row 0 at
 /// the top, converted to `f32`; channels in alphabetical order. Meant for
 /// tests and tools that check what [`write_exr`] produced.
-pub fn read_exr_channels(path: &Path) -> Result<(u32, u32, Vec<(String, Vec<f32>)>)> {
+pub fn read_exr_channels(path: &Path) -> Result<(u32, u32, ExrChannels)> {
     let bytes = crate::io::read_input(path)?;
     decode_exr_channels(path, &bytes)
 }

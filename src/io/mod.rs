@@ -15,11 +15,7 @@ pub(crate) const MAX_DECODE_BYTES: u64 = 4 << 30;
 /// Collapses an error message from a dependency onto one line.
 pub(crate) fn one_line(message: impl std::fmt::Display) -> String {
     let text = message.to_string();
-    let parts: Vec<&str> = text
-        .lines()
-        .map(str::trim)
-        .filter(|l| !l.is_empty())
-        .collect();
+    let parts: Vec<&str> = text.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
     parts.join("; ")
 }
 

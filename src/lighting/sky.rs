@@ -8,7 +8,9 @@ use crate::error::Result;
 use crate::graph::{Access, RenderGraph, ResourceId};
 use crate::renderer::FrameParams;
 use crate::shaders;
-use crate::vulkan::{Blend, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, PrimitiveTopology};
+use crate::vulkan::{
+    Blend, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, PrimitiveTopology,
+};
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]

@@ -27,18 +27,27 @@ impl Camera {
         }
         let dir = self.target - self.eye;
         if dir.length() <= 1e-9 * self.eye.length().max(1.0) {
-            return Err(Error::invalid("camera", "eye equals target; there is no view direction"));
+            return Err(Error::invalid(
+                "camera",
+                "eye equals target; there is no view direction",
+            ));
         }
         if self.up.length() == 0.0 || dir.normalize().cross(self.up.normalize()).length() < 1e-6 {
             return Err(Error::invalid("camera", "up is zero or parallel to the view direction"));
         }
         if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
-            return Err(Error::invalid("--fov-y", format!("{} degrees; must be in (0, 180)", self.fov_y_deg)));
+            return Err(Error::invalid(
+                "--fov-y",
+                format!("{} degrees; must be in (0, 180)", self.fov_y_deg),
+            ));
         }
         if !(self.near > 0.0 && self.near.is_finite() && self.far > self.near && self.far.is_finite()) {
             return Err(Error::invalid(
                 "--near/--far",
-                format!("near {} and far {}; need 0 < near < far, both finite", self.near, self.far),
+                format!(
+                    "near {} and far {}; need 0 < near < far, both finite",
+                    self.near, self.far
+                ),
             ));
         }
         Ok(())
@@ -124,6 +133,9 @@ mod tests {
         // Vulkan NDC y grows downwards: a point above the horizon has smaller y.
         assert!(above.y / above.w < 0.0 && below.y / below.w > 0.0);
         let right = vp * glam::Vec4::new(100.0, -20.0, 10.0, 1.0);
-        assert!(right.x / right.w > 0.0, "-Y is to the right when looking along +X with +Z up");
+        assert!(
+            right.x / right.w > 0.0,
+            "-Y is to the right when looking along +X with +Z up"
+        );
     }
 }

@@ -22,7 +22,9 @@ use crate::graph::{Access, BakedGraph, FrameOutcome, ImageInfo, RenderGraph};
 use crate::lighting::sky::add_sky_pass;
 use crate::profile::FrameProfile;
 use crate::terrain::grid::TerrainGrid;
-use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Context, Format, FrameRing, MemoryLocation, FRAMES_IN_FLIGHT};
+use crate::vulkan::{
+    Buffer, BufferDesc, BufferUsageFlags, Context, Format, FrameRing, MemoryLocation, FRAMES_IN_FLIGHT,
+};
 
 /// Largest accepted image side (the device limit may be lower).
 pub const MAX_IMAGE_SIDE: u32 = 16384;
@@ -116,7 +118,10 @@ impl Renderer {
         let (w, h) = (settings.width, settings.height);
         let max = ctx.max_image_dimension();
         if w > max || h > max {
-            return Err(Error::invalid("image size", format!("{w}×{h} exceeds the device limit of {max} per side")));
+            return Err(Error::invalid(
+                "image size",
+                format!("{w}×{h} exceeds the device limit of {max} per side"),
+            ));
         }
         let terrain = TerrainGrid::new(ctx, &scene.heights)?;
         let mut graph = RenderGraph::new();

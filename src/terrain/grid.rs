@@ -201,7 +201,10 @@ impl TerrainGrid {
                 let (color, view_depth, depth) = (pass.image(color)?, pass.image(view_depth)?, pass.image(depth)?);
                 let (vertices, indices) = (pass.buffer(vertices)?, pass.buffer(indices)?);
                 let cmd = pass.cmd();
-                cmd.begin_rendering(&[(color, LoadOp::Load), (view_depth, LoadOp::Load)], Some((depth, Some(1.0))));
+                cmd.begin_rendering(
+                    &[(color, LoadOp::Load), (view_depth, LoadOp::Load)],
+                    Some((depth, Some(1.0))),
+                );
                 cmd.bind_graphics(&draw_pipeline);
                 cmd.push_constants(&push)?;
                 cmd.bind_vertex_buffer(vertices);

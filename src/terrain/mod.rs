@@ -1,4 +1,4 @@
 //! Terrain: procedural height fields (§6.1) and the terrain passes.
 
-pub mod procedural;
 pub mod grid;
+pub mod procedural;

@@ -5,8 +5,8 @@
 //! heterogeneous terrain (6.3) — and Musgrave's hybrid and ridged
 //! multifractals (Ebert et al., *Texturing & Modeling*, ch. 16).
 //!
-//! Everything is pure `f64` arithmetic on integer hashes (no tables, no
-//! randomness from the environment), so a given parameter set produces the
+//! Everything is pure `f64` arithmetic on integer hashes (no permutation
+//! tables, no randomness from the environment), so a given parameter set produces the
 //! same terrain on every run and for any thread count. The per-octave
 //! weights `L^(−iH)` use `f64::powf`, the only libm call; across platforms
 //! with different libm implementations results may differ in the last bit.
@@ -41,24 +41,12 @@ const GRADIENTS: [(f64, f64); 16] = {
     const B: f64 = 0.195_090_322_016_128_25; // sin 11.25°
     const C: f64 = 0.831_469_612_302_545_2; // cos 33.75°
     const D: f64 = 0.555_570_233_019_602_2; // sin 33.75°
-    [
-        (A, B),
-        (C, D),
-        (D, C),
-        (B, A),
-        (-B, A),
-        (-D, C),
-        (-C, D),
-        (-A, B),
-        (-A, -B),
-        (-C, -D),
-        (-D, -C),
-        (-B, -A),
-        (B, -A),
-        (D, -C),
-        (C, -D),
-        (A, -B),
-    ]
+    #[rustfmt::skip]
+    let directions = [
+        (A, B), (C, D), (D, C), (B, A), (-B, A), (-D, C), (-C, D), (-A, B),
+        (-A, -B), (-C, -D), (-D, -C), (-B, -A), (B, -A), (D, -C), (C, -D), (A, -B),
+    ];
+    directions
 };
 
 /// Quintic fade `6t⁵ − 15t⁴ + 10t³` (Perlin 2002): C² across cells.
@@ -72,7 +60,7 @@ fn fade(t: f64) -> f64 {
 /// 64-bit hash of `(seed, i, j)`, so the noise does not repeat. It is zero
 /// at lattice points and C² smooth. Range: unit-gradient Perlin noise in
 /// n dimensions is bounded by `√n / 2`, so the result, scaled by `√2`, lies
-/// in **[−1, 1]**; typical values are within ±0.7.
+/// in **[−1, 1]**; values beyond ±0.7 are rare.
 pub fn gradient_noise(seed: u64, x: f64, y: f64) -> f64 {
     let (xf, yf) = (x.floor(), y.floor());
     // `as` saturates for huge or non-finite inputs; it never panics.
@@ -434,7 +422,11 @@ mod tests {
             let amp = t.amplitude as f32;
             assert!(lo >= -amp * 1.0001 && hi <= amp * 1.0001, "{model:?}: {lo}..{hi}");
             // The multiplicative multifractal stays far below its bound.
-            let relief = if model == TerrainModel::Multifractal { 0.01 } else { 0.05 };
+            let relief = if model == TerrainModel::Multifractal {
+                0.01
+            } else {
+                0.05
+            };
             assert!(hi - lo > relief * amp, "{model:?} is flat: {lo}..{hi}");
             if model != TerrainModel::Fbm {
                 assert!(lo >= 0.0, "{model:?} negative: {lo}");
@@ -459,7 +451,11 @@ mod tests {
             .iter()
             .enumerate()
             .map(|(i, o)| {
-                let n = gradient_noise(t.seed, x * 2f64.powi(i as i32) + o.shift.x, y * 2f64.powi(i as i32) + o.shift.y);
+                let n = gradient_noise(
+                    t.seed,
+                    x * 2f64.powi(i as i32) + o.shift.x,
+                    y * 2f64.powi(i as i32) + o.shift.y,
+                );
                 n * 2f64.powf(-(i as f64) * 0.5)
             })
             .sum();
@@ -473,11 +469,21 @@ mod tests {
         assert!(d.validate().is_ok());
         assert!(ProceduralTerrain { octaves: 0, ..d }.validate().is_err());
         assert!(ProceduralTerrain { lacunarity: 1.0, ..d }.validate().is_err());
-        assert!(ProceduralTerrain { base_wavelength: 0.0, ..d }.validate().is_err());
+        assert!(ProceduralTerrain {
+            base_wavelength: 0.0,
+            ..d
+        }
+        .validate()
+        .is_err());
         assert!(ProceduralTerrain { gain: f64::NAN, ..d }.validate().is_err());
         assert!(d.try_generate(1, 5, DVec2::ONE).is_err());
         assert!(d.try_generate(4, 4, DVec2::new(1.0, 0.0)).is_err());
-        let f = ProceduralTerrain { h: -3.0, lacunarity: 16.0, octaves: 32, ..d };
+        let f = ProceduralTerrain {
+            h: -3.0,
+            lacunarity: 16.0,
+            octaves: 32,
+            ..d
+        };
         let g = f.generate(8, 8, DVec2::splat(1e6));
         assert!(g.heights.iter().all(|h| h.is_finite()));
     }

@@ -9,7 +9,6 @@ use super::memory::{subresource_range, Barrier, Buffer, Image};
 use super::pipeline::{ComputePipeline, GraphicsPipeline};
 use crate::error::{Error, Result};
 
-
 /// How a colour attachment starts.
 #[derive(Clone, Copy, Debug)]
 pub enum LoadOp {
@@ -121,7 +120,10 @@ impl CommandRecorder {
     /// Binds a compute pipeline and the descriptor heap.
     pub fn bind_compute(&mut self, pipeline: &ComputePipeline) {
         // SAFETY: the pipeline is alive for the frame (callers keep it).
-        unsafe { self.device().cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::COMPUTE, pipeline.raw) };
+        unsafe {
+            self.device()
+                .cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::COMPUTE, pipeline.raw)
+        };
         if self.bound_layout_is_graphics != Some(false) {
             self.bind_heap(vk::PipelineBindPoint::COMPUTE);
             self.bound_layout_is_graphics = Some(false);
@@ -131,7 +133,10 @@ impl CommandRecorder {
     /// Binds a graphics pipeline and the descriptor heap.
     pub fn bind_graphics(&mut self, pipeline: &GraphicsPipeline) {
         // SAFETY: as in `bind_compute`.
-        unsafe { self.device().cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.raw) };
+        unsafe {
+            self.device()
+                .cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.raw)
+        };
         if self.bound_layout_is_graphics != Some(true) {
             self.bind_heap(vk::PipelineBindPoint::GRAPHICS);
             self.bound_layout_is_graphics = Some(true);
@@ -142,11 +147,17 @@ impl CommandRecorder {
     pub fn push_constants<T: bytemuck::Pod>(&mut self, data: &T) -> Result<()> {
         let bytes = bytemuck::bytes_of(data);
         if bytes.len() > PUSH_CONSTANT_BYTES as usize {
-            return Err(Error::invalid("push constants", format!("{} bytes, at most {PUSH_CONSTANT_BYTES}", bytes.len())));
+            return Err(Error::invalid(
+                "push constants",
+                format!("{} bytes, at most {PUSH_CONSTANT_BYTES}", bytes.len()),
+            ));
         }
         let layout = self.ctx.shared.heap.pipeline_layout;
         // SAFETY: the range lies within the layout's push-constant range.
-        unsafe { self.device().cmd_push_constants(self.cmd, layout, vk::ShaderStageFlags::ALL, 0, bytes) };
+        unsafe {
+            self.device()
+                .cmd_push_constants(self.cmd, layout, vk::ShaderStageFlags::ALL, 0, bytes)
+        };
         Ok(())
     }
 
@@ -241,7 +252,10 @@ impl CommandRecorder {
     /// Binds `buffer` as a 32-bit index buffer.
     pub fn bind_index_buffer(&mut self, buffer: &Buffer) {
         // SAFETY: the buffer has INDEX_BUFFER usage.
-        unsafe { self.device().cmd_bind_index_buffer(self.cmd, buffer.raw, 0, vk::IndexType::UINT32) };
+        unsafe {
+            self.device()
+                .cmd_bind_index_buffer(self.cmd, buffer.raw, 0, vk::IndexType::UINT32)
+        };
     }
 
     /// Draws non-indexed vertices.
@@ -292,8 +306,13 @@ impl CommandRecorder {
         let region = Self::image_copy_region(src);
         // SAFETY: the graph put `src` in TRANSFER_SRC_OPTIMAL; `dst` is large enough.
         unsafe {
-            self.device()
-                .cmd_copy_image_to_buffer(self.cmd, src.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, dst.raw, &[region])
+            self.device().cmd_copy_image_to_buffer(
+                self.cmd,
+                src.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                dst.raw,
+                &[region],
+            )
         };
     }
 
@@ -302,8 +321,13 @@ impl CommandRecorder {
         let region = Self::image_copy_region(dst);
         // SAFETY: `dst` is in TRANSFER_DST_OPTIMAL; `src` holds enough texels.
         unsafe {
-            self.device()
-                .cmd_copy_buffer_to_image(self.cmd, src.raw, dst.raw, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &[region])
+            self.device().cmd_copy_buffer_to_image(
+                self.cmd,
+                src.raw,
+                dst.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[region],
+            )
         };
     }
 }
@@ -324,7 +348,8 @@ impl Context {
                 .level(vk::CommandBufferLevel::PRIMARY)
                 .command_buffer_count(1);
             // SAFETY: the pool is live and owned by this thread.
-            let cmd = unsafe { device.allocate_command_buffers(&alloc) }.map_err(vk_err("vkAllocateCommandBuffers"))?[0];
+            let cmd =
+                unsafe { device.allocate_command_buffers(&alloc) }.map_err(vk_err("vkAllocateCommandBuffers"))?[0];
             let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             // SAFETY: fresh command buffer.
             unsafe { device.begin_command_buffer(cmd, &begin) }.map_err(vk_err("vkBeginCommandBuffer"))?;

@@ -53,7 +53,6 @@ pub(crate) struct Shared {
     debug_instance: Option<ash::ext::debug_utils::Instance>,
     messenger: vk::DebugUtilsMessengerEXT,
     pub debug_device: Option<ash::ext::debug_utils::Device>,
-    pub physical: vk::PhysicalDevice,
     pub device: ash::Device,
     queue: Mutex<vk::Queue>,
     pub queue_family: u32,
@@ -75,7 +74,9 @@ pub struct Context {
 
 impl std::fmt::Debug for Context {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Context").field("device", &self.shared.info.name).finish()
+        f.debug_struct("Context")
+            .field("device", &self.shared.info.name)
+            .finish()
     }
 }
 
@@ -139,7 +140,9 @@ impl Context {
             .enabled_layer_names(&layer_names)
             .enabled_extension_names(&extension_names);
         if let Some(messenger_create) = messenger_create.as_mut() {
-            instance_info = instance_info.push_next(messenger_create).push_next(&mut validation_features);
+            instance_info = instance_info
+                .push_next(messenger_create)
+                .push_next(&mut validation_features);
         }
         // SAFETY: every pointer in the create info refers to locals that outlive the call.
         let instance = unsafe { entry.create_instance(&instance_info, None) }.map_err(|e| match e {
@@ -162,8 +165,7 @@ impl Context {
             _ => vk::DebugUtilsMessengerEXT::null(),
         };
 
-        let result = Self::create_device(entry, instance, debug_instance, messenger, report, options);
-        result
+        Self::create_device(entry, instance, debug_instance, messenger, report, options)
     }
 
     fn create_device(
@@ -265,11 +267,13 @@ impl Context {
             message: e.to_string(),
         })?;
 
-        let mut timeline_type =
-            vk::SemaphoreTypeCreateInfo::default().semaphore_type(vk::SemaphoreType::TIMELINE).initial_value(0);
+        let mut timeline_type = vk::SemaphoreTypeCreateInfo::default()
+            .semaphore_type(vk::SemaphoreType::TIMELINE)
+            .initial_value(0);
         let semaphore_info = vk::SemaphoreCreateInfo::default().push_next(&mut timeline_type);
         // SAFETY: valid device; timeline semaphores were enabled.
-        let timeline = unsafe { device.create_semaphore(&semaphore_info, None) }.map_err(vk_err("vkCreateSemaphore"))?;
+        let timeline =
+            unsafe { device.create_semaphore(&semaphore_info, None) }.map_err(vk_err("vkCreateSemaphore"))?;
         let heap = DescriptorHeap::new(&device, &candidate.properties.limits)?;
 
         let props = &candidate.properties;
@@ -298,7 +302,6 @@ impl Context {
             debug_instance,
             messenger,
             debug_device,
-            physical: candidate.physical,
             device,
             queue: Mutex::new(queue),
             queue_family,
@@ -335,7 +338,11 @@ impl Context {
     /// Submits `command_buffer`, signalling the timeline; returns the value
     /// that marks its completion.
     pub(crate) fn submit(&self, command_buffer: vk::CommandBuffer) -> Result<u64> {
-        let queue = self.shared.queue.lock().map_err(|_| Error::Device("queue lock poisoned".into()))?;
+        let queue = self
+            .shared
+            .queue
+            .lock()
+            .map_err(|_| Error::Device("queue lock poisoned".into()))?;
         let value = self.shared.last_submitted.load(Ordering::SeqCst) + 1;
         let signal = [vk::SemaphoreSubmitInfo::default()
             .semaphore(self.shared.timeline)
@@ -402,7 +409,11 @@ impl Context {
     pub(crate) fn collect_garbage(&self) -> Result<()> {
         let done = self.completed()?;
         let ready: Vec<Garbage> = {
-            let mut list = self.shared.garbage.lock().map_err(|_| Error::Device("garbage lock poisoned".into()))?;
+            let mut list = self
+                .shared
+                .garbage
+                .lock()
+                .map_err(|_| Error::Device("garbage lock poisoned".into()))?;
             let (ready, waiting): (Vec<_>, Vec<_>) = list.drain(..).partition(|(v, _)| *v <= done);
             *list = waiting;
             ready.into_iter().map(|(_, g)| g).collect()
@@ -418,7 +429,9 @@ impl Context {
     pub(crate) fn name_object<H: vk::Handle>(&self, handle: H, name: &str) {
         if let Some(debug) = &self.shared.debug_device {
             if let Ok(name) = std::ffi::CString::new(name) {
-                let info = vk::DebugUtilsObjectNameInfoEXT::default().object_handle(handle).object_name(&name);
+                let info = vk::DebugUtilsObjectNameInfoEXT::default()
+                    .object_handle(handle)
+                    .object_name(&name);
                 // SAFETY: the handle belongs to this device; the name outlives the call.
                 let _ = unsafe { debug.set_debug_utils_object_name(&info) };
             }
@@ -434,7 +447,7 @@ impl Drop for Shared {
         // device, messenger, instance.
         unsafe {
             let _ = self.device.device_wait_idle();
-            let garbage: Vec<_> = self.garbage.get_mut().map(|g| g.drain(..).collect()).unwrap_or_default();
+            let garbage: Vec<_> = self.garbage.get_mut().map(std::mem::take).unwrap_or_default();
             for (_, g) in garbage {
                 g.destroy(self);
             }

@@ -112,20 +112,23 @@ pub(crate) fn inspect(instance: &ash::Instance, physical: vk::PhysicalDevice, in
     let queue_family = families
         .iter()
         .position(|f| {
-            f.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE) && f.timestamp_valid_bits > 0
+            f.queue_flags
+                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+                && f.timestamp_valid_bits > 0
         })
         .map(|i| i as u32);
 
     let mut v12 = vk::PhysicalDeviceVulkan12Features::default();
     let mut v13 = vk::PhysicalDeviceVulkan13Features::default();
-    let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut v12).push_next(&mut v13);
-    let missing;
-    if properties.api_version < vk::API_VERSION_1_3 {
-        missing = Some(format!(
+    let mut features2 = vk::PhysicalDeviceFeatures2::default()
+        .push_next(&mut v12)
+        .push_next(&mut v13);
+    let missing = if properties.api_version < vk::API_VERSION_1_3 {
+        Some(format!(
             "Vulkan 1.3 (the driver offers {}.{})",
             vk::api_version_major(properties.api_version),
             vk::api_version_minor(properties.api_version)
-        ));
+        ))
     } else {
         // SAFETY: the device supports Vulkan 1.3, so both feature structs are valid in the chain.
         unsafe { instance.get_physical_device_features2(physical, &mut features2) };
@@ -136,7 +139,10 @@ pub(crate) fn inspect(instance: &ash::Instance, physical: vk::PhysicalDevice, in
             ("timelineSemaphore", v12.timeline_semaphore),
             ("descriptorIndexing", v12.descriptor_indexing),
             ("runtimeDescriptorArray", v12.runtime_descriptor_array),
-            ("descriptorBindingPartiallyBound", v12.descriptor_binding_partially_bound),
+            (
+                "descriptorBindingPartiallyBound",
+                v12.descriptor_binding_partially_bound,
+            ),
             (
                 "descriptorBindingSampledImageUpdateAfterBind",
                 v12.descriptor_binding_sampled_image_update_after_bind,
@@ -162,12 +168,16 @@ pub(crate) fn inspect(instance: &ash::Instance, physical: vk::PhysicalDevice, in
                 v12.shader_storage_buffer_array_non_uniform_indexing,
             ),
         ];
-        missing = checks
+        checks
             .iter()
             .find(|(_, supported)| *supported == vk::FALSE)
             .map(|(feature, _)| format!("feature {feature}"))
-            .or_else(|| queue_family.is_none().then(|| "timestamp queries on a graphics+compute queue".into()));
-    }
+            .or_else(|| {
+                queue_family
+                    .is_none()
+                    .then(|| "timestamp queries on a graphics+compute queue".into())
+            })
+    };
     Candidate {
         physical,
         index,
@@ -216,7 +226,12 @@ pub(crate) fn choose(candidates: Vec<Candidate>, selector: &DeviceSelector) -> R
     let chosen = match selector {
         DeviceSelector::Index(i) => match candidates.iter().position(|c| c.index == *i) {
             Some(pos) => pos,
-            None => return Err(Error::Device(format!("no Vulkan device with index {i} (devices: {})", listing()))),
+            None => {
+                return Err(Error::Device(format!(
+                    "no Vulkan device with index {i} (devices: {})",
+                    listing()
+                )))
+            }
         },
         DeviceSelector::Name(name) => {
             let needle = name.to_lowercase();

@@ -54,7 +54,8 @@ impl FrameRing {
         for i in 0..FRAMES_IN_FLIGHT {
             let pool_info = vk::CommandPoolCreateInfo::default().queue_family_index(ctx.shared.queue_family);
             // SAFETY: valid create info on a live device.
-            let pool = unsafe { device.create_command_pool(&pool_info, None) }.map_err(vk_err("vkCreateCommandPool"))?;
+            let pool =
+                unsafe { device.create_command_pool(&pool_info, None) }.map_err(vk_err("vkCreateCommandPool"))?;
             let alloc = vk::CommandBufferAllocateInfo::default()
                 .command_pool(pool)
                 .level(vk::CommandBufferLevel::PRIMARY)

@@ -99,8 +99,8 @@ impl DescriptorHeap {
             .bindings(&bindings)
             .push_next(&mut binding_flags);
         // SAFETY: valid create infos on a live device; the features were enabled.
-        let layout =
-            unsafe { device.create_descriptor_set_layout(&layout_info, None) }.map_err(vk_err("vkCreateDescriptorSetLayout"))?;
+        let layout = unsafe { device.create_descriptor_set_layout(&layout_info, None) }
+            .map_err(vk_err("vkCreateDescriptorSetLayout"))?;
         let pool_sizes: Vec<_> = (0..4)
             .map(|i| vk::DescriptorPoolSize {
                 ty: types[i],
@@ -112,13 +112,15 @@ impl DescriptorHeap {
             .max_sets(1)
             .pool_sizes(&pool_sizes);
         // SAFETY: as above.
-        let pool = unsafe { device.create_descriptor_pool(&pool_info, None) }.map_err(vk_err("vkCreateDescriptorPool"))?;
+        let pool =
+            unsafe { device.create_descriptor_pool(&pool_info, None) }.map_err(vk_err("vkCreateDescriptorPool"))?;
         let layouts = [layout];
         let alloc_info = vk::DescriptorSetAllocateInfo::default()
             .descriptor_pool(pool)
             .set_layouts(&layouts);
         // SAFETY: the pool has room for exactly this set.
-        let set = unsafe { device.allocate_descriptor_sets(&alloc_info) }.map_err(vk_err("vkAllocateDescriptorSets"))?[0];
+        let set =
+            unsafe { device.allocate_descriptor_sets(&alloc_info) }.map_err(vk_err("vkAllocateDescriptorSets"))?[0];
         let push = [vk::PushConstantRange {
             stage_flags: vk::ShaderStageFlags::ALL,
             offset: 0,
@@ -176,7 +178,10 @@ impl DescriptorHeap {
     }
 
     fn allocate(&self, kind: HeapKind) -> Result<u32> {
-        let mut handles = self.handles.lock().map_err(|_| Error::Device("heap lock poisoned".into()))?;
+        let mut handles = self
+            .handles
+            .lock()
+            .map_err(|_| Error::Device("heap lock poisoned".into()))?;
         handles[kind as usize].allocate(match kind {
             HeapKind::SampledImage => "sampled-image",
             HeapKind::StorageImage => "storage-image",
@@ -188,7 +193,11 @@ impl DescriptorHeap {
     pub fn register_image(&self, device: &ash::Device, kind: HeapKind, view: vk::ImageView) -> Result<u32> {
         let handle = self.allocate(kind)?;
         let (binding, ty, layout) = match kind {
-            HeapKind::SampledImage => (0, vk::DescriptorType::SAMPLED_IMAGE, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
+            HeapKind::SampledImage => (
+                0,
+                vk::DescriptorType::SAMPLED_IMAGE,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            ),
             _ => (1, vk::DescriptorType::STORAGE_IMAGE, vk::ImageLayout::GENERAL),
         };
         let info = [vk::DescriptorImageInfo::default().image_view(view).image_layout(layout)];

@@ -126,7 +126,10 @@ pub struct Buffer {
 
 impl std::fmt::Debug for Buffer {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Buffer").field("name", &self.desc.name).field("size", &self.desc.size).finish()
+        f.debug_struct("Buffer")
+            .field("name", &self.desc.name)
+            .field("size", &self.desc.size)
+            .finish()
     }
 }
 
@@ -134,7 +137,10 @@ impl Buffer {
     /// Creates a buffer; storage buffers are registered in the descriptor heap.
     pub fn new(ctx: &Context, desc: BufferDesc) -> Result<Buffer> {
         if desc.size == 0 {
-            return Err(Error::invalid("buffer size", format!("buffer '{}' has size 0", desc.name)));
+            return Err(Error::invalid(
+                "buffer size",
+                format!("buffer '{}' has size 0", desc.name),
+            ));
         }
         let device = &ctx.shared.device;
         let info = vk::BufferCreateInfo::default()
@@ -232,12 +238,19 @@ impl Buffer {
         let mapped = self.mapped()?;
         let end = offset as usize + data.len();
         if end > mapped.len() {
-            return Err(Error::invalid("buffer write", format!("{} bytes past the end of '{}'", end - mapped.len(), self.desc.name)));
+            return Err(Error::invalid(
+                "buffer write",
+                format!("{} bytes past the end of '{}'", end - mapped.len(), self.desc.name),
+            ));
         }
         // SAFETY: the range is inside the mapping; the CPU writes only to host-visible
         // memory the GPU is not using (callers write before submitting work on it).
         unsafe {
-            std::ptr::copy_nonoverlapping(data.as_ptr(), mapped.as_ptr().add(offset as usize) as *mut u8, data.len());
+            std::ptr::copy_nonoverlapping(
+                data.as_ptr(),
+                mapped.as_ptr().add(offset as usize) as *mut u8,
+                data.len(),
+            );
         }
         Ok(())
     }
@@ -249,7 +262,12 @@ impl Buffer {
             .as_ref()
             .and_then(|a| a.mapped_slice())
             .map(|s| &s[..self.desc.size as usize])
-            .ok_or_else(|| Error::invalid("buffer mapping", format!("buffer '{}' is not host-visible", self.desc.name)))
+            .ok_or_else(|| {
+                Error::invalid(
+                    "buffer mapping",
+                    format!("buffer '{}' is not host-visible", self.desc.name),
+                )
+            })
     }
 
     pub fn state(&self) -> AccessState {
@@ -266,7 +284,10 @@ impl Buffer {
 impl Drop for Buffer {
     fn drop(&mut self) {
         if let Some(handle) = self.storage_handle {
-            self.ctx.shared.heap.release(HeapKind::StorageBuffer, handle, self.ctx.last_submitted());
+            self.ctx
+                .shared
+                .heap
+                .release(HeapKind::StorageBuffer, handle, self.ctx.last_submitted());
         }
         if let Some(allocation) = self.allocation.take() {
             self.ctx.defer_destroy(Garbage::Buffer(self.raw, allocation));
@@ -318,7 +339,10 @@ impl Image {
         if desc.width == 0 || desc.height == 0 || desc.width > max || desc.height > max {
             return Err(Error::invalid(
                 "image size",
-                format!("'{}' is {}x{}; each side must be in 1..={max}", desc.name, desc.width, desc.height),
+                format!(
+                    "'{}' is {}x{}; each side must be in 1..={max}",
+                    desc.name, desc.width, desc.height
+                ),
             ));
         }
         let device = &ctx.shared.device;

@@ -10,7 +10,10 @@ mod memory;
 mod pipeline;
 mod validation;
 
-pub use ash::vk::{BufferUsageFlags, Format, ImageLayout, ImageUsageFlags, PipelineStageFlags2, AccessFlags2, CompareOp, PrimitiveTopology};
+pub use ash::vk::{
+    AccessFlags2, BufferUsageFlags, CompareOp, Format, ImageLayout, ImageUsageFlags, PipelineStageFlags2,
+    PrimitiveTopology,
+};
 pub use commands::{CommandRecorder, LoadOp};
 pub use context::{Context, ContextOptions, DeviceInfo};
 pub use device_select::{DeviceSelector, REQUIRED_FEATURES};

@@ -95,7 +95,9 @@ impl ValidationReport {
 /// Whether `text` is a synchronization hazard reported on an element of a
 /// descriptor array (the layer names the descriptor type, binding and index).
 fn is_descriptor_array_hazard(text: &str) -> bool {
-    text.contains("SYNC-HAZARD") && text.contains("VkDescriptorSet") && text.contains(", type: VK_DESCRIPTOR_TYPE_")
+    text.contains("SYNC-HAZARD")
+        && text.contains("VkDescriptorSet")
+        && text.contains(", type: VK_DESCRIPTOR_TYPE_")
         && text.contains("binding #")
 }
 

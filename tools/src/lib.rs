@@ -9,8 +9,8 @@
 
 use anyhow::{anyhow, bail, Context, Result};
 use shaderc::{
-    CompileOptions, Compiler, EnvVersion, IncludeType, OptimizationLevel, ResolvedInclude,
-    ShaderKind, SpirvVersion, TargetEnv,
+    CompileOptions, Compiler, EnvVersion, IncludeType, OptimizationLevel, ResolvedInclude, ShaderKind, SpirvVersion,
+    TargetEnv,
 };
 use std::collections::BTreeSet;
 use std::fs;
@@ -92,8 +92,7 @@ fn relative(root: &Path, source: &Path) -> Option<PathBuf> {
 
 /// Output path of `source`: `spirv_root/<path relative to glsl_root>.spv`.
 pub fn spirv_path(glsl_root: &Path, spirv_root: &Path, source: &Path) -> PathBuf {
-    let rel = relative(glsl_root, source)
-        .unwrap_or_else(|| source.file_name().map(PathBuf::from).unwrap_or_default());
+    let rel = relative(glsl_root, source).unwrap_or_else(|| source.file_name().map(PathBuf::from).unwrap_or_default());
     let mut name = rel.into_os_string();
     name.push(".spv");
     spirv_root.join(name)
@@ -103,19 +102,13 @@ pub fn spirv_path(glsl_root: &Path, spirv_root: &Path, source: &Path) -> PathBuf
 /// against `root`. Names are `base`-relative paths (e.g. `glsl/common.glsl`).
 fn resolve_include(base: &Path, root: &Path, name: &str, from: &str) -> Result<ResolvedInclude> {
     let from_dir = base.join(from).parent().map(Path::to_path_buf);
-    let candidates = from_dir
-        .iter()
-        .map(|d| d.join(name))
-        .chain([root.join(name)]);
+    let candidates = from_dir.iter().map(|d| d.join(name)).chain([root.join(name)]);
     for candidate in candidates {
         if candidate.is_file() {
             let path = candidate.canonicalize()?;
             let content = fs::read_to_string(&path)?;
             let resolved_name = display_name(base, &path);
-            return Ok(ResolvedInclude {
-                resolved_name,
-                content,
-            });
+            return Ok(ResolvedInclude { resolved_name, content });
         }
     }
     bail!(
@@ -133,8 +126,7 @@ fn display_name(base: &Path, path: &Path) -> String {
 /// Compiles one shader to SPIR-V (little-endian bytes). Warnings are printed
 /// to stderr; errors carry shaderc's `file:line: error: ...` messages.
 pub fn compile(glsl_root: &Path, source: &Path) -> Result<Vec<u8>> {
-    let kind = stage_for(source)
-        .ok_or_else(|| anyhow!("{}: not a shader stage extension", source.display()))?;
+    let kind = stage_for(source).ok_or_else(|| anyhow!("{}: not a shader stage extension", source.display()))?;
     let root = glsl_root
         .canonicalize()
         .with_context(|| format!("shader root {}", glsl_root.display()))?;
@@ -146,8 +138,7 @@ pub fn compile(glsl_root: &Path, source: &Path) -> Result<Vec<u8>> {
     let text = fs::read_to_string(&path).with_context(|| format!("reading {name}"))?;
 
     let compiler = Compiler::new().ok_or_else(|| anyhow!("failed to create shaderc compiler"))?;
-    let mut options =
-        CompileOptions::new().ok_or_else(|| anyhow!("failed to create shaderc options"))?;
+    let mut options = CompileOptions::new().ok_or_else(|| anyhow!("failed to create shaderc options"))?;
     options.set_target_env(TargetEnv::Vulkan, EnvVersion::Vulkan1_3 as u32);
     options.set_target_spirv(SpirvVersion::V1_6);
     options.set_optimization_level(OptimizationLevel::Performance);
@@ -162,19 +153,12 @@ pub fn compile(glsl_root: &Path, source: &Path) -> Result<Vec<u8>> {
     if artifact.get_num_warnings() > 0 {
         eprint!("{}", artifact.get_warning_messages());
     }
-    Ok(artifact
-        .as_binary()
-        .iter()
-        .flat_map(|w| w.to_le_bytes())
-        .collect())
+    Ok(artifact.as_binary().iter().flat_map(|w| w.to_le_bytes()).collect())
 }
 
 /// Every `.spv` file under `spirv_root` that no source in `glsl_root` maps to.
 fn orphans(glsl_root: &Path, spirv_root: &Path, sources: &[PathBuf]) -> Result<Vec<PathBuf>> {
-    let expected: BTreeSet<PathBuf> = sources
-        .iter()
-        .map(|s| spirv_path(glsl_root, spirv_root, s))
-        .collect();
+    let expected: BTreeSet<PathBuf> = sources.iter().map(|s| spirv_path(glsl_root, spirv_root, s)).collect();
     let mut files = Vec::new();
     if spirv_root.is_dir() {
         walk(spirv_root, &mut files)?;
@@ -214,10 +198,7 @@ pub fn check(glsl_root: &Path, spirv_root: &Path) -> Result<Vec<String>> {
         }
     }
     for orphan in orphans(glsl_root, spirv_root, &sources)? {
-        problems.push(format!(
-            "orphan: {} (no source)",
-            short(spirv_root, &orphan)
-        ));
+        problems.push(format!("orphan: {} (no source)", short(spirv_root, &orphan)));
     }
     Ok(problems)
 }

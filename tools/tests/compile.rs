@@ -9,8 +9,7 @@ struct Repo(PathBuf);
 
 impl Repo {
     fn new(name: &str) -> Self {
-        let dir =
-            std::env::temp_dir().join(format!("alpenglow-tools-{}-{name}", std::process::id()));
+        let dir = std::env::temp_dir().join(format!("alpenglow-tools-{}-{name}", std::process::id()));
         let _ = fs::remove_dir_all(&dir);
         fs::create_dir_all(dir.join("glsl")).unwrap();
         Repo(dir)
@@ -79,11 +78,7 @@ fn compiled_module_is_valid_spirv_1_6_and_fresh() {
     let bytes = fs::read(repo.spirv().join("terrain/grid.comp.spv")).unwrap();
     assert_eq!(&bytes[0..4], &0x0723_0203u32.to_le_bytes(), "SPIR-V magic");
     assert_eq!(&bytes[4..8], &0x0001_0600u32.to_le_bytes(), "SPIR-V 1.6");
-    assert_eq!(
-        bytes,
-        compile(&repo.glsl(), &grid).unwrap(),
-        "deterministic"
-    );
+    assert_eq!(bytes, compile(&repo.glsl(), &grid).unwrap(), "deterministic");
     assert!(repo.check().is_empty(), "{:?}", repo.check());
     assert_eq!(
         compile_all(&repo.glsl(), &repo.spirv()).unwrap(),
@@ -119,10 +114,7 @@ fn nested_include_resolves_relative_then_root() {
     let repo = Repo::new("nested");
     repo.write("common.glsl", COMMON);
     // `local.glsl` is found next to the includer; `common.glsl` from the root.
-    repo.write(
-        "a/local.glsl",
-        "#include \"common.glsl\"\nconst float K = SCALE;\n",
-    );
+    repo.write("a/local.glsl", "#include \"common.glsl\"\nconst float K = SCALE;\n");
     let src = repo.write("a/b.comp", &comp("K").replace("common.glsl", "local.glsl"));
     compile(&repo.glsl(), &src).unwrap();
 }
@@ -139,27 +131,18 @@ fn orphan_and_missing_modules_are_reported() {
     assert!(problems[0].starts_with("missing:") && problems[0].contains("tri.vert.spv"));
     assert!(problems[1].starts_with("orphan:") && problems[1].contains("gone.frag.spv"));
     assert_eq!(compile_all(&repo.glsl(), &repo.spirv()).unwrap(), 1);
-    assert!(
-        !repo.spirv().join("old").exists(),
-        "empty orphan dir removed"
-    );
+    assert!(!repo.spirv().join("old").exists(), "empty orphan dir removed");
     assert!(repo.check().is_empty());
 }
 
 #[test]
 fn syntax_error_names_file_and_line() {
     let repo = Repo::new("syntax");
-    let src = repo.write(
-        "broken/bad.frag",
-        "#version 460\nvoid main() {\n  oops\n}\n",
-    );
+    let src = repo.write("broken/bad.frag", "#version 460\nvoid main() {\n  oops\n}\n");
     let err = format!("{:#}", compile(&repo.glsl(), &src).unwrap_err());
     assert!(err.contains("glsl/broken/bad.frag:"), "{err}");
     assert!(err.contains("error"), "{err}");
-    let err = format!(
-        "{:#}",
-        compile_all(&repo.glsl(), &repo.spirv()).unwrap_err()
-    );
+    let err = format!("{:#}", compile_all(&repo.glsl(), &repo.spirv()).unwrap_err());
     assert!(err.contains("bad.frag"), "{err}");
     assert!(!repo.spirv().exists(), "nothing written on failure");
 }

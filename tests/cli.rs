@@ -1,0 +1,563 @@
+//! End-to-end tests of the `alpenglow` binary: error paths (one line on
+//! stderr, non-zero exit, no output files), a full render with every output,
+//! determinism, the contents of the EXR, `info` and `bench`.
+//!
+//! Every command that creates a Vulkan device runs with `--validation`, so a
+//! validation message fails the run (and the test).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+/// The binary under test.
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_alpenglow")
+}
+
+/// A test fixture in `tests/data`.
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
+}
+
+/// A fresh, empty directory unique to this test and process.
+fn fresh_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("alpenglow-cli-{test}-{}", std::process::id()));
+    if dir.exists() {
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Runs the binary with `args` (the device choice comes from the
+/// environment, `ALPENGLOW_DEVICE`, as for every user).
+fn run<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
+    Command::new(bin())
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {}: {e}", bin()))
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Panics with the command's output unless it exited 0.
+fn assert_success(what: &str, out: &Output) {
+    assert!(
+        out.status.success(),
+        "{what} failed ({}):\nstdout:\n{}\nstderr:\n{}",
+        out.status,
+        text(&out.stdout),
+        text(&out.stderr)
+    );
+}
+
+/// Checks a failed run: non-zero exit, exactly one non-empty stderr line
+/// that mentions every string of `needles`, and no panic.
+fn assert_one_line_error(what: &str, out: &Output, needles: &[&str]) {
+    let stderr = text(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "{what}: expected failure, got {}\nstdout:\n{}\nstderr:\n{stderr}",
+        out.status,
+        text(&out.stdout)
+    );
+    let trimmed = stderr.trim();
+    assert!(!trimmed.is_empty(), "{what}: nothing on stderr");
+    assert_eq!(
+        trimmed.lines().count(),
+        1,
+        "{what}: expected one line on stderr, got:\n{stderr}"
+    );
+    let lower = trimmed.to_lowercase();
+    assert!(
+        !lower.contains("panicked") && !lower.contains("backtrace"),
+        "{what}: panic on stderr: {trimmed}"
+    );
+    for needle in needles {
+        assert!(
+            trimmed.contains(needle),
+            "{what}: stderr does not mention {needle:?}: {trimmed}"
+        );
+    }
+}
+
+/// The entries of `dir` (file names), sorted.
+fn entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// Runs `render` with `scene_args` plus every output (PNG, EXR, profile,
+/// trace) in a fresh directory, expects a one-line error mentioning
+/// `needles`, and checks that the directory is still empty (no output and
+/// no temporary file). Adds a small size unless `scene_args` sets one.
+fn expect_render_error(test: &str, scene_args: &[&str], needles: &[&str]) {
+    let dir = fresh_dir(test);
+    let mut args: Vec<String> = vec!["render".into(), "--validation".into()];
+    if !scene_args.contains(&"--width") {
+        args.extend(["--width".into(), "32".into()]);
+    }
+    if !scene_args.contains(&"--height") {
+        args.extend(["--height".into(), "32".into()]);
+    }
+    args.extend(scene_args.iter().map(|s| s.to_string()));
+    for (flag, file) in [
+        ("--out", "o.png"),
+        ("--exr", "o.exr"),
+        ("--profile", "p.json"),
+        ("--trace", "t.json"),
+    ] {
+        args.push(flag.into());
+        args.push(dir.join(file).to_string_lossy().into_owned());
+    }
+    let out = run(&args);
+    let what = format!("render {}", scene_args.join(" "));
+    assert_one_line_error(&what, &out, needles);
+    assert!(
+        entries(&dir).is_empty(),
+        "{what}: files left behind: {:?}",
+        entries(&dir)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+fn heightmap_error(test: &str, file: &str) {
+    let path = data(file);
+    expect_render_error(test, &["--heightmap", path.to_str().unwrap()], &[file]);
+}
+
+// ---------------------------------------------------------------- errors
+
+#[test]
+fn missing_heightmap() {
+    heightmap_error("missing_heightmap", "no-such-heightmap.png");
+}
+
+#[test]
+fn truncated_png() {
+    heightmap_error("truncated_png", "truncated.png");
+}
+
+#[test]
+fn empty_file() {
+    heightmap_error("empty_file", "empty.png");
+}
+
+#[test]
+fn not_an_image() {
+    heightmap_error("not_an_image", "not-an-image.png");
+}
+
+#[test]
+fn colour_png() {
+    heightmap_error("colour_png", "colour.png");
+}
+
+#[test]
+fn nan_heights_exr() {
+    heightmap_error("nan_heights_exr", "nan.exr");
+}
+
+#[test]
+fn zero_width() {
+    expect_render_error("zero_width", &["--width", "0"], &["--width"]);
+}
+
+#[test]
+fn zero_height() {
+    expect_render_error("zero_height", &["--height", "0"], &["--height"]);
+}
+
+#[test]
+fn huge_width() {
+    expect_render_error("huge_width", &["--width", "100000"], &["--width"]);
+}
+
+#[test]
+fn eye_equals_target() {
+    expect_render_error("eye_equals_target", &["--eye", "1,2,3", "--target", "1,2,3"], &["eye"]);
+}
+
+#[test]
+fn unparsable_eye() {
+    expect_render_error("unparsable_eye", &["--eye", "1,2"], &["--eye"]);
+}
+
+#[test]
+fn zero_fov() {
+    expect_render_error("zero_fov", &["--fov-y", "0"], &["--fov-y"]);
+}
+
+#[test]
+fn near_beyond_far() {
+    expect_render_error("near_beyond_far", &["--near", "10", "--far", "5"], &["--near", "--far"]);
+}
+
+/// Each output flag in turn points into a directory that does not exist
+/// while the others are valid: one error naming the directory, nothing
+/// written anywhere.
+#[test]
+fn output_into_missing_directory() {
+    let dir = fresh_dir("output_into_missing_directory");
+    let missing = dir.join("does-not-exist");
+    for (flag, file) in [
+        ("--out", "o.png"),
+        ("--exr", "o.exr"),
+        ("--profile", "p.json"),
+        ("--trace", "t.json"),
+    ] {
+        let mut args: Vec<String> = ["render", "--validation", "--width", "32", "--height", "32"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        for (f, name) in [
+            ("--out", "o.png"),
+            ("--exr", "o.exr"),
+            ("--profile", "p.json"),
+            ("--trace", "t.json"),
+        ] {
+            let base = if f == flag { &missing } else { &dir };
+            args.push(f.into());
+            args.push(base.join(name).to_string_lossy().into_owned());
+        }
+        let out = run(&args);
+        let what = format!("render {flag} into a missing directory");
+        assert_one_line_error(&what, &out, &["does-not-exist", file]);
+        assert!(!missing.exists(), "{what}: the directory was created");
+        assert!(
+            entries(&dir).is_empty(),
+            "{what}: files left behind: {:?}",
+            entries(&dir)
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// An output that can only fail when it is written (its path is an existing
+/// directory) must not leave the outputs written before it behind: a failed
+/// render writes nothing.
+#[test]
+fn failing_later_output_leaves_no_earlier_file() {
+    let dir = fresh_dir("failing_later_output");
+    let blocker = dir.join("blocker");
+    std::fs::create_dir(&blocker).unwrap();
+    let png = dir.join("o.png");
+    let profile = dir.join("p.json");
+    let out = run(&[
+        "render".as_ref(),
+        "--validation".as_ref(),
+        "--width".as_ref(),
+        "32".as_ref(),
+        "--height".as_ref(),
+        "32".as_ref(),
+        "--out".as_ref(),
+        png.as_os_str(),
+        "--exr".as_ref(),
+        blocker.as_os_str(),
+        "--profile".as_ref(),
+        profile.as_os_str(),
+    ]);
+    assert_one_line_error("render --exr <existing directory>", &out, &["blocker"]);
+    assert_eq!(
+        entries(&dir),
+        vec!["blocker".to_string()],
+        "a failed render left files behind"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The same for `bench`: the JSON summary is written before the trace, so a
+/// trace path that cannot be written must not leave the JSON behind.
+#[test]
+fn bench_failing_trace_leaves_no_json() {
+    let dir = fresh_dir("bench_failing_trace");
+    let blocker = dir.join("blocker");
+    std::fs::create_dir(&blocker).unwrap();
+    let json = dir.join("b.json");
+    let out = run(&[
+        "bench".as_ref(),
+        "--validation".as_ref(),
+        "--frames".as_ref(),
+        "1".as_ref(),
+        "--warmup".as_ref(),
+        "0".as_ref(),
+        "--width".as_ref(),
+        "32".as_ref(),
+        "--height".as_ref(),
+        "32".as_ref(),
+        "--json".as_ref(),
+        json.as_os_str(),
+        "--trace".as_ref(),
+        blocker.as_os_str(),
+    ]);
+    assert_one_line_error("bench --trace <existing directory>", &out, &["blocker"]);
+    assert_eq!(
+        entries(&dir),
+        vec!["blocker".to_string()],
+        "a failed bench left files behind"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// ---------------------------------------------------------------- success
+
+/// A finite, non-negative number at `value[key]`.
+fn finite_ms(value: &Value, key: &str, what: &str) -> f64 {
+    let v = value[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{what}: {key} is not a number: {value}"));
+    assert!(v.is_finite() && v >= 0.0, "{what}: {key} = {v}");
+    v
+}
+
+const RENDER_PASSES: [&str; 5] = ["sky", "terrain.grid", "terrain.draw", "tonemap", "readback"];
+
+#[test]
+fn render_writes_every_output() {
+    let dir = fresh_dir("render_writes_every_output");
+    let (png, exr, profile, trace) = (
+        dir.join("a.png"),
+        dir.join("a.exr"),
+        dir.join("p.json"),
+        dir.join("t.json"),
+    );
+    let out = run(&[
+        "render".as_ref(),
+        "--validation".as_ref(),
+        "--width".as_ref(),
+        "160".as_ref(),
+        "--height".as_ref(),
+        "90".as_ref(),
+        "--out".as_ref(),
+        png.as_os_str(),
+        "--exr".as_ref(),
+        exr.as_os_str(),
+        "--profile".as_ref(),
+        profile.as_os_str(),
+        "--trace".as_ref(),
+        trace.as_os_str(),
+    ]);
+    assert_success("render", &out);
+    assert!(
+        text(&out.stderr).trim().is_empty(),
+        "render printed on stderr:\n{}",
+        text(&out.stderr)
+    );
+    assert_eq!(
+        entries(&dir),
+        vec!["a.exr", "a.png", "p.json", "t.json"],
+        "unexpected files"
+    );
+
+    let image = image::open(&png).expect("the PNG decodes");
+    assert_eq!((image.width(), image.height()), (160, 90));
+
+    // Profile: every pass in every frame and in the summary, finite times.
+    let p: Value = serde_json::from_slice(&std::fs::read(&profile).unwrap()).unwrap();
+    let frames = p["frames"].as_array().expect("profile has frames");
+    assert!(!frames.is_empty(), "profile has no frames");
+    for frame in frames {
+        finite_ms(frame, "gpu_ms", "frame");
+        let passes = frame["passes"].as_array().expect("frame has passes");
+        for name in RENDER_PASSES {
+            let pass = passes
+                .iter()
+                .find(|q| q["name"] == name)
+                .unwrap_or_else(|| panic!("profile frame lacks pass {name}: {frame}"));
+            finite_ms(pass, "gpu_ms", name);
+            finite_ms(pass, "cpu_ms", name);
+        }
+    }
+    let summary = p["summary"]["passes"].as_array().expect("profile has summary.passes");
+    for name in RENDER_PASSES {
+        let pass = summary
+            .iter()
+            .find(|q| q["name"] == name)
+            .unwrap_or_else(|| panic!("profile summary lacks pass {name}"));
+        finite_ms(pass, "median_gpu_ms", name);
+    }
+
+    // Trace: complete events for every pass.
+    let t: Value = serde_json::from_slice(&std::fs::read(&trace).unwrap()).unwrap();
+    let events = t["traceEvents"].as_array().expect("traceEvents array");
+    let complete: Vec<&Value> = events.iter().filter(|e| e["ph"] == "X").collect();
+    assert!(!complete.is_empty(), "no complete events in the trace");
+    for e in &complete {
+        finite_ms(e, "ts", "trace event");
+        finite_ms(e, "dur", "trace event");
+    }
+    for name in RENDER_PASSES {
+        assert!(
+            complete.iter().any(|e| e["name"] == name),
+            "trace lacks a complete event for {name}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// ---------------------------------------------------------------- determinism
+
+/// Renders twice into separate directories and returns both PNG and EXR files.
+fn render_twice(test: &str, extra: &[&str]) -> [(Vec<u8>, Vec<u8>); 2] {
+    let dir = fresh_dir(test);
+    let result = [0, 1].map(|i| {
+        let (png, exr) = (dir.join(format!("{i}.png")), dir.join(format!("{i}.exr")));
+        let mut args: Vec<&std::ffi::OsStr> = ["render", "--validation", "--width", "160", "--height", "90"]
+            .iter()
+            .map(|s| s.as_ref())
+            .collect();
+        args.extend(extra.iter().map(|s| std::ffi::OsStr::new(*s)));
+        args.extend(["--out".as_ref(), png.as_os_str(), "--exr".as_ref(), exr.as_os_str()]);
+        let out = run(&args);
+        assert_success(&format!("render {}", extra.join(" ")), &out);
+        (std::fs::read(&png).unwrap(), std::fs::read(&exr).unwrap())
+    });
+    let _ = std::fs::remove_dir_all(&dir);
+    result
+}
+
+#[test]
+fn default_scene_is_deterministic() {
+    let [a, b] = render_twice("default_scene_is_deterministic", &[]);
+    assert!(a.0 == b.0, "two renders of the default scene wrote different PNGs");
+    assert!(a.1 == b.1, "two renders of the default scene wrote different EXRs");
+}
+
+#[test]
+fn heightmap_scene_is_deterministic() {
+    let dem = data("jacksboro-fault.png");
+    let [a, b] = render_twice(
+        "heightmap_scene_is_deterministic",
+        &["--heightmap", dem.to_str().unwrap(), "--spacing", "74.4,92.6"],
+    );
+    assert!(a.0 == b.0, "two renders of the DEM wrote different PNGs");
+    assert!(a.1 == b.1, "two renders of the DEM wrote different EXRs");
+}
+
+// ---------------------------------------------------------------- EXR contents
+
+#[test]
+fn exr_has_colour_and_depth() {
+    let dir = fresh_dir("exr_has_colour_and_depth");
+    let exr = dir.join("a.exr");
+    let out = run(&[
+        "render".as_ref(),
+        "--validation".as_ref(),
+        "--width".as_ref(),
+        "160".as_ref(),
+        "--height".as_ref(),
+        "90".as_ref(),
+        "--exr".as_ref(),
+        exr.as_os_str(),
+    ]);
+    assert_success("render --exr", &out);
+    let (w, h, channels) = alpenglow::io::image_out::read_exr_channels(&exr).unwrap();
+    assert_eq!((w, h), (160, 90));
+    let (w, h) = (w as usize, h as usize);
+    let channel = |name: &str| -> &Vec<f32> {
+        &channels
+            .iter()
+            .find(|(n, _)| n == name)
+            .unwrap_or_else(|| {
+                panic!(
+                    "EXR lacks channel {name}; has {:?}",
+                    channels.iter().map(|c| &c.0).collect::<Vec<_>>()
+                )
+            })
+            .1
+    };
+    for name in ["R", "G", "B", "A"] {
+        let c = channel(name);
+        assert_eq!(c.len(), w * h);
+        assert!(
+            c.iter().all(|v| v.is_finite() && *v >= 0.0),
+            "channel {name} has negative or non-finite values"
+        );
+    }
+
+    let camera = alpenglow::renderer::Scene::default_procedural()
+        .unwrap()
+        .default_camera();
+    let (near, far) = (camera.near as f32, camera.far as f32);
+    let z = channel("Z");
+    assert_eq!(z.len(), w * h);
+    assert!(
+        z.iter().all(|v| !v.is_nan() && *v != f32::NEG_INFINITY),
+        "Z has NaN or -inf"
+    );
+    let top = &z[..w];
+    assert!(
+        top.contains(&f32::INFINITY),
+        "no sky (+inf depth) in the top row: {top:?}"
+    );
+    let bottom = &z[(h - 1) * w..];
+    assert!(
+        bottom.iter().all(|v| v.is_finite() && *v > 0.0),
+        "bottom row is not all terrain (finite positive depth): {bottom:?}"
+    );
+    for v in z.iter().filter(|v| v.is_finite()) {
+        assert!(
+            *v < far && *v >= near * 0.999,
+            "depth {v} outside [near {near}, far {far})"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// ---------------------------------------------------------------- info, bench
+
+#[test]
+fn info_names_device_and_driver() {
+    let out = run(&["info", "--validation"]);
+    assert_success("info", &out);
+    let stdout = text(&out.stdout);
+    for prefix in ["device:", "driver:"] {
+        assert!(
+            stdout.lines().any(|l| l.starts_with(prefix) && l.len() > prefix.len()),
+            "info prints no {prefix:?} line:\n{stdout}"
+        );
+    }
+}
+
+#[test]
+fn bench_writes_json_summary() {
+    let dir = fresh_dir("bench_writes_json_summary");
+    let json = dir.join("b.json");
+    let out = run(&[
+        "bench".as_ref(),
+        "--validation".as_ref(),
+        "--frames".as_ref(),
+        "3".as_ref(),
+        "--warmup".as_ref(),
+        "1".as_ref(),
+        "--width".as_ref(),
+        "64".as_ref(),
+        "--height".as_ref(),
+        "64".as_ref(),
+        "--json".as_ref(),
+        json.as_os_str(),
+    ]);
+    assert_success("bench", &out);
+    let b: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(b["frames"], 3, "bench JSON: {b}");
+    assert_eq!((b["width"].as_u64(), b["height"].as_u64()), (Some(64), Some(64)));
+    finite_ms(&b, "median_frame_gpu_ms", "bench");
+    let passes = b["passes"].as_array().expect("bench JSON has passes");
+    // Bench renders without readback.
+    for name in ["sky", "terrain.grid", "terrain.draw", "tonemap"] {
+        let pass = passes
+            .iter()
+            .find(|p| p["name"] == name)
+            .unwrap_or_else(|| panic!("bench JSON lacks pass {name}: {b}"));
+        finite_ms(pass, "median_gpu_ms", name);
+        assert_eq!(pass["samples"], 3, "pass {name}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
