@@ -233,6 +233,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     let ctx = context(&args.scene.device)?;
     let report = ctx.validation_report();
     let device = ctx.info().clone();
+    let mut intervals = Vec::new();
     let profiles = {
         let settings = RenderSettings {
             width: args.scene.width,
@@ -240,8 +241,13 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
             readback: false,
         };
         let mut renderer = Renderer::new(&ctx, &scene, settings)?;
-        for _ in 0..args.warmup + args.frames {
+        let mut last = std::time::Instant::now();
+        for i in 0..args.warmup + args.frames {
             renderer.render(&camera)?;
+            if i >= args.warmup {
+                intervals.push(last.elapsed().as_secs_f64() * 1e3);
+            }
+            last = std::time::Instant::now();
         }
         renderer.finish()?
     };
@@ -263,6 +269,9 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
         frame.median_gpu_ms,
         frame.median_cpu_ms
     );
+    let interval_median = alpenglow::profile::median(intervals.iter().copied());
+    let interval_max = intervals.iter().copied().fold(0.0, f64::max);
+    println!("  frame interval   median {interval_median:>8.3} ms wall (max {interval_max:.3}), 2 frames in flight");
     for p in &passes {
         println!(
             "  {:<16} median {:>8.3} ms GPU (min {:.3}, max {:.3}), {:.3} ms CPU",
@@ -278,6 +287,8 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
             "frames": frame.frames,
             "median_frame_gpu_ms": frame.median_gpu_ms,
             "median_frame_cpu_ms": frame.median_cpu_ms,
+            "median_frame_interval_ms": interval_median,
+            "max_frame_interval_ms": interval_max,
             "passes": passes,
         });
         let text = serde_json::to_string_pretty(&value)?;

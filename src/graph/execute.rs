@@ -158,9 +158,10 @@ impl<P> BakedGraph<P> {
     /// Records and submits one frame. Returns once the frame is submitted; its
     /// GPU timings arrive in [`BakedGraph::take_profiles`] when the GPU is done.
     pub fn execute(&mut self, frames: &mut FrameRing, params: &P) -> Result<FrameOutcome> {
-        let frame_start = Instant::now();
         let query_count = 2 * self.passes.len() as u32;
+        // Waits for the frame slot (the GPU) first; CPU times start after it.
         let (mut recording, completed) = frames.begin(query_count)?;
+        let frame_start = Instant::now();
         if let Some(c) = completed {
             self.complete(c);
         }
