@@ -37,6 +37,7 @@ impl std::str::FromStr for DeviceSelector {
 }
 
 /// Everything about a candidate device that choosing one needs.
+#[derive(Debug)]
 pub(crate) struct Candidate {
     pub physical: vk::PhysicalDevice,
     pub index: usize,
@@ -262,4 +263,99 @@ pub(crate) fn choose(candidates: Vec<Candidate>, selector: &DeviceSelector) -> R
         )));
     }
     Ok(candidate)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn candidate(index: usize, name: &str, device_type: vk::PhysicalDeviceType, missing: Option<&str>) -> Candidate {
+        Candidate {
+            physical: vk::PhysicalDevice::null(),
+            index,
+            name: name.into(),
+            device_type,
+            properties: vk::PhysicalDeviceProperties::default(),
+            driver_name: "driver".into(),
+            driver_info: "1.0".into(),
+            driver_id: if name.contains("llvmpipe") {
+                vk::DriverId::MESA_LLVMPIPE
+            } else {
+                vk::DriverId::NVIDIA_PROPRIETARY
+            },
+            queue_family: Some(0),
+            missing: missing.map(String::from),
+        }
+    }
+
+    #[test]
+    fn prefers_discrete_then_integrated_then_cpu() {
+        let pick = |list: Vec<Candidate>| choose(list, &DeviceSelector::Best).map(|c| c.name);
+        let cpu = || candidate(0, "llvmpipe", vk::PhysicalDeviceType::CPU, None);
+        let igpu = || candidate(1, "iGPU", vk::PhysicalDeviceType::INTEGRATED_GPU, None);
+        let dgpu = || candidate(2, "dGPU", vk::PhysicalDeviceType::DISCRETE_GPU, None);
+        assert_eq!(pick(vec![cpu(), igpu(), dgpu()]).unwrap(), "dGPU");
+        assert_eq!(pick(vec![cpu(), igpu()]).unwrap(), "iGPU");
+        assert_eq!(pick(vec![cpu()]).unwrap(), "llvmpipe");
+        // A capable CPU device beats a discrete GPU that lacks a feature.
+        let broken = candidate(
+            2,
+            "old dGPU",
+            vk::PhysicalDeviceType::DISCRETE_GPU,
+            Some("feature maintenance4"),
+        );
+        assert_eq!(pick(vec![broken, cpu()]).unwrap(), "llvmpipe");
+    }
+
+    #[test]
+    fn selection_by_name_and_index() {
+        let list = || {
+            vec![
+                candidate(0, "llvmpipe (LLVM 15)", vk::PhysicalDeviceType::CPU, None),
+                candidate(1, "NVIDIA H100", vk::PhysicalDeviceType::DISCRETE_GPU, None),
+            ]
+        };
+        let by_name = choose(list(), &"llvm".parse().unwrap()).unwrap();
+        assert_eq!(by_name.index, 0);
+        let by_index = choose(list(), &"1".parse().unwrap()).unwrap();
+        assert_eq!(by_index.name, "NVIDIA H100");
+        let err = choose(list(), &DeviceSelector::Index(5)).unwrap_err().to_string();
+        assert!(
+            err.contains("no Vulkan device with index 5") && err.contains("1: NVIDIA H100"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_missing_feature_is_named_with_the_lavapipe_fix() {
+        let old_lavapipe = candidate(
+            0,
+            "llvmpipe (LLVM 15.0.6, 256 bits)",
+            vk::PhysicalDeviceType::CPU,
+            Some("feature descriptorBindingSampledImageUpdateAfterBind"),
+        );
+        let err = choose(vec![old_lavapipe], &DeviceSelector::Best)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("lacks feature descriptorBindingSampledImageUpdateAfterBind"),
+            "{err}"
+        );
+        assert!(
+            err.contains("Mesa >= 23") && err.contains("bookworm-backports"),
+            "{err}"
+        );
+        assert_eq!(err.lines().count(), 1);
+        let gpu = candidate(
+            0,
+            "GPU",
+            vk::PhysicalDeviceType::DISCRETE_GPU,
+            Some("Vulkan 1.3 (the driver offers 1.2)"),
+        );
+        let err = choose(vec![gpu], &DeviceSelector::Best).unwrap_err().to_string();
+        assert!(
+            err.contains("lacks Vulkan 1.3") && err.contains("update the GPU driver"),
+            "{err}"
+        );
+    }
 }
