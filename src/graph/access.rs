@@ -155,20 +155,9 @@ impl Access {
         )
     }
 
-    /// Whether this access applies to buffers.
+    /// Whether this access applies to buffers (transfers apply to both).
     pub fn is_buffer(self) -> bool {
-        use Access::*;
-        !matches!(
-            self,
-            SampledImage(_)
-                | StorageImageRead(_)
-                | StorageImageWrite(_)
-                | StorageImageReadWrite(_)
-                | ColorAttachmentWrite
-                | ColorAttachmentReadWrite
-                | DepthAttachmentWrite
-                | DepthAttachmentRead
-        )
+        !self.is_image() || matches!(self, Access::TransferSrc | Access::TransferDst)
     }
 
     /// Image usage flags this access needs.
