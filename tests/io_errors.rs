@@ -189,39 +189,3 @@ fn writes_into_a_missing_directory_fail_and_create_nothing() {
     assert!(write_exr(&target, 2, 2, &[0.0; 4], &[0.0; 4], &[]).is_err());
     assert!(listing(&dir).is_empty());
 }
-
-/// Regenerates the small fixtures in tests/data (the committed files are
-/// what the other tests read). Runs only when asked twice, so that a plain
-/// `--ignored` run never rewrites source files:
-/// `ALPENGLOW_REGENERATE_FIXTURES=1 cargo test --test io_errors -- --ignored regenerate_fixtures`.
-#[test]
-#[ignore = "rewrites tests/data fixtures"]
-fn regenerate_fixtures() {
-    if std::env::var_os("ALPENGLOW_REGENERATE_FIXTURES").is_none() {
-        eprintln!("set ALPENGLOW_REGENERATE_FIXTURES=1 to rewrite tests/data fixtures");
-        return;
-    }
-    let dem = std::fs::read(data("jacksboro-fault.png")).unwrap();
-    std::fs::write(data("truncated.png"), &dem[..1000]).unwrap();
-    std::fs::write(data("empty.png"), b"").unwrap();
-    std::fs::write(
-        data("not-an-image.png"),
-        b"This is a text file with a .png name, not an image.\n",
-    )
-    .unwrap();
-    let colour = image::RgbImage::from_fn(4, 3, |x, y| image::Rgb([x as u8 * 60, y as u8 * 80, 128]));
-    colour.save(data("colour.png")).unwrap();
-    let ramp: Vec<u16> = (0..6u16)
-        .flat_map(|r| (0..8u16).map(move |c| 1000 * r + 10 * c))
-        .collect();
-    write_grey16(&data("tiny-ramp.png"), 8, 6, &ramp);
-
-    use exr::prelude::*;
-    let mut y: Vec<f32> = (0..12).map(|i| 100.0 + i as f32).collect();
-    y[4 + 2] = f32::NAN; // column 2, row 1 of a 4×3 image
-    let mut list = SmallVec::new();
-    list.push(AnyChannel::new("Y", FlatSamples::F32(y)));
-    let channels = AnyChannels::sort(list);
-    let layer = Layer::new((4, 3), LayerAttributes::default(), Encoding::UNCOMPRESSED, channels);
-    Image::from_layer(layer).write().to_file(data("nan.exr")).unwrap();
-}

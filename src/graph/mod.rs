@@ -3,7 +3,7 @@
 //! and returns a [`BakedGraph`] that records and times every frame, deriving
 //! each barrier and layout transition from the declared accesses.
 //!
-//! ```ignore
+//! ```text
 //! let mut graph = RenderGraph::new();
 //! let vertices = graph.import_buffer(vertex_buffer);
 //! let hdr = graph.create_image("hdr", ImageInfo::new(w, h, Format::R32G32B32A32_SFLOAT));
