@@ -47,7 +47,8 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
                 assert_eq!(images.rgba8.len(), 96 * 64 * 4);
             }
         }
-        let images = renderer.read(&last.expect("a frame")).expect("readback");
+        let last = last.expect("a frame");
+        let images = renderer.read(&last).expect("readback");
         // Bottom centre sees terrain drawn from the compute-written vertex buffer;
         // the top row sees sky.
         let bottom = ((63 * 96) + 48) as usize;
@@ -56,8 +57,13 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
             "terrain at the bottom"
         );
         assert!(images.depth[48].is_infinite(), "sky at the top");
+        // A frame whose readback slot was reused cannot be read any more.
+        renderer.render(&camera).expect("frame");
+        renderer.render(&camera).expect("frame");
+        let err = renderer.read(&last).expect_err("slot reused").to_string();
+        assert!(err.contains("overwritten"), "{err}");
         let profiles = renderer.finish().expect("timings");
-        assert_eq!(profiles.len(), 4, "every frame's timestamps come back");
+        assert_eq!(profiles.len(), 6, "every frame's timestamps come back");
         for p in &profiles {
             assert_eq!(p.passes.len(), 5);
             assert!(p.passes.iter().all(|t| t.gpu_ms.is_finite() && t.gpu_ms >= 0.0));

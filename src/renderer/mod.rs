@@ -80,6 +80,8 @@ pub struct Renderer {
     readback: Option<Readback>,
     scene_sun: Vec3,
     snow_line: f32,
+    /// Frames rendered so far.
+    frames_rendered: u64,
     /// Kept alive for the graph's imported resources.
     _terrain: TerrainGrid,
 }
@@ -182,6 +184,7 @@ impl Renderer {
             readback,
             scene_sun: scene.sun_direction,
             snow_line: lo + (hi - lo) * 0.8,
+            frames_rendered: 0,
             _terrain: terrain,
         })
     }
@@ -206,7 +209,9 @@ impl Renderer {
             exposure: 1.0,
             snow_line: self.snow_line,
         };
-        self.graph.execute(&mut self.frames, &params)
+        let outcome = self.graph.execute(&mut self.frames, &params)?;
+        self.frames_rendered = outcome.frame + 1;
+        Ok(outcome)
     }
 
     /// Waits for `frame` and copies its images out of the readback buffers.
@@ -216,6 +221,15 @@ impl Renderer {
             .readback
             .as_ref()
             .ok_or_else(|| Error::invalid("readback", "the renderer was created without readback"))?;
+        if self.frames_rendered > frame.frame + FRAMES_IN_FLIGHT as u64 {
+            return Err(Error::invalid(
+                "readback",
+                format!(
+                    "frame {} was overwritten: read a frame before rendering {FRAMES_IN_FLIGHT} more",
+                    frame.frame
+                ),
+            ));
+        }
         self.ctx.wait_timeline(frame.timeline)?;
         let slot = frame.slot % FRAMES_IN_FLIGHT;
         let floats = |b: &Buffer| -> Result<Vec<f32>> { Ok(bytemuck::pod_collect_to_vec(b.mapped()?)) };
