@@ -105,6 +105,9 @@ pub(crate) fn live_passes<P>(graph: &RenderGraph<P>) -> Vec<bool> {
 
 fn validate<P>(graph: &RenderGraph<P>) -> Result<()> {
     for pass in &graph.passes {
+        if let Some(m) = pass.misdeclared.first() {
+            return Err(Error::Graph(format!("pass '{}' declares {m}", pass.name)));
+        }
         for (r, a) in &pass.uses {
             let decl = graph
                 .resources
@@ -222,6 +225,7 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
             kind,
             uses,
             record,
+            ..
         } = decl;
         match (alive, record) {
             (true, Some(record)) => passes.push(BakedPass {
@@ -275,6 +279,20 @@ mod tests {
             .record(|_, _| Ok(()));
         g.keep(b);
         assert_eq!(live_passes(&g), vec![true, false, true]);
+    }
+
+    #[test]
+    fn reads_of_writing_accesses_are_rejected() {
+        let mut g: RenderGraph<()> = RenderGraph::new();
+        let a = g.create_image("a", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
+        g.pass("bad")
+            .read(a, Access::ColorAttachmentWrite)
+            .record(|_, _| Ok(()));
+        let err = validate(&g).unwrap_err().to_string();
+        assert!(
+            err.contains("'bad'") && err.contains("read() of the writing access"),
+            "{err}"
+        );
     }
 
     #[test]

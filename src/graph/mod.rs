@@ -109,6 +109,9 @@ pub(crate) struct PassDecl<P> {
     pub kind: PassKind,
     pub uses: Vec<(ResourceId, Access)>,
     pub record: Option<RecordFn<P>>,
+    /// Accesses declared with the wrong verb (`read` of a write access, or
+    /// `write` of a read-only one), reported when baking.
+    pub misdeclared: Vec<String>,
 }
 
 /// A render graph being declared. `P` is the per-frame parameter type every
@@ -202,6 +205,7 @@ impl<P: 'static> RenderGraph<P> {
                 kind,
                 uses: Vec::new(),
                 record: None,
+                misdeclared: Vec::new(),
             },
         }
     }
@@ -231,14 +235,24 @@ impl<P: 'static> PassBuilder<'_, P> {
         self
     }
 
-    /// Declares a read of `resource`.
+    /// Declares a read of `resource` (`access` must not write).
     pub fn read(mut self, resource: ResourceId, access: Access) -> Self {
+        if access.writes() {
+            self.decl
+                .misdeclared
+                .push(format!("read() of the writing access {access:?}"));
+        }
         self.decl.uses.push((resource, access));
         self
     }
 
-    /// Declares a write (or read-write) of `resource`.
+    /// Declares a write (or read-write) of `resource` (`access` must write).
     pub fn write(mut self, resource: ResourceId, access: Access) -> Self {
+        if !access.writes() {
+            self.decl
+                .misdeclared
+                .push(format!("write() of the read-only access {access:?}"));
+        }
         self.decl.uses.push((resource, access));
         self
     }

@@ -254,15 +254,6 @@ impl DescriptorHeap {
         }
     }
 
-    /// Handles in use per array (sampled images, storage images, storage buffers).
-    #[allow(dead_code)]
-    pub fn live_handles(&self) -> [u32; 3] {
-        self.handles
-            .lock()
-            .map(|h| [0, 1, 2].map(|i| h[i].next - h[i].free.len() as u32 - h[i].pending.len() as u32))
-            .unwrap_or_default()
-    }
-
     pub fn destroy(self, device: &ash::Device) {
         // SAFETY: the device is idle; nothing uses the heap any more.
         unsafe {
