@@ -211,7 +211,7 @@ pub fn derive_barrier(state: &mut AccessState, access: Access, discard: bool) ->
     } else {
         state.layout
     };
-    let read_access = accesses & !write_bits();
+    let read_access = accesses & !write_access_bits();
     let barrier;
     if access.writes() || layout_change {
         let src_stages = state.write_stages | state.read_stages | state.visible_stages;
@@ -229,7 +229,7 @@ pub fn derive_barrier(state: &mut AccessState, access: Access, discard: bool) ->
             })
         };
         if access.writes() {
-            *state = AccessState::written(stages, accesses & write_bits(), layout);
+            *state = AccessState::written(stages, accesses & write_access_bits(), layout);
         } else {
             // A layout transition for a read: it is a write at `stages`, visible to this read.
             *state = AccessState {
@@ -265,7 +265,8 @@ pub fn derive_barrier(state: &mut AccessState, access: Access, discard: bool) ->
     barrier
 }
 
-fn write_bits() -> A {
+/// Every access flag that writes.
+pub fn write_access_bits() -> A {
     A::SHADER_STORAGE_WRITE
         | A::SHADER_WRITE
         | A::COLOR_ATTACHMENT_WRITE

@@ -6,10 +6,13 @@ use std::collections::VecDeque;
 use std::sync::Arc;
 use std::time::Instant;
 
+use super::alias::{assign_slots, AliasSlot};
 use super::{Access, PassDecl, PassKind, RenderGraph, ResourceDecl, ResourceId};
 use crate::error::{Error, Result};
 use crate::profile::FrameProfile;
-use crate::vulkan::{AccessState, Buffer, BufferDesc, BufferUsageFlags, Context, Image, ImageDesc, ImageUsageFlags};
+use crate::vulkan::{
+    AccessState, Buffer, BufferDesc, BufferUsageFlags, Context, Image, ImageDesc, ImageUsageFlags, MemoryBlock,
+};
 
 /// The physical resource(s) behind a graph resource.
 pub(crate) enum Physical {
@@ -42,6 +45,9 @@ pub struct BakedGraph<P> {
     pub(crate) imported: Vec<bool>,
     /// Tracked state of each transient across frames.
     pub(crate) transient_states: Vec<AccessState>,
+    /// Alias slot of each transient image that shares memory.
+    pub(crate) alias_of: Vec<Option<usize>>,
+    pub(crate) alias_slots: Vec<AliasSlot>,
     pub(crate) final_accesses: Vec<(ResourceId, Access)>,
     pub(crate) culled: Vec<String>,
     pub(crate) pending: VecDeque<PendingFrame>,
@@ -141,6 +147,72 @@ fn validate<P>(graph: &RenderGraph<P>) -> Result<()> {
     Ok(())
 }
 
+/// Chooses which transient images share memory and allocates the shared
+/// blocks: per resource, its alias slot and block (None: own memory).
+#[allow(clippy::type_complexity)]
+fn plan_aliasing<P>(
+    graph: &RenderGraph<P>,
+    live: &[bool],
+    image_usage: &[ImageUsageFlags],
+    ctx: &Context,
+) -> Result<(Vec<Option<usize>>, Vec<Option<Arc<MemoryBlock>>>)> {
+    let n = graph.resources.len();
+    let mut alias_of = vec![None; n];
+    let mut blocks = vec![None; n];
+    if !graph.alias_transients {
+        return Ok((alias_of, blocks));
+    }
+    let live_passes: Vec<&PassDecl<P>> = graph
+        .passes
+        .iter()
+        .zip(live)
+        .filter(|(_, l)| **l)
+        .map(|(p, _)| p)
+        .collect();
+    let mut candidates = Vec::new();
+    let mut intervals = Vec::new();
+    for (r, decl) in graph.resources.iter().enumerate() {
+        let ResourceDecl::TransientImage { name, info } = decl else {
+            continue;
+        };
+        let used: Vec<usize> = (0..live_passes.len())
+            .filter(|&p| live_passes[p].uses.iter().any(|(id, _)| id.0 == r))
+            .collect();
+        let kept = graph.outputs.iter().any(|(o, _)| o.0 == r);
+        if let (Some(&first), Some(&last), false) = (used.first(), used.last(), kept) {
+            let desc = ImageDesc {
+                name: name.clone(),
+                width: info.width,
+                height: info.height,
+                format: info.format,
+                usage: image_usage[r],
+            };
+            candidates.push((r, desc));
+            intervals.push((first, last));
+        }
+    }
+    let slots = assign_slots(&intervals);
+    let slot_count = slots.iter().max().map_or(0, |m| m + 1);
+    let mut next_slot = 0;
+    for slot in 0..slot_count {
+        let members: Vec<usize> = (0..candidates.len()).filter(|&i| slots[i] == slot).collect();
+        if members.len() < 2 {
+            continue;
+        }
+        let descs: Vec<&ImageDesc> = members.iter().map(|&i| &candidates[i].1).collect();
+        let name = descs.iter().map(|d| d.name.as_str()).collect::<Vec<_>>().join(" | ");
+        if let Some(block) = MemoryBlock::for_images(ctx, &format!("aliased: {name}"), &descs)? {
+            for &i in &members {
+                alias_of[candidates[i].0] = Some(next_slot);
+                blocks[candidates[i].0] = Some(block.clone());
+            }
+            log::debug!("render graph: {name} share {} bytes", block.size());
+            next_slot += 1;
+        }
+    }
+    Ok((alias_of, blocks))
+}
+
 pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<BakedGraph<P>> {
     validate(&graph)?;
     let live = live_passes(&graph);
@@ -152,6 +224,7 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
             buffer_usage[r.0] |= a.buffer_usage();
         }
     }
+    let (alias_of, blocks) = plan_aliasing(&graph, &live, &image_usage, ctx)?;
     let mut physical = Vec::with_capacity(graph.resources.len());
     let mut imported = Vec::with_capacity(graph.resources.len());
     for (i, decl) in graph.resources.into_iter().enumerate() {
@@ -161,16 +234,17 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
                 if image_usage[i].is_empty() {
                     Physical::Unused
                 } else {
-                    let image = Image::new(
-                        ctx,
-                        ImageDesc {
-                            name,
-                            width: info.width,
-                            height: info.height,
-                            format: info.format,
-                            usage: image_usage[i],
-                        },
-                    )?;
+                    let desc = ImageDesc {
+                        name,
+                        width: info.width,
+                        height: info.height,
+                        format: info.format,
+                        usage: image_usage[i],
+                    };
+                    let image = match &blocks[i] {
+                        Some(block) => Image::new_aliased(ctx, desc, block.clone())?,
+                        None => Image::new(ctx, desc)?,
+                    };
                     Physical::Image(vec![Arc::new(image)])
                 }
             }
@@ -244,6 +318,8 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
     Ok(BakedGraph {
         passes,
         transient_states: vec![AccessState::UNUSED; physical.len()],
+        alias_slots: vec![AliasSlot::default(); alias_of.iter().flatten().max().map_or(0, |m| m + 1)],
+        alias_of,
         physical,
         imported,
         final_accesses,

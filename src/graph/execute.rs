@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use super::access::derive_barrier;
+use super::access::{derive_barrier, write_access_bits};
 use super::bake::{BakedGraph, PendingFrame, Physical};
 use super::{PassKind, ResourceId};
 use crate::error::{Error, Result};
@@ -126,6 +126,11 @@ impl<P> BakedGraph<P> {
         let mut buffer_barriers: Vec<(usize, Barrier)> = Vec::new();
         for &(r, access) in uses {
             let mut state = self.state_of(r, frame);
+            if let Some(slot) = self.alias_of[r.0] {
+                state = self.alias_slots[slot].state_for(r.0, state);
+                let (stages, accesses, _) = access.state();
+                self.alias_slots[slot].record(r.0, stages, accesses & write_access_bits());
+            }
             let discard = !self.imported[r.0] && !touched[r.0];
             touched[r.0] = true;
             if let Some(b) = derive_barrier(&mut state, access, discard) {

@@ -19,6 +19,7 @@
 //! ```
 
 pub mod access;
+mod alias;
 mod bake;
 mod execute;
 
@@ -121,6 +122,8 @@ pub struct RenderGraph<P> {
     pub(crate) passes: Vec<PassDecl<P>>,
     /// Resources whose final contents are wanted after the frame.
     pub(crate) outputs: Vec<(ResourceId, Option<Access>)>,
+    /// Let transient images whose uses do not overlap share memory.
+    pub(crate) alias_transients: bool,
 }
 
 impl<P> Default for RenderGraph<P> {
@@ -129,6 +132,7 @@ impl<P> Default for RenderGraph<P> {
             resources: Vec::new(),
             passes: Vec::new(),
             outputs: Vec::new(),
+            alias_transients: true,
         }
     }
 }
@@ -178,6 +182,12 @@ impl<P: 'static> RenderGraph<P> {
     pub fn import_buffers_per_frame(&mut self, buffers: Vec<Arc<Buffer>>) -> ResourceId {
         self.resources.push(ResourceDecl::ImportedBuffers(buffers));
         ResourceId(self.resources.len() - 1)
+    }
+
+    /// Whether transient images whose uses within a frame do not overlap may
+    /// share memory (default: yes).
+    pub fn set_transient_aliasing(&mut self, enabled: bool) {
+        self.alias_transients = enabled;
     }
 
     /// Keeps the passes that produce `resource` even if no pass reads it.

@@ -5,7 +5,8 @@ use ash::vk;
 
 use super::context::{vk_err, Context};
 use super::heap::PUSH_CONSTANT_BYTES;
-use super::memory::{subresource_range, Barrier, Buffer, Image};
+use super::image::Image;
+use super::memory::{subresource_range, Barrier, Buffer};
 use super::pipeline::{ComputePipeline, GraphicsPipeline};
 use crate::error::{Error, Result};
 

@@ -67,7 +67,8 @@ pub struct Barrier {
 /// An object waiting for the GPU to finish before it is destroyed.
 pub(crate) enum Garbage {
     Buffer(vk::Buffer, Allocation),
-    Image(vk::Image, vk::ImageView, Allocation),
+    Image(vk::Image, vk::ImageView, Option<Allocation>),
+    Memory(Allocation),
     Pipeline(vk::Pipeline),
     CommandPool(vk::CommandPool),
     QueryPool(vk::QueryPool),
@@ -87,8 +88,11 @@ impl Garbage {
                 Garbage::Image(image, view, allocation) => {
                     device.destroy_image_view(view, None);
                     device.destroy_image(image, None);
-                    free(shared, allocation);
+                    if let Some(allocation) = allocation {
+                        free(shared, allocation);
+                    }
                 }
+                Garbage::Memory(allocation) => free(shared, allocation),
                 Garbage::Pipeline(p) => device.destroy_pipeline(p, None),
                 Garbage::CommandPool(p) => device.destroy_command_pool(p, None),
                 Garbage::QueryPool(p) => device.destroy_query_pool(p, None),
@@ -295,182 +299,6 @@ impl Drop for Buffer {
     }
 }
 
-/// What a 2-D image is for.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ImageDesc {
-    pub name: String,
-    pub width: u32,
-    pub height: u32,
-    pub format: vk::Format,
-    pub usage: vk::ImageUsageFlags,
-}
-
-/// Whether `format` holds depth.
-pub fn is_depth_format(format: vk::Format) -> bool {
-    matches!(
-        format,
-        vk::Format::D16_UNORM | vk::Format::D32_SFLOAT | vk::Format::D24_UNORM_S8_UINT | vk::Format::D32_SFLOAT_S8_UINT
-    )
-}
-
-/// A 2-D GPU image with one view. Sampled and storage images get
-/// descriptor-heap handles.
-pub struct Image {
-    ctx: Context,
-    pub(crate) raw: vk::Image,
-    pub(crate) view: vk::ImageView,
-    allocation: Option<Allocation>,
-    desc: ImageDesc,
-    sampled_handle: Option<u32>,
-    storage_handle: Option<u32>,
-    pub(crate) state: Mutex<AccessState>,
-}
-
-impl std::fmt::Debug for Image {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Image").field("name", &self.desc.name).finish()
-    }
-}
-
-impl Image {
-    /// Creates a device-local image and its view, registered in the heap.
-    pub fn new(ctx: &Context, desc: ImageDesc) -> Result<Image> {
-        let max = ctx.max_image_dimension();
-        if desc.width == 0 || desc.height == 0 || desc.width > max || desc.height > max {
-            return Err(Error::invalid(
-                "image size",
-                format!(
-                    "'{}' is {}x{}; each side must be in 1..={max}",
-                    desc.name, desc.width, desc.height
-                ),
-            ));
-        }
-        let device = &ctx.shared.device;
-        let info = vk::ImageCreateInfo::default()
-            .image_type(vk::ImageType::TYPE_2D)
-            .format(desc.format)
-            .extent(vk::Extent3D {
-                width: desc.width,
-                height: desc.height,
-                depth: 1,
-            })
-            .mip_levels(1)
-            .array_layers(1)
-            .samples(vk::SampleCountFlags::TYPE_1)
-            .tiling(vk::ImageTiling::OPTIMAL)
-            .usage(desc.usage)
-            .sharing_mode(vk::SharingMode::EXCLUSIVE)
-            .initial_layout(vk::ImageLayout::UNDEFINED);
-        // SAFETY: valid create info on a live device.
-        let raw = unsafe { device.create_image(&info, None) }.map_err(vk_err("vkCreateImage"))?;
-        // SAFETY: `raw` was just created on this device.
-        let requirements = unsafe { device.get_image_memory_requirements(raw) };
-        let allocation = match allocate(ctx, &desc.name, requirements, MemoryLocation::GpuOnly, false) {
-            Ok(a) => a,
-            Err(e) => {
-                // SAFETY: the image was never used.
-                unsafe { device.destroy_image(raw, None) };
-                return Err(e);
-            }
-        };
-        // SAFETY: the allocation satisfies the image's requirements and is unbound.
-        let bound = unsafe { device.bind_image_memory(raw, allocation.memory(), allocation.offset()) };
-        let aspect = if is_depth_format(desc.format) {
-            vk::ImageAspectFlags::DEPTH
-        } else {
-            vk::ImageAspectFlags::COLOR
-        };
-        let view_info = vk::ImageViewCreateInfo::default()
-            .image(raw)
-            .view_type(vk::ImageViewType::TYPE_2D)
-            .format(desc.format)
-            .subresource_range(subresource_range(aspect));
-        let view = bound.map_err(vk_err("vkBindImageMemory")).and_then(|_| {
-            // SAFETY: the image is bound to memory; the view matches its format.
-            unsafe { device.create_image_view(&view_info, None) }.map_err(vk_err("vkCreateImageView"))
-        });
-        let view = match view {
-            Ok(v) => v,
-            Err(e) => {
-                ctx.defer_destroy(Garbage::Image(raw, vk::ImageView::null(), allocation));
-                return Err(e);
-            }
-        };
-        ctx.name_object(raw, &desc.name);
-        ctx.name_object(view, &desc.name);
-        let heap = &ctx.shared.heap;
-        let sampled_handle = if desc.usage.contains(vk::ImageUsageFlags::SAMPLED) {
-            Some(heap.register_image(device, HeapKind::SampledImage, view)?)
-        } else {
-            None
-        };
-        let storage_handle = if desc.usage.contains(vk::ImageUsageFlags::STORAGE) {
-            Some(heap.register_image(device, HeapKind::StorageImage, view)?)
-        } else {
-            None
-        };
-        Ok(Image {
-            ctx: ctx.clone(),
-            raw,
-            view,
-            allocation: Some(allocation),
-            desc,
-            sampled_handle,
-            storage_handle,
-            state: Mutex::new(AccessState::UNUSED),
-        })
-    }
-
-    /// The image's description.
-    pub fn desc(&self) -> &ImageDesc {
-        &self.desc
-    }
-
-    /// Heap index for sampling (layout SHADER_READ_ONLY_OPTIMAL).
-    pub fn sampled_handle(&self) -> Option<u32> {
-        self.sampled_handle
-    }
-
-    /// Heap index for storage access (layout GENERAL).
-    pub fn storage_handle(&self) -> Option<u32> {
-        self.storage_handle
-    }
-
-    pub(crate) fn aspect(&self) -> vk::ImageAspectFlags {
-        if is_depth_format(self.desc.format) {
-            vk::ImageAspectFlags::DEPTH
-        } else {
-            vk::ImageAspectFlags::COLOR
-        }
-    }
-
-    pub fn state(&self) -> AccessState {
-        self.state.lock().map(|s| *s).unwrap_or(AccessState::UNUSED)
-    }
-
-    pub fn set_state(&self, state: AccessState) {
-        if let Ok(mut s) = self.state.lock() {
-            *s = state;
-        }
-    }
-}
-
-impl Drop for Image {
-    fn drop(&mut self) {
-        let heap = &self.ctx.shared.heap;
-        let last = self.ctx.last_submitted();
-        if let Some(handle) = self.sampled_handle {
-            heap.release(HeapKind::SampledImage, handle, last);
-        }
-        if let Some(handle) = self.storage_handle {
-            heap.release(HeapKind::StorageImage, handle, last);
-        }
-        if let Some(allocation) = self.allocation.take() {
-            self.ctx.defer_destroy(Garbage::Image(self.raw, self.view, allocation));
-        }
-    }
-}
-
 pub(crate) fn subresource_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
     vk::ImageSubresourceRange {
         aspect_mask: aspect,
@@ -481,7 +309,7 @@ pub(crate) fn subresource_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubres
     }
 }
 
-fn allocate(
+pub(crate) fn allocate(
     ctx: &Context,
     name: &str,
     requirements: vk::MemoryRequirements,
@@ -505,33 +333,4 @@ fn allocate(
             what: name.to_string(),
             message: e.to_string(),
         })
-}
-
-impl Image {
-    /// Creates a device-local image (with TRANSFER_DST added to `desc.usage`)
-    /// holding `texels`, tightly packed rows, through a staging copy.
-    pub fn with_data(ctx: &Context, mut desc: ImageDesc, texels: &[u8]) -> Result<Image> {
-        desc.usage |= vk::ImageUsageFlags::TRANSFER_DST;
-        let name = desc.name.clone();
-        let image = Image::new(ctx, desc)?;
-        let staging = Buffer::staging(ctx, &name, texels)?;
-        let to_transfer = Barrier {
-            src_stages: vk::PipelineStageFlags2::NONE,
-            src_access: vk::AccessFlags2::NONE,
-            dst_stages: vk::PipelineStageFlags2::ALL_TRANSFER,
-            dst_access: vk::AccessFlags2::TRANSFER_WRITE,
-            old_layout: vk::ImageLayout::UNDEFINED,
-            new_layout: vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-        };
-        ctx.one_shot(|rec| {
-            rec.barriers(&[], &[(&image, to_transfer)]);
-            rec.copy_buffer_to_image(&staging, &image);
-        })?;
-        image.set_state(AccessState::written(
-            vk::PipelineStageFlags2::ALL_TRANSFER,
-            vk::AccessFlags2::TRANSFER_WRITE,
-            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-        ));
-        Ok(image)
-    }
 }
