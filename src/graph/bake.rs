@@ -7,7 +7,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::alias::{assign_slots, AliasSlot};
-use super::{Access, PassDecl, PassKind, RenderGraph, ResourceDecl, ResourceId};
+use super::{Access, ImageInfo, PassDecl, PassKind, RenderGraph, ResourceDecl, ResourceId};
 use crate::error::{Error, Result};
 use crate::profile::FrameProfile;
 use crate::vulkan::{
@@ -20,6 +20,24 @@ pub(crate) enum Physical {
     Buffer(Vec<Arc<Buffer>>),
     /// A transient nobody uses after culling.
     Unused,
+}
+
+impl Physical {
+    /// The image frame `frame` uses (per-frame imports rotate).
+    pub(crate) fn image(&self, frame: u64) -> Option<&Arc<Image>> {
+        match self {
+            Physical::Image(v) if !v.is_empty() => Some(&v[frame as usize % v.len()]),
+            _ => None,
+        }
+    }
+
+    /// The buffer frame `frame` uses.
+    pub(crate) fn buffer(&self, frame: u64) -> Option<&Arc<Buffer>> {
+        match self {
+            Physical::Buffer(v) if !v.is_empty() => Some(&v[frame as usize % v.len()]),
+            _ => None,
+        }
+    }
 }
 
 pub(crate) struct BakedPass<P> {
@@ -68,10 +86,7 @@ impl<P> BakedGraph<P> {
 
     /// The physical image behind a transient or imported image (slot 0).
     pub fn image(&self, id: ResourceId) -> Option<&Arc<Image>> {
-        match self.physical.get(id.0) {
-            Some(Physical::Image(images)) => images.first(),
-            _ => None,
-        }
+        self.physical.get(id.0).and_then(|p| p.image(0))
     }
 }
 
@@ -147,6 +162,16 @@ fn validate<P>(graph: &RenderGraph<P>) -> Result<()> {
     Ok(())
 }
 
+fn transient_image_desc(name: String, info: &ImageInfo, usage: ImageUsageFlags) -> ImageDesc {
+    ImageDesc {
+        name,
+        width: info.width,
+        height: info.height,
+        format: info.format,
+        usage,
+    }
+}
+
 /// Chooses which transient images share memory and allocates the shared
 /// blocks: per resource, its alias slot and block (None: own memory).
 #[allow(clippy::type_complexity)]
@@ -180,13 +205,7 @@ fn plan_aliasing<P>(
             .collect();
         let kept = graph.outputs.iter().any(|(o, _)| o.0 == r);
         if let (Some(&first), Some(&last), false) = (used.first(), used.last(), kept) {
-            let desc = ImageDesc {
-                name: name.clone(),
-                width: info.width,
-                height: info.height,
-                format: info.format,
-                usage: image_usage[r],
-            };
+            let desc = transient_image_desc(name.clone(), info, image_usage[r]);
             candidates.push((r, desc));
             intervals.push((first, last));
         }
@@ -234,13 +253,7 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
                 if image_usage[i].is_empty() {
                     Physical::Unused
                 } else {
-                    let desc = ImageDesc {
-                        name,
-                        width: info.width,
-                        height: info.height,
-                        format: info.format,
-                        usage: image_usage[i],
-                    };
+                    let desc = transient_image_desc(name, &info, image_usage[i]);
                     let image = match &blocks[i] {
                         Some(block) => Image::new_aliased(ctx, desc, block.clone())?,
                         None => Image::new(ctx, desc)?,

@@ -29,26 +29,20 @@ impl<'a> PassContext<'a> {
 
     /// The image behind `id` this frame.
     pub fn image(&self, id: ResourceId) -> Result<&'a Image> {
-        match self.physical.get(id.0) {
-            Some(Physical::Image(images)) if !images.is_empty() => Ok(&images[(self.frame as usize) % images.len()]),
-            _ => Err(Error::Graph(format!(
-                "resource #{} is not an image of this graph",
-                id.0
-            ))),
-        }
+        self.physical
+            .get(id.0)
+            .and_then(|p| p.image(self.frame))
+            .map(|i| &**i)
+            .ok_or_else(|| Error::Graph(format!("resource #{} is not an image of this graph", id.0)))
     }
 
     /// The buffer behind `id` this frame.
     pub fn buffer(&self, id: ResourceId) -> Result<&'a Buffer> {
-        match self.physical.get(id.0) {
-            Some(Physical::Buffer(buffers)) if !buffers.is_empty() => {
-                Ok(&buffers[(self.frame as usize) % buffers.len()])
-            }
-            _ => Err(Error::Graph(format!(
-                "resource #{} is not a buffer of this graph",
-                id.0
-            ))),
-        }
+        self.physical
+            .get(id.0)
+            .and_then(|p| p.buffer(self.frame))
+            .map(|b| &**b)
+            .ok_or_else(|| Error::Graph(format!("resource #{} is not a buffer of this graph", id.0)))
     }
 
     /// Heap handle for sampling the image `id`.
@@ -78,10 +72,9 @@ impl<'a> PassContext<'a> {
 pub struct FrameOutcome {
     /// Frame number (0, 1, ...).
     pub frame: u64,
-    /// Timeline value that marks the frame's completion.
+    /// Timeline value that marks the frame's completion. Per-frame imported
+    /// resources are used round-robin: copy `frame % copies`.
     pub timeline: u64,
-    /// Which physical copy of per-frame imported resources this frame used.
-    pub slot: usize,
 }
 
 fn label_color(kind: PassKind) -> [f32; 4] {
@@ -94,23 +87,24 @@ fn label_color(kind: PassKind) -> [f32; 4] {
 
 impl<P> BakedGraph<P> {
     fn state_of(&self, r: ResourceId, frame: u64) -> AccessState {
-        match &self.physical[r.0] {
-            _ if !self.imported[r.0] => self.transient_states[r.0],
-            Physical::Image(v) => v[(frame as usize) % v.len()].state(),
-            Physical::Buffer(v) => v[(frame as usize) % v.len()].state(),
-            Physical::Unused => AccessState::UNUSED,
+        let p = &self.physical[r.0];
+        if !self.imported[r.0] {
+            self.transient_states[r.0]
+        } else if let Some(image) = p.image(frame) {
+            image.state()
+        } else {
+            p.buffer(frame).map_or(AccessState::UNUSED, |b| b.state())
         }
     }
 
     fn set_state_of(&mut self, r: ResourceId, frame: u64, state: AccessState) {
+        let p = &self.physical[r.0];
         if !self.imported[r.0] {
             self.transient_states[r.0] = state;
-            return;
-        }
-        match &self.physical[r.0] {
-            Physical::Image(v) => v[(frame as usize) % v.len()].set_state(state),
-            Physical::Buffer(v) => v[(frame as usize) % v.len()].set_state(state),
-            Physical::Unused => {}
+        } else if let Some(image) = p.image(frame) {
+            image.set_state(state);
+        } else if let Some(buffer) = p.buffer(frame) {
+            buffer.set_state(state);
         }
     }
 
@@ -142,20 +136,13 @@ impl<P> BakedGraph<P> {
             }
             self.set_state_of(r, frame, state);
         }
-        let slot = frame as usize;
         let images: Vec<(&Image, Barrier)> = image_barriers
             .iter()
-            .filter_map(|(r, b)| match &self.physical[*r] {
-                Physical::Image(v) => Some((&*v[slot % v.len()], *b)),
-                _ => None,
-            })
+            .filter_map(|(r, b)| Some((&**self.physical[*r].image(frame)?, *b)))
             .collect();
         let buffers: Vec<(&Buffer, Barrier)> = buffer_barriers
             .iter()
-            .filter_map(|(r, b)| match &self.physical[*r] {
-                Physical::Buffer(v) => Some((&*v[slot % v.len()], *b)),
-                _ => None,
-            })
+            .filter_map(|(r, b)| Some((&**self.physical[*r].buffer(frame)?, *b)))
             .collect();
         cmd.barriers(&buffers, &images);
     }
@@ -213,11 +200,7 @@ impl<P> BakedGraph<P> {
             cpu_ms: frame_start.elapsed().as_secs_f64() * 1e3,
             cpu_passes,
         });
-        Ok(FrameOutcome {
-            frame,
-            timeline,
-            slot: frame as usize,
-        })
+        Ok(FrameOutcome { frame, timeline })
     }
 
     fn complete(&mut self, completed: CompletedFrame) {

@@ -230,8 +230,8 @@ impl Renderer {
                 ),
             ));
         }
-        self.ctx.wait_timeline(frame.timeline)?;
-        let slot = frame.slot % FRAMES_IN_FLIGHT;
+        self.ctx.wait(frame.timeline)?;
+        let slot = frame.frame as usize % FRAMES_IN_FLIGHT;
         let floats = |b: &Buffer| -> Result<Vec<f32>> { Ok(bytemuck::pod_collect_to_vec(b.mapped()?)) };
         Ok(FrameImages {
             width: self.settings.width,

@@ -274,7 +274,7 @@ impl Context {
         // SAFETY: valid device; timeline semaphores were enabled.
         let timeline =
             unsafe { device.create_semaphore(&semaphore_info, None) }.map_err(vk_err("vkCreateSemaphore"))?;
-        let heap = DescriptorHeap::new(&device, &candidate.properties.limits)?;
+        let heap = DescriptorHeap::new(&device)?;
 
         let props = &candidate.properties;
         let info = DeviceInfo {
@@ -374,7 +374,7 @@ impl Context {
 
     /// Blocks until the GPU has completed timeline value `value`, then frees
     /// what was waiting on it.
-    pub(crate) fn wait(&self, value: u64) -> Result<()> {
+    pub fn wait(&self, value: u64) -> Result<()> {
         if value > 0 {
             let semaphores = [self.shared.timeline];
             let values = [value];
@@ -383,11 +383,6 @@ impl Context {
             unsafe { self.shared.device.wait_semaphores(&info, u64::MAX) }.map_err(vk_err("vkWaitSemaphores"))?;
         }
         self.collect_garbage()
-    }
-
-    /// Blocks until the GPU has completed timeline value `value`.
-    pub fn wait_timeline(&self, value: u64) -> Result<()> {
-        self.wait(value)
     }
 
     /// Blocks until every submission so far has completed.

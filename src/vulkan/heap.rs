@@ -74,8 +74,7 @@ pub(crate) struct DescriptorHeap {
 }
 
 impl DescriptorHeap {
-    pub fn new(device: &ash::Device, limits: &vk::PhysicalDeviceLimits) -> Result<Self> {
-        let _ = limits;
+    pub fn new(device: &ash::Device) -> Result<Self> {
         let counts = [4096u32, 4096, 4096, 16];
         let types = [
             vk::DescriptorType::SAMPLED_IMAGE,
