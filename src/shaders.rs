@@ -14,8 +14,8 @@ macro_rules! spirv {
     };
 }
 
-/// terrain.grid: height field → vertex buffer (compute).
-pub const TERRAIN_GRID: SpirV = spirv!("terrain/grid.comp");
+/// terrain.warp: warp and zoom of the geometry image into the vertex buffer (compute).
+pub const TERRAIN_WARP: SpirV = spirv!("terrain/warp.comp");
 /// terrain.draw: vertex stage.
 pub const TERRAIN_DRAW_VERT: SpirV = spirv!("terrain/draw.vert");
 /// terrain.draw: fragment stage.

@@ -317,7 +317,7 @@ fn finite_ms(value: &Value, key: &str, what: &str) -> f64 {
     v
 }
 
-const RENDER_PASSES: [&str; 5] = ["sky", "terrain.grid", "terrain.draw", "tonemap", "readback"];
+const RENDER_PASSES: [&str; 5] = ["sky", "terrain.warp", "terrain.draw", "tonemap", "readback"];
 
 #[test]
 fn render_writes_every_output() {
@@ -551,7 +551,7 @@ fn bench_writes_json_summary() {
     finite_ms(&b, "median_frame_gpu_ms", "bench");
     let passes = b["passes"].as_array().expect("bench JSON has passes");
     // Bench renders without readback.
-    for name in ["sky", "terrain.grid", "terrain.draw", "tonemap"] {
+    for name in ["sky", "terrain.warp", "terrain.draw", "tonemap"] {
         let pass = passes
             .iter()
             .find(|p| p["name"] == name)

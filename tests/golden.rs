@@ -40,6 +40,7 @@ fn check_golden(name: &str, scene: &Scene, camera: &Camera) {
             width: WIDTH,
             height: HEIGHT,
             readback: true,
+            terrain: Default::default(),
         };
         let mut renderer = Renderer::new(&ctx, scene, settings).expect("renderer");
         let frame = renderer.render(camera).and_then(|f| renderer.read(&f)).expect("frame");

@@ -31,11 +31,12 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
             width: 96,
             height: 64,
             readback: true,
+            terrain: Default::default(),
         };
         let mut renderer = Renderer::new(&ctx, &scene, settings).expect("renderer");
         assert_eq!(
             renderer.pass_names(),
-            ["sky", "terrain.grid", "terrain.draw", "tonemap", "readback"]
+            ["sky", "terrain.warp", "terrain.draw", "tonemap", "readback"]
         );
         let camera = scene.default_camera();
         // Several frames, two in flight: exercises cross-frame barrier state.
@@ -82,6 +83,7 @@ fn renders_are_deterministic() {
             width: 80,
             height: 48,
             readback: true,
+            terrain: Default::default(),
         };
         let camera = scene.default_camera();
         let mut first = Renderer::new(&ctx, &scene, settings).expect("renderer");
@@ -219,6 +221,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
                 width: 16,
                 height: 16,
                 readback: true,
+                terrain: Default::default(),
             },
         )
         .unwrap();
@@ -238,7 +241,8 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
             RenderSettings {
                 width: 0,
                 height: 16,
-                readback: false
+                readback: false,
+                terrain: Default::default(),
             }
         )
         .is_err());

@@ -1,39 +1,107 @@
 #version 460
-// terrain.draw: sun (Lambert) and sky ambient over a slope/altitude albedo,
-// with haze; writes HDR radiance and view-space depth.
+// terrain.draw, fragment stage (dissertation §7.4.3 "Procedural Detail" and
+// "Colour"; ALGORITHMS.md §3 items 6 and 8): per-pixel bump mapping with the
+// detail octaves between the vertex's split octave and the pixel footprint,
+// surface type from altitude, slope and orientation with turbulence-perturbed
+// boundaries, sun and sky ambient, haze. Writes HDR radiance and view depth.
+// The debug views colour the same surface by a diagnostic instead.
+#include "../include/heap.glsl"
 #include "../include/atmosphere.glsl"
-
-layout(push_constant) uniform Push {
-    mat4 view_proj;
-    vec4 eye;
-    vec4 forward;
-    vec4 sun;
-} pc;
+#include "../include/terrain_detail.glsl"
+#include "../include/terrain_draw.glsl"
 
 layout(location = 0) in vec3 in_world;
 layout(location = 1) in vec3 in_normal;
+layout(location = 2) in float in_split;
+layout(location = 3) in float in_debug;
+layout(location = 4) in vec2 in_grid;
 
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_depth;
 
-vec3 albedo(vec3 n, float h) {
-    vec3 grass = vec3(0.20, 0.28, 0.10);
-    vec3 rock = vec3(0.36, 0.33, 0.30);
+// Blue → green → yellow → red for t in [0, 1].
+vec3 ramp(float t) {
+    t = clamp(t, 0.0, 1.0);
+    return clamp(vec3(1.5 - abs(4.0 * t - 3.0), 1.5 - abs(4.0 * t - 2.0), 1.5 - abs(4.0 * t - 1.0)), 0.0, 1.0);
+}
+
+// Surface type → albedo. Boundaries are perturbed by low-frequency
+// turbulence (the wavelet tile at coarse scales) before classification.
+vec3 albedo(vec3 n, vec3 p, uint tile) {
+    // Turbulence needs no smooth derivative: one bilinear fetch per octave.
+    float turb = 0.0;
+    float scale = 1.0 / 180.0;
+    float a = 1.0;
+    for (int k = 0; k < 3; ++k) {
+        vec2 uv = (p.xy * scale + vec2(5.3 * float(k))) / float(NOISE_TILE);
+        turb += a * abs(textureLod(sampler2D(g_textures[tile], g_samplers[SAMPLER_LINEAR_REPEAT]), uv, 0.0).r);
+        scale *= 2.03;
+        a *= 0.5;
+    }
+    float slope = 1.0 - n.z + 0.12 * (turb - 0.3);
+    float altitude = p.z + 80.0 * (turb - 0.3);
+    // Orientation: slopes facing the sun dry out, slopes facing away keep snow.
+    float facing = dot(normalize(n.xy + 1e-6), normalize(pc.sun.xy + 1e-6)) * (1.0 - n.z) * 4.0;
+    vec3 grass = vec3(0.16, 0.24, 0.08);
+    vec3 dry_grass = vec3(0.34, 0.31, 0.15);
+    vec3 rock = vec3(0.34, 0.31, 0.28);
     vec3 snow = vec3(0.90, 0.92, 0.95);
-    float slope = 1.0 - n.z;
-    vec3 a = mix(grass, rock, smoothstep(0.18, 0.35, slope));
-    float snow_line = pc.sun.w;
-    return mix(a, snow, smoothstep(snow_line, snow_line + 60.0, h) * (1.0 - smoothstep(0.35, 0.55, slope)));
+    vec3 c = mix(grass, dry_grass, smoothstep(0.1, 0.6, facing + 0.8 * (turb - 0.3)));
+    c = mix(c, rock, smoothstep(0.22, 0.34, slope));
+    float snow_line = pc.sun.w - 60.0 * clamp(-facing, -1.0, 1.0);
+    return mix(c, snow, smoothstep(snow_line, snow_line + 40.0, altitude) * (1.0 - smoothstep(0.38, 0.55, slope)));
 }
 
 void main() {
-    vec3 n = normalize(in_normal);
+    uint flags = draw_flags();
+    uint view = flags & 7u;
+    bool detail = (flags & 8u) != 0u;
+    uint tile = floatBitsToUint(pc.params.z);
+    float d0 = pc.eye.w;
     vec3 sun = normalize(pc.sun.xyz);
-    vec3 a = albedo(n, in_world.z);
-    vec3 sky_ambient = mix(SKY_HORIZON, SKY_ZENITH, 0.5 + 0.5 * n.z) * (0.5 + 0.5 * n.z);
-    vec3 radiance = a * (SUN_RADIANCE * max(dot(n, sun), 0.0) + sky_ambient);
     vec3 to_point = in_world - pc.eye.xyz;
     float dist = length(to_point);
-    out_color = vec4(apply_haze(radiance, dist, to_point / max(dist, 1e-6), sun), 1.0);
-    out_depth = dot(to_point, pc.forward.xyz);
+    float depth = dot(to_point, pc.forward.xyz);
+    out_depth = depth;
+
+    vec3 n = normalize(in_normal);
+    if (detail && view == VIEW_SHADED) {
+        // Octaves from the split octave up to the pixel footprint (Nyquist:
+        // two pixels per wavelength) go into the normal.
+        float footprint = max(depth, 1e-3) * pc.forward.w;
+        float o_pixel = clamp(log2(d0 / footprint), 0.0, float(MAX_DETAIL_OCTAVES));
+        vec2 grad;
+        detail_octaves(tile, in_world.xy, d0, pc.params.x, pc.params.y, in_split, max(o_pixel, in_split), grad);
+        n = normalize(n + vec3(-grad, 0.0) * n.z);
+    }
+
+    vec3 radiance;
+    if (view == VIEW_SHADED) {
+        vec3 a = albedo(n, in_world, tile);
+        vec3 sky_ambient = mix(SKY_HORIZON, SKY_ZENITH, 0.5 + 0.5 * n.z) * (0.5 + 0.5 * n.z);
+        radiance = a * (SUN_RADIANCE * max(dot(n, sun), 0.0) + sky_ambient);
+        radiance = apply_haze(radiance, dist, to_point / max(dist, 1e-6), sun);
+    } else {
+        vec3 c;
+        if (view == VIEW_IMPORTANCE) {
+            c = ramp(sqrt(in_debug));
+        } else if (view == VIEW_DENSITY_RATIO) {
+            // log2 ratio: [0.5, 1] is green, lower blue, higher yellow to red.
+            c = ramp(0.5 + 0.25 * log2(max(in_debug, 1e-3) / 0.7071));
+        } else if (view == VIEW_SPLIT_OCTAVE) {
+            c = ramp(in_split / 6.0);
+        } else {
+            c = vec3(0.55);
+        }
+        float light = 0.45 + 0.55 * max(dot(n, sun), 0.0);
+        radiance = c * light;
+        if (view == VIEW_WIREFRAME) {
+            // Every fourth grid line, so the mesh stays legible at small image sizes.
+            vec2 g = in_grid / 4.0;
+            vec2 f = abs(fract(g + 0.5) - 0.5) / max(fwidth(g), vec2(1e-6));
+            float line = 1.0 - clamp(min(f.x, f.y) - 0.5, 0.0, 1.0);
+            radiance = mix(radiance, vec3(0.02, 0.05, 0.12), line);
+        }
+    }
+    out_color = vec4(radiance, 1.0);
 }

@@ -2,8 +2,11 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
+
+use alpenglow::renderer::camera_path::{parse_orbit, Orbit};
+use alpenglow::terrain::terrain_spec::TerrainSpec;
 
 /// alpenglow: a Vulkan renderer for large outdoor scenes.
 #[derive(Parser, Debug)]
@@ -19,6 +22,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Render N frames and report the median GPU time per pass and per frame.
     Bench(BenchArgs),
+    /// Render a camera path (keyframe file or orbit) to a PNG sequence and report per-frame times.
+    Fly(FlyArgs),
     /// Print the Vulkan device, driver and the features in use.
     Info(DeviceArgs),
 }
@@ -73,7 +78,86 @@ pub struct SceneArgs {
     #[arg(long = "height-offset", default_value_t = 0.0, allow_hyphen_values = true)]
     pub height_offset: f32,
     #[command(flatten)]
+    pub terrain: TerrainArgs,
+    #[command(flatten)]
     pub device: DeviceArgs,
+}
+
+/// On or off.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Switch {
+    On,
+    Off,
+}
+
+/// Terrain LOD placement.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LodArg {
+    /// Geometry image warping by the importance map (§7.4).
+    Warped,
+    /// A regular grid over the sketch map with the same vertex count.
+    Uniform,
+}
+
+/// What the terrain shows.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ViewArg {
+    Shaded,
+    Importance,
+    DensityRatio,
+    SplitOctave,
+    Wireframe,
+}
+
+/// Orientation of the sketch map.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AlignArg {
+    /// Rows across the view direction (default).
+    View,
+    /// Rows along world x (the text's choice).
+    Axes,
+}
+
+/// A factor of the importance map (eq. 7.4).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FactorArg {
+    Distance,
+    Frustum,
+    Backface,
+    Surface,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct TerrainArgs {
+    /// Procedural terrain instead of a height map: procedural:MODEL[,key=value...]
+    /// with MODEL fbm|multifractal|heterogeneous|hybrid|ridged and keys seed, octaves,
+    /// lacunarity, h, offset, gain, wavelength, amplitude, size, spacing (DX or DX:DY).
+    #[arg(long, conflicts_with = "heightmap")]
+    pub terrain: Option<TerrainSpec>,
+    /// Procedural displacement and bump mapping; off shows the sketch atlas surface alone.
+    #[arg(long = "terrain-detail", value_enum, default_value = "on")]
+    pub terrain_detail: Switch,
+    /// Detail amplitude relative to the height-sample spacing.
+    #[arg(long = "detail-amplitude", default_value_t = 0.15)]
+    pub detail_amplitude: f32,
+    /// Vertex placement.
+    #[arg(long, value_enum, default_value = "warped")]
+    pub lod: LodArg,
+    /// Debug view of the terrain.
+    #[arg(long, value_enum, default_value = "shaded")]
+    pub view: ViewArg,
+    /// Output grid side (vertices per side of the geometry image).
+    #[arg(long, default_value_t = 512)]
+    pub grid: u32,
+    /// Sketch map side (texels per side).
+    #[arg(long, default_value_t = 128)]
+    pub sketch: usize,
+    /// Sketch map orientation.
+    #[arg(long = "sketch-align", value_enum, default_value = "view")]
+    pub sketch_align: AlignArg,
+    /// Switch importance factors off (comma-separated), for debugging.
+    #[arg(long = "importance-off", value_enum, value_delimiter = ',')]
+    pub importance_off: Vec<FactorArg>,
 }
 
 #[derive(Args, Debug)]
@@ -108,6 +192,30 @@ pub struct BenchArgs {
     #[arg(long)]
     pub json: Option<PathBuf>,
     /// Chrome trace of the timed frames.
+    #[arg(long)]
+    pub trace: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+pub struct FlyArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Keyframes (TOML: [[keyframe]] time, eye = [x,y,z], target = [x,y,z]); fov, near, far from the camera options.
+    #[arg(long, conflicts_with = "orbit")]
+    pub path: Option<PathBuf>,
+    /// Orbit CX,CY,CZ,RADIUS,HEIGHT[,TURNS] (default: one turn around the terrain's centre).
+    #[arg(long, value_parser = parse_orbit, allow_hyphen_values = true)]
+    pub orbit: Option<Orbit>,
+    /// Frames over the whole path.
+    #[arg(long, default_value_t = 60)]
+    pub frames: u32,
+    /// Directory for frame_00000.png…; must not exist or be empty (without it, frames are only timed).
+    #[arg(long = "out-dir")]
+    pub out_dir: Option<PathBuf>,
+    /// Per-frame times and pass medians as JSON.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Chrome trace of all frames.
     #[arg(long)]
     pub trace: Option<PathBuf>,
 }

@@ -1,6 +1,7 @@
 //! Subcommands of the `alpenglow` binary.
 
 mod args;
+mod fly;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -13,8 +14,14 @@ use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
 use alpenglow::io::image_out::{write_exr, write_png_rgba8};
 use alpenglow::profile::{summarize, write_chrome_trace, write_profile_json, FrameProfile};
 use alpenglow::renderer::{validate_size, Camera, RenderSettings, Renderer, Scene};
+use alpenglow::terrain::geometry_image::{TerrainSettings, TerrainView};
+use alpenglow::terrain::lod::{ImportanceFactors, LodMode, LodSettings};
+use alpenglow::terrain::sketch_map::SketchAlignment;
 use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector, ValidationReport};
-use args::{BenchArgs, Cli, Command, DeviceArgs, RenderArgs, SceneArgs};
+use args::{
+    AlignArg, BenchArgs, Cli, Command, DeviceArgs, FactorArg, LodArg, RenderArgs, SceneArgs, Switch, TerrainArgs,
+    ViewArg,
+};
 
 /// Parses the command line and runs the subcommand.
 pub fn run() -> Result<ExitCode> {
@@ -39,6 +46,7 @@ pub fn run() -> Result<ExitCode> {
     match cli.command {
         Command::Render(args) => render(args),
         Command::Bench(args) => bench(args),
+        Command::Fly(args) => fly::fly(args),
         Command::Info(args) => info(args),
     }
 }
@@ -132,6 +140,9 @@ fn check_output_path(path: &Option<PathBuf>, what: &str) -> Result<()> {
 
 fn load_scene(args: &SceneArgs) -> Result<Scene> {
     validate_size(args.width, args.height)?;
+    if let Some(spec) = &args.terrain.terrain {
+        return Ok(Scene::new(spec.generate()?));
+    }
     match &args.heightmap {
         Some(path) => {
             let field = load_heightmap(
@@ -146,6 +157,42 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
         }
         None => Ok(Scene::default_procedural()?),
     }
+}
+
+fn terrain_settings(args: &TerrainArgs) -> Result<TerrainSettings> {
+    let off = |f: FactorArg| args.importance_off.contains(&f);
+    let settings = TerrainSettings {
+        grid_side: args.grid,
+        lod: LodSettings {
+            sketch_side: args.sketch,
+            mode: match args.lod {
+                LodArg::Warped => LodMode::Warped,
+                LodArg::Uniform => LodMode::Uniform,
+            },
+            factors: ImportanceFactors {
+                distance: !off(FactorArg::Distance),
+                frustum: !off(FactorArg::Frustum),
+                backface: !off(FactorArg::Backface),
+                surface: !off(FactorArg::Surface),
+            },
+            alignment: match args.sketch_align {
+                AlignArg::View => SketchAlignment::View,
+                AlignArg::Axes => SketchAlignment::Axes,
+            },
+        },
+        detail: args.terrain_detail == Switch::On,
+        detail_amplitude: args.detail_amplitude,
+        view: match args.view {
+            ViewArg::Shaded => TerrainView::Shaded,
+            ViewArg::Importance => TerrainView::Importance,
+            ViewArg::DensityRatio => TerrainView::DensityRatio,
+            ViewArg::SplitOctave => TerrainView::SplitOctave,
+            ViewArg::Wireframe => TerrainView::Wireframe,
+        },
+        ..TerrainSettings::default()
+    };
+    settings.validate()?;
+    Ok(settings)
 }
 
 fn camera(args: &SceneArgs, scene: &Scene) -> Result<Camera> {
@@ -197,6 +244,7 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
             width: args.scene.width,
             height: args.scene.height,
             readback: true,
+            terrain: terrain_settings(&args.scene.terrain)?,
         };
         let mut renderer = Renderer::new(&ctx, &scene, settings)?;
         let frame = renderer.render(&camera)?;
@@ -239,6 +287,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
             width: args.scene.width,
             height: args.scene.height,
             readback: false,
+            terrain: terrain_settings(&args.scene.terrain)?,
         };
         let mut renderer = Renderer::new(&ctx, &scene, settings)?;
         let mut last = std::time::Instant::now();

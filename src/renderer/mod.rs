@@ -2,11 +2,13 @@
 //! of it, headless, into HDR radiance, view-space depth and tone-mapped sRGB.
 //!
 //! Frame graph of the default scene:
-//! `terrain.grid` (compute, writes the vertex buffer) → `sky` (graphics) →
+//! `sky` (graphics) → `terrain.warp` (compute: CPU warp of the sketch map,
+//! then warp and zoom on the GPU into the vertex buffer, §7.4) →
 //! `terrain.draw` (graphics, reads the vertex buffer) → `tonemap` (compute)
 //! → `readback` (transfer).
 
 pub mod camera;
+pub mod camera_path;
 pub mod scene;
 pub mod tonemap;
 
@@ -21,7 +23,8 @@ use crate::error::{Error, Result};
 use crate::graph::{Access, BakedGraph, FrameOutcome, ImageInfo, RenderGraph};
 use crate::lighting::sky::add_sky_pass;
 use crate::profile::FrameProfile;
-use crate::terrain::grid::TerrainGrid;
+use crate::terrain::geometry_image::{GeometryImage, TerrainSettings};
+use crate::terrain::shading::add_draw_pass;
 use crate::vulkan::{
     Buffer, BufferDesc, BufferUsageFlags, Context, Format, FrameRing, MemoryLocation, FRAMES_IN_FLIGHT,
 };
@@ -43,13 +46,27 @@ pub struct FrameParams {
     pub snow_line: f32,
 }
 
-/// Output size and whether frames are read back to the host.
+/// Output size, whether frames are read back to the host, and the
+/// terrain's LOD and detail settings.
 #[derive(Clone, Copy, Debug)]
 pub struct RenderSettings {
     pub width: u32,
     pub height: u32,
     /// Copy HDR, depth and sRGB images to host memory every frame.
     pub readback: bool,
+    pub terrain: TerrainSettings,
+}
+
+impl RenderSettings {
+    /// `width`×`height` with readback and the default terrain settings.
+    pub fn new(width: u32, height: u32) -> RenderSettings {
+        RenderSettings {
+            width,
+            height,
+            readback: true,
+            terrain: TerrainSettings::default(),
+        }
+    }
 }
 
 /// A rendered frame in host memory. Row 0 is the top of the image.
@@ -83,7 +100,7 @@ pub struct Renderer {
     /// Frames rendered so far.
     frames_rendered: u64,
     /// Kept alive for the graph's imported resources.
-    _terrain: TerrainGrid,
+    _terrain: GeometryImage,
 }
 
 /// Checks an output size.
@@ -125,7 +142,7 @@ impl Renderer {
                 format!("{w}×{h} exceeds the device limit of {max} per side"),
             ));
         }
-        let terrain = TerrainGrid::new(ctx, &scene.heights)?;
+        let terrain = GeometryImage::new(ctx, Arc::new(scene.heights.clone()), settings.terrain)?;
         let mut graph = RenderGraph::new();
         let hdr = graph.create_image("hdr radiance", ImageInfo::new(w, h, Format::R32G32B32A32_SFLOAT));
         let view_depth = graph.create_image("view depth", ImageInfo::new(w, h, Format::R32_SFLOAT));
@@ -133,7 +150,15 @@ impl Renderer {
         let ldr = graph.create_image("srgb", ImageInfo::new(w, h, Format::R8G8B8A8_UNORM));
 
         add_sky_pass(ctx, &mut graph, hdr, view_depth)?;
-        terrain.add_passes(ctx, &mut graph, hdr, view_depth, depth)?;
+        let terrain_resources = terrain.add_warp_pass(ctx, &mut graph)?;
+        add_draw_pass(
+            ctx,
+            &mut graph,
+            &terrain,
+            terrain_resources,
+            (hdr, view_depth, depth),
+            h,
+        )?;
         tonemap::add_tonemap_pass(ctx, &mut graph, hdr, ldr, (w, h))?;
 
         let pixels = w as u64 * h as u64;

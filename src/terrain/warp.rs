@@ -152,7 +152,7 @@ pub struct WarpOptions {
 }
 
 /// The result of [`warp`]: `n×n` row-major images.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct WarpResult {
     /// Warped `(x, y, h)` after both passes: the warping function `Φ(s, t)`
     /// in x and y, and box-filtered heights.

@@ -1,0 +1,593 @@
+//! Camera paths for the `fly` command: keyframes read from a TOML file, or
+//! an orbit around a point.
+//!
+//! A keyframe file is a list of `[[keyframe]]` tables, each with a `time`
+//! in seconds and an `eye` and a `target` position in world metres:
+//!
+//! ```toml
+//! [[keyframe]]
+//! time = 0.0
+//! eye = [5120.0, -1200.0, 1400.0]
+//! target = [5120.0, 5120.0, 200.0]
+//!
+//! [[keyframe]]
+//! time = 4.0
+//! eye = [9000.0, 2000.0, 1100.0]
+//! target = [5120.0, 5120.0, 200.0]
+//! ```
+//!
+//! At least two keyframes, times finite and strictly increasing, positions
+//! finite with three components, eye ≠ target; any other key is an error.
+//! Field of view, near/far planes and the up vector come from a base
+//! [`Camera`].
+//!
+//! Between keyframes, eye and target each follow a **centripetal**
+//! Catmull–Rom spline (α = ½, Yuksel et al. 2011), which passes through
+//! every keyframe and, unlike the uniform spline, never forms cusps or
+//! loops within a segment when keyframes are unevenly spaced. Time maps
+//! linearly onto each segment, so the speed may change at a keyframe when
+//! neighbouring segments differ in length or duration. The end keyframes
+//! are duplicated as phantom neighbours, which gives the path zero velocity
+//! at its first and last keyframe (it eases in and out); outside the
+//! keyframe times the camera holds the end keyframes.
+
+use std::f64::consts::TAU;
+use std::path::Path;
+
+use glam::DVec3;
+use serde::Deserialize;
+
+use super::camera::Camera;
+use crate::error::{Error, Result};
+
+/// A camera position at a time (seconds).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Keyframe {
+    pub time: f64,
+    pub eye: DVec3,
+    pub target: DVec3,
+}
+
+/// The angle at which [`parse_orbit`] starts an orbit: −90°, i.e. south of
+/// the centre looking north, like [`crate::renderer::Scene::default_camera`].
+pub const DEFAULT_START_ANGLE_DEG: f64 = -90.0;
+
+/// The eye circles `centre` at `radius` (in the xy plane) and at height
+/// `centre.z + height`, always looking at `centre`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Orbit {
+    pub centre: DVec3,
+    /// Horizontal distance from the centre, metres (> 0).
+    pub radius: f64,
+    /// Eye z above `centre.z`, metres.
+    pub height: f64,
+    /// Full turns over the path; positive is counter-clockwise seen from above.
+    pub turns: f64,
+    /// Where the eye starts, degrees counter-clockwise from +X
+    /// (0: east of the centre, −90: south of it).
+    pub start_angle_deg: f64,
+}
+
+impl Orbit {
+    /// Eye position at normalised time `t` (clamped to [0, 1]).
+    pub fn eye_at(&self, t: f64) -> DVec3 {
+        let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
+        let angle = self.start_angle_deg.to_radians() + TAU * self.turns * t;
+        self.centre + DVec3::new(self.radius * angle.cos(), self.radius * angle.sin(), self.height)
+    }
+
+    /// Checks that all numbers are finite and the radius is positive.
+    pub fn validate(&self) -> Result<()> {
+        let finite = self.centre.is_finite()
+            && [self.radius, self.height, self.turns, self.start_angle_deg]
+                .iter()
+                .all(|v| v.is_finite());
+        if !finite {
+            return Err(Error::invalid("orbit", "all numbers must be finite"));
+        }
+        if self.radius <= 0.0 {
+            return Err(Error::invalid(
+                "--orbit",
+                format!("radius {} must be positive", self.radius),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// How the camera moves over a flythrough.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CameraPath {
+    /// Catmull–Rom through keyframes (see the module documentation); time in
+    /// the keyframes' seconds.
+    Keyframes(Vec<Keyframe>),
+    /// A circle around a point; time normalised to [0, 1].
+    Orbit(Orbit),
+}
+
+/// What is wrong with keyframe `k` (following `prev`), if anything.
+fn keyframe_problem(prev: Option<&Keyframe>, k: &Keyframe) -> Option<String> {
+    if !k.time.is_finite() {
+        return Some(format!("time {} is not finite", k.time));
+    }
+    if let Some(p) = prev {
+        if k.time <= p.time {
+            return Some(format!(
+                "time {} is not after the previous keyframe's {}; times must strictly increase",
+                k.time, p.time
+            ));
+        }
+    }
+    if !k.eye.is_finite() || !k.target.is_finite() {
+        return Some("eye and target must be finite".into());
+    }
+    if k.eye.distance(k.target) <= 1e-9 * k.eye.length().max(1.0) {
+        return Some("eye equals target; there is no view direction".into());
+    }
+    None
+}
+
+impl CameraPath {
+    /// Checks the path: for keyframes what [`load_keyframes`] checks, for an
+    /// orbit [`Orbit::validate`].
+    pub fn validate(&self) -> Result<()> {
+        match self {
+            CameraPath::Keyframes(keys) => {
+                if keys.len() < 2 {
+                    return Err(Error::invalid(
+                        "camera path",
+                        format!("needs at least 2 keyframes, has {}", keys.len()),
+                    ));
+                }
+                for (i, k) in keys.iter().enumerate() {
+                    if let Some(problem) = keyframe_problem(i.checked_sub(1).map(|j| &keys[j]), k) {
+                        return Err(Error::invalid("camera path", format!("keyframe {}: {problem}", i + 1)));
+                    }
+                }
+                Ok(())
+            }
+            CameraPath::Orbit(orbit) => orbit.validate(),
+        }
+    }
+
+    /// Time of the path's first camera: the first keyframe's time, 0 for an
+    /// orbit.
+    pub fn start_time(&self) -> f64 {
+        match self {
+            CameraPath::Keyframes(keys) => keys.first().map_or(0.0, |k| k.time),
+            CameraPath::Orbit(_) => 0.0,
+        }
+    }
+
+    /// Length of the path: last minus first keyframe time (seconds), 1.0 for
+    /// an orbit.
+    pub fn duration(&self) -> f64 {
+        match self {
+            CameraPath::Keyframes(keys) => match (keys.first(), keys.last()) {
+                (Some(a), Some(b)) => b.time - a.time,
+                _ => 0.0,
+            },
+            CameraPath::Orbit(_) => 1.0,
+        }
+    }
+
+    /// `base` moved to time `t` of the path (clamped to the path's time
+    /// range; NaN means the start). Keyframe times are absolute: the path
+    /// runs from [`CameraPath::start_time`] for [`CameraPath::duration`].
+    /// A keyframe path with no keyframes returns `base` unchanged. The
+    /// result passes [`Camera::validate`] when the path passes
+    /// [`CameraPath::validate`], `base` does, and the view direction neither
+    /// vanishes nor becomes parallel to `base.up` along the way.
+    pub fn camera_at(&self, t: f64, base: &Camera) -> Camera {
+        let (eye, target) = match self {
+            CameraPath::Keyframes(keys) => match interpolate(keys, t) {
+                Some(pose) => pose,
+                None => return *base,
+            },
+            CameraPath::Orbit(orbit) => (orbit.eye_at(t), orbit.centre),
+        };
+        Camera { eye, target, ..*base }
+    }
+
+    /// `frames` cameras evenly spaced over the whole path, both ends
+    /// included; one frame gives just the start, zero none.
+    pub fn sample(&self, frames: u32, base: &Camera) -> Vec<Camera> {
+        let (start, duration) = (self.start_time(), self.duration());
+        (0..frames)
+            .map(|i| {
+                let t = if i + 1 == frames && frames > 1 {
+                    start + duration
+                } else if frames > 1 {
+                    start + duration * f64::from(i) / f64::from(frames - 1)
+                } else {
+                    start
+                };
+                self.camera_at(t, base)
+            })
+            .collect()
+    }
+}
+
+/// Cubic Hermite curve from `p1` (tangent `m1`) to `p2` (tangent `m2`),
+/// `u` in [0, 1]; exactly `p1` at 0 and `p2` at 1.
+fn hermite(p1: DVec3, m1: DVec3, p2: DVec3, m2: DVec3, u: f64) -> DVec3 {
+    let (u2, u3) = (u * u, u * u * u);
+    p1 * (2.0 * u3 - 3.0 * u2 + 1.0) + m1 * (u3 - 2.0 * u2 + u) + p2 * (3.0 * u2 - 2.0 * u3) + m2 * (u3 - u2)
+}
+
+/// Centripetal Catmull–Rom segment from `p1` to `p2` with neighbours `p0`
+/// and `p3`, in Hermite form: knot intervals are `|Δp|^½` (floored so
+/// coincident points, e.g. a fixed target, stay finite) and the tangents
+/// those of the non-uniform spline, scaled to the segment.
+fn catmull_rom(p0: DVec3, p1: DVec3, p2: DVec3, p3: DVec3, u: f64) -> DVec3 {
+    let knot = |a: DVec3, b: DVec3| a.distance(b).sqrt().max(1e-12);
+    let (d0, d1, d2) = (knot(p0, p1), knot(p1, p2), knot(p2, p3));
+    let m1 = ((p1 - p0) / d0 - (p2 - p0) / (d0 + d1) + (p2 - p1) / d1) * d1;
+    let m2 = ((p2 - p1) / d1 - (p3 - p1) / (d1 + d2) + (p3 - p2) / d2) * d1;
+    hermite(p1, m1, p2, m2, u)
+}
+
+/// Eye and target at time `t`; `None` without keyframes.
+fn interpolate(keys: &[Keyframe], t: f64) -> Option<(DVec3, DVec3)> {
+    let (first, last) = (keys.first()?, keys.last()?);
+    if t.is_nan() || t <= first.time {
+        return Some((first.eye, first.target));
+    }
+    if t >= last.time {
+        return Some((last.eye, last.target));
+    }
+    // keys[i].time <= t < keys[i + 1].time (times increase on valid paths;
+    // the clamps keep invalid ones in bounds).
+    let i = keys.partition_point(|k| k.time <= t).clamp(1, keys.len() - 1) - 1;
+    let (a, b) = (&keys[i], &keys[i + 1]);
+    let before = &keys[i.saturating_sub(1)];
+    let after = &keys[(i + 2).min(keys.len() - 1)];
+    let span = b.time - a.time;
+    let u = if span > 0.0 {
+        ((t - a.time) / span).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    Some((
+        catmull_rom(before.eye, a.eye, b.eye, after.eye, u),
+        catmull_rom(before.target, a.target, b.target, after.target, u),
+    ))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct KeyframeFile {
+    #[serde(default)]
+    keyframe: Vec<RawKeyframe>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawKeyframe {
+    time: toml::Spanned<f64>,
+    eye: toml::Spanned<Vec<f64>>,
+    target: toml::Spanned<Vec<f64>>,
+}
+
+/// 1-based line of byte `offset` in `text`.
+fn line_of(text: &str, offset: usize) -> usize {
+    let end = offset.min(text.len());
+    text.as_bytes()[..end].iter().filter(|&&b| b == b'\n').count() + 1
+}
+
+/// Parses keyframe-file `text`; errors name `origin` (see [`load_keyframes`]).
+pub fn parse_keyframes(text: &str, origin: &Path) -> Result<CameraPath> {
+    let file: KeyframeFile = toml::from_str(text).map_err(|e| {
+        let message = e.message().trim().replace('\n', "; ");
+        match e.span() {
+            Some(span) => Error::input(origin, format!("line {}: {message}", line_of(text, span.start))),
+            None => Error::input(origin, message),
+        }
+    })?;
+    if file.keyframe.len() < 2 {
+        return Err(Error::input(
+            origin,
+            format!("needs at least 2 [[keyframe]] tables, found {}", file.keyframe.len()),
+        ));
+    }
+    let mut keys: Vec<Keyframe> = Vec::with_capacity(file.keyframe.len());
+    for (i, raw) in file.keyframe.iter().enumerate() {
+        let at = |span: std::ops::Range<usize>| format!("keyframe {} (line {})", i + 1, line_of(text, span.start));
+        let vector = |v: &toml::Spanned<Vec<f64>>, name: &str| match v.get_ref().as_slice() {
+            &[x, y, z] => Ok(DVec3::new(x, y, z)),
+            other => Err(Error::input(
+                origin,
+                format!(
+                    "{}: {name} has {} components; expected [x, y, z]",
+                    at(v.span()),
+                    other.len()
+                ),
+            )),
+        };
+        let k = Keyframe {
+            time: *raw.time.get_ref(),
+            eye: vector(&raw.eye, "eye")?,
+            target: vector(&raw.target, "target")?,
+        };
+        if let Some(problem) = keyframe_problem(keys.last(), &k) {
+            return Err(Error::input(origin, format!("{}: {problem}", at(raw.time.span()))));
+        }
+        keys.push(k);
+    }
+    Ok(CameraPath::Keyframes(keys))
+}
+
+/// Reads a keyframe TOML file (format in the module documentation). Errors
+/// are one line naming the file, and the line for syntax errors and bad
+/// keyframes.
+pub fn load_keyframes(path: &Path) -> Result<CameraPath> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::input(path, format!("cannot read keyframes: {e}")))?;
+    parse_keyframes(&text, path)
+}
+
+/// Parses the CLI value `CX,CY,CZ,RADIUS,HEIGHT[,TURNS]` (TURNS default 1)
+/// into an orbit starting at [`DEFAULT_START_ANGLE_DEG`].
+pub fn parse_orbit(s: &str) -> std::result::Result<Orbit, String> {
+    let usage = "CX,CY,CZ,RADIUS,HEIGHT[,TURNS]";
+    let numbers = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<std::result::Result<Vec<_>, _>>()
+        .map_err(|_| format!("--orbit '{s}' is not {usage} (comma-separated numbers)"))?;
+    let (centre, radius, height, turns) = match numbers.as_slice() {
+        &[x, y, z, r, h] => (DVec3::new(x, y, z), r, h, 1.0),
+        &[x, y, z, r, h, n] => (DVec3::new(x, y, z), r, h, n),
+        other => return Err(format!("--orbit '{s}' has {} numbers; expected {usage}", other.len())),
+    };
+    let orbit = Orbit {
+        centre,
+        radius,
+        height,
+        turns,
+        start_angle_deg: DEFAULT_START_ANGLE_DEG,
+    };
+    orbit.validate().map_err(|e| format!("--orbit '{s}': {e}"))?;
+    Ok(orbit)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn base() -> Camera {
+        Camera {
+            eye: DVec3::ZERO,
+            target: DVec3::X,
+            up: DVec3::Z,
+            fov_y_deg: 50.0,
+            near: 1.0,
+            far: 100_000.0,
+        }
+    }
+
+    const FILE: &str = "\
+# a flythrough
+[[keyframe]]
+time = 0.0
+eye = [5120.0, -1200.0, 1400.0]
+target = [5120.0, 5120.0, 200.0]
+
+[[keyframe]]
+time = 4
+eye = [9000, 2000, 1100]
+target = [5120.0, 5120.0, 200.0]
+
+[[keyframe]]
+time = 5.5
+eye = [9500.0, 6000.0, 900.0]
+target = [4000.0, 6000.0, 300.0]
+
+[[keyframe]]
+time = 10.0
+eye = [6000.0, 9500.0, 1500.0]
+target = [5120.0, 5120.0, 0.0]
+";
+
+    fn parse(text: &str) -> Result<CameraPath> {
+        parse_keyframes(text, Path::new("path.toml"))
+    }
+
+    fn keys(path: &CameraPath) -> &[Keyframe] {
+        match path {
+            CameraPath::Keyframes(k) => k,
+            CameraPath::Orbit(_) => panic!("not keyframes"),
+        }
+    }
+
+    #[test]
+    fn keyframes_load_and_interpolate_through_every_keyframe() {
+        let path = parse(FILE).unwrap();
+        path.validate().unwrap();
+        let k = keys(&path);
+        assert_eq!(k.len(), 4);
+        assert_eq!(k[1].eye, DVec3::new(9000.0, 2000.0, 1100.0));
+        assert_eq!((path.start_time(), path.duration()), (0.0, 10.0));
+        for key in k {
+            let c = path.camera_at(key.time, &base());
+            assert_eq!((c.eye, c.target), (key.eye, key.target), "t = {}", key.time);
+            assert_eq!((c.up, c.fov_y_deg, c.near, c.far), (DVec3::Z, 50.0, 1.0, 100_000.0));
+        }
+        // Clamped outside the keyframe times.
+        assert_eq!(path.camera_at(-3.0, &base()).eye, k[0].eye);
+        assert_eq!(path.camera_at(f64::NAN, &base()).eye, k[0].eye);
+        assert_eq!(path.camera_at(99.0, &base()).eye, k[3].eye);
+        // Continuous across a keyframe, and between its neighbours' range.
+        let (a, b) = (path.camera_at(4.0 - 1e-7, &base()), path.camera_at(4.0 + 1e-7, &base()));
+        assert!(a.eye.distance(b.eye) < 1e-2, "{a:?} {b:?}");
+        // A fixed target stays fixed.
+        let mid = path.camera_at(2.0, &base());
+        assert!(mid.target.distance(k[0].target) < 1e-9, "{:?}", mid.target);
+        assert!(mid.eye.x > 5120.0 && mid.eye.x < 9000.0, "{:?}", mid.eye);
+        // Eases in: zero velocity at the start.
+        let early = path.camera_at(1e-4, &base());
+        assert!(early.eye.distance(k[0].eye) < 1e-3);
+    }
+
+    #[test]
+    fn uniform_spacing_gives_the_uniform_spline() {
+        // Collinear, evenly spaced points: the spline is the straight line,
+        // and in the interior segment a point moves linearly with time.
+        let keys: Vec<Keyframe> = (0..4)
+            .map(|i| Keyframe {
+                time: f64::from(i),
+                eye: DVec3::new(100.0 * f64::from(i), 0.0, 50.0),
+                target: DVec3::new(100.0 * f64::from(i), 500.0, 0.0),
+            })
+            .collect();
+        let path = CameraPath::Keyframes(keys);
+        let c = path.camera_at(1.25, &base());
+        assert!(c.eye.distance(DVec3::new(125.0, 0.0, 50.0)) < 1e-9, "{:?}", c.eye);
+    }
+
+    #[test]
+    fn times_must_strictly_increase() {
+        let text = FILE.replace("time = 5.5", "time = 4.0");
+        let e = parse(&text).unwrap_err().to_string();
+        assert!(
+            e.starts_with("path.toml: keyframe 3 (line 13): time 4 is not after"),
+            "{e}"
+        );
+        let text = FILE.replace("time = 5.5", "time = 3.0");
+        assert!(parse(&text).unwrap_err().to_string().contains("strictly increase"));
+        let text = FILE.replace("time = 5.5", "time = nan");
+        assert!(parse(&text).unwrap_err().to_string().contains("not finite"));
+        let mut path = parse(FILE).unwrap();
+        if let CameraPath::Keyframes(k) = &mut path {
+            k[2].time = 1.0;
+        }
+        assert!(path.validate().unwrap_err().to_string().contains("keyframe 3"));
+        // Must not panic on an invalid path.
+        let _ = path.sample(7, &base());
+    }
+
+    #[test]
+    fn too_few_keyframes() {
+        let one = "[[keyframe]]\ntime = 0\neye = [0, 0, 10]\ntarget = [1, 0, 0]\n";
+        let e = parse(one).unwrap_err().to_string();
+        assert!(
+            e.contains("path.toml") && e.contains("at least 2") && e.contains("found 1"),
+            "{e}"
+        );
+        assert!(parse("").unwrap_err().to_string().contains("found 0"));
+        assert!(CameraPath::Keyframes(vec![]).validate().is_err());
+        assert_eq!(CameraPath::Keyframes(vec![]).camera_at(1.0, &base()), base());
+        assert_eq!(CameraPath::Keyframes(vec![]).sample(3, &base()).len(), 3);
+    }
+
+    #[test]
+    fn bad_toml_reports_the_line() {
+        let text = FILE.replace("eye = [9000, 2000, 1100]", "eye = [9000, 2000 1100]");
+        let e = parse(&text).unwrap_err().to_string();
+        assert!(e.starts_with("path.toml: line 9: "), "{e}");
+        assert!(!e.contains('\n'), "{e}");
+        // An unclosed array may continue on the next line: toml reports where `]` was expected.
+        let text = FILE.replace("eye = [9000, 2000, 1100]", "eye = [9000, 2000, 1100");
+        let e = parse(&text).unwrap_err().to_string();
+        assert!(
+            e.starts_with("path.toml: line 10: ") && e.contains("expected `]`"),
+            "{e}"
+        );
+        let text = FILE.replace("time = 4\n", "time = 4\nfov = 30\n");
+        let e = parse(&text).unwrap_err().to_string();
+        assert!(e.starts_with("path.toml: line 9: ") && e.contains("fov"), "{e}");
+        let text = FILE.replace("target = [4000.0, 6000.0, 300.0]", "target = [4000.0, 6000.0]");
+        let e = parse(&text).unwrap_err().to_string();
+        assert!(e.contains("keyframe 3 (line 15): target has 2 components"), "{e}");
+        let text = FILE.replace("time = 4\n", "time = \"4\"\n");
+        assert!(parse(&text).unwrap_err().to_string().starts_with("path.toml: line 8: "));
+        let text = FILE.replace("[9500.0, 6000.0, 900.0]", "[4000.0, 6000.0, 300.0]");
+        assert!(parse(&text).unwrap_err().to_string().contains("eye equals target"));
+    }
+
+    #[test]
+    fn load_keyframes_names_the_file() {
+        let dir = std::env::temp_dir().join(format!("alpenglow-camera-path-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("fly.toml");
+        std::fs::write(&file, FILE).unwrap();
+        assert_eq!(load_keyframes(&file).unwrap(), parse(FILE).unwrap());
+        std::fs::write(&file, "[[keyframe]\n").unwrap();
+        let e = load_keyframes(&file).unwrap_err().to_string();
+        assert!(e.contains("fly.toml: line 1"), "{e}");
+        let missing = dir.join("missing.toml");
+        let e = load_keyframes(&missing).unwrap_err().to_string();
+        assert!(e.contains("missing.toml: cannot read keyframes"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn orbit_circles_the_centre_and_returns() {
+        let orbit = parse_orbit("5120, 5120, 200, 3000, 900").unwrap();
+        assert_eq!(orbit.turns, 1.0);
+        assert_eq!(orbit.start_angle_deg, DEFAULT_START_ANGLE_DEG);
+        let path = CameraPath::Orbit(orbit);
+        assert_eq!((path.start_time(), path.duration()), (0.0, 1.0));
+        let start = path.camera_at(0.0, &base());
+        // Starts south of the centre.
+        assert!(
+            start.eye.distance(DVec3::new(5120.0, 2120.0, 1100.0)) < 1e-9,
+            "{:?}",
+            start.eye
+        );
+        for c in path.sample(37, &base()) {
+            let d = (c.eye - orbit.centre).truncate().length();
+            assert!((d - 3000.0).abs() < 1e-9, "{d}");
+            assert_eq!(c.eye.z, 1100.0);
+            assert_eq!(c.target, orbit.centre);
+        }
+        let end = path.camera_at(1.0, &base());
+        assert!(end.eye.distance(start.eye) < 1e-9);
+        let quarter = path.camera_at(0.25, &base());
+        assert!(
+            quarter.eye.distance(DVec3::new(8120.0, 5120.0, 1100.0)) < 1e-9,
+            "counter-clockwise"
+        );
+        let half = CameraPath::Orbit(parse_orbit("0,0,0,10,5,0.5").unwrap());
+        assert!(half.camera_at(1.0, &base()).eye.distance(DVec3::new(0.0, 10.0, 5.0)) < 1e-12);
+    }
+
+    #[test]
+    fn parse_orbit_rejects_bad_values() {
+        for s in [
+            "",
+            "1,2,3,4",
+            "1,2,3,4,5,6,7",
+            "1,2,x,4,5",
+            "1,2,3,0,5",
+            "1,2,3,-1,5",
+            "1,2,3,4,inf",
+        ] {
+            let e = parse_orbit(s).unwrap_err();
+            assert!(e.starts_with(&format!("--orbit '{s}'")), "{e}");
+        }
+    }
+
+    #[test]
+    fn sample_counts_and_valid_cameras() {
+        let paths = [
+            parse(FILE).unwrap(),
+            CameraPath::Orbit(parse_orbit("0,0,0,1000,300,2.5").unwrap()),
+        ];
+        for path in &paths {
+            assert!(path.sample(0, &base()).is_empty());
+            let one = path.sample(1, &base());
+            assert_eq!(one, vec![path.camera_at(path.start_time(), &base())]);
+            let two = path.sample(2, &base());
+            assert_eq!(two[1], path.camera_at(path.start_time() + path.duration(), &base()));
+            let many = path.sample(241, &base());
+            assert_eq!(many.len(), 241);
+            assert_eq!(
+                many[120],
+                path.camera_at(path.start_time() + path.duration() / 2.0, &base())
+            );
+            for c in &many {
+                c.validate().unwrap();
+            }
+        }
+    }
+}

@@ -1,0 +1,354 @@
+//! The GPU half of geometry image warping (dissertation §7.4.2 "Warp and
+//! Zoom", §7.4.3; `ALGORITHMS.md` §3 items 5–7): the sketch atlas and a
+//! wavelet noise tile on the GPU, the per-frame warp from the CPU
+//! ([`crate::terrain::lod`]), and the compute pass `terrain.warp` that
+//! writes the warped, displaced `N×N` geometry image straight into the
+//! vertex buffer that `terrain.draw` ([`crate::terrain::shading`]) draws
+//! with the fixed grid's index buffer (render-to-vertex-buffer).
+//!
+//! Frame graph: `terrain.warp` (compute: reads the atlas, the noise tile and
+//! this frame's warp upload; writes the vertex buffer) → `terrain.draw`
+//! (vertex input). The CPU stage runs inside `terrain.warp`'s record
+//! callback, after the frame slot's previous use has finished, so the
+//! profile's CPU time of that pass is the CPU warp.
+
+use std::sync::Arc;
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::error::{Error, Result};
+use crate::graph::{Access, RenderGraph, ResourceId, Stage};
+use crate::io::heightmap::HeightField;
+use crate::renderer::FrameParams;
+use crate::shaders;
+use crate::terrain::lod::{DebugScalar, LodFrame, LodSettings};
+use crate::terrain::wavelet_noise;
+use crate::vulkan::{
+    Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, Format, Image, ImageDesc, ImageUsageFlags,
+    MemoryLocation, FRAMES_IN_FLIGHT,
+};
+
+/// Default output grid side (vertices), as in the text.
+pub const DEFAULT_GRID_SIDE: u32 = 512;
+/// Bytes per vertex: position (xyz, w = split octave) and normal (xyz,
+/// w = debug scalar).
+pub const VERTEX_STRIDE: u32 = 32;
+/// Conservative shift of detail from geometry to shading, in octaves (also
+/// `SPLIT_BIAS` in `glsl/include/terrain_detail.glsl`).
+pub const SPLIT_BIAS: f32 = 0.5;
+/// Side of the wavelet noise tile (also `NOISE_TILE` in the shader).
+pub const NOISE_TILE: usize = 128;
+
+/// What `terrain.draw` shows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TerrainView {
+    /// Shaded terrain.
+    #[default]
+    Shaded,
+    /// Importance map (normalised, square-root colour ramp).
+    Importance,
+    /// Obtained / demanded sample density (green: within [0.5, 1]).
+    DensityRatio,
+    /// Split octave per vertex (0 blue … 6 red).
+    SplitOctave,
+    /// Every fourth grid line of the warped mesh.
+    Wireframe,
+}
+
+impl TerrainView {
+    /// The value the shaders test (`VIEW_*` in `terrain_draw.glsl`).
+    pub fn code(self) -> u32 {
+        self as u32
+    }
+
+    fn debug_scalar(self) -> DebugScalar {
+        match self {
+            TerrainView::Importance => DebugScalar::Importance,
+            TerrainView::DensityRatio => DebugScalar::DensityRatio,
+            _ => DebugScalar::None,
+        }
+    }
+}
+
+/// Settings of the terrain LOD and its detail.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TerrainSettings {
+    /// Output grid side `N` (vertices per side, 2..=2048).
+    pub grid_side: u32,
+    pub lod: LodSettings,
+    /// Procedural displacement and bump mapping (`--terrain-detail`).
+    pub detail: bool,
+    /// Detail amplitude relative to the atlas spacing: octave k has
+    /// amplitude `amplitude · d0 · 2^(−k·H)`.
+    pub detail_amplitude: f32,
+    /// Roughness exponent `H` of the detail octaves.
+    pub detail_h: f32,
+    /// Seed of the wavelet noise tile.
+    pub noise_seed: u64,
+    pub view: TerrainView,
+}
+
+impl Default for TerrainSettings {
+    fn default() -> Self {
+        Self {
+            grid_side: DEFAULT_GRID_SIDE,
+            lod: LodSettings::default(),
+            detail: true,
+            detail_amplitude: 0.15,
+            detail_h: 0.9,
+            noise_seed: 7,
+            view: TerrainView::Shaded,
+        }
+    }
+}
+
+impl TerrainSettings {
+    /// Checks the sizes and detail parameters.
+    pub fn validate(&self) -> Result<()> {
+        if !(2..=2048).contains(&self.grid_side) {
+            return Err(Error::invalid(
+                "--grid",
+                format!("{} (must be 2..=2048)", self.grid_side),
+            ));
+        }
+        if !(4..=1024).contains(&self.lod.sketch_side) {
+            return Err(Error::invalid(
+                "--sketch",
+                format!("{} (must be 4..=1024)", self.lod.sketch_side),
+            ));
+        }
+        if !(self.detail_amplitude.is_finite() && self.detail_amplitude >= 0.0 && self.detail_amplitude <= 10.0) {
+            return Err(Error::invalid(
+                "detail amplitude",
+                format!("{} (must be in 0..=10)", self.detail_amplitude),
+            ));
+        }
+        if !(self.detail_h.is_finite() && self.detail_h >= 0.0 && self.detail_h <= 2.0) {
+            return Err(Error::invalid(
+                "detail H",
+                format!("{} (must be in 0..=2)", self.detail_h),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The `terrain.draw` flags word: view, detail bit, grid side.
+    pub fn draw_flags(&self) -> u32 {
+        self.view.code() | (u32::from(self.detail) << 3) | (self.grid_side << 8)
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct WarpPush {
+    handles: [u32; 4],
+    grid: [u32; 4],
+    spacing: [f32; 4],
+    extent: [f32; 4],
+}
+
+/// Indices of the two triangles of every grid cell, counter-clockwise seen
+/// from above (+Z) for a grid whose rows run along `s` and columns along
+/// `t` with `s × t = +z`.
+pub fn grid_indices(columns: u32, rows: u32) -> Vec<u32> {
+    let mut indices = Vec::with_capacity(((columns - 1) * (rows - 1) * 6) as usize);
+    for r in 0..rows - 1 {
+        for c in 0..columns - 1 {
+            let i = r * columns + c;
+            indices.extend_from_slice(&[i, i + 1, i + columns, i + 1, i + columns + 1, i + columns]);
+        }
+    }
+    indices
+}
+
+/// GPU resources of the warped terrain.
+pub struct GeometryImage {
+    pub field: Arc<HeightField>,
+    pub settings: TerrainSettings,
+    /// The sketch atlas: the whole height field, R32F.
+    pub atlas: Arc<Image>,
+    /// Wavelet noise tile (R32F, `NOISE_TILE`²).
+    pub noise: Arc<Image>,
+    /// Per frame slot: the warped sketch map `(Φx, Φy, debug, 0)`.
+    pub warp_uploads: Vec<Arc<Buffer>>,
+    /// The geometry image as vertex buffer (`grid_side`² vertices).
+    pub vertices: Arc<Buffer>,
+    /// Fixed grid topology, built once.
+    pub indices: Arc<Buffer>,
+}
+
+impl GeometryImage {
+    /// Uploads the atlas and the noise tile, creates the vertex and index
+    /// buffers.
+    pub fn new(ctx: &Context, field: Arc<HeightField>, settings: TerrainSettings) -> Result<GeometryImage> {
+        settings.validate()?;
+        let max = ctx.max_image_dimension();
+        if field.columns > max || field.rows > max {
+            return Err(Error::invalid(
+                "height field",
+                format!(
+                    "{}×{} samples exceed the device's image limit of {max} per side",
+                    field.columns, field.rows
+                ),
+            ));
+        }
+        let image = |name: &str, w: u32, h: u32, data: &[f32]| {
+            Image::with_data(
+                ctx,
+                ImageDesc {
+                    name: name.into(),
+                    width: w,
+                    height: h,
+                    format: Format::R32_SFLOAT,
+                    usage: ImageUsageFlags::SAMPLED,
+                },
+                bytemuck::cast_slice(data),
+            )
+            .map(Arc::new)
+        };
+        let atlas = image("sketch atlas", field.columns, field.rows, &field.heights)?;
+        let tile = wavelet_noise::noise_tile(settings.noise_seed, NOISE_TILE)?;
+        let noise = image("wavelet noise tile", NOISE_TILE as u32, NOISE_TILE as u32, &tile)?;
+        let n = settings.lod.sketch_side as u64;
+        let warp_uploads = (0..FRAMES_IN_FLIGHT)
+            .map(|i| {
+                Buffer::new(
+                    ctx,
+                    BufferDesc {
+                        name: format!("terrain warp upload {i}"),
+                        size: n * n * 16,
+                        usage: BufferUsageFlags::STORAGE_BUFFER,
+                        location: MemoryLocation::CpuToGpu,
+                    },
+                )
+                .map(Arc::new)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let side = settings.grid_side;
+        let vertices = Arc::new(Buffer::new(
+            ctx,
+            BufferDesc {
+                name: "terrain geometry image (vertices)".into(),
+                size: u64::from(side) * u64::from(side) * u64::from(VERTEX_STRIDE),
+                usage: BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::VERTEX_BUFFER,
+                location: MemoryLocation::GpuOnly,
+            },
+        )?);
+        let indices = Arc::new(Buffer::with_data(
+            ctx,
+            "terrain grid indices",
+            BufferUsageFlags::INDEX_BUFFER,
+            bytemuck::cast_slice(&grid_indices(side, side)),
+        )?);
+        Ok(GeometryImage {
+            field,
+            settings,
+            atlas,
+            noise,
+            warp_uploads,
+            vertices,
+            indices,
+        })
+    }
+
+    /// Sketch-atlas spacing `d0`: the finer of the two sample spacings.
+    pub fn atlas_spacing(&self) -> f32 {
+        self.field.spacing.x.min(self.field.spacing.y) as f32
+    }
+
+    /// Declares `terrain.warp`. Returns the vertex buffer and the noise
+    /// tile as graph resources, for `terrain.draw`.
+    pub fn add_warp_pass(
+        &self,
+        ctx: &Context,
+        graph: &mut RenderGraph<FrameParams>,
+    ) -> Result<(ResourceId, ResourceId)> {
+        let atlas = graph.import_image(self.atlas.clone());
+        let noise = graph.import_image(self.noise.clone());
+        let upload = graph.import_buffers_per_frame(self.warp_uploads.clone());
+        let vertices = graph.import_buffer(self.vertices.clone());
+        let pipeline = ComputePipeline::new(ctx, shaders::TERRAIN_WARP)?;
+        let field = self.field.clone();
+        let settings = self.settings;
+        let d0 = self.atlas_spacing();
+        let mut frame = LodFrame::default();
+        graph
+            .pass("terrain.warp")
+            .read(atlas, Access::SampledImage(Stage::Compute))
+            .read(noise, Access::SampledImage(Stage::Compute))
+            .read(upload, Access::StorageBufferRead(Stage::Compute))
+            .write(vertices, Access::StorageBufferWrite(Stage::Compute))
+            .record(move |pass, params| {
+                // The CPU stage: sketch map, importance map, warp (§7.4.2).
+                frame.plan(
+                    &field,
+                    &params.camera,
+                    params.aspect,
+                    &settings.lod,
+                    settings.view.debug_scalar(),
+                )?;
+                pass.buffer(upload)?.write(0, bytemuck::cast_slice(&frame.upload))?;
+                let extent = field.extent();
+                let push = WarpPush {
+                    handles: [
+                        pass.sampled(atlas)?,
+                        pass.storage_buffer(upload)?,
+                        pass.storage_buffer(vertices)?,
+                        pass.sampled(noise)?,
+                    ],
+                    grid: [
+                        settings.grid_side,
+                        settings.lod.sketch_side as u32,
+                        field.columns,
+                        field.rows,
+                    ],
+                    spacing: [
+                        field.spacing.x as f32,
+                        field.spacing.y as f32,
+                        settings.detail_amplitude,
+                        settings.detail_h,
+                    ],
+                    extent: [
+                        extent.x as f32,
+                        extent.y as f32,
+                        d0,
+                        if settings.detail { 1.0 } else { 0.0 },
+                    ],
+                };
+                let cmd = pass.cmd();
+                cmd.bind_compute(&pipeline);
+                cmd.push_constants(&push)?;
+                let groups = settings.grid_side.div_ceil(8);
+                cmd.dispatch(groups, groups, 1);
+                Ok(())
+            });
+        Ok((vertices, noise))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_indices_cover_every_cell_once() {
+        let idx = grid_indices(3, 2);
+        assert_eq!(idx, vec![0, 1, 3, 1, 4, 3, 1, 2, 4, 2, 5, 4]);
+    }
+
+    #[test]
+    fn settings_are_checked() {
+        let ok = TerrainSettings::default();
+        assert!(ok.validate().is_ok());
+        assert!(TerrainSettings { grid_side: 1, ..ok }.validate().is_err());
+        assert!(TerrainSettings {
+            detail_amplitude: f32::NAN,
+            ..ok
+        }
+        .validate()
+        .is_err());
+        assert_eq!(ok.draw_flags() & 7, 0);
+        assert_eq!(ok.draw_flags() >> 8, DEFAULT_GRID_SIDE);
+        assert_ne!(ok.draw_flags() & 8, 0);
+    }
+}
