@@ -1,4 +1,7 @@
-//! Golden-image tests: frames compared with stored PNGs by FLIP.
+//! Golden-image tests: frames compared with stored PNGs by FLIP: the
+//! default scene and the real Jacksboro DEM from three viewpoints (high and
+//! oblique, low and grazing, along a valley), all with the warped terrain
+//! and its procedural detail (§7.4).
 //!
 //! Threshold: mean FLIP ≤ [`MEAN_FLIP_THRESHOLD`] (0.02; override with
 //! `ALPENGLOW_FLIP_THRESHOLD`). On the lavapipe that made the goldens the
@@ -100,12 +103,16 @@ fn jacksboro() -> Scene {
     Scene::new(field)
 }
 
+/// The Jacksboro DEM seen high and oblique: the default camera, from
+/// beyond the southern edge and above the highest point.
 #[test]
-fn real_dem_matches_golden() {
+fn real_dem_high_oblique_view_matches_golden() {
     let scene = jacksboro();
-    check_golden("jacksboro-default", &scene, &scene.default_camera());
+    check_golden("jacksboro-high-oblique", &scene, &scene.default_camera());
 }
 
+/// Low and grazing: 80 m above a ridge, looking across the terrain just
+/// below the horizon (large depth range, strong warping).
 #[test]
 fn real_dem_low_grazing_view_matches_golden() {
     let scene = jacksboro();
@@ -118,4 +125,20 @@ fn real_dem_low_grazing_view_matches_golden() {
         far: 100000.0,
     };
     check_golden("jacksboro-grazing", &scene, &camera);
+}
+
+/// Along the valley of the Jacksboro fault, from its south-western part
+/// towards the north-east, a few hundred metres above the valley floor.
+#[test]
+fn real_dem_along_valley_view_matches_golden() {
+    let scene = jacksboro();
+    let camera = Camera {
+        eye: DVec3::new(13600.0, 9600.0, 750.0),
+        target: DVec3::new(18500.0, 21500.0, 350.0),
+        up: DVec3::Z,
+        fov_y_deg: 50.0,
+        near: 5.0,
+        far: 100000.0,
+    };
+    check_golden("jacksboro-valley", &scene, &camera);
 }

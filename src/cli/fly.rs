@@ -75,7 +75,9 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
         if dir.exists() && (!dir.is_dir() || std::fs::read_dir(dir)?.next().is_some()) {
             bail!("--out-dir {} exists and is not an empty directory", dir.display());
         }
-        check_output_path(&Some(dir.join("x")), "frame directory")?;
+        if !dir.exists() {
+            check_output_path(&Some(dir.clone()), "frame directory")?;
+        }
     }
     let scene = load_scene(&args.scene)?;
     let base = camera(&args.scene, &scene)?;

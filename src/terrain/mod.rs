@@ -11,3 +11,4 @@ pub mod sketch_map;
 pub mod terrain_spec;
 pub mod warp;
 pub mod wavelet_noise;
+pub mod zoom;

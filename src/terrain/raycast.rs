@@ -23,17 +23,19 @@
 //! height range, padded by one march step), then marched with a step `dt`
 //! chosen so that both the horizontal and the vertical displacement per
 //! step are at most a quarter of `min(dx, dy)`. The first step that ends
-//! under the surface brackets the crossing, which 40 bisection iterations
+//! under the surface brackets the crossing, which 30 bisection iterations
 //! and a final linear (regula falsi) step refine; a planar surface is hit
 //! to rounding accuracy. Features thinner than a quarter sample can be
 //! stepped over, as with any fixed-step march.
 //!
-//! [`raycast`] is the plain march. [`Raycaster`] precomputes, per block of
-//! 8×8 cells, an upper bound of the surface (the B-spline lies in the
-//! convex hull of its taps) and skips the march samples of blocks that the
-//! ray crosses entirely above that bound. It evaluates the same samples
-//! where it does not skip and therefore returns bit-identical results; use
-//! it for many rays (a 640×360 image).
+//! [`raycast`] is the plain march; it scans the whole field for its height
+//! range on every call. [`Raycaster`] does that once and precomputes, per
+//! block of 8×8 cells, bounds of the surface height and slope, with which
+//! it skips march samples that are certainly above the surface. It
+//! evaluates the same samples where it does not skip and therefore returns
+//! bit-identical results. Use it for images: 640×360 rays on a 403×344
+//! field take about 0.5 s in a release build (7 s unoptimised), against
+//! about 10 s for [`raycast`] even optimised.
 
 use glam::{DVec2, DVec3};
 
@@ -42,7 +44,7 @@ use crate::io::heightmap::HeightField;
 use crate::terrain::bspline::sample_bspline;
 
 /// Iterations of bisection on the bracketing step.
-const BISECTIONS: u32 = 40;
+const BISECTIONS: u32 = 30;
 
 /// Most march steps per ray; longer rays take proportionally longer steps.
 const MAX_STEPS: u64 = 1 << 22;
@@ -618,5 +620,33 @@ mod tests {
         }
         // The view shows both terrain and sky.
         assert!(hits > (w * h / 4) as usize && hits < (w * h) as usize, "{hits}");
+
+        // A rough field (independent pseudo-random heights: steep slopes
+        // everywhere) seen from all around, including from inside the
+        // rectangle and nearly straight down.
+        let rough = field(40, 33, DVec2::new(1.0, 1.5), |c, r| {
+            let k = (c * 7919.0 + r * 104_729.0).sin() * 43_758.545;
+            50.0 * (k - k.floor())
+        });
+        let caster = Raycaster::new(&rough).unwrap();
+        let mut hits = 0;
+        for k in 0..400 {
+            let a = f64::from(k) * 0.731;
+            let eye = DVec3::new(
+                20.0 + 30.0 * a.cos(),
+                25.0 + 30.0 * a.sin(),
+                55.0 + f64::from(k % 7) * 10.0,
+            );
+            let aim = DVec3::new(f64::from(k % 40), f64::from(k % 33) * 1.5, f64::from(k % 11) * 4.0);
+            let d = aim - eye;
+            let a = raycast(&rough, eye, d, f64::INFINITY);
+            assert_eq!(
+                a.map(f64::to_bits),
+                caster.raycast(eye, d, f64::INFINITY).map(f64::to_bits),
+                "ray {k}"
+            );
+            hits += usize::from(a.is_some());
+        }
+        assert!(hits > 200, "{hits}");
     }
 }
