@@ -4,14 +4,19 @@
 //!
 //! Times `warp`, `warp_into` (buffers reused, the per-frame case) and, for
 //! reference, the per-column variant and `importance_map` on a 128² sketch map
-//! of the default procedural terrain seen from one side; prints the median
-//! and the spread over 200 runs on one thread.
+//! of the default procedural terrain seen from one side; then the whole
+//! per-frame CPU stage (`LodFrame::plan`: sketch map resampled with the cubic
+//! B-spline, importance map, warp) for the default scene and camera; prints
+//! the median and the spread over 200 runs on one thread.
 
 use std::hint::black_box;
 use std::time::Instant;
 
+use alpenglow::renderer::Scene;
 use alpenglow::terrain::importance::{importance_map, Backface, Frustum, ImportanceParams};
+use alpenglow::terrain::lod::{DebugScalar, LodFrame, LodSettings};
 use alpenglow::terrain::procedural::ProceduralTerrain;
+use alpenglow::terrain::sketch_map::{SketchAlignment, SketchMap};
 use alpenglow::terrain::warp::{warp, warp_into, warp_with, ColumnImportance, WarpOptions};
 use glam::DVec3;
 
@@ -97,6 +102,27 @@ fn main() -> alpenglow::Result<()> {
         "importance_map (all four factors)",
         time(|| {
             black_box(importance_map(black_box(&sketch), N, eye, &params).ok());
+        }),
+    );
+    let scene = Scene::default_procedural()?;
+    let camera = scene.default_camera();
+    let aspect = 16.0 / 9.0;
+    report(
+        "sketch map (128², cubic B-spline)",
+        time(|| {
+            black_box(SketchMap::for_view(&scene.heights, &camera, aspect, SketchAlignment::View, N).ok());
+        }),
+    );
+    let mut frame = LodFrame::default();
+    let settings = LodSettings::default();
+    report(
+        "whole CPU stage per frame (plan)",
+        time(|| {
+            black_box(
+                frame
+                    .plan(&scene.heights, &camera, aspect, &settings, DebugScalar::None)
+                    .ok(),
+            );
         }),
     );
     Ok(())

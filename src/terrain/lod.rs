@@ -90,9 +90,10 @@ pub struct LodFrame {
 /// local roughness of the sketch map: the deviation of a texel's height
 /// from the mean of its four neighbours, relative to the texel size (0 on
 /// planes and smooth slopes). Smooth ground gets at most 20 % of the map's
-/// largest importance, rough ground is unbounded; texels outside the
-/// terrain get 0 (lifted to the importance floor).
-fn surface_bound(sketch: &SketchMap, max_importance: f64) -> Vec<f64> {
+/// largest view-distance importance `max I_v`, rough ground is effectively
+/// unbounded; texels outside the terrain get 0 (lifted to the importance
+/// floor).
+fn surface_bound(sketch: &SketchMap, max_distance_importance: f64) -> Vec<f64> {
     let n = sketch.n;
     let g = &sketch.geometry;
     let texel = (sketch.region.side_s.length() / (n - 1) as f64)
@@ -111,7 +112,7 @@ fn surface_bound(sketch: &SketchMap, max_importance: f64) -> Vec<f64> {
                     + h(r.saturating_sub(1), c)
                     + h((r + 1).min(n - 1), c));
             let roughness = (h(r, c) - mean).abs() / texel;
-            max_importance * (0.2 + 0.8 * smoothstep(0.0, 0.05, roughness))
+            max_distance_importance * (0.2 + 0.8 * smoothstep(0.0, 0.05, roughness))
         })
         .collect()
 }
@@ -153,12 +154,21 @@ impl LodFrame {
             backface: f.backface.then(Backface::default),
             ..Default::default()
         };
-        let mut importance = importance_map(&sketch.geometry, n, camera.eye, &params)?;
         if f.surface {
-            let max = importance.iter().copied().fold(0.0, f64::max);
+            // The largest view-distance importance over the map: the scale of the bound.
+            let max = if f.distance {
+                let nearest = sketch
+                    .geometry
+                    .iter()
+                    .map(|p| p.distance(camera.eye))
+                    .fold(f64::INFINITY, f64::min);
+                params.c / nearest.max(params.min_distance)
+            } else {
+                params.c
+            };
             params.surface_bound = Some(surface_bound(&sketch, max));
-            importance = importance_map(&sketch.geometry, n, camera.eye, &params)?;
         }
+        let importance = importance_map(&sketch.geometry, n, camera.eye, &params)?;
         if settings.mode == LodMode::Uniform {
             self.warp.positions.clone_from(&sketch.geometry);
         } else {
