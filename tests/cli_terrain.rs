@@ -8,9 +8,11 @@
 //! 65×65 procedural terrain, 64×40 pixels) to keep each run around a second
 //! on a software rasteriser.
 
-use std::ffi::{OsStr, OsString};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+
+use common::cli::*;
+use std::ffi::OsString;
+use std::path::Path;
 
 use serde_json::Value;
 
@@ -24,88 +26,9 @@ const SMALL_TERRAIN: &str = "procedural:ridged,size=65,spacing=40";
 /// An orbit around the centre of [`SMALL_TERRAIN`], well above it.
 const SMALL_ORBIT: &str = "1280,1280,0,1800,1500";
 
-/// The binary under test.
-fn bin() -> &'static str {
-    env!("CARGO_BIN_EXE_alpenglow")
-}
-
-/// A fresh, empty directory unique to this test and process.
-fn fresh_dir(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("alpenglow-cli-terrain-{test}-{}", std::process::id()));
-    if dir.exists() {
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// Runs the binary with `args` (the device choice comes from the
-/// environment, `ALPENGLOW_DEVICE`, as for every user).
-fn run<S: AsRef<OsStr>>(args: &[S]) -> Output {
-    Command::new(bin())
-        .args(args)
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run {}: {e}", bin()))
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
 /// `args` as owned OS strings, for mixing with paths.
 fn os_args(args: &[&str]) -> Vec<OsString> {
     args.iter().map(OsString::from).collect()
-}
-
-/// Panics with the command's output unless it exited 0.
-fn assert_success(what: &str, out: &Output) {
-    assert!(
-        out.status.success(),
-        "{what} failed ({}):\nstdout:\n{}\nstderr:\n{}",
-        out.status,
-        text(&out.stdout),
-        text(&out.stderr)
-    );
-}
-
-/// Checks a failed run: non-zero exit, exactly one non-empty stderr line
-/// that mentions every string of `needles`, and no panic.
-fn assert_one_line_error(what: &str, out: &Output, needles: &[&str]) {
-    let stderr = text(&out.stderr);
-    assert!(
-        !out.status.success(),
-        "{what}: expected failure, got {}\nstdout:\n{}\nstderr:\n{stderr}",
-        out.status,
-        text(&out.stdout)
-    );
-    let trimmed = stderr.trim();
-    assert!(!trimmed.is_empty(), "{what}: nothing on stderr");
-    assert_eq!(
-        trimmed.lines().count(),
-        1,
-        "{what}: expected one line on stderr, got:\n{stderr}"
-    );
-    let lower = trimmed.to_lowercase();
-    assert!(
-        !lower.contains("panicked") && !lower.contains("backtrace"),
-        "{what}: panic on stderr: {trimmed}"
-    );
-    for needle in needles {
-        assert!(
-            trimmed.contains(needle),
-            "{what}: stderr does not mention {needle:?}: {trimmed}"
-        );
-    }
-}
-
-/// The entries of `dir` (file names), sorted.
-fn entries(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
 }
 
 /// The `render` arguments for a small image of `terrain` plus `extra`.
@@ -350,15 +273,6 @@ fn assert_frames(what: &str, dir: &Path, n: usize) {
 fn assert_no_partial(what: &str, parent: &Path) {
     let partial: Vec<String> = entries(parent).into_iter().filter(|n| n.contains(".partial")).collect();
     assert!(partial.is_empty(), "{what}: staging directories left: {partial:?}");
-}
-
-/// A number at `value[key]`, finite and non-negative.
-fn finite_ms(value: &Value, key: &str, what: &str) -> f64 {
-    let v = value[key]
-        .as_f64()
-        .unwrap_or_else(|| panic!("{what}: {key} is not a number: {value}"));
-    assert!(v.is_finite() && v >= 0.0, "{what}: {key} = {v}");
-    v
 }
 
 /// Where `fly --out-dir` points before the run.

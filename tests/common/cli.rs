@@ -1,0 +1,95 @@
+//! Helpers of the end-to-end tests of the `alpenglow` binary
+//! (`tests/cli.rs`, `tests/cli_terrain.rs`).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+/// The binary under test.
+pub fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_alpenglow")
+}
+
+/// A fresh, empty directory unique to this test and process.
+pub fn fresh_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("alpenglow-cli-{test}-{}", std::process::id()));
+    if dir.exists() {
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Runs the binary with `args` (the device choice comes from the
+/// environment, `ALPENGLOW_DEVICE`, as for every user).
+pub fn run<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
+    Command::new(bin())
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {}: {e}", bin()))
+}
+
+pub fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Panics with the command's output unless it exited 0.
+pub fn assert_success(what: &str, out: &Output) {
+    assert!(
+        out.status.success(),
+        "{what} failed ({}):\nstdout:\n{}\nstderr:\n{}",
+        out.status,
+        text(&out.stdout),
+        text(&out.stderr)
+    );
+}
+
+/// Checks a failed run: non-zero exit, exactly one non-empty stderr line
+/// that mentions every string of `needles`, and no panic.
+pub fn assert_one_line_error(what: &str, out: &Output, needles: &[&str]) {
+    let stderr = text(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "{what}: expected failure, got {}\nstdout:\n{}\nstderr:\n{stderr}",
+        out.status,
+        text(&out.stdout)
+    );
+    let trimmed = stderr.trim();
+    assert!(!trimmed.is_empty(), "{what}: nothing on stderr");
+    assert_eq!(
+        trimmed.lines().count(),
+        1,
+        "{what}: expected one line on stderr, got:\n{stderr}"
+    );
+    let lower = trimmed.to_lowercase();
+    assert!(
+        !lower.contains("panicked") && !lower.contains("backtrace"),
+        "{what}: panic on stderr: {trimmed}"
+    );
+    for needle in needles {
+        assert!(
+            trimmed.contains(needle),
+            "{what}: stderr does not mention {needle:?}: {trimmed}"
+        );
+    }
+}
+
+/// The entries of `dir` (file names), sorted.
+pub fn entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// A finite, non-negative number at `value[key]`.
+pub fn finite_ms(value: &Value, key: &str, what: &str) -> f64 {
+    let v = value[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{what}: {key} is not a number: {value}"));
+    assert!(v.is_finite() && v >= 0.0, "{what}: {key} = {v}");
+    v
+}
