@@ -55,6 +55,7 @@
 use glam::DVec2;
 
 use crate::error::{Error, Result};
+use crate::random::SplitMix64;
 
 /// Default tile size (texels per side), as in the paper.
 pub const TILE: usize = 128;
@@ -85,33 +86,6 @@ const A_COEFFS: [f64; 2 * ARAD] = [
 /// The paper's refinement (upsampling) coefficients of the quadratic
 /// B-spline.
 const P_COEFFS: [f64; 4] = [0.25, 0.75, 0.75, 0.25];
-
-/// SplitMix64 (Steele, Lea & Flood 2014): small, fast, deterministic.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[0, 1)` with 53 random bits.
-    fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-
-    /// Two independent standard normal numbers (Box–Muller).
-    fn gaussian_pair(&mut self) -> (f64, f64) {
-        let u1 = 1.0 - self.next_f64(); // (0, 1]: ln is finite
-        let u2 = self.next_f64();
-        let r = (-2.0 * u1.ln()).sqrt();
-        let (s, c) = (std::f64::consts::TAU * u2).sin_cos();
-        (r * c, r * s)
-    }
-}
 
 /// The paper's `Downsample`: `to[i] = Σ_{j=0..32} aCoeffs[j] · from[(2i + j − 16) mod n]`
 /// for `i < n/2` (`n = from.len()`, even).

@@ -1,0 +1,45 @@
+//! Points: sequential point trees and EWA splatting (dissertation §10.1–10.3;
+//! `ALGORITHMS.md` §7–8) for vegetation, rocks and scans. Files follow the
+//! pipeline of chapter 10: inputs (PLY, OBJ) → surface samples (surfels) →
+//! SPT build and file → rendering.
+
+pub mod estimate;
+pub mod input;
+pub mod sampling;
+pub mod spt;
+pub mod spt_file;
+
+use glam::Vec3;
+
+/// A surface sample: an oriented disk with a colour.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Surfel {
+    pub position: Vec3,
+    /// Unit normal.
+    pub normal: Vec3,
+    /// Disk radius (world units, > 0).
+    pub radius: f32,
+    /// sRGB colour.
+    pub color: [u8; 3],
+}
+
+/// An indexed triangle mesh as read from a file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriangleMesh {
+    pub positions: Vec<Vec3>,
+    /// Per-vertex normals, when the file had them.
+    pub normals: Option<Vec<Vec3>>,
+    /// Per-vertex sRGB colours, when the file had them.
+    pub colors: Option<Vec<[u8; 3]>>,
+    /// Counter-clockwise triangles (polygons are fanned, strips unrolled).
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Points as read from a file, attributes optional.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PointCloud {
+    pub positions: Vec<Vec3>,
+    pub normals: Option<Vec<Vec3>>,
+    pub colors: Option<Vec<[u8; 3]>>,
+    pub radii: Option<Vec<f32>>,
+}

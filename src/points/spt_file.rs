@@ -1,0 +1,476 @@
+//! Sequential point tree files (dissertation §10.1; `ALGORITHMS.md` §7): the
+//! output of [`super::spt::build_spt`], stored so that renderers need not
+//! rebuild the tree.
+//!
+//! # Layout (version 1, all little-endian)
+//!
+//! | offset | size | field |
+//! |---|---|---|
+//! | 0 | 8 | magic `b"ALPSPT\0\0"` |
+//! | 8 | 4 | u32 version = 1 |
+//! | 12 | 4 | u32 node count N (≥ 1) |
+//! | 16 | 4 | f32 ε |
+//! | 20 | 12 | f32×3 bounds centre |
+//! | 32 | 4 | f32 bounds radius |
+//! | 36 | 60·N | nodes, in list order (decreasing `r_max`) |
+//! | 36 + 60·N | 8 | u64 FNV-1a 64 checksum of all bytes before it |
+//!
+//! A node record (60 bytes): f32×3 position (0), f32×3 normal (12), f32
+//! diameter (24), f32 e_p (28), f32 e_t (32), f32 e_g (36), f32 r_min (40),
+//! f32 r_max (44), u32 parent index (48; `0xFFFF_FFFF` for the root), u8×3
+//! sRGB colour (52), u8 flags (55; bit 0 = leaf, other bits 0), u32 depth (56).
+//!
+//! Every value is finite: the root's `r_max` "∞" is stored as `f32::MAX`
+//! ([`super::spt::ROOT_R_MAX`]). The reader checks, in this order: magic,
+//! version (before the checksum, so that a file of a later version gets a
+//! clear message even though its layout may differ), length against the node
+//! count, checksum, then every value and the tree structure (one root, parent
+//! indices in range, depth = parent's depth + 1 so there are no cycles,
+//! leaves without children, sorted by decreasing `r_max`, non-negative
+//! errors, `r_min ≤ r_max`).
+
+use std::path::Path;
+
+use glam::Vec3;
+
+use super::spt::{SequentialPointTree, SptNode, NO_PARENT};
+use crate::error::{Error, Result};
+
+/// The first eight bytes of every SPT file.
+pub const SPT_MAGIC: [u8; 8] = *b"ALPSPT\0\0";
+/// The version this build writes and reads.
+pub const SPT_VERSION: u32 = 1;
+/// Bytes before the first node.
+pub const HEADER_BYTES: usize = 36;
+/// Bytes per node record.
+pub const NODE_BYTES: usize = 60;
+/// Bytes of the trailing checksum.
+pub const CHECKSUM_BYTES: usize = 8;
+
+/// Flag bit of a leaf node.
+const FLAG_LEAF: u8 = 1;
+
+/// FNV-1a, 64 bit.
+fn fnv1a64(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+/// Checks the values and structure of a tree; the message is one line
+/// without the file name.
+fn validate(tree: &SequentialPointTree) -> std::result::Result<(), String> {
+    let n = tree.nodes.len();
+    if n == 0 {
+        return Err("the tree has no nodes".into());
+    }
+    if n >= NO_PARENT as usize {
+        return Err(format!("{n} nodes exceed the format's limit"));
+    }
+    if !(tree.epsilon.is_finite() && tree.epsilon > 0.0) {
+        return Err(format!("epsilon {} is not positive and finite", tree.epsilon));
+    }
+    if !tree.bounds_centre.is_finite() {
+        return Err("bounds centre is not finite".into());
+    }
+    if !(tree.bounds_radius.is_finite() && tree.bounds_radius >= 0.0) {
+        return Err(format!("bounds radius {} is not finite and ≥ 0", tree.bounds_radius));
+    }
+    let mut roots = 0usize;
+    for (i, node) in tree.nodes.iter().enumerate() {
+        let bad = |what: &str| Err(format!("node {i}: {what}"));
+        if !node.position.is_finite() {
+            return bad("non-finite position");
+        }
+        if !node.normal.is_finite() {
+            return bad("non-finite normal");
+        }
+        if (node.normal.length() - 1.0).abs() > 1e-3 {
+            return bad("normal is not unit length");
+        }
+        let scalars = [
+            ("diameter", node.diameter),
+            ("e_p", node.e_p),
+            ("e_t", node.e_t),
+            ("e_g", node.e_g),
+            ("r_min", node.r_min),
+            ("r_max", node.r_max),
+        ];
+        for (name, v) in scalars {
+            if !v.is_finite() {
+                return bad(&format!("non-finite {name}"));
+            }
+            if v < 0.0 {
+                return bad(&format!("negative {name}"));
+            }
+        }
+        if node.diameter <= 0.0 {
+            return bad("diameter is zero");
+        }
+        if node.r_min > node.r_max {
+            return bad("r_min exceeds r_max");
+        }
+        if i > 0 && tree.nodes[i - 1].r_max < node.r_max {
+            return bad("nodes are not sorted by decreasing r_max");
+        }
+        if node.parent == NO_PARENT {
+            roots += 1;
+            if node.depth != 0 {
+                return bad("the root has a depth other than 0");
+            }
+        } else {
+            let p = node.parent as usize;
+            if p >= n || p == i {
+                return bad(&format!("parent index {p} is out of range"));
+            }
+            let parent = &tree.nodes[p];
+            if parent.is_leaf {
+                return bad(&format!("parent {p} is a leaf"));
+            }
+            if parent.depth.checked_add(1) != Some(node.depth) {
+                return bad(&format!(
+                    "depth {} does not follow its parent's {}",
+                    node.depth, parent.depth
+                ));
+            }
+        }
+    }
+    if roots != 1 {
+        return Err(format!("{roots} root nodes (expected exactly 1)"));
+    }
+    Ok(())
+}
+
+/// The file bytes of `tree` (assumed valid).
+fn encode(tree: &SequentialPointTree) -> Vec<u8> {
+    let mut out = Vec::with_capacity(HEADER_BYTES + NODE_BYTES * tree.nodes.len() + CHECKSUM_BYTES);
+    out.extend_from_slice(&SPT_MAGIC);
+    out.extend_from_slice(&SPT_VERSION.to_le_bytes());
+    out.extend_from_slice(&(tree.nodes.len() as u32).to_le_bytes());
+    let f = |out: &mut Vec<u8>, v: f32| out.extend_from_slice(&v.to_le_bytes());
+    f(&mut out, tree.epsilon);
+    for v in tree.bounds_centre.to_array() {
+        f(&mut out, v);
+    }
+    f(&mut out, tree.bounds_radius);
+    for node in &tree.nodes {
+        for v in node.position.to_array() {
+            f(&mut out, v);
+        }
+        for v in node.normal.to_array() {
+            f(&mut out, v);
+        }
+        for v in [node.diameter, node.e_p, node.e_t, node.e_g, node.r_min, node.r_max] {
+            f(&mut out, v);
+        }
+        out.extend_from_slice(&node.parent.to_le_bytes());
+        out.extend_from_slice(&node.color);
+        out.push(if node.is_leaf { FLAG_LEAF } else { 0 });
+        out.extend_from_slice(&node.depth.to_le_bytes());
+    }
+    let checksum = fnv1a64(&out);
+    out.extend_from_slice(&checksum.to_le_bytes());
+    out
+}
+
+fn u32_at(bytes: &[u8], at: usize) -> u32 {
+    let mut b = [0u8; 4];
+    b.copy_from_slice(&bytes[at..at + 4]);
+    u32::from_le_bytes(b)
+}
+
+fn f32_at(bytes: &[u8], at: usize) -> f32 {
+    f32::from_bits(u32_at(bytes, at))
+}
+
+fn vec3_at(bytes: &[u8], at: usize) -> Vec3 {
+    Vec3::new(f32_at(bytes, at), f32_at(bytes, at + 4), f32_at(bytes, at + 8))
+}
+
+/// Parses file bytes; the message is one line without the file name.
+fn decode(bytes: &[u8]) -> std::result::Result<SequentialPointTree, String> {
+    let len = bytes.len();
+    let magic_len = len.min(SPT_MAGIC.len());
+    if bytes[..magic_len] != SPT_MAGIC[..magic_len] {
+        return Err("not an alpenglow SPT file (wrong magic)".into());
+    }
+    if len < HEADER_BYTES {
+        return Err(format!(
+            "truncated: {len} bytes, shorter than the {HEADER_BYTES}-byte header"
+        ));
+    }
+    let version = u32_at(bytes, 8);
+    if version != SPT_VERSION {
+        return Err(format!(
+            "unsupported SPT version {version} (this build reads version {SPT_VERSION})"
+        ));
+    }
+    let count = u32_at(bytes, 12);
+    let expected = HEADER_BYTES as u64 + NODE_BYTES as u64 * u64::from(count) + CHECKSUM_BYTES as u64;
+    if (len as u64) < expected {
+        return Err(format!(
+            "truncated or wrong node count: the header says {count} nodes ({expected} bytes), the file has {len} bytes"
+        ));
+    }
+    if (len as u64) > expected {
+        return Err(format!(
+            "node count mismatch: the header says {count} nodes ({expected} bytes), the file has {len} bytes"
+        ));
+    }
+    let body = len - CHECKSUM_BYTES;
+    let mut stored = [0u8; 8];
+    stored.copy_from_slice(&bytes[body..]);
+    let stored = u64::from_le_bytes(stored);
+    let computed = fnv1a64(&bytes[..body]);
+    if stored != computed {
+        return Err(format!(
+            "checksum mismatch (stored {stored:016x}, computed {computed:016x}): the file is corrupt"
+        ));
+    }
+    let mut nodes = Vec::with_capacity(count as usize);
+    for i in 0..count as usize {
+        let at = HEADER_BYTES + i * NODE_BYTES;
+        let flags = bytes[at + 55];
+        if flags & !FLAG_LEAF != 0 {
+            return Err(format!("node {i}: unknown flags {flags:#04x}"));
+        }
+        nodes.push(SptNode {
+            position: vec3_at(bytes, at),
+            normal: vec3_at(bytes, at + 12),
+            diameter: f32_at(bytes, at + 24),
+            e_p: f32_at(bytes, at + 28),
+            e_t: f32_at(bytes, at + 32),
+            e_g: f32_at(bytes, at + 36),
+            r_min: f32_at(bytes, at + 40),
+            r_max: f32_at(bytes, at + 44),
+            parent: u32_at(bytes, at + 48),
+            color: [bytes[at + 52], bytes[at + 53], bytes[at + 54]],
+            is_leaf: flags & FLAG_LEAF != 0,
+            depth: u32_at(bytes, at + 56),
+        });
+    }
+    let tree = SequentialPointTree {
+        nodes,
+        bounds_centre: vec3_at(bytes, 20),
+        bounds_radius: f32_at(bytes, 32),
+        epsilon: f32_at(bytes, 16),
+    };
+    validate(&tree)?;
+    Ok(tree)
+}
+
+/// Writes `tree` to `path` in the format above, atomically (a failed write
+/// leaves any existing file untouched).
+///
+/// Errors (one line, naming `path`): the tree is invalid (non-finite values,
+/// broken structure: the same checks as [`read_spt`]), or the file cannot be
+/// written.
+pub fn write_spt(path: &Path, tree: &SequentialPointTree) -> Result<()> {
+    validate(tree).map_err(|m| Error::output(path, format!("invalid sequential point tree: {m}")))?;
+    crate::io::atomic::write_bytes_atomically(path, &encode(tree))
+}
+
+/// Reads a tree written by [`write_spt`].
+///
+/// Errors (one line, naming `path` and the problem): the file cannot be
+/// read, wrong magic, unsupported version, truncated file or a node count
+/// that does not match the length, checksum mismatch, non-finite or
+/// out-of-range values, broken tree structure.
+pub fn read_spt(path: &Path) -> Result<SequentialPointTree> {
+    let bytes = crate::io::read_input(path)?;
+    decode(&bytes).map_err(|m| Error::input(path, m))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::points::spt::{build_spt, SptOptions};
+    use crate::points::Surfel;
+    use std::path::PathBuf;
+
+    fn scratch_dir(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("alpenglow-spt-file-{}-{}", std::process::id(), name));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn tree() -> SequentialPointTree {
+        let mut surfels = Vec::new();
+        for i in 0..12 {
+            for j in 0..9 {
+                let (x, y) = (i as f32 * 0.5, j as f32 * 0.5);
+                surfels.push(Surfel {
+                    position: Vec3::new(x, y, (x * 0.7).sin() * (y * 0.3).cos()),
+                    normal: Vec3::new(-0.2 * x.cos(), 0.1, 1.0).normalize(),
+                    radius: 0.35,
+                    color: [(i * 20) as u8, (j * 25) as u8, 77],
+                });
+            }
+        }
+        build_spt(&surfels, &SptOptions::default(), &mut |_| {}).unwrap()
+    }
+
+    /// Recomputes the checksum after a deliberate edit of the body.
+    fn reseal(bytes: &mut [u8]) {
+        let body = bytes.len() - CHECKSUM_BYTES;
+        let c = fnv1a64(&bytes[..body]);
+        bytes[body..].copy_from_slice(&c.to_le_bytes());
+    }
+
+    fn read_err(path: &Path, bytes: &[u8]) -> String {
+        std::fs::write(path, bytes).unwrap();
+        let err = read_spt(path).unwrap_err().to_string();
+        assert!(err.contains(&*path.to_string_lossy()), "{err}");
+        assert!(!err.contains('\n'), "{err}");
+        err
+    }
+
+    #[test]
+    fn fnv1a64_reference_values() {
+        assert_eq!(fnv1a64(b""), 0xcbf2_9ce4_8422_2325);
+        assert_eq!(fnv1a64(b"a"), 0xaf63_dc4c_8601_ec8c);
+        assert_eq!(fnv1a64(b"foobar"), 0x8594_4171_f739_67e8);
+    }
+
+    #[test]
+    fn round_trip_is_exact() {
+        let dir = scratch_dir("round");
+        let path = dir.join("t.spt");
+        let t = tree();
+        write_spt(&path, &t).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        assert_eq!(bytes.len(), HEADER_BYTES + NODE_BYTES * t.nodes.len() + CHECKSUM_BYTES);
+        assert_eq!(&bytes[..8], b"ALPSPT\0\0");
+        let back = read_spt(&path).unwrap();
+        assert_eq!(back, t);
+        // Overwriting goes through the atomic writer and leaves no temporaries.
+        write_spt(&path, &back).unwrap();
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn corruption_is_detected() {
+        let dir = scratch_dir("corrupt");
+        let path = dir.join("c.spt");
+        let good = encode(&tree());
+        let len = good.len();
+
+        // Any flipped byte after the header fields checked before the
+        // checksum is a checksum mismatch.
+        for at in [
+            13,
+            16,
+            20,
+            32,
+            HEADER_BYTES,
+            HEADER_BYTES + 7,
+            len / 2,
+            len - 9,
+            len - 1,
+        ] {
+            let mut b = good.clone();
+            b[at] ^= 0x40;
+            let err = read_err(&path, &b);
+            let expected = if at < 16 { "node count" } else { "checksum mismatch" };
+            assert!(err.contains(expected), "byte {at}: {err}");
+        }
+        // Magic.
+        let mut b = good.clone();
+        b[0] = b'X';
+        assert!(read_err(&path, &b).contains("wrong magic"));
+        assert!(read_err(&path, b"PNG\x89 not an spt file at all").contains("wrong magic"));
+        // Future version (with a valid checksum, so the version is the message).
+        let mut b = good.clone();
+        b[8..12].copy_from_slice(&2u32.to_le_bytes());
+        reseal(&mut b);
+        assert!(read_err(&path, &b).contains("unsupported SPT version 2"));
+        // Truncation anywhere.
+        for cut in [0, 5, 8, 20, HEADER_BYTES, HEADER_BYTES + 30, len - 1] {
+            let err = read_err(&path, &good[..cut]);
+            assert!(err.contains("truncated"), "cut {cut}: {err}");
+        }
+        // Count mismatch: too few nodes claimed (trailing bytes), too many.
+        let mut b = good.clone();
+        let count = u32_at(&b, 12);
+        b[12..16].copy_from_slice(&(count - 1).to_le_bytes());
+        assert!(read_err(&path, &b).contains("node count mismatch"));
+        b[12..16].copy_from_slice(&u32::MAX.to_le_bytes());
+        assert!(read_err(&path, &b).contains("truncated or wrong node count"));
+        // Appended garbage.
+        let mut b = good.clone();
+        b.extend_from_slice(&[0; 3]);
+        assert!(read_err(&path, &b).contains("node count mismatch"));
+        // Missing file, directory.
+        assert!(read_spt(&dir.join("missing.spt"))
+            .unwrap_err()
+            .to_string()
+            .contains("not found"));
+        assert!(read_spt(&dir).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn invalid_values_are_rejected_even_with_a_valid_checksum() {
+        let dir = scratch_dir("values");
+        let path = dir.join("v.spt");
+        let good = encode(&tree());
+        let node1 = HEADER_BYTES + NODE_BYTES;
+        let cases: Vec<(usize, Vec<u8>, &str)> = vec![
+            (16, f32::NAN.to_le_bytes().to_vec(), "epsilon"),
+            (20, f32::INFINITY.to_le_bytes().to_vec(), "bounds centre"),
+            (node1, f32::NAN.to_le_bytes().to_vec(), "node 1: non-finite position"),
+            (node1 + 12, f32::NAN.to_le_bytes().to_vec(), "node 1: non-finite normal"),
+            (
+                node1 + 24,
+                f32::INFINITY.to_le_bytes().to_vec(),
+                "node 1: non-finite diameter",
+            ),
+            (node1 + 36, (-1.0f32).to_le_bytes().to_vec(), "node 1: negative e_g"),
+            (
+                HEADER_BYTES + 44,
+                f32::INFINITY.to_le_bytes().to_vec(),
+                "node 0: non-finite r_max",
+            ),
+            (node1 + 48, 9_999_999u32.to_le_bytes().to_vec(), "node 1: parent index"),
+            (node1 + 55, vec![0x82], "node 1: unknown flags"),
+            (node1 + 56, 77u32.to_le_bytes().to_vec(), "node 1: depth"),
+            (HEADER_BYTES + 48, 1u32.to_le_bytes().to_vec(), "node 0"),
+        ];
+        for (at, patch, expected) in cases {
+            let mut b = good.clone();
+            b[at..at + patch.len()].copy_from_slice(&patch);
+            reseal(&mut b);
+            let err = read_err(&path, &b);
+            assert!(err.contains(expected), "patch at {at}: {err}");
+        }
+        // Zero nodes.
+        let mut b = good[..HEADER_BYTES].to_vec();
+        b[12..16].copy_from_slice(&0u32.to_le_bytes());
+        b.extend_from_slice(&[0; CHECKSUM_BYTES]);
+        reseal(&mut b);
+        assert!(read_err(&path, &b).contains("no nodes"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn writing_an_invalid_tree_is_an_error_and_writes_nothing() {
+        let dir = scratch_dir("write");
+        let path = dir.join("w.spt");
+        let mut t = tree();
+        t.nodes[3].e_t = f32::NAN;
+        let err = write_spt(&path, &t).unwrap_err().to_string();
+        assert!(err.contains("w.spt") && err.contains("node 3: non-finite e_t"), "{err}");
+        assert!(!path.exists());
+        let mut t = tree();
+        t.nodes.swap(0, 5);
+        assert!(write_spt(&path, &t).is_err());
+        assert!(write_spt(&dir.join("no/such/dir.spt"), &tree()).is_err());
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
