@@ -24,6 +24,9 @@ pub enum Command {
     Bench(BenchArgs),
     /// Render a camera path (keyframe file or orbit) to a PNG sequence and report per-frame times.
     Fly(FlyArgs),
+    /// Sequential point trees: `spt build IN OUT`.
+    #[command(subcommand)]
+    Spt(SptCommand),
     /// Print the Vulkan device, driver and the features in use.
     Info(DeviceArgs),
 }
@@ -218,6 +221,45 @@ pub struct FlyArgs {
     /// Chrome trace of all frames.
     #[arg(long)]
     pub trace: Option<PathBuf>,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum SptCommand {
+    /// Build a sequential point tree from a PLY or OBJ file and write it as an SPT file.
+    Build(SptBuildArgs),
+}
+
+/// How meshes are sampled into surfels.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SamplingArg {
+    Stratified,
+    BlueNoise,
+}
+
+#[derive(Args, Debug)]
+pub struct SptBuildArgs {
+    /// Input: PLY (points or mesh) or OBJ (mesh).
+    pub input: PathBuf,
+    /// Output SPT file.
+    pub output: PathBuf,
+    /// Surfels sampled from a mesh (point clouds keep their points).
+    #[arg(long, default_value_t = 100_000)]
+    pub samples: usize,
+    /// Mesh sampling method.
+    #[arg(long, value_enum, default_value = "blue-noise")]
+    pub sampling: SamplingArg,
+    /// Sampling seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// SPT error threshold in pixels (r_min = e_g / ε).
+    #[arg(long, default_value_t = 1.0)]
+    pub epsilon: f32,
+    /// Vertical field of view the pixel threshold refers to, degrees.
+    #[arg(long = "fov-y", default_value_t = 60.0)]
+    pub fov_y: f32,
+    /// Image rows the pixel threshold refers to.
+    #[arg(long, default_value_t = 1080)]
+    pub rows: u32,
 }
 
 fn parse_numbers(s: &str, what: &str) -> Result<Vec<f64>, String> {

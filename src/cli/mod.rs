@@ -2,6 +2,7 @@
 
 mod args;
 mod fly;
+mod spt;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -47,6 +48,7 @@ pub fn run() -> Result<ExitCode> {
         Command::Render(args) => render(args),
         Command::Bench(args) => bench(args),
         Command::Fly(args) => fly::fly(args),
+        Command::Spt(args::SptCommand::Build(args)) => spt::build(args),
         Command::Info(args) => info(args),
     }
 }
