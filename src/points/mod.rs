@@ -5,6 +5,7 @@
 
 pub mod estimate;
 pub mod input;
+pub mod rocks;
 pub mod sampling;
 pub mod spt;
 pub mod spt_file;
