@@ -8,15 +8,11 @@
 mod common;
 
 use common::cli::*;
-use std::path::{Path, PathBuf};
+use common::data;
 
 use serde_json::Value;
 
 /// A test fixture in `tests/data`.
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
-}
-
 /// Runs `render` with `scene_args` plus every output (PNG, EXR, profile,
 /// trace) in a fresh directory, expects a one-line error mentioning
 /// `needles`, and checks that the directory is still empty (no output and
@@ -43,11 +39,7 @@ fn expect_render_error(test: &str, scene_args: &[&str], needles: &[&str]) {
     let out = run(&args);
     let what = format!("render {}", scene_args.join(" "));
     assert_one_line_error(&what, &out, needles);
-    assert!(
-        entries(&dir).is_empty(),
-        "{what}: files left behind: {:?}",
-        entries(&dir)
-    );
+    assert_no_files_left(&what, &dir);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -154,11 +146,7 @@ fn output_into_missing_directory() {
         let what = format!("render {flag} into a missing directory");
         assert_one_line_error(&what, &out, &["does-not-exist", file]);
         assert!(!missing.exists(), "{what}: the directory was created");
-        assert!(
-            entries(&dir).is_empty(),
-            "{what}: files left behind: {:?}",
-            entries(&dir)
-        );
+        assert_no_files_left(&what, &dir);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -5,14 +5,9 @@
 mod common;
 
 use common::cli::*;
+use common::data;
 
 use alpenglow::points::spt_file::read_spt;
-
-fn data(name: &str) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name)
-}
 
 #[test]
 fn builds_the_bunny_into_a_readable_tree() {
@@ -64,7 +59,7 @@ fn bad_inputs_are_one_line_errors_without_output() {
         let input = data(file);
         let r = run(&["spt".as_ref(), "build".as_ref(), input.as_os_str(), out.as_os_str()]);
         assert_one_line_error(file, &r, &[needle]);
-        assert!(entries(&dir).is_empty(), "{file}: output left behind");
+        assert_no_files_left(file, &dir);
     }
     let input = data("models/teapot.obj");
     let r = run(&[
@@ -76,6 +71,6 @@ fn bad_inputs_are_one_line_errors_without_output() {
         "0".as_ref(),
     ]);
     assert_one_line_error("--epsilon 0", &r, &["pixel threshold"]);
-    assert!(entries(&dir).is_empty());
+    assert_no_files_left("--epsilon 0", &dir);
     std::fs::remove_dir_all(dir).unwrap();
 }

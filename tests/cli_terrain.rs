@@ -96,11 +96,7 @@ fn expect_render_error(test: &str, terrain: Option<&str>, extra: &[&str], needle
     let out = run(&args);
     let what = format!("render --terrain {terrain:?} {}", extra.join(" "));
     assert_one_line_error(&what, &out, needles);
-    assert!(
-        entries(&dir).is_empty(),
-        "{what}: files left behind: {:?}",
-        entries(&dir)
-    );
+    assert_no_files_left(&what, &dir);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

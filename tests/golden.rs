@@ -17,13 +17,10 @@
 
 mod common;
 
-use std::path::Path;
-
-use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
 use alpenglow::io::image_out::write_png_rgba8;
 use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
-use common::{assert_validation_clean, failure_dir, golden_dir, mean_flip, validated_context};
-use glam::{DVec2, DVec3};
+use common::{assert_validation_clean, failure_dir, golden_dir, jacksboro_field, mean_flip, validated_context};
+use glam::DVec3;
 
 const MEAN_FLIP_THRESHOLD: f32 = 0.02;
 const WIDTH: u32 = 256;
@@ -89,25 +86,11 @@ fn default_scene_matches_golden() {
     check_golden("default-scene", &scene, &scene.default_camera());
 }
 
-fn jacksboro() -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/jacksboro-fault.png");
-    let field = load_heightmap(
-        &path,
-        &HeightmapOptions {
-            scale: 1.0,
-            offset: 0.0,
-            spacing: DVec2::new(74.4, 92.6),
-        },
-    )
-    .expect("real DEM");
-    Scene::new(field)
-}
-
 /// The Jacksboro DEM seen high and oblique: the default camera, from
 /// beyond the southern edge and above the highest point.
 #[test]
 fn real_dem_high_oblique_view_matches_golden() {
-    let scene = jacksboro();
+    let scene = Scene::new(jacksboro_field());
     check_golden("jacksboro-high-oblique", &scene, &scene.default_camera());
 }
 
@@ -115,7 +98,7 @@ fn real_dem_high_oblique_view_matches_golden() {
 /// below the horizon (large depth range, strong warping).
 #[test]
 fn real_dem_low_grazing_view_matches_golden() {
-    let scene = jacksboro();
+    let scene = Scene::new(jacksboro_field());
     let camera = Camera {
         eye: DVec3::new(2000.0, 3000.0, 1150.0),
         target: DVec3::new(20000.0, 20000.0, 600.0),
@@ -131,7 +114,7 @@ fn real_dem_low_grazing_view_matches_golden() {
 /// towards the north-east, a few hundred metres above the valley floor.
 #[test]
 fn real_dem_along_valley_view_matches_golden() {
-    let scene = jacksboro();
+    let scene = Scene::new(jacksboro_field());
     let camera = Camera {
         eye: DVec3::new(13600.0, 9600.0, 750.0),
         target: DVec3::new(18500.0, 21500.0, 350.0),

@@ -1,15 +1,14 @@
 //! Height-map loading against the real DEM and bad fixtures in tests/data,
 //! EXR and PNG output round trips, and atomic-write guarantees.
 
+mod common;
+
+use common::data;
 use std::path::{Path, PathBuf};
 
 use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
 use alpenglow::io::image_out::{read_exr_channels, write_exr, write_png_rgba8};
 use glam::DVec2;
-
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
-}
 
 /// A fresh, empty scratch directory for one test.
 fn scratch(name: &str) -> PathBuf {

@@ -10,29 +10,16 @@
 
 mod common;
 
-use std::path::Path;
-
-use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
 use alpenglow::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
 use alpenglow::terrain::geometry_image::TerrainSettings;
 use alpenglow::terrain::lod::{DebugScalar, LodFrame, LodMode, LodSettings};
 use alpenglow::terrain::raycast::Raycaster;
 use alpenglow::terrain::zoom::{projected_quad_areas, quantile, zoom_positions};
-use common::{assert_validation_clean, validated_context};
-use glam::{DVec2, DVec3};
+use common::{assert_validation_clean, jacksboro_field, validated_context};
+use glam::DVec3;
 
 const WIDTH: u32 = 192;
 const HEIGHT: u32 = 108;
-
-fn jacksboro() -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/jacksboro-fault.png");
-    let options = HeightmapOptions {
-        scale: 1.0,
-        offset: 0.0,
-        spacing: DVec2::new(74.4, 92.6),
-    };
-    Scene::new(load_heightmap(&path, &options).expect("real DEM"))
-}
 
 fn views(scene: &Scene) -> Vec<(&'static str, Camera)> {
     let base = scene.default_camera();
@@ -115,7 +102,7 @@ fn raycast_depth(scene: &Scene, camera: &Camera) -> Vec<f32> {
 
 #[test]
 fn depth_matches_cpu_ray_cast_without_detail_and_has_no_holes() {
-    let scene = jacksboro();
+    let scene = Scene::new(jacksboro_field());
     let views = views(&scene);
     let cameras: Vec<Camera> = views.iter().map(|v| v.1).collect();
     let terrain = TerrainSettings {
@@ -168,7 +155,7 @@ fn depth_matches_cpu_ray_cast_without_detail_and_has_no_holes() {
 /// the coverage must stay the same: no holes at the borders either.
 #[test]
 fn detail_keeps_the_mesh_closed() {
-    let scene = jacksboro();
+    let scene = Scene::new(jacksboro_field());
     let cameras: Vec<Camera> = views(&scene).iter().map(|v| v.1).collect();
     let frames = render(&scene, &cameras, TerrainSettings::default());
     for (camera, frame) in cameras.iter().zip(&frames) {
@@ -193,7 +180,7 @@ fn detail_keeps_the_mesh_closed() {
 /// test above ties to the GPU): the 90th percentile over the median.
 #[test]
 fn warped_quads_are_more_uniform_on_screen_than_uniform_ones() {
-    let scene = jacksboro();
+    let scene = Scene::new(jacksboro_field());
     for (name, camera) in views(&scene).into_iter().take(3) {
         let spread = |mode: LodMode| {
             let settings = LodSettings {

@@ -4,9 +4,11 @@
 //! the surface up to the box filter, obtained/demanded density (Fig. 7.12)
 //! and the identity warp. Run with `--nocapture` to see the histograms.
 
-use std::path::Path;
+mod common;
 
-use alpenglow::io::heightmap::{load_heightmap, HeightField, HeightmapOptions};
+use common::jacksboro_field;
+
+use alpenglow::io::heightmap::HeightField;
 use alpenglow::terrain::importance::{importance_map, Backface, Frustum, ImportanceParams};
 use alpenglow::terrain::procedural::ProceduralTerrain;
 use alpenglow::terrain::warp::{
@@ -127,18 +129,11 @@ fn procedural() -> HeightField {
         .expect("procedural terrain")
 }
 
-fn dem() -> HeightField {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/jacksboro-fault.png");
-    let options = HeightmapOptions {
-        scale: 1.0,
-        offset: 0.0,
-        spacing: DVec2::new(74.4, 92.6),
-    };
-    load_heightmap(&path, &options).expect("DEM loads")
-}
-
 fn terrains() -> [(&'static str, HeightField); 2] {
-    [("procedural ridged", procedural()), ("Jacksboro DEM", dem())]
+    [
+        ("procedural ridged", procedural()),
+        ("Jacksboro DEM", jacksboro_field()),
+    ]
 }
 
 /// Both terrains seen by `cameras`, warped with the default options and the

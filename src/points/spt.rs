@@ -748,28 +748,25 @@ pub fn build_spt(
 mod tests {
     use super::*;
 
-    /// splitmix64: a small deterministic generator for test inputs.
-    struct Rng(u64);
+    /// Test inputs from the project's generator.
+    struct Rng(crate::random::SplitMix64);
 
     impl Rng {
-        fn next_u64(&mut self) -> u64 {
-            let mut r = crate::random::SplitMix64(self.0);
-            let v = r.next_u64();
-            self.0 = r.0;
-            v
+        fn new(seed: u64) -> Rng {
+            Rng(crate::random::SplitMix64(seed))
         }
         /// Uniform in [0, 1).
         fn f(&mut self) -> f32 {
-            (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+            (self.0.next_u64() >> 40) as f32 / (1u64 << 24) as f32
         }
         fn color(&mut self) -> [u8; 3] {
-            let v = self.next_u64();
+            let v = self.0.next_u64();
             [v as u8, (v >> 8) as u8, (v >> 16) as u8]
         }
     }
 
     fn sphere(count: usize, seed: u64) -> Vec<Surfel> {
-        let mut rng = Rng(seed);
+        let mut rng = Rng::new(seed);
         let radius = 2.0 * (4.0 * std::f32::consts::PI / count as f32).sqrt();
         (0..count)
             .map(|_| {
@@ -788,7 +785,7 @@ mod tests {
     }
 
     fn plane(count: usize, seed: u64) -> Vec<Surfel> {
-        let mut rng = Rng(seed);
+        let mut rng = Rng::new(seed);
         (0..count)
             .map(|_| Surfel {
                 position: Vec3::new(10.0 * rng.f(), 10.0 * rng.f(), 0.0),
@@ -1172,9 +1169,9 @@ mod tests {
     fn errors_match_brute_force_on_disk_rims() {
         // One inner node over a few random disks: the closed forms for d,
         // e_p and e_t against densely sampled disk rims.
-        let mut rng = Rng(7);
+        let mut rng = Rng::new(7);
         for _ in 0..20 {
-            let count = 2 + (rng.next_u64() % 5) as usize;
+            let count = 2 + (rng.0.next_u64() % 5) as usize;
             let surfels: Vec<Surfel> = (0..count)
                 .map(|_| Surfel {
                     position: Vec3::new(rng.f(), rng.f(), rng.f() * 0.3) * 4.0,

@@ -11,7 +11,7 @@ use crate::io::heightmap::HeightField;
 use crate::renderer::Camera;
 use crate::terrain::importance::{importance_map, smoothstep, Backface, Frustum, ImportanceParams};
 use crate::terrain::sketch_map::{SketchAlignment, SketchMap, DEFAULT_SKETCH_SIDE};
-use crate::terrain::warp::{density_ratio, warp_into, PassOrder, WarpOptions, WarpResult};
+use crate::terrain::warp::{bilinear, density_ratio, warp_into, PassOrder, WarpOptions, WarpResult};
 
 /// How the output grid is placed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -80,6 +80,7 @@ impl Default for LodSettings {
 #[derive(Clone, Debug, Default)]
 pub struct LodFrame {
     pub sketch: Option<SketchMap>,
+    /// Empty for a uniform grid without a debug view that needs it.
     pub importance: Vec<f64>,
     pub warp: WarpResult,
     /// Per sketch texel `(Φx, Φy, debug scalar, 0)`, what the GPU reads.
@@ -117,6 +118,47 @@ fn surface_bound(sketch: &SketchMap, max_distance_importance: f64) -> Vec<f64> {
         .collect()
 }
 
+/// The importance map of eq. 7.4 on `sketch` for `camera`, with the
+/// factors `f` on.
+fn sketch_importance(sketch: &SketchMap, camera: &Camera, aspect: f64, f: ImportanceFactors) -> Result<Vec<f64>> {
+    let n = sketch.n;
+    let texel = (sketch.region.side_s.length().max(sketch.region.side_t.length()) / (n - 1) as f64).max(1e-6);
+    let frustum = if f.frustum {
+        Some(Frustum::perspective(
+            camera.eye,
+            camera.forward(),
+            camera.up,
+            camera.fov_y_deg.to_radians(),
+            aspect,
+            2.0 * texel,
+        )?)
+    } else {
+        None
+    };
+    let mut params = ImportanceParams {
+        min_distance: texel,
+        distance: f.distance,
+        frustum,
+        backface: f.backface.then(Backface::default),
+        ..Default::default()
+    };
+    if f.surface {
+        // The largest view-distance importance over the map: the scale of the bound.
+        let max = if f.distance {
+            let nearest = sketch
+                .geometry
+                .iter()
+                .map(|p| p.distance(camera.eye))
+                .fold(f64::INFINITY, f64::min);
+            params.c / nearest.max(params.min_distance)
+        } else {
+            params.c
+        };
+        params.surface_bound = Some(surface_bound(sketch, max));
+    }
+    importance_map(&sketch.geometry, n, camera.eye, &params)
+}
+
 impl LodFrame {
     /// Runs sketch map, importance map and warp for `camera` into `self`
     /// (buffers reused from frame to frame).
@@ -133,42 +175,12 @@ impl LodFrame {
             return Err(Error::invalid("sketch map size", format!("{n} (must be 4..=1024)")));
         }
         let sketch = SketchMap::for_view(field, camera, aspect, settings.alignment, n)?;
-        let texel = (sketch.region.side_s.length().max(sketch.region.side_t.length()) / (n - 1) as f64).max(1e-6);
-        let f = settings.factors;
-        let frustum = if f.frustum {
-            Some(Frustum::perspective(
-                camera.eye,
-                camera.forward(),
-                camera.up,
-                camera.fov_y_deg.to_radians(),
-                aspect,
-                2.0 * texel,
-            )?)
+        // A uniform grid needs the importance map only for the debug views.
+        let importance = if settings.mode == LodMode::Warped || debug != DebugScalar::None {
+            sketch_importance(&sketch, camera, aspect, settings.factors)?
         } else {
-            None
+            Vec::new()
         };
-        let mut params = ImportanceParams {
-            min_distance: texel,
-            distance: f.distance,
-            frustum,
-            backface: f.backface.then(Backface::default),
-            ..Default::default()
-        };
-        if f.surface {
-            // The largest view-distance importance over the map: the scale of the bound.
-            let max = if f.distance {
-                let nearest = sketch
-                    .geometry
-                    .iter()
-                    .map(|p| p.distance(camera.eye))
-                    .fold(f64::INFINITY, f64::min);
-                params.c / nearest.max(params.min_distance)
-            } else {
-                params.c
-            };
-            params.surface_bound = Some(surface_bound(&sketch, max));
-        }
-        let importance = importance_map(&sketch.geometry, n, camera.eye, &params)?;
         if settings.mode == LodMode::Uniform {
             self.warp.positions.clone_from(&sketch.geometry);
         } else {
@@ -187,8 +199,8 @@ impl LodFrame {
             DebugScalar::Importance => {
                 let max = importance.iter().copied().fold(0.0, f64::max).max(1e-30);
                 // Importance at the warped positions: bilinear in the sketch frame.
-                let at = sample_on_sketch(&sketch, &importance);
-                self.warp.positions.iter().map(|p| at(*p) / max).collect()
+                let at = |p: &DVec3| bilinear(&importance, n, sketch.region.grid_coord(p.truncate(), n));
+                self.warp.positions.iter().map(|p| at(p) / max).collect()
             }
             DebugScalar::DensityRatio => {
                 density_ratio(&self.warp.positions, &sketch.geometry, &importance, n)?.combined
@@ -206,27 +218,5 @@ impl LodFrame {
         self.importance = importance;
         self.sketch = Some(sketch);
         Ok(())
-    }
-}
-
-/// Bilinear lookup of a per-texel sketch quantity at a world position.
-fn sample_on_sketch<'a>(sketch: &'a SketchMap, values: &'a [f64]) -> impl Fn(DVec3) -> f64 + 'a {
-    let n = sketch.n;
-    let m = (n - 1) as f64;
-    let r = sketch.region;
-    let (ls, lt) = (
-        r.side_s.length_squared().max(1e-30),
-        r.side_t.length_squared().max(1e-30),
-    );
-    move |p: DVec3| {
-        let d = p.truncate() - r.origin;
-        let gs = (d.dot(r.side_s) / ls * m).clamp(0.0, m);
-        let gt = (d.dot(r.side_t) / lt * m).clamp(0.0, m);
-        let (c, rr) = ((gs as usize).min(n - 2), (gt as usize).min(n - 2));
-        let (fs, ft) = (gs - c as f64, gt - rr as f64);
-        let v = |r: usize, c: usize| values[r * n + c];
-        let top = v(rr, c) + (v(rr, c + 1) - v(rr, c)) * fs;
-        let bottom = v(rr + 1, c) + (v(rr + 1, c + 1) - v(rr + 1, c)) * fs;
-        top + (bottom - top) * ft
     }
 }

@@ -109,6 +109,33 @@ pub enum TerrainModel {
     Ridged,
 }
 
+impl TerrainModel {
+    /// Every model, in the order of §6.1.2.
+    pub const ALL: [TerrainModel; 5] = [
+        TerrainModel::Fbm,
+        TerrainModel::Multifractal,
+        TerrainModel::Heterogeneous,
+        TerrainModel::Hybrid,
+        TerrainModel::Ridged,
+    ];
+
+    /// The model's name on the command line (`--terrain procedural:NAME`).
+    pub fn name(self) -> &'static str {
+        match self {
+            TerrainModel::Fbm => "fbm",
+            TerrainModel::Multifractal => "multifractal",
+            TerrainModel::Heterogeneous => "heterogeneous",
+            TerrainModel::Hybrid => "hybrid",
+            TerrainModel::Ridged => "ridged",
+        }
+    }
+
+    /// The model called `name` ([`TerrainModel::name`]).
+    pub fn from_name(name: &str) -> Option<TerrainModel> {
+        TerrainModel::ALL.into_iter().find(|m| m.name() == name)
+    }
+}
+
 /// Parameters of a procedural terrain (§6.1.2).
 ///
 /// The height at world `(x, y)` metres is
@@ -355,14 +382,6 @@ impl ProceduralTerrain {
 mod tests {
     use super::*;
 
-    const MODELS: [TerrainModel; 5] = [
-        TerrainModel::Fbm,
-        TerrainModel::Multifractal,
-        TerrainModel::Heterogeneous,
-        TerrainModel::Hybrid,
-        TerrainModel::Ridged,
-    ];
-
     #[test]
     fn noise_is_bounded_zero_on_lattice_and_seeded() {
         let (mut lo, mut hi) = (f64::MAX, f64::MIN);
@@ -407,7 +426,7 @@ mod tests {
 
     #[test]
     fn every_model_is_finite_and_in_range() {
-        for model in MODELS {
+        for model in TerrainModel::ALL {
             let t = ProceduralTerrain {
                 model,
                 octaves: 8,

@@ -61,6 +61,18 @@ impl SketchRegion {
         self.origin + s * self.side_s + t * self.side_t
     }
 
+    /// Grid coordinate (column, row) of world `xy` on an `n×n` map of this
+    /// region (the sides are orthogonal).
+    pub fn grid_coord(&self, xy: DVec2, n: usize) -> DVec2 {
+        let d = xy - self.origin;
+        let m = (n - 1) as f64;
+        let (ls, lt) = (
+            self.side_s.length_squared().max(1e-30),
+            self.side_t.length_squared().max(1e-30),
+        );
+        DVec2::new(d.dot(self.side_s) / ls, d.dot(self.side_t) / lt) * m
+    }
+
     /// The region of `camera` (aspect = width / height) over `field`.
     pub fn for_view(field: &HeightField, camera: &Camera, aspect: f64, alignment: SketchAlignment) -> Result<Self> {
         camera.validate()?;

@@ -4,7 +4,7 @@
 //! procedural:ridged,seed=7,octaves=8,lacunarity=2,h=1,offset=1,gain=2,wavelength=2500,amplitude=600,size=513,spacing=20
 //! ```
 //!
-//! `MODEL` is one of [`MODEL_NAMES`]; the keys ([`KEYS`]) are optional, each
+//! `MODEL` is one of the [`TerrainModel::name`]s; the keys ([`KEYS`]) are optional, each
 //! at most once, and those not given take the values of
 //! [`ProceduralTerrain::default`] (whatever the model), a 513×513 grid and
 //! 20 m spacing. `size=N` gives an N×N grid (`size=C:R` for C columns and R
@@ -47,26 +47,9 @@ pub const KEYS: [&str; 10] = [
     "spacing",
 ];
 
-/// The accepted model names.
-pub const MODEL_NAMES: [&str; 5] = ["fbm", "multifractal", "heterogeneous", "hybrid", "ridged"];
-
-const MODELS: [TerrainModel; 5] = [
-    TerrainModel::Fbm,
-    TerrainModel::Multifractal,
-    TerrainModel::Heterogeneous,
-    TerrainModel::Hybrid,
-    TerrainModel::Ridged,
-];
-
-/// The spec's name of `model` (one of [`MODEL_NAMES`]).
-pub fn model_name(model: TerrainModel) -> &'static str {
-    match model {
-        TerrainModel::Fbm => "fbm",
-        TerrainModel::Multifractal => "multifractal",
-        TerrainModel::Heterogeneous => "heterogeneous",
-        TerrainModel::Hybrid => "hybrid",
-        TerrainModel::Ridged => "ridged",
-    }
+/// The accepted model names, comma-separated ([`TerrainModel::name`]).
+fn model_names() -> String {
+    TerrainModel::ALL.map(TerrainModel::name).join(", ")
 }
 
 /// A procedural terrain and the grid it is sampled on.
@@ -127,7 +110,7 @@ impl TerrainSpec {
 fn usage() -> String {
     format!(
         "expected {PREFIX}MODEL[,key=value...] with MODEL one of {} and keys {}",
-        MODEL_NAMES.join(", "),
+        model_names(),
         KEYS.join(", ")
     )
 }
@@ -162,16 +145,8 @@ impl FromStr for TerrainSpec {
             .ok_or_else(|| format!("--terrain '{s}': missing '{PREFIX}' prefix; {}", usage()))?;
         let mut parts = body.split(',').map(str::trim);
         let model_part = parts.next().unwrap_or_default();
-        let model = MODEL_NAMES
-            .iter()
-            .position(|&m| m == model_part)
-            .map(|i| MODELS[i])
-            .ok_or_else(|| {
-                format!(
-                    "--terrain: unknown model '{model_part}' (models: {})",
-                    MODEL_NAMES.join(", ")
-                )
-            })?;
+        let model = TerrainModel::from_name(model_part)
+            .ok_or_else(|| format!("--terrain: unknown model '{model_part}' (models: {})", model_names()))?;
         let mut spec = TerrainSpec {
             terrain: ProceduralTerrain {
                 model,
@@ -225,7 +200,7 @@ impl fmt::Display for TerrainSpec {
         write!(
             f,
             "{PREFIX}{},seed={},octaves={},lacunarity={},h={},offset={},gain={},wavelength={},amplitude={}",
-            model_name(t.model),
+            t.model.name(),
             t.seed,
             t.octaves,
             t.lacunarity,
@@ -276,14 +251,14 @@ mod tests {
     #[test]
     fn defaults_and_models() {
         assert_eq!(parse("procedural:ridged").unwrap(), TerrainSpec::default());
-        for (name, model) in MODEL_NAMES.iter().zip(MODELS) {
+        for (name, model) in TerrainModel::ALL.map(|m| m.name()).iter().zip(TerrainModel::ALL) {
             let spec = parse(&format!("procedural:{name}")).unwrap();
             let expect = ProceduralTerrain {
                 model,
                 ..ProceduralTerrain::default()
             };
             assert_eq!(spec.terrain, expect);
-            assert_eq!(model_name(model), *name);
+            assert_eq!(model.name(), *name);
         }
         let spec = parse(" procedural:fbm, h = 0.5 ,size=65:33,spacing=10:12.5 ").unwrap();
         assert_eq!(spec.terrain.model, TerrainModel::Fbm);

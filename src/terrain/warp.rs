@@ -166,8 +166,20 @@ pub struct WarpResult {
 }
 
 /// What a line sample can be: `(x, y, h)` or `(x, y, h, I)`.
-trait Sample: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<f64, Output = Self> {}
+pub(crate) trait Sample: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<f64, Output = Self> {}
 impl<T: Copy + Add<Output = T> + Sub<Output = T> + Mul<f64, Output = T>> Sample for T {}
+
+/// Bilinear interpolation of an `n×n` row-major grid (`n ≥ 2`) at grid
+/// coordinate `g` (column, row), clamped to the grid.
+pub(crate) fn bilinear<T: Sample>(values: &[T], n: usize, g: DVec2) -> T {
+    let g = g.clamp(DVec2::ZERO, DVec2::splat((n - 1) as f64));
+    let (c0, r0) = ((g.x.floor() as usize).min(n - 2), (g.y.floor() as usize).min(n - 2));
+    let (fx, fy) = (g.x - c0 as f64, g.y - r0 as f64);
+    let at = |r: usize, c: usize| values[r * n + c];
+    let top = at(r0, c0) + (at(r0, c0 + 1) - at(r0, c0)) * fx;
+    let bottom = at(r0 + 1, c0) + (at(r0 + 1, c0 + 1) - at(r0 + 1, c0)) * fx;
+    top + (bottom - top) * fy
+}
 
 /// Non-finite or non-positive importance counts as 0.
 pub(crate) fn clean(i: f64) -> f64 {

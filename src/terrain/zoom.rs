@@ -12,6 +12,7 @@ use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
 use crate::renderer::Camera;
 use crate::terrain::bspline::sample_bspline;
+use crate::terrain::warp::bilinear;
 
 /// Vertex positions of the `side×side` output grid: `Φ` (the `n×n` warped
 /// sketch map, world `(x, y, ·)`) bilinearly interpolated, clamped onto the
@@ -28,14 +29,8 @@ pub fn zoom_positions(field: &HeightField, warped: &[DVec3], n: usize, side: usi
     let mut out = Vec::with_capacity(side * side);
     for j in 0..side {
         for i in 0..side {
-            let s = DVec2::new(i as f64, j as f64) * scale;
-            let c = (s.x as usize).min(n - 2);
-            let r = (s.y as usize).min(n - 2);
-            let f = s - DVec2::new(c as f64, r as f64);
-            let p = |r: usize, c: usize| warped[r * n + c].truncate();
-            let top = p(r, c).lerp(p(r, c + 1), f.x);
-            let bottom = p(r + 1, c).lerp(p(r + 1, c + 1), f.x);
-            let xy = top.lerp(bottom, f.y).clamp(DVec2::ZERO, extent);
+            let g = DVec2::new(i as f64, j as f64) * scale;
+            let xy = bilinear(warped, n, g).truncate().clamp(DVec2::ZERO, extent);
             out.push(DVec3::new(xy.x, xy.y, sample_bspline(field, xy.x, xy.y)));
         }
     }

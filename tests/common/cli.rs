@@ -93,3 +93,9 @@ pub fn finite_ms(value: &Value, key: &str, what: &str) -> f64 {
     assert!(v.is_finite() && v >= 0.0, "{what}: {key} = {v}");
     v
 }
+
+/// Fails unless `dir` is empty (a failed command must leave no file).
+pub fn assert_no_files_left(what: &str, dir: &Path) {
+    let left = entries(dir);
+    assert!(left.is_empty(), "{what}: files left behind: {left:?}");
+}

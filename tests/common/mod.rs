@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use alpenglow::io::heightmap::{load_heightmap, HeightField, HeightmapOptions};
 use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector, ValidationReport};
 
 /// A context with validation and synchronization validation on.
@@ -33,6 +34,22 @@ pub fn assert_validation_clean(report: &ValidationReport) {
         report.warnings(),
         messages.join("\n")
     );
+}
+
+/// A file in `tests/data`.
+pub fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
+}
+
+/// The real Jacksboro DEM (`tests/data/README.md`): metres, 74.4 m × 92.6 m
+/// spacing.
+pub fn jacksboro_field() -> HeightField {
+    let options = HeightmapOptions {
+        scale: 1.0,
+        offset: 0.0,
+        spacing: glam::DVec2::new(74.4, 92.6),
+    };
+    load_heightmap(&data("jacksboro-fault.png"), &options).expect("real DEM")
 }
 
 /// The directory holding golden images.

@@ -5,7 +5,7 @@ use std::fmt;
 
 use glam::{DMat2, DVec2, DVec3};
 
-use super::clean;
+use super::{bilinear, clean};
 use crate::error::{Error, Result};
 use crate::terrain::importance::check_grid;
 
@@ -57,15 +57,8 @@ pub fn density_ratio(warped: &[DVec3], sketch: &[DVec3], importance: &[f64], n: 
         return Err(Error::invalid("importance map", "no positive finite importance"));
     }
     let k = m / integral.sqrt();
-    let lookup = |xy: DVec2| -> f64 {
-        let g = (inv * (xy - origin)).clamp(DVec2::ZERO, DVec2::splat(m));
-        let (c0, r0) = ((g.x.floor() as usize).min(n - 2), (g.y.floor() as usize).min(n - 2));
-        let (fx, fy) = (g.x - c0 as f64, g.y - r0 as f64);
-        let at = |r: usize, c: usize| clean(importance[r * n + c]);
-        let top = at(r0, c0) + (at(r0, c0 + 1) - at(r0, c0)) * fx;
-        let bottom = at(r0 + 1, c0) + (at(r0 + 1, c0 + 1) - at(r0 + 1, c0)) * fx;
-        top + (bottom - top) * fy
-    };
+    let cleaned: Vec<f64> = importance.iter().map(|&i| clean(i)).collect();
+    let lookup = |xy: DVec2| -> f64 { bilinear(&cleaned, n, inv * (xy - origin)) };
     let xy = |r: usize, c: usize| warped[r * n + c].truncate();
     let spacing = |p: DVec2, q: DVec2, steps: usize| (q - p).length() / steps as f64;
     let mut out = DensityRatio {
