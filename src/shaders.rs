@@ -26,3 +26,13 @@ pub const SKY_VERT: SpirV = spirv!("lighting/sky.vert");
 pub const SKY_FRAG: SpirV = spirv!("lighting/sky.frag");
 /// tonemap: HDR → sRGB8.
 pub const TONEMAP: SpirV = spirv!("post/tonemap.comp");
+/// points.*: vertex stage of every splat pass (interval test, EWA set-up).
+pub const SPLAT_VERT: SpirV = spirv!("points/splat.vert");
+/// points.visibility: ray–plane depth pushed back by ε.
+pub const SPLAT_VISIBILITY_FRAG: SpirV = spirv!("points/visibility.frag");
+/// points.accumulate: weighted colour, normal and depth, additively blended.
+pub const SPLAT_ACCUMULATE_FRAG: SpirV = spirv!("points/accumulate.frag");
+/// points.opaque: opaque shaded discs.
+pub const SPLAT_OPAQUE_FRAG: SpirV = spirv!("points/opaque.frag");
+/// points.normalize: divide by the weight and shade (full-screen fragment stage).
+pub const SPLAT_NORMALIZE_FRAG: SpirV = spirv!("points/normalize.frag");

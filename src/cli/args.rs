@@ -83,7 +83,63 @@ pub struct SceneArgs {
     #[command(flatten)]
     pub terrain: TerrainArgs,
     #[command(flatten)]
+    pub points: PointArgs,
+    #[command(flatten)]
     pub device: DeviceArgs,
+}
+
+/// Splat mode (§10.2).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SplatArg {
+    /// Opaque discs, one pass (the fast baseline).
+    Opaque,
+    /// Perspective-accurate EWA splatting in three passes.
+    Ewa,
+}
+
+/// Primitive carrying a splat (§10.3).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SplatPrimitiveArg {
+    /// Point primitives (quads where a splat exceeds the largest point size).
+    Point,
+    /// Quads by vertex pulling.
+    Quad,
+    /// Instanced quads.
+    Instanced,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct PointArgs {
+    /// Point object: PLY (points or mesh), OBJ (mesh) or SPT file; repeatable.
+    #[arg(long = "points")]
+    pub points: Vec<PathBuf>,
+    /// Placement of the n-th --points object: t=X,Y,Z;r=RX,RY,RZ;s=S (degrees; each part optional); repeatable.
+    #[arg(long = "points-transform", allow_hyphen_values = true)]
+    pub transforms: Vec<String>,
+    /// Splat mode.
+    #[arg(long, value_enum, default_value = "ewa")]
+    pub splat: SplatArg,
+    /// Splat primitive.
+    #[arg(long = "splat-primitive", value_enum, default_value = "quad")]
+    pub splat_primitive: SplatPrimitiveArg,
+    /// SPT error threshold in pixels of this image (r_min = e_g / ε).
+    #[arg(long, default_value_t = 1.0)]
+    pub epsilon: f32,
+    /// Surfels sampled from PLY/OBJ meshes given to --points.
+    #[arg(long = "points-samples", default_value_t = 50_000)]
+    pub samples: usize,
+    /// Splat shading; off writes the splats' albedo (debugging, tests).
+    #[arg(long = "splat-shading", value_enum, default_value = "on")]
+    pub shading: Switch,
+    /// Draw back-facing splats (open surfaces); by default they are culled.
+    #[arg(long = "two-sided")]
+    pub two_sided: bool,
+    /// Procedural boulders scattered over the built-in terrain (0: none).
+    #[arg(long, default_value_t = 300)]
+    pub rocks: usize,
+    /// Draw no terrain: point objects against the sky.
+    #[arg(long = "no-terrain")]
+    pub no_terrain: bool,
 }
 
 /// On or off.
@@ -170,7 +226,7 @@ pub struct RenderArgs {
     /// Tone-mapped sRGB PNG.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// OpenEXR: linear R,G,B,A and Z (view-space depth, +inf where nothing was hit).
+    /// OpenEXR: linear R,G,B,A, Z (view-space depth, +inf where nothing was hit) and, with points, W (EWA weight).
     #[arg(long)]
     pub exr: Option<PathBuf>,
     /// Per-pass timings as JSON (name, GPU ms, CPU ms; frame totals).

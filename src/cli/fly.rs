@@ -15,10 +15,10 @@ use indicatif::{ProgressBar, ProgressStyle};
 use alpenglow::io::image_out::write_png_rgba8;
 use alpenglow::profile::{median, summarize, write_chrome_trace};
 use alpenglow::renderer::camera_path::{load_keyframes, CameraPath, Orbit, DEFAULT_START_ANGLE_DEG};
-use alpenglow::renderer::{FrameImages, RenderSettings, Renderer, Scene};
+use alpenglow::renderer::{FrameImages, Renderer, Scene};
 
 use super::args::FlyArgs;
-use super::{camera, check_output_path, check_validation, context, load_scene, terrain_settings, OutputSet};
+use super::{camera, check_output_path, check_validation, context, load_scene, render_settings, OutputSet};
 
 /// The default path: one turn around the terrain's centre at 60 % of its
 /// half-size, 0.4 of its size above the highest point.
@@ -104,12 +104,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     let device = ctx.info().name.clone();
     let mut wall_ms = Vec::with_capacity(cameras.len());
     let profiles = {
-        let settings = RenderSettings {
-            width: args.scene.width,
-            height: args.scene.height,
-            readback: staging.is_some(),
-            terrain: terrain_settings(&args.scene.terrain)?,
-        };
+        let settings = render_settings(&args.scene, staging.is_some())?;
         let mut renderer = Renderer::new(&ctx, &scene, settings)?;
         let bar = ProgressBar::new(cameras.len() as u64);
         bar.set_style(

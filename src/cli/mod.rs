@@ -2,6 +2,7 @@
 
 mod args;
 mod fly;
+mod points;
 mod spt;
 
 use std::path::{Path, PathBuf};
@@ -142,6 +143,24 @@ fn check_output_path(path: &Option<PathBuf>, what: &str) -> Result<()> {
 
 fn load_scene(args: &SceneArgs) -> Result<Scene> {
     validate_size(args.width, args.height)?;
+    let builtin = args.terrain.terrain.is_none() && args.heightmap.is_none();
+    let mut scene = load_terrain(args)?;
+    points::add_points(&args.points, &mut scene, builtin)?;
+    Ok(scene)
+}
+
+/// Render settings of the scene arguments.
+fn render_settings(args: &SceneArgs, readback: bool) -> Result<RenderSettings> {
+    Ok(RenderSettings {
+        width: args.width,
+        height: args.height,
+        readback,
+        terrain: terrain_settings(&args.terrain)?,
+        points: points::splat_settings(&args.points, args.fov_y, args.height)?,
+    })
+}
+
+fn load_terrain(args: &SceneArgs) -> Result<Scene> {
     if let Some(spec) = &args.terrain.terrain {
         return Ok(Scene::new(spec.generate()?));
     }
@@ -157,7 +176,7 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
             )?;
             Ok(Scene::new(field))
         }
-        None => Ok(Scene::default_procedural()?),
+        None => Ok(Scene::default_terrain()?),
     }
 }
 
@@ -242,16 +261,14 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
     let report = ctx.validation_report();
     let device = ctx.info().name.clone();
     let (images, profiles) = {
-        let settings = RenderSettings {
-            width: args.scene.width,
-            height: args.scene.height,
-            readback: true,
-            terrain: terrain_settings(&args.scene.terrain)?,
-        };
+        let settings = render_settings(&args.scene, true)?;
         let mut renderer = Renderer::new(&ctx, &scene, settings)?;
         let frame = renderer.render(&camera)?;
         let images = renderer.read(&frame)?;
         let profiles = renderer.finish()?;
+        if let Some(stats) = renderer.take_point_stats()?.last() {
+            println!("{}", stats.summary());
+        }
         (images, profiles)
     };
     drop(ctx);
@@ -261,7 +278,8 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
         write_png_rgba8(p, &images.rgba8, images.width, images.height)
     })?;
     outputs.write(&args.exr, |p| {
-        write_exr(p, images.width, images.height, &images.hdr, &images.depth, &[])
+        let extra: Vec<(&str, &[f32])> = images.weight.iter().map(|w| ("W", w.as_slice())).collect();
+        write_exr(p, images.width, images.height, &images.hdr, &images.depth, &extra)
     })?;
     outputs.write(&args.profile, |p| write_profile_json(p, &device, &profiles))?;
     outputs.write(&args.trace, |p| write_chrome_trace(p, &device, &profiles))?;
@@ -284,13 +302,9 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     let report = ctx.validation_report();
     let device = ctx.info().clone();
     let mut intervals = Vec::new();
+    let point_stats;
     let profiles = {
-        let settings = RenderSettings {
-            width: args.scene.width,
-            height: args.scene.height,
-            readback: false,
-            terrain: terrain_settings(&args.scene.terrain)?,
-        };
+        let settings = render_settings(&args.scene, false)?;
         let mut renderer = Renderer::new(&ctx, &scene, settings)?;
         let mut last = std::time::Instant::now();
         for i in 0..args.warmup + args.frames {
@@ -300,10 +314,13 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
             }
             last = std::time::Instant::now();
         }
-        renderer.finish()?
+        let profiles = renderer.finish()?;
+        point_stats = renderer.take_point_stats()?;
+        profiles
     };
     drop(ctx);
     check_validation(report)?;
+    let point_stats: Vec<_> = point_stats.into_iter().skip(args.warmup as usize).collect();
     let timed: Vec<FrameProfile> = profiles.into_iter().skip(args.warmup as usize).collect();
     if timed.is_empty() {
         return Err(anyhow!("no frame timings were collected"));
@@ -329,6 +346,14 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
             p.name, p.median_gpu_ms, p.min_gpu_ms, p.max_gpu_ms, p.median_cpu_ms
         );
     }
+    if let Some(stats) = point_stats.last() {
+        println!("  {}", stats.summary());
+        let cpu = alpenglow::profile::median(point_stats.iter().map(|s| s.cpu_ms));
+        println!(
+            "  points CPU selection median {cpu:.3} ms per frame ({:.4} ms per instance)",
+            cpu / stats.instances.max(1) as f64
+        );
+    }
     let mut outputs = OutputSet::default();
     if args.json.is_some() {
         let value = serde_json::json!({
@@ -341,6 +366,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
             "median_frame_interval_ms": interval_median,
             "max_frame_interval_ms": interval_max,
             "passes": passes,
+            "points": point_stats,
         });
         let text = serde_json::to_string_pretty(&value)?;
         outputs.write(&args.json, |p| {
@@ -373,5 +399,7 @@ fn info(args: DeviceArgs) -> Result<ExitCode> {
         }
     );
     println!("features:    {}", i.features.join(", "));
+    println!("optional:    {}", i.optional_features.join(", "));
+    println!("point size:  up to {} px", i.max_point_size);
     Ok(ExitCode::SUCCESS)
 }

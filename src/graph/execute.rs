@@ -10,7 +10,8 @@ use super::{PassKind, ResourceId};
 use crate::error::{Error, Result};
 use crate::profile::{FrameProfile, PassTiming};
 use crate::vulkan::{
-    AccessState, Barrier, Buffer, CommandRecorder, CompletedFrame, FrameRing, Image, PipelineStageFlags2,
+    AccessFlags2, AccessState, Barrier, Buffer, CommandRecorder, CompletedFrame, FrameRing, Image, ImageLayout,
+    PipelineStageFlags2,
 };
 
 /// What a pass's recording closure gets: the command recorder and the
@@ -25,6 +26,11 @@ impl<'a> PassContext<'a> {
     /// The command recorder.
     pub fn cmd(&mut self) -> &mut CommandRecorder {
         &mut *self.cmd
+    }
+
+    /// Index of the frame being recorded (0, 1, 2, …).
+    pub fn frame(&self) -> u64 {
+        self.frame
     }
 
     /// The image behind `id` this frame.
@@ -127,7 +133,16 @@ impl<P> BakedGraph<P> {
             }
             let discard = !self.imported[r.0] && !touched[r.0];
             touched[r.0] = true;
-            if let Some(b) = derive_barrier(&mut state, access, discard) {
+            if let Some(mut b) = derive_barrier(&mut state, access, discard) {
+                if discard && access.is_image() && b.old_layout == ImageLayout::UNDEFINED {
+                    // First use of a transient image this frame: its contents are
+                    // discarded, so wait for everything before. Once per image and
+                    // frame, this costs little, and it keeps validation layers before
+                    // 1.3.268 quiet: they count every draw and dispatch as touching
+                    // every image of the bindless heap (KhronosGroup/Vulkan-ValidationLayers#3450).
+                    b.src_stages |= PipelineStageFlags2::ALL_COMMANDS;
+                    b.src_access |= AccessFlags2::MEMORY_WRITE;
+                }
                 if access.is_image() && matches!(self.physical[r.0], Physical::Image(_)) {
                     image_barriers.push((r.0, b));
                 } else {

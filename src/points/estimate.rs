@@ -43,6 +43,7 @@ use std::collections::BinaryHeap;
 
 use glam::Vec3;
 
+use super::clip::ClipLines;
 use super::{PointCloud, Surfel};
 use crate::error::{Error, Result};
 
@@ -91,6 +92,10 @@ pub fn estimate_radii(positions: &[Vec3], k: usize) -> Result<Vec<f32>> {
 /// PCA normal turned towards the given normals of its neighbours. Given radii
 /// that are not finite and positive are replaced by estimates.
 ///
+/// Given clip lines (§10.2.4) are kept: they are relative to the tangent
+/// frame of the point's normal, so a point whose normal is estimated rather
+/// than given gets none (its lines' frame is unknown).
+///
 /// Errors on empty or non-finite positions, attribute arrays whose length
 /// differs from the positions', and clouds too small to estimate what is
 /// missing (fewer than 3 points for normals, 2 for radii).
@@ -113,6 +118,9 @@ pub fn complete_cloud(cloud: &PointCloud) -> Result<Vec<Surfel>> {
     }
     if let Some(radii) = &cloud.radii {
         check_len("radii", radii.len())?;
+    }
+    if let Some(clip) = &cloud.clip {
+        check_len("clip lines", clip.len())?;
     }
 
     let tree_cell = std::cell::OnceCell::new();
@@ -152,12 +160,22 @@ pub fn complete_cloud(cloud: &PointCloud) -> Result<Vec<Surfel>> {
         }
     };
 
+    let given_normal = |i: usize| {
+        cloud
+            .normals
+            .as_ref()
+            .is_some_and(|given| given[i].normalize_or_zero() != Vec3::ZERO)
+    };
     Ok((0..n)
         .map(|i| Surfel {
             position: positions[i],
             normal: normals[i],
             radius: radii[i],
             color: cloud.colors.as_ref().map_or(DEFAULT_COLOR, |c| c[i]),
+            clip: match &cloud.clip {
+                Some(clip) if given_normal(i) => clip[i],
+                _ => ClipLines::NONE,
+            },
         })
         .collect())
 }
@@ -888,6 +906,12 @@ mod tests {
         })
         .is_err());
         assert!(complete_cloud(&PointCloud {
+            positions: points.clone(),
+            clip: Some(vec![ClipLines::NONE; 3]),
+            ..Default::default()
+        })
+        .is_err());
+        assert!(complete_cloud(&PointCloud {
             positions: points[..2].to_vec(),
             ..Default::default()
         })
@@ -915,11 +939,14 @@ mod tests {
         let mut radii = vec![0.5; 500];
         radii[9] = f32::NAN;
         let colors: Vec<[u8; 3]> = (0..500).map(|i| [i as u8, 1, 2]).collect();
+        let line = |angle: f32| crate::points::clip::ClipLine { angle, offset: 0.01 };
+        let clip: Vec<ClipLines> = (0..500).map(|i| ClipLines([Some(line(i as f32)), None])).collect();
         let surfels = complete_cloud(&PointCloud {
             positions: points.clone(),
             normals: Some(normals),
             colors: Some(colors),
             radii: Some(radii),
+            clip: Some(clip.clone()),
         })
         .unwrap();
         for (i, s) in surfels.iter().enumerate() {
@@ -929,6 +956,9 @@ mod tests {
                 "{i}: inward like the given ones"
             );
             assert_eq!(s.color, [i as u8, 1, 2]);
+            // Clip lines are kept where the normal (their frame) was given.
+            let expected = if i == 7 { ClipLines::NONE } else { clip[i] };
+            assert_eq!(s.clip, expected, "{i}");
             if i != 9 {
                 assert_eq!(s.radius, 0.5);
             }

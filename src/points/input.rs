@@ -8,13 +8,18 @@
 //! * PLY (ASCII, binary little- and big-endian): a `vertex` element with
 //!   `x, y, z` of any scalar type; optional `nx, ny, nz`; optional
 //!   `red, green, blue` (also `r, g, b` or `diffuse_red, …`), integers taken
-//!   as 0–255 (`ushort` as 0–65535) and floats as 0–1; optional `radius`.
+//!   as 0–255 (`ushort` as 0–65535) and floats as 0–1; optional `radius`;
+//!   optional clip lines for sharp features (§10.2.4), `clip0_angle,
+//!   clip0_offset` and/or `clip1_angle, clip1_offset` (each pair complete):
+//!   the kept side is `u·cos θ + v·sin θ ≤ c` in the tangent frame of the
+//!   point's normal (see `clip`); an offset of `+inf` or ≥ `f32::MAX` is no
+//!   line, other non-finite values are errors.
 //!   Faces come from a `face` element (`vertex_indices` or `vertex_index`
 //!   integer lists; polygons are fanned into triangles) and/or a `tristrips`
 //!   element (`vertex_indices` lists, `-1` restarts a strip, the winding of
 //!   every other triangle is flipped back, degenerate stitching triangles are
 //!   dropped). A PLY whose faces/strips are non-empty is a
-//!   [`PointInput::Mesh`] (a `radius` is then ignored); otherwise
+//!   [`PointInput::Mesh`] (a `radius` and clip lines are then ignored); otherwise
 //!   [`PointInput::Points`]. Other elements are read and skipped.
 //! * OBJ: triangulated into a single index buffer; vertex colours (`v x y z r
 //!   g b`, 0–1, or 0–255 if any exceeds 1) when every vertex has them; normals
@@ -61,6 +66,7 @@ use glam::Vec3;
 use ply_rs_bw::parser::{Parser, Reader};
 use ply_rs_bw::ply::{Header, Property, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType};
 
+use super::clip::{ClipLine, ClipLines};
 use super::{PointCloud, TriangleMesh};
 use crate::error::{Error, Result};
 
@@ -122,6 +128,8 @@ struct PlyVertex {
     normal: [f32; 3],
     color: [u8; 3],
     radius: f32,
+    /// `clip0_angle, clip0_offset, clip1_angle, clip1_offset`.
+    clip: [f32; 4],
 }
 
 impl PropertyAccess for PlyVertex {
@@ -153,6 +161,7 @@ impl PropertyAccess for PlyVertex {
             Slot::Position(i) => self.position[i] = value,
             Slot::Normal(i) => self.normal[i] = value,
             Slot::Radius => self.radius = value,
+            Slot::Clip(i) => self.clip[i] = value,
             Slot::Color(_) => {}
         }
         PropertyAccessResult::Set
@@ -200,7 +209,12 @@ enum Slot {
     Normal(usize),
     Color(usize),
     Radius,
+    /// `clip0_angle, clip0_offset, clip1_angle, clip1_offset`.
+    Clip(usize),
 }
+
+/// The PLY names of the clip-line properties, in [`Slot::Clip`] order.
+const CLIP_PROPERTIES: [&str; 4] = ["clip0_angle", "clip0_offset", "clip1_angle", "clip1_offset"];
 
 fn vertex_slot(name: &str) -> Option<Slot> {
     Some(match name {
@@ -214,6 +228,10 @@ fn vertex_slot(name: &str) -> Option<Slot> {
         "green" | "g" | "diffuse_green" => Slot::Color(1),
         "blue" | "b" | "diffuse_blue" => Slot::Color(2),
         "radius" => Slot::Radius,
+        "clip0_angle" => Slot::Clip(0),
+        "clip0_offset" => Slot::Clip(1),
+        "clip1_angle" => Slot::Clip(2),
+        "clip1_offset" => Slot::Clip(3),
         _ => return None,
     })
 }
@@ -279,6 +297,8 @@ struct VertexLayout {
     normals: bool,
     colors: bool,
     radius: bool,
+    /// Whether clip line 0 / 1 is present (both of its properties).
+    clip: [bool; 2],
 }
 
 /// Checks the header for what we need and returns the vertex layout.
@@ -287,7 +307,7 @@ fn check_ply_header(header: &Header) -> std::result::Result<VertexLayout, String
         .elements
         .get("vertex")
         .ok_or_else(|| "PLY header has no 'vertex' element".to_string())?;
-    let mut seen = [false; 10];
+    let mut seen = [false; 14];
     for (name, def) in &vertex.properties {
         let Some(slot) = vertex_slot(name) else { continue };
         if !matches!(def.data_type, PropertyType::Scalar(_)) {
@@ -298,12 +318,24 @@ fn check_ply_header(header: &Header) -> std::result::Result<VertexLayout, String
             Slot::Normal(i) => 3 + i,
             Slot::Color(i) => 6 + i,
             Slot::Radius => 9,
+            Slot::Clip(i) => 10 + i,
         };
         seen[k] = true;
     }
     for (i, axis) in ["x", "y", "z"].iter().enumerate() {
         if !seen[i] {
             return Err(format!("PLY vertex element has no property '{axis}'"));
+        }
+    }
+    for k in 0..2 {
+        let (angle, offset) = (10 + 2 * k, 11 + 2 * k);
+        if seen[angle] != seen[offset] {
+            let (has, lacks) = if seen[angle] { (angle, offset) } else { (offset, angle) };
+            return Err(format!(
+                "PLY vertex property '{}' without '{}'",
+                CLIP_PROPERTIES[has - 10],
+                CLIP_PROPERTIES[lacks - 10]
+            ));
         }
     }
     for element in ["face", "tristrips"] {
@@ -326,6 +358,7 @@ fn check_ply_header(header: &Header) -> std::result::Result<VertexLayout, String
         normals: seen[3] && seen[4] && seen[5],
         colors: seen[6] && seen[7] && seen[8],
         radius: seen[9],
+        clip: [seen[10], seen[12]],
     })
 }
 
@@ -462,11 +495,26 @@ fn read_ply(source: impl Read, path: &Path) -> Result<PointInput> {
         } else {
             None
         };
+        let clip = if layout.clip.contains(&true) {
+            let mut clip = Vec::with_capacity(n);
+            for (i, v) in vertices.iter().enumerate() {
+                clip.push(clip_lines(v, layout.clip).ok_or_else(|| {
+                    bad(format!(
+                        "vertex {i} has a non-finite clip line ({}, {}, {}, {})",
+                        v.clip[0], v.clip[1], v.clip[2], v.clip[3]
+                    ))
+                })?);
+            }
+            Some(clip)
+        } else {
+            None
+        };
         return Ok(PointInput::Points(PointCloud {
             positions,
             normals,
             colors,
             radii,
+            clip,
         }));
     }
     drop(vertices);
@@ -513,6 +561,24 @@ fn read_ply(source: impl Read, path: &Path) -> Result<PointInput> {
         colors,
         triangles,
     }))
+}
+
+/// The clip lines of a PLY vertex (`present`: which of the two the header
+/// has); `None` when a present line has a NaN or infinite value other than
+/// the offset `+inf`, which, like offsets ≥ `f32::MAX`, means "no line".
+fn clip_lines(v: &PlyVertex, present: [bool; 2]) -> Option<ClipLines> {
+    let mut lines = ClipLines::NONE;
+    for k in 0..2 {
+        let (angle, offset) = (v.clip[2 * k], v.clip[2 * k + 1]);
+        if !present[k] || offset >= f32::MAX {
+            continue;
+        }
+        if !(angle.is_finite() && offset.is_finite()) {
+            return None;
+        }
+        lines.0[k] = Some(ClipLine { angle, offset });
+    }
+    Some(lines)
 }
 
 /// Appends the triangles of one strip (no restarts in `run`): triangle `i`
@@ -819,6 +885,68 @@ mod tests {
         assert_eq!(p.radii, Some(vec![0.5, 0.25, 2.0]));
         assert_eq!(p.normals.as_ref().map(Vec::len), Some(3));
         assert_eq!(p.normals.unwrap()[1], Vec3::Y);
+    }
+
+    #[test]
+    fn ply_points_with_clip_lines() {
+        let header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                      property float z\nproperty float nx\nproperty float ny\nproperty float nz\n\
+                      property float clip0_angle\nproperty float clip0_offset\n\
+                      property float clip1_angle\nproperty float clip1_offset\nend_header\n";
+        let body = "0 0 0 0 0 1 0.5 0.1 1.0 3.4028235e38\n\
+                    1 0 0 0 0 1 0 0.2 1.5 -0.125\n\
+                    2 0 0 0 0 1 0 3.4028235e38 0 3.4028235e38\n";
+        let file = Scratch::new("clip.ply", format!("{header}{body}").as_bytes());
+        let p = points(load_points_file(&file.0).unwrap());
+        let line = |angle, offset| Some(ClipLine { angle, offset });
+        assert_eq!(
+            p.clip,
+            Some(vec![
+                ClipLines([line(0.5, 0.1), None]),
+                ClipLines([line(0.0, 0.2), line(1.5, -0.125)]),
+                ClipLines::NONE,
+            ])
+        );
+        // One line only; the other clip fields absent.
+        let one = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+                   property float z\nproperty double clip0_offset\nproperty float clip0_angle\n\
+                   end_header\n0 0 0 0.25 -1\n";
+        let p = points(parse(one.as_bytes()).unwrap());
+        assert_eq!(p.clip, Some(vec![ClipLines([line(-1.0, 0.25), None])]));
+        // Without clip properties there are none.
+        let plain = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+                     property float z\nend_header\n0 0 0\n";
+        assert_eq!(points(parse(plain.as_bytes()).unwrap()).clip, None);
+        // An incomplete pair, a NaN, a −inf offset: errors.
+        let half = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+                    property float z\nproperty float clip1_angle\nend_header\n0 0 0 1\n";
+        let message = err(parse(half.as_bytes()));
+        assert!(message.contains("'clip1_angle' without 'clip1_offset'"), "{message}");
+        // (ASCII PLY has no NaN or infinity: binary.)
+        let header = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\n\
+                      property float y\nproperty float z\nproperty float clip0_angle\n\
+                      property float clip0_offset\nend_header\n";
+        for (angle, offset) in [(f32::NAN, 0.1), (0.5, f32::NEG_INFINITY), (f32::INFINITY, 0.1)] {
+            let mut b = Bin::new(header, true);
+            b.f32(0.0).f32(0.0).f32(0.0).f32(0.0).f32(0.1);
+            b.f32(1.0).f32(1.0).f32(1.0).f32(angle).f32(offset);
+            let message = err(parse(&b.bytes));
+            assert!(message.contains("vertex 1 has a non-finite clip line"), "{message}");
+        }
+        // An infinite offset is no line, whatever the angle.
+        let mut b = Bin::new(header, true);
+        b.f32(0.0).f32(0.0).f32(0.0).f32(f32::NAN).f32(f32::INFINITY);
+        b.f32(1.0).f32(1.0).f32(1.0).f32(0.0).f32(0.5);
+        assert_eq!(
+            points(parse(&b.bytes).unwrap()).clip,
+            Some(vec![ClipLines::NONE, ClipLines([line(0.0, 0.5), None])])
+        );
+        // Meshes ignore them.
+        let mesh_text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                         property float z\nproperty float clip0_angle\nproperty float clip0_offset\n\
+                         element face 1\nproperty list uchar int vertex_indices\nend_header\n\
+                         0 0 0 0 nan\n1 0 0 0 0\n0 1 0 0 0\n3 0 1 2\n";
+        assert_eq!(mesh(parse(mesh_text.as_bytes()).unwrap()).triangles.len(), 1);
     }
 
     #[test]

@@ -3,14 +3,20 @@
 //! pipeline of chapter 10: inputs (PLY, OBJ) → surface samples (surfels) →
 //! SPT build and file → rendering.
 
+pub mod clip;
+pub mod clusters;
 pub mod estimate;
 pub mod input;
+pub mod render;
 pub mod rocks;
 pub mod sampling;
+pub mod scene;
 pub mod spt;
 pub mod spt_file;
 
 use glam::Vec3;
+
+use clip::ClipLines;
 
 /// A surface sample: an oriented disk with a colour.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -22,6 +28,9 @@ pub struct Surfel {
     pub radius: f32,
     /// sRGB colour.
     pub color: [u8; 3],
+    /// Clip lines for sharp features (§10.2.4), in the tangent frame
+    /// [`clip::tangent_frame`] of `normal`; [`ClipLines::NONE`] for none.
+    pub clip: ClipLines,
 }
 
 /// An indexed triangle mesh as read from a file.
@@ -43,4 +52,6 @@ pub struct PointCloud {
     pub normals: Option<Vec<Vec3>>,
     pub colors: Option<Vec<[u8; 3]>>,
     pub radii: Option<Vec<f32>>,
+    /// Per-point clip lines (§10.2.4), when the file had them.
+    pub clip: Option<Vec<ClipLines>>,
 }

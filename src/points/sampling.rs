@@ -54,6 +54,10 @@
 //!
 //! An overlap of 1.5 leaves holes with both methods (largest gaps above).
 //!
+//! Clip lines (§10.2.4): a surfel within its radius of a crease of the mesh
+//! (an edge whose two triangles' normals differ by more than 30°) is clipped
+//! along it, at most twice; see [`super::clip`] for the rules.
+//!
 //! Degenerate (zero-area) triangles are skipped. Sampling is deterministic
 //! for a given seed.
 
@@ -61,6 +65,7 @@ use std::cmp::Ordering;
 
 use glam::Vec3;
 
+use super::clip::{ClipLines, Creases};
 use super::estimate::KdTree;
 use super::{Surfel, TriangleMesh};
 use crate::error::{Error, Result};
@@ -130,7 +135,7 @@ pub fn sample_mesh(mesh: &TriangleMesh, options: &SamplingOptions) -> Result<Vec
             format!("surface area {} too small for {count} samples", prepared.total_area),
         ));
     }
-    let mut surfels = match options.method {
+    let samples = match options.method {
         SamplingMethod::Stratified => prepared.stratified(count, options.seed)?,
         SamplingMethod::BlueNoise => {
             let candidates = count
@@ -141,10 +146,24 @@ pub fn sample_mesh(mesh: &TriangleMesh, options: &SamplingOptions) -> Result<Vec
             eliminate(candidates, count, prepared.total_area)
         }
     };
-    for s in &mut surfels {
-        s.radius = radius;
-    }
-    Ok(surfels)
+    let vertices: Vec<[usize; 3]> = prepared.triangles.iter().map(|t| t.vertices).collect();
+    let normals: Vec<Vec3> = prepared.triangles.iter().map(|t| t.face_normal).collect();
+    let creases = Creases::new(&mesh.positions, &vertices, &normals);
+    Ok(samples
+        .into_iter()
+        .map(|Sample { mut surfel, triangle }| {
+            surfel.radius = radius;
+            surfel.clip = creases.lines(triangle as usize, surfel.position, surfel.normal, radius);
+            surfel
+        })
+        .collect())
+}
+
+/// A surfel (radius still 0) and the index of the triangle it lies in.
+#[derive(Clone, Copy, Debug)]
+struct Sample {
+    surfel: Surfel,
+    triangle: u32,
 }
 
 /// A non-degenerate triangle.
@@ -217,7 +236,7 @@ impl<'a> Prepared<'a> {
 
     /// Exactly `count` stratified samples (module docs), radius left 0;
     /// errors only when they do not fit in memory.
-    fn stratified(&self, count: usize, seed: u64) -> Result<Vec<Surfel>> {
+    fn stratified(&self, count: usize, seed: u64) -> Result<Vec<Sample>> {
         // Roberts' R2 sequence: 1/g and 1/g² for the plastic number g.
         const G: f64 = 1.324_717_957_244_746;
         const ALPHA: [f64; 2] = [1.0 / G, 1.0 / (G * G)];
@@ -248,7 +267,10 @@ impl<'a> Prepared<'a> {
             for i in 0..n {
                 let u = (shift[0] + i as f64 * ALPHA[0]).fract();
                 let v = (shift[1] + i as f64 * ALPHA[1]).fract();
-                surfels.push(self.surfel(triangle, square_to_triangle(u as f32, v as f32)));
+                surfels.push(Sample {
+                    surfel: self.surfel(triangle, square_to_triangle(u as f32, v as f32)),
+                    triangle: t as u32,
+                });
             }
         }
         Ok(surfels)
@@ -276,6 +298,7 @@ impl<'a> Prepared<'a> {
             normal,
             radius: 0.0,
             color,
+            clip: ClipLines::NONE,
         }
     }
 }
@@ -296,7 +319,7 @@ fn square_to_triangle(u: f32, v: f32) -> [f32; 3] {
 
 /// Yuksel 2015 weighted sample elimination of `candidates` down to `target`
 /// (module docs); keeps the candidates' order.
-fn eliminate(candidates: Vec<Surfel>, target: usize, area: f64) -> Vec<Surfel> {
+fn eliminate(candidates: Vec<Sample>, target: usize, area: f64) -> Vec<Sample> {
     let m = candidates.len();
     if m <= target {
         return candidates;
@@ -307,14 +330,14 @@ fn eliminate(candidates: Vec<Surfel>, target: usize, area: f64) -> Vec<Surfel> {
     let d_max2 = (d_max * d_max) as f32;
     let weight = |d2: f32| (1.0 - (f64::from(d2).sqrt().clamp(d_min, d_max) / d_max)).powi(8);
     // Opposite-facing samples (more than 120° apart) do not interact.
-    let interacts = |a: &Surfel, b: &Surfel| a.normal.dot(b.normal) > -0.5;
+    let interacts = |a: &Sample, b: &Sample| a.surfel.normal.dot(b.surfel.normal) > -0.5;
 
-    let positions: Vec<Vec3> = candidates.iter().map(|s| s.position).collect();
+    let positions: Vec<Vec3> = candidates.iter().map(|s| s.surfel.position).collect();
     let tree = KdTree::new(&positions);
     let mut weights = vec![0.0f64; m];
     for (i, s) in candidates.iter().enumerate() {
         let mut w = 0.0;
-        tree.for_each_within(s.position, d_max2, &mut |j, d2| {
+        tree.for_each_within(s.surfel.position, d_max2, &mut |j, d2| {
             if j as usize != i && interacts(s, &candidates[j as usize]) {
                 w += weight(d2);
             }
@@ -329,7 +352,7 @@ fn eliminate(candidates: Vec<Surfel>, target: usize, area: f64) -> Vec<Surfel> {
         };
         removed[i] = true;
         let s = &candidates[i];
-        tree.for_each_within(s.position, d_max2, &mut |j, d2| {
+        tree.for_each_within(s.surfel.position, d_max2, &mut |j, d2| {
             let j = j as usize;
             if j != i && !removed[j] && interacts(s, &candidates[j]) {
                 weights[j] -= weight(d2);
@@ -680,6 +703,142 @@ mod tests {
         }
         assert!(sample_mesh(&mesh, &options(usize::MAX / 2, SamplingMethod::BlueNoise, 0)).is_err());
         assert!(sample_mesh(&mesh, &options(usize::MAX / 2, SamplingMethod::Stratified, 0)).is_err());
+    }
+
+    /// The unit cube [0, 1]³, outward counter-clockwise, two triangles per
+    /// face; `split`: every face has its own four vertices (as OBJ files with
+    /// face normals have them), else the 8 corners are shared.
+    fn cube(split: bool) -> TriangleMesh {
+        let mut mesh = TriangleMesh::default();
+        let corner = |p: Vec3| (p.x as u32) | (p.y as u32) << 1 | (p.z as u32) << 2;
+        if !split {
+            mesh.positions = (0..8u32)
+                .map(|i| Vec3::new((i & 1) as f32, (i >> 1 & 1) as f32, (i >> 2 & 1) as f32))
+                .collect();
+        }
+        for axis in 0..3 {
+            for side in [0.0f32, 1.0] {
+                let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                let mut quad = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+                if side == 0.0 {
+                    quad.reverse();
+                }
+                let points = quad.map(|(a, b)| {
+                    let mut p = Vec3::ZERO;
+                    p[axis] = side;
+                    p[u] = a;
+                    p[v] = b;
+                    p
+                });
+                let index = points.map(|p| {
+                    if split {
+                        mesh.positions.push(p);
+                        mesh.positions.len() as u32 - 1
+                    } else {
+                        corner(p)
+                    }
+                });
+                mesh.triangles.push([index[0], index[1], index[2]]);
+                mesh.triangles.push([index[0], index[2], index[3]]);
+            }
+        }
+        mesh
+    }
+
+    #[test]
+    fn cube_edges_clip_the_surfels_near_them() {
+        use crate::points::clip::tangent_frame;
+        for split in [false, true] {
+            let mesh = cube(split);
+            for method in [SamplingMethod::Stratified, SamplingMethod::BlueNoise] {
+                let surfels = sample_mesh(&mesh, &options(3000, method, 3)).unwrap();
+                let (mut near, mut corners) = (0, 0);
+                for s in &surfels {
+                    let r = s.radius;
+                    let axis = (0..3).find(|&k| s.normal[k].abs() == 1.0).unwrap();
+                    let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                    // The face's four edges: (distance, unit direction towards it).
+                    let mut edges = Vec::new();
+                    for w in [u, v] {
+                        let mut e = Vec3::ZERO;
+                        e[w] = 1.0;
+                        edges.push((s.position[w], -e));
+                        edges.push((1.0 - s.position[w], e));
+                    }
+                    let dmin = edges.iter().map(|e| e.0).fold(f32::INFINITY, f32::min);
+                    let lines = s.clip.0.iter().flatten().count();
+                    if dmin > r * (1.0 + 1e-4) {
+                        assert_eq!(s.clip, ClipLines::NONE, "{s:?}: the middle of a face");
+                        continue;
+                    }
+                    let cut: Vec<(f32, Vec3)> = edges.iter().copied().filter(|e| e.0 < r).collect();
+                    if dmin < r * (1.0 - 1e-4) {
+                        // One line per edge closer than r (two at most),
+                        // give or take edges at distance ≈ r.
+                        let sure = cut.iter().filter(|e| e.0 < r * (1.0 - 1e-4)).count();
+                        assert!((sure.min(2)..=cut.len().min(2)).contains(&lines), "{s:?}");
+                        near += 1;
+                        corners += usize::from(lines == 2);
+                    }
+                    assert!(s.clip.keeps(0.0, 0.0), "{s:?}: the centre is kept");
+                    let (t, b) = tangent_frame(s.normal);
+                    let tangent = |q: Vec3| (q.dot(t), q.dot(b));
+                    for &(d, dir) in &cut {
+                        // The point of the disk across the edge goes, the
+                        // point short of it on the face stays.
+                        let (a, c) = tangent(dir * r);
+                        assert!(d > r * 0.999 || !s.clip.keeps(a, c), "{s:?}: across {dir}");
+                        let (a, c) = tangent(dir * d * 0.99);
+                        assert!(s.clip.keeps(a, c), "{s:?}: short of {dir}");
+                    }
+                }
+                println!("{method:?}, split {split}: {near} of 3000 surfels clipped, {corners} twice");
+                assert!(near > 300 && corners > 5, "{near} {corners}");
+            }
+        }
+    }
+
+    #[test]
+    fn only_creases_and_not_boundaries_clip() {
+        // Flat square: boundary edges only.
+        for s in sample_mesh(&unit_square(), &options(500, SamplingMethod::Stratified, 1)).unwrap() {
+            assert_eq!(s.clip, ClipLines::NONE);
+        }
+        // Two squares hinged along the y axis at a dihedral angle below and
+        // above 30°.
+        for (degrees, creased) in [(20.0f32, false), (40.0, true)] {
+            let a = degrees.to_radians();
+            let mesh = TriangleMesh {
+                positions: vec![
+                    Vec3::new(0.0, 0.0, 0.0),
+                    Vec3::new(0.0, 1.0, 0.0),
+                    Vec3::new(1.0, 1.0, 0.0),
+                    Vec3::new(1.0, 0.0, 0.0),
+                    Vec3::new(-a.cos(), 1.0, a.sin()),
+                    Vec3::new(-a.cos(), 0.0, a.sin()),
+                ],
+                triangles: vec![[0, 3, 2], [0, 2, 1], [0, 1, 4], [0, 4, 5]],
+                ..Default::default()
+            };
+            let surfels = sample_mesh(&mesh, &options(1000, SamplingMethod::BlueNoise, 2)).unwrap();
+            let clipped = surfels.iter().filter(|s| s.clip != ClipLines::NONE).count();
+            if creased {
+                // The fold (x = 0) only: the clip keeps x ≥ 0 on the flat side.
+                assert!(clipped > 50, "{clipped}");
+                for s in surfels.iter().filter(|s| s.normal == Vec3::Z) {
+                    let near = s.position.x < s.radius;
+                    assert_eq!(s.clip != ClipLines::NONE, near, "{s:?}");
+                    if near {
+                        let (t, b) = crate::points::clip::tangent_frame(s.normal);
+                        let across = Vec3::new(-s.position.x - 1e-3, 0.0, 0.0);
+                        assert!(!s.clip.keeps(across.dot(t), across.dot(b)));
+                        assert!(s.clip.0[1].is_none());
+                    }
+                }
+            } else {
+                assert_eq!(clipped, 0);
+            }
+        }
     }
 
     #[test]

@@ -120,9 +120,22 @@
 //! `r_min`; the sum is rounded upward to f32 so that rounding cannot break
 //! it. The price is overdraw: with overlap, a node and some of its
 //! descendants can both be selected.
+//!
+//! # Sequentialisation (§10.1.7)
+//!
+//! The nodes are sorted by decreasing `r_max`. Nodes of equal `r_max` (all
+//! children of one parent without the overlap term, children equally far
+//! from their parent with it) are ordered by depth, then by their values
+//! (position, normal, diameter, errors, colour): an order that depends
+//! neither on ε nor on the order of the build, so that a tree re-derived for
+//! another ε ([`SequentialPointTree::with_epsilon`]) is exactly the tree
+//! built with it. `r_min` is computed from the error as stored (f32) for the
+//! same reason. Nodes equal in all these values are leaves of one parent
+//! (coincident duplicates), whose order does not matter.
 
 use glam::{DMat3, DVec3, Vec3};
 
+use super::clip::ClipLines;
 use super::Surfel;
 use crate::error::{Error, Result};
 
@@ -171,6 +184,9 @@ pub struct SptNode {
     pub parent: u32,
     /// Number of edges to the root (root 0); for level-of-detail debug views.
     pub depth: u32,
+    /// Clip lines for sharp features (§10.2.4): a leaf's are its surfel's,
+    /// an inner node has [`ClipLines::NONE`].
+    pub clip: ClipLines,
 }
 
 /// A point hierarchy as a list sorted by decreasing `r_max` (§10.1.7).
@@ -273,6 +289,61 @@ impl SequentialPointTree {
             .map(|(i, _)| i)
             .collect()
     }
+
+    /// The same tree for another threshold ε (§10.1.6): `r_min = e_g/ε`
+    /// (leaves 0) and `r_max = r_min(parent) + |p − p_parent|` (root
+    /// [`ROOT_R_MAX`]) are re-derived from the stored errors and positions,
+    /// and the nodes re-sorted by decreasing `r_max` with the build's
+    /// tie-breaking, so the result equals [`build_spt`] with that ε. Whether
+    /// `r_max` has the overlap term ([`SptOptions::overlap`]) is read off the
+    /// tree: some child has `r_max > r_min(parent)` only with it (a tree in
+    /// which every child sits at its parent's centre comes out the same either
+    /// way).
+    ///
+    /// Errors (one line): ε not positive and finite; ε so small that a
+    /// distance overflows f32; a parent index out of range.
+    pub fn with_epsilon(&self, epsilon: f32) -> Result<SequentialPointTree> {
+        validate_epsilon(epsilon)?;
+        let n = self.nodes.len();
+        let mut overlap = false;
+        for (i, node) in self.nodes.iter().enumerate() {
+            if node.parent == NO_PARENT {
+                continue;
+            }
+            let parent = self.nodes.get(node.parent as usize).ok_or_else(|| {
+                Error::invalid(
+                    "sequential point tree",
+                    format!("node {i}: parent index {} of {n} is out of range", node.parent),
+                )
+            })?;
+            overlap |= node.r_max > parent.r_min;
+        }
+        let eps = f64::from(epsilon);
+        let r_min: Vec<f32> = self
+            .nodes
+            .iter()
+            .map(|node| r_min_of(node.is_leaf, node.e_g, eps).ok_or_else(|| epsilon_overflow(epsilon)))
+            .collect::<Result<_>>()?;
+        let mut nodes = self.nodes.clone();
+        for (i, node) in nodes.iter_mut().enumerate() {
+            node.r_min = r_min[i];
+            node.r_max = if node.parent == NO_PARENT {
+                ROOT_R_MAX
+            } else {
+                let p = node.parent as usize;
+                r_max_of(node.position, self.nodes[p].position, r_min[p], overlap)
+            };
+            if !node.r_max.is_finite() {
+                return Err(epsilon_overflow(epsilon));
+            }
+        }
+        Ok(SequentialPointTree {
+            nodes: sequentialise(nodes),
+            bounds_centre: self.bounds_centre,
+            bounds_radius: self.bounds_radius,
+            epsilon,
+        })
+    }
 }
 
 /// A node during the build, in f64 (sums of many positions and squared
@@ -289,6 +360,7 @@ struct Work {
     e_g: f64,
     is_leaf: bool,
     parent: u32,
+    clip: ClipLines,
 }
 
 struct Builder<'a, 'p> {
@@ -317,6 +389,7 @@ impl Builder<'_, '_> {
             e_g: 0.0,
             is_leaf: true,
             parent: NO_PARENT,
+            clip: s.clip,
         });
         self.leaves_done += 1;
         // The octree pass is 90 % of the reported progress.
@@ -517,6 +590,7 @@ fn combine(work: &[Work], children: &[usize], color_threshold: f32) -> Work {
         e_g,
         is_leaf: false,
         parent: NO_PARENT,
+        clip: ClipLines::NONE,
     }
 }
 
@@ -530,13 +604,105 @@ fn f32_round_up(x: f64) -> f32 {
     }
 }
 
-fn validate_options(options: &SptOptions) -> Result<()> {
-    if !(options.epsilon.is_finite() && options.epsilon > 0.0) {
+/// `r_min = e_g/ε` of a node (0 for leaves), `None` when it overflows f32.
+fn r_min_of(is_leaf: bool, e_g: f32, epsilon: f64) -> Option<f32> {
+    let r_min = if is_leaf {
+        0.0
+    } else {
+        (f64::from(e_g) / epsilon) as f32
+    };
+    r_min.is_finite().then_some(r_min)
+}
+
+/// `r_max` of a non-root node at `position` whose parent is at
+/// `parent_position` with `parent_r_min` (§10.1.6): with the overlap term
+/// `r_min(parent) + |p − p_parent|`, rounded up to f32 (see "The overlap
+/// term"), else `r_min(parent)`.
+fn r_max_of(position: Vec3, parent_position: Vec3, parent_r_min: f32, overlap: bool) -> f32 {
+    if overlap {
+        let distance = (position.as_dvec3() - parent_position.as_dvec3()).length();
+        f32_round_up(f64::from(parent_r_min) + distance)
+    } else {
+        parent_r_min
+    }
+}
+
+fn epsilon_overflow(epsilon: f32) -> Error {
+    Error::invalid(
+        "SPT epsilon",
+        format!("{epsilon} is too small: r_min = e_g/ε overflows f32"),
+    )
+}
+
+/// The order among nodes of equal `r_max` (see "Sequentialisation"): by
+/// depth, then by the node's values. It depends only on the node itself, not
+/// on ε or on the order of the build, so [`SequentialPointTree::with_epsilon`]
+/// sorts exactly like [`build_spt`].
+fn tie_order(a: &SptNode, b: &SptNode) -> std::cmp::Ordering {
+    let floats = |n: &SptNode| {
+        [
+            n.position.x,
+            n.position.y,
+            n.position.z,
+            n.normal.x,
+            n.normal.y,
+            n.normal.z,
+            n.diameter,
+            n.e_p,
+            n.e_t,
+            n.e_g,
+        ]
+    };
+    a.depth
+        .cmp(&b.depth)
+        .then(b.is_leaf.cmp(&a.is_leaf))
+        .then_with(|| {
+            floats(a)
+                .iter()
+                .zip(floats(b).iter())
+                .map(|(x, y)| x.total_cmp(y))
+                .find(|o| o.is_ne())
+                .unwrap_or(std::cmp::Ordering::Equal)
+        })
+        .then(a.color.cmp(&b.color))
+}
+
+/// Sorts `nodes` by decreasing `r_max`, ties by [`tie_order`] (§10.1.7), and
+/// renumbers the parent indices (which must be in range).
+fn sequentialise(nodes: Vec<SptNode>) -> Vec<SptNode> {
+    let mut order: Vec<usize> = (0..nodes.len()).collect();
+    order.sort_by(|&a, &b| {
+        let (a, b) = (&nodes[a], &nodes[b]);
+        b.r_max.total_cmp(&a.r_max).then_with(|| tie_order(a, b))
+    });
+    let mut new_index = vec![0u32; nodes.len()];
+    for (new, &old) in order.iter().enumerate() {
+        new_index[old] = new as u32;
+    }
+    order
+        .iter()
+        .map(|&old| {
+            let mut n = nodes[old];
+            if n.parent != NO_PARENT {
+                n.parent = new_index[n.parent as usize];
+            }
+            n
+        })
+        .collect()
+}
+
+fn validate_epsilon(epsilon: f32) -> Result<()> {
+    if !(epsilon.is_finite() && epsilon > 0.0) {
         return Err(Error::invalid(
             "SPT epsilon",
-            format!("{} is not a positive finite number", options.epsilon),
+            format!("{epsilon} is not a positive finite number"),
         ));
     }
+    Ok(())
+}
+
+fn validate_options(options: &SptOptions) -> Result<()> {
+    validate_epsilon(options.epsilon)?;
     if options.leaf_size == 0 {
         return Err(Error::invalid("SPT leaf size", "must be at least 1"));
     }
@@ -649,29 +815,23 @@ pub fn build_spt(
             is_leaf: false,
             parent: NO_PARENT,
             depth: 0,
+            clip: ClipLines::NONE,
         },
     );
     for i in (0..work.len()).rev() {
         let w = &work[i];
         let position = w.position.as_vec3();
-        let r_min = if w.is_leaf { 0.0 } else { (w.e_g / eps) as f32 };
-        if !r_min.is_finite() {
-            return Err(Error::invalid(
-                "SPT epsilon",
-                format!("{} is too small: r_min = e_g/ε overflows f32", options.epsilon),
-            ));
-        }
+        // From the stored (f32) error, so that [`SequentialPointTree::with_epsilon`]
+        // reproduces it exactly.
+        let r_min = r_min_of(w.is_leaf, w.e_g as f32, eps).ok_or_else(|| epsilon_overflow(options.epsilon))?;
         let (r_max, depth) = if w.parent == NO_PARENT {
             (ROOT_R_MAX, 0)
         } else {
             let parent = &nodes[w.parent as usize];
-            let r_max = if options.overlap {
-                let distance = (position.as_dvec3() - parent.position.as_dvec3()).length();
-                f32_round_up(f64::from(parent.r_min) + distance)
-            } else {
-                parent.r_min
-            };
-            (r_max, parent.depth + 1)
+            (
+                r_max_of(position, parent.position, parent.r_min, options.overlap),
+                parent.depth + 1,
+            )
         };
         let node = SptNode {
             position,
@@ -686,6 +846,7 @@ pub fn build_spt(
             is_leaf: w.is_leaf,
             parent: w.parent,
             depth,
+            clip: w.clip,
         };
         let finite = node.position.is_finite()
             && node.diameter.is_finite()
@@ -717,23 +878,7 @@ pub fn build_spt(
         ));
     }
 
-    // Sequentialise: decreasing r_max (stable: ties keep post-order).
-    let mut order: Vec<usize> = (0..nodes.len()).collect();
-    order.sort_by(|&a, &b| nodes[b].r_max.total_cmp(&nodes[a].r_max));
-    let mut new_index = vec![0u32; nodes.len()];
-    for (new, &old) in order.iter().enumerate() {
-        new_index[old] = new as u32;
-    }
-    let sorted: Vec<SptNode> = order
-        .iter()
-        .map(|&old| {
-            let mut n = nodes[old];
-            if n.parent != NO_PARENT {
-                n.parent = new_index[n.parent as usize];
-            }
-            n
-        })
-        .collect();
+    let sorted = sequentialise(nodes);
     progress(1.0);
 
     Ok(SequentialPointTree {
@@ -779,6 +924,7 @@ mod tests {
                     normal: n,
                     radius: radius * 3.0,
                     color: rng.color(),
+                    clip: ClipLines::NONE,
                 }
             })
             .collect()
@@ -792,6 +938,7 @@ mod tests {
                 normal: Vec3::Z,
                 radius: 0.3,
                 color: [200, 180, (rng.f() * 8.0) as u8],
+                clip: ClipLines::NONE,
             })
             .collect()
     }
@@ -1045,6 +1192,7 @@ mod tests {
             normal: Vec3::Z,
             radius: 0.5,
             color,
+            clip: ClipLines::NONE,
         }
     }
 
@@ -1118,6 +1266,7 @@ mod tests {
             normal: Vec3::Z,
             radius: 0.5,
             color: [0; 3],
+            clip: ClipLines::NONE,
         };
         let b = Surfel {
             position: Vec3::new(0.0, 0.0, 1.0),
@@ -1178,6 +1327,7 @@ mod tests {
                     normal: Vec3::new(rng.f() - 0.5, rng.f() - 0.5, 1.0).normalize(),
                     radius: 0.2 + rng.f(),
                     color: [50; 3],
+                    clip: ClipLines::NONE,
                 })
                 .collect();
             let options = SptOptions {
@@ -1235,6 +1385,7 @@ mod tests {
             normal: Vec3::Z,
             radius: 0.4,
             color: [0; 3],
+            clip: ClipLines::NONE,
         };
         let b = Surfel {
             normal: -Vec3::Z,
@@ -1330,6 +1481,85 @@ mod tests {
         let huge = [disk(-3e38, [0; 3]), disk(3e38, [0; 3])];
         let err = build_spt(&huge, &o, &mut nop).unwrap_err().to_string();
         assert!(err.contains("overflow"), "{err}");
+    }
+
+    /// Relative comparison for re-derived distances.
+    fn close(a: f32, b: f32) -> bool {
+        (a - b).abs() <= 1e-5 * a.abs().max(b.abs()) || a == b
+    }
+
+    #[test]
+    fn with_epsilon_equals_a_build_with_that_epsilon() {
+        for (name, surfels) in inputs() {
+            for overlap in [true, false] {
+                for leaf_size in [1, 4] {
+                    let options = |epsilon: f32| SptOptions {
+                        epsilon,
+                        overlap,
+                        leaf_size,
+                        ..SptOptions::default()
+                    };
+                    for (e1, e2) in [(1e-3, 1e-2), (0.05, 2e-4), (1e-3, 1e-3)] {
+                        let direct = build(&surfels, &options(e2));
+                        let derived = build(&surfels, &options(e1)).with_epsilon(e2).unwrap();
+                        assert_eq!(derived.epsilon, e2);
+                        assert_eq!(derived.nodes.len(), direct.nodes.len());
+                        check_structure(&derived, &surfels);
+                        assert!(derived.nodes.windows(2).all(|w| w[0].r_max >= w[1].r_max));
+                        // The same multiset of nodes (parents by position),
+                        // distances within rounding …
+                        let key = |t: &SequentialPointTree, i: usize| {
+                            let n = &t.nodes[i];
+                            let parent = (n.parent != NO_PARENT)
+                                .then(|| t.nodes[n.parent as usize].position.to_array().map(f32::to_bits));
+                            (n.depth, n.position.to_array().map(f32::to_bits), parent, i)
+                        };
+                        let mut a: Vec<_> = (0..direct.nodes.len()).map(|i| key(&direct, i)).collect();
+                        let mut b: Vec<_> = (0..derived.nodes.len()).map(|i| key(&derived, i)).collect();
+                        a.sort_unstable();
+                        b.sort_unstable();
+                        for (ka, kb) in a.iter().zip(&b) {
+                            assert_eq!((ka.0, ka.1, ka.2), (kb.0, kb.1, kb.2), "{name}");
+                            let (x, y) = (&direct.nodes[ka.3], &derived.nodes[kb.3]);
+                            assert!(
+                                close(x.r_min, y.r_min) && close(x.r_max, y.r_max),
+                                "{name}: {x:?} {y:?}"
+                            );
+                            assert_eq!((x.e_g, x.diameter, x.is_leaf), (y.e_g, y.diameter, y.is_leaf));
+                        }
+                        // … and in fact the identical list.
+                        assert_eq!(derived, direct, "{name} overlap {overlap} leaf {leaf_size} {e1}→{e2}");
+                    }
+                }
+            }
+        }
+        // A tree loaded from elsewhere: leaves keep their clip lines.
+        let mut surfels = plane(200, 9);
+        let line = crate::points::clip::ClipLine {
+            angle: 1.0,
+            offset: 0.1,
+        };
+        surfels[17].clip = ClipLines([Some(line), None]);
+        let tree = build(&surfels, &SptOptions::default());
+        let derived = tree.with_epsilon(0.1).unwrap();
+        let clipped: Vec<_> = derived.nodes.iter().filter(|n| n.clip != ClipLines::NONE).collect();
+        assert_eq!(clipped.len(), 1);
+        assert!(clipped[0].is_leaf && clipped[0].position == surfels[17].position);
+    }
+
+    #[test]
+    fn with_epsilon_rejects_bad_epsilon() {
+        let tree = build(&plane(100, 3), &SptOptions::default());
+        for bad in [0.0, -1e-3, f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            let err = tree.with_epsilon(bad).unwrap_err().to_string();
+            assert!(err.contains("epsilon"), "{err}");
+        }
+        let err = tree.with_epsilon(f32::from_bits(1)).unwrap_err().to_string();
+        assert!(err.contains("overflows") && !err.contains('\n'), "{err}");
+        let mut broken = tree.clone();
+        broken.nodes[5].parent = 1_000_000;
+        let err = broken.with_epsilon(0.01).unwrap_err().to_string();
+        assert!(err.contains("node 5") && err.contains("out of range"), "{err}");
     }
 
     #[test]

@@ -2,23 +2,29 @@
 //! output of [`super::spt::build_spt`], stored so that renderers need not
 //! rebuild the tree.
 //!
-//! # Layout (version 1, all little-endian)
+//! # Layout (version 2, all little-endian)
 //!
 //! | offset | size | field |
 //! |---|---|---|
 //! | 0 | 8 | magic `b"ALPSPT\0\0"` |
-//! | 8 | 4 | u32 version = 1 |
+//! | 8 | 4 | u32 version = 2 |
 //! | 12 | 4 | u32 node count N (≥ 1) |
 //! | 16 | 4 | f32 ε |
 //! | 20 | 12 | f32×3 bounds centre |
 //! | 32 | 4 | f32 bounds radius |
-//! | 36 | 60·N | nodes, in list order (decreasing `r_max`) |
-//! | 36 + 60·N | 8 | u64 FNV-1a 64 checksum of all bytes before it |
+//! | 36 | 76·N | nodes, in list order (decreasing `r_max`) |
+//! | 36 + 76·N | 8 | u64 FNV-1a 64 checksum of all bytes before it |
 //!
-//! A node record (60 bytes): f32×3 position (0), f32×3 normal (12), f32
+//! A node record (76 bytes): f32×3 position (0), f32×3 normal (12), f32
 //! diameter (24), f32 e_p (28), f32 e_t (32), f32 e_g (36), f32 r_min (40),
 //! f32 r_max (44), u32 parent index (48; `0xFFFF_FFFF` for the root), u8×3
-//! sRGB colour (52), u8 flags (55; bit 0 = leaf, other bits 0), u32 depth (56).
+//! sRGB colour (52), u8 flags (55; bit 0 = leaf, other bits 0), u32 depth
+//! (56), f32×4 clip lines (60; §10.2.4) as [`super::clip::ClipLines::packed`]
+//! writes them: `θ0, c0, θ1, c1`, an absent line `c = f32::MAX`.
+//!
+//! Version 1 (still read, never written) is the same without the clip lines:
+//! 60-byte node records, `36 + 60·N` then the checksum; its nodes get no clip
+//! lines.
 //!
 //! Every value is finite: the root's `r_max` "∞" is stored as `f32::MAX`
 //! ([`super::spt::ROOT_R_MAX`]). The reader checks, in this order: magic,
@@ -27,23 +33,28 @@
 //! count, checksum, then every value and the tree structure (one root, parent
 //! indices in range, depth = parent's depth + 1 so there are no cycles,
 //! leaves without children, sorted by decreasing `r_max`, non-negative
-//! errors, `r_min ≤ r_max`).
+//! errors, `r_min ≤ r_max`, finite clip lines).
 
 use std::path::Path;
 
 use glam::Vec3;
 
+use super::clip::{ClipLine, ClipLines};
 use super::spt::{SequentialPointTree, SptNode, NO_PARENT};
 use crate::error::{Error, Result};
 
 /// The first eight bytes of every SPT file.
 pub const SPT_MAGIC: [u8; 8] = *b"ALPSPT\0\0";
-/// The version this build writes and reads.
-pub const SPT_VERSION: u32 = 1;
+/// The version this build writes (it also reads [`SPT_VERSION_1`]).
+pub const SPT_VERSION: u32 = 2;
+/// The first version, without clip lines; read, never written.
+pub const SPT_VERSION_1: u32 = 1;
 /// Bytes before the first node.
 pub const HEADER_BYTES: usize = 36;
-/// Bytes per node record.
-pub const NODE_BYTES: usize = 60;
+/// Bytes per node record (version 2).
+pub const NODE_BYTES: usize = 76;
+/// Bytes per node record of version 1.
+pub const NODE_BYTES_V1: usize = 60;
 /// Bytes of the trailing checksum.
 pub const CHECKSUM_BYTES: usize = 8;
 
@@ -113,6 +124,9 @@ fn validate(tree: &SequentialPointTree) -> std::result::Result<(), String> {
         if node.r_min > node.r_max {
             return bad("r_min exceeds r_max");
         }
+        if !node.clip.packed().iter().all(|v| v.is_finite()) {
+            return bad("non-finite clip line");
+        }
         if i > 0 && tree.nodes[i - 1].r_max < node.r_max {
             return bad("nodes are not sorted by decreasing r_max");
         }
@@ -170,6 +184,9 @@ fn encode(tree: &SequentialPointTree) -> Vec<u8> {
         out.extend_from_slice(&node.color);
         out.push(if node.is_leaf { FLAG_LEAF } else { 0 });
         out.extend_from_slice(&node.depth.to_le_bytes());
+        for v in node.clip.packed() {
+            f(&mut out, v);
+        }
     }
     let checksum = fnv1a64(&out);
     out.extend_from_slice(&checksum.to_le_bytes());
@@ -190,6 +207,19 @@ fn vec3_at(bytes: &[u8], at: usize) -> Vec3 {
     Vec3::new(f32_at(bytes, at), f32_at(bytes, at + 4), f32_at(bytes, at + 8))
 }
 
+/// The clip lines of a packed `θ0, c0, θ1, c1` (inverse of
+/// [`ClipLines::packed`]; `c = f32::MAX` is no line).
+fn clip_lines_at(bytes: &[u8], at: usize) -> ClipLines {
+    let line = |k: usize| {
+        let offset = f32_at(bytes, at + 8 * k + 4);
+        (offset != f32::MAX).then(|| ClipLine {
+            angle: f32_at(bytes, at + 8 * k),
+            offset,
+        })
+    };
+    ClipLines([line(0), line(1)])
+}
+
 /// Parses file bytes; the message is one line without the file name.
 fn decode(bytes: &[u8]) -> std::result::Result<SequentialPointTree, String> {
     let len = bytes.len();
@@ -203,13 +233,17 @@ fn decode(bytes: &[u8]) -> std::result::Result<SequentialPointTree, String> {
         ));
     }
     let version = u32_at(bytes, 8);
-    if version != SPT_VERSION {
-        return Err(format!(
-            "unsupported SPT version {version} (this build reads version {SPT_VERSION})"
-        ));
-    }
+    let node_bytes = match version {
+        SPT_VERSION => NODE_BYTES,
+        SPT_VERSION_1 => NODE_BYTES_V1,
+        _ => {
+            return Err(format!(
+                "unsupported SPT version {version} (this build reads versions {SPT_VERSION_1} and {SPT_VERSION})"
+            ))
+        }
+    };
     let count = u32_at(bytes, 12);
-    let expected = HEADER_BYTES as u64 + NODE_BYTES as u64 * u64::from(count) + CHECKSUM_BYTES as u64;
+    let expected = HEADER_BYTES as u64 + node_bytes as u64 * u64::from(count) + CHECKSUM_BYTES as u64;
     if (len as u64) < expected {
         return Err(format!(
             "truncated or wrong node count: the header says {count} nodes ({expected} bytes), the file has {len} bytes"
@@ -232,7 +266,7 @@ fn decode(bytes: &[u8]) -> std::result::Result<SequentialPointTree, String> {
     }
     let mut nodes = Vec::with_capacity(count as usize);
     for i in 0..count as usize {
-        let at = HEADER_BYTES + i * NODE_BYTES;
+        let at = HEADER_BYTES + i * node_bytes;
         let flags = bytes[at + 55];
         if flags & !FLAG_LEAF != 0 {
             return Err(format!("node {i}: unknown flags {flags:#04x}"));
@@ -250,6 +284,11 @@ fn decode(bytes: &[u8]) -> std::result::Result<SequentialPointTree, String> {
             color: [bytes[at + 52], bytes[at + 53], bytes[at + 54]],
             is_leaf: flags & FLAG_LEAF != 0,
             depth: u32_at(bytes, at + 56),
+            clip: if node_bytes == NODE_BYTES {
+                clip_lines_at(bytes, at + 60)
+            } else {
+                ClipLines::NONE
+            },
         });
     }
     let tree = SequentialPointTree {
@@ -308,6 +347,27 @@ mod tests {
                     normal: Vec3::new(-0.2 * x.cos(), 0.1, 1.0).normalize(),
                     radius: 0.35,
                     color: [(i * 20) as u8, (j * 25) as u8, 77],
+                    // A few surfels with one or two clip lines.
+                    clip: match (i + j) % 5 {
+                        0 => ClipLines([
+                            Some(ClipLine {
+                                angle: 0.5,
+                                offset: 0.1,
+                            }),
+                            None,
+                        ]),
+                        1 => ClipLines([
+                            Some(ClipLine {
+                                angle: -2.0,
+                                offset: -0.05,
+                            }),
+                            Some(ClipLine {
+                                angle: 3.0,
+                                offset: 0.2,
+                            }),
+                        ]),
+                        _ => ClipLines::NONE,
+                    },
                 });
             }
         }
@@ -353,6 +413,55 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// The version 1 bytes of `tree` (60-byte records without clip lines),
+    /// as earlier builds wrote them.
+    fn encode_v1(tree: &SequentialPointTree) -> Vec<u8> {
+        let v2 = encode(tree);
+        let mut out = v2[..HEADER_BYTES].to_vec();
+        out[8..12].copy_from_slice(&1u32.to_le_bytes());
+        for i in 0..tree.nodes.len() {
+            let at = HEADER_BYTES + i * NODE_BYTES;
+            out.extend_from_slice(&v2[at..at + NODE_BYTES_V1]);
+        }
+        out.extend_from_slice(&[0; CHECKSUM_BYTES]);
+        reseal(&mut out);
+        out
+    }
+
+    #[test]
+    fn clip_lines_round_trip_and_version_1_still_reads() {
+        let dir = scratch_dir("v1");
+        let path = dir.join("t.spt");
+        let t = tree();
+        let clipped = t.nodes.iter().filter(|n| n.clip != ClipLines::NONE).count();
+        assert!(clipped > 10 && t.nodes.iter().all(|n| n.is_leaf || n.clip == ClipLines::NONE));
+        write_spt(&path, &t).unwrap();
+        assert_eq!(u32_at(&std::fs::read(&path).unwrap(), 8), 2);
+        assert_eq!(read_spt(&path).unwrap(), t);
+
+        let v1 = encode_v1(&t);
+        assert_eq!(v1.len(), HEADER_BYTES + NODE_BYTES_V1 * t.nodes.len() + CHECKSUM_BYTES);
+        std::fs::write(&path, &v1).unwrap();
+        let back = read_spt(&path).unwrap();
+        let mut expected = t.clone();
+        for n in &mut expected.nodes {
+            n.clip = ClipLines::NONE;
+        }
+        assert_eq!(back, expected);
+        // Version 1 errors are still the same one-line messages.
+        let err = read_err(&path, &v1[..v1.len() - 3]);
+        assert!(err.contains("truncated"), "{err}");
+        let mut b = v1.clone();
+        b[HEADER_BYTES + 3] ^= 1;
+        assert!(read_err(&path, &b).contains("checksum mismatch"));
+        // A version 2 body labelled version 1 does not fit the length.
+        let mut b = encode(&t);
+        b[8..12].copy_from_slice(&1u32.to_le_bytes());
+        reseal(&mut b);
+        assert!(read_err(&path, &b).contains("node count mismatch"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     #[test]
     fn corruption_is_detected() {
         let dir = scratch_dir("corrupt");
@@ -386,9 +495,9 @@ mod tests {
         assert!(read_err(&path, b"PNG\x89 not an spt file at all").contains("wrong magic"));
         // Future version (with a valid checksum, so the version is the message).
         let mut b = good.clone();
-        b[8..12].copy_from_slice(&2u32.to_le_bytes());
+        b[8..12].copy_from_slice(&3u32.to_le_bytes());
         reseal(&mut b);
-        assert!(read_err(&path, &b).contains("unsupported SPT version 2"));
+        assert!(read_err(&path, &b).contains("unsupported SPT version 3"));
         // Truncation anywhere.
         for cut in [0, 5, 8, 20, HEADER_BYTES, HEADER_BYTES + 30, len - 1] {
             let err = read_err(&path, &good[..cut]);
@@ -440,6 +549,16 @@ mod tests {
             (node1 + 55, vec![0x82], "node 1: unknown flags"),
             (node1 + 56, 77u32.to_le_bytes().to_vec(), "node 1: depth"),
             (HEADER_BYTES + 48, 1u32.to_le_bytes().to_vec(), "node 0"),
+            (
+                node1 + 64,
+                f32::NAN.to_le_bytes().to_vec(),
+                "node 1: non-finite clip line",
+            ),
+            (
+                node1 + 72,
+                f32::INFINITY.to_le_bytes().to_vec(),
+                "node 1: non-finite clip line",
+            ),
         ];
         for (at, patch, expected) in cases {
             let mut b = good.clone();

@@ -71,10 +71,15 @@ impl Camera {
     /// World → clip transform for Vulkan (depth 0..1, y flipped so image row 0
     /// is the top). Computed in f64, rounded once.
     pub fn view_proj(&self, aspect: f64) -> Mat4 {
+        self.view_proj_f64(aspect).as_mat4()
+    }
+
+    /// [`Camera::view_proj`] in f64.
+    pub fn view_proj_f64(&self, aspect: f64) -> DMat4 {
         let view = DMat4::look_at_rh(self.eye, self.target, self.up);
         let mut proj = DMat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, self.near, self.far);
         proj.y_axis.y = -proj.y_axis.y;
-        (proj * view).as_mat4()
+        proj * view
     }
 
     /// Right and up axes scaled by the half-extents of the image plane at

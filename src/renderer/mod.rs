@@ -4,8 +4,10 @@
 //! Frame graph of the default scene:
 //! `sky` (graphics) → `terrain.warp` (compute: CPU warp of the sketch map,
 //! then warp and zoom on the GPU into the vertex buffer, §7.4) →
-//! `terrain.draw` (graphics, reads the vertex buffer) → `tonemap` (compute)
-//! → `readback` (transfer).
+//! `terrain.draw` (graphics, reads the vertex buffer) → the points passes
+//! (`points.visibility` → `points.accumulate` → `points.normalize` for EWA
+//! splats, or `points.opaque`; see [`crate::points::render`]) → `tonemap`
+//! (compute) → `readback` (transfer).
 
 pub mod camera;
 pub mod camera_path;
@@ -22,6 +24,7 @@ pub use scene::Scene;
 use crate::error::{Error, Result};
 use crate::graph::{Access, BakedGraph, FrameOutcome, ImageInfo, RenderGraph};
 use crate::lighting::sky::add_sky_pass;
+use crate::points::render::{add_point_passes, PointFrameStats, PointPasses, SplatSettings, SplatTargets};
 use crate::profile::FrameProfile;
 use crate::terrain::geometry_image::{GeometryImage, TerrainSettings};
 use crate::terrain::shading::add_draw_pass;
@@ -55,6 +58,8 @@ pub struct RenderSettings {
     /// Copy HDR, depth and sRGB images to host memory every frame.
     pub readback: bool,
     pub terrain: TerrainSettings,
+    /// How point objects are splatted.
+    pub points: SplatSettings,
 }
 
 impl RenderSettings {
@@ -65,6 +70,7 @@ impl RenderSettings {
             height,
             readback: true,
             terrain: TerrainSettings::default(),
+            points: SplatSettings::default(),
         }
     }
 }
@@ -80,12 +86,16 @@ pub struct FrameImages {
     pub hdr: Vec<f32>,
     /// View-space depth along the camera's forward axis, metres; +inf for sky.
     pub depth: Vec<f32>,
+    /// W: the accumulated EWA splat weight before normalisation (opaque
+    /// splats: 1), 0 where no splat reached; None for scenes without points.
+    pub weight: Option<Vec<f32>>,
 }
 
 struct Readback {
     hdr: Vec<Arc<Buffer>>,
     depth: Vec<Arc<Buffer>>,
     ldr: Vec<Arc<Buffer>>,
+    weight: Option<Vec<Arc<Buffer>>>,
 }
 
 /// Renders one scene, frame after frame.
@@ -99,8 +109,10 @@ pub struct Renderer {
     snow_line: f32,
     /// Frames rendered so far.
     frames_rendered: u64,
+    /// Point passes' statistics (None without points).
+    points: Option<PointPasses>,
     /// Kept alive for the graph's imported resources.
-    _terrain: GeometryImage,
+    _terrain: Option<GeometryImage>,
 }
 
 /// Checks an output size.
@@ -142,7 +154,6 @@ impl Renderer {
                 format!("{w}×{h} exceeds the device limit of {max} per side"),
             ));
         }
-        let terrain = GeometryImage::new(ctx, Arc::new(scene.heights.clone()), settings.terrain)?;
         let mut graph = RenderGraph::new();
         let hdr = graph.create_image("hdr radiance", ImageInfo::new(w, h, Format::R32G32B32A32_SFLOAT));
         let view_depth = graph.create_image("view depth", ImageInfo::new(w, h, Format::R32_SFLOAT));
@@ -150,15 +161,35 @@ impl Renderer {
         let ldr = graph.create_image("srgb", ImageInfo::new(w, h, Format::R8G8B8A8_UNORM));
 
         add_sky_pass(ctx, &mut graph, hdr, view_depth)?;
-        let terrain_resources = terrain.add_warp_pass(ctx, &mut graph)?;
-        add_draw_pass(
-            ctx,
-            &mut graph,
-            &terrain,
-            terrain_resources,
-            (hdr, view_depth, depth),
-            h,
-        )?;
+        let terrain = if scene.draw_terrain {
+            let terrain = GeometryImage::new(ctx, Arc::new(scene.heights.clone()), settings.terrain)?;
+            let terrain_resources = terrain.add_warp_pass(ctx, &mut graph)?;
+            add_draw_pass(
+                ctx,
+                &mut graph,
+                &terrain,
+                terrain_resources,
+                (hdr, view_depth, depth),
+                h,
+            )?;
+            Some(terrain)
+        } else {
+            None
+        };
+        let (points, weight) = if scene.points.is_empty() {
+            (None, None)
+        } else {
+            let weight = graph.create_image("splat weight", ImageInfo::new(w, h, Format::R32_SFLOAT));
+            let targets = SplatTargets {
+                radiance: hdr,
+                view_depth,
+                depth,
+                weight,
+                clear_depth: !scene.draw_terrain,
+            };
+            let passes = add_point_passes(ctx, &mut graph, &scene.points, settings.points, targets, (w, h))?;
+            (Some(passes), Some(weight))
+        };
         tonemap::add_tonemap_pass(ctx, &mut graph, hdr, ldr, (w, h))?;
 
         let pixels = w as u64 * h as u64;
@@ -167,32 +198,36 @@ impl Renderer {
                 hdr: host_buffers(ctx, "hdr", pixels * 16)?,
                 depth: host_buffers(ctx, "depth", pixels * 4)?,
                 ldr: host_buffers(ctx, "srgb", pixels * 4)?,
+                weight: match weight {
+                    Some(_) => Some(host_buffers(ctx, "splat weight", pixels * 4)?),
+                    None => None,
+                },
             };
-            let hdr_rb = graph.import_buffers_per_frame(rb.hdr.clone());
-            let depth_rb = graph.import_buffers_per_frame(rb.depth.clone());
-            let ldr_rb = graph.import_buffers_per_frame(rb.ldr.clone());
-            graph
-                .pass("readback")
-                .transfer()
-                .read(hdr, Access::TransferSrc)
-                .read(view_depth, Access::TransferSrc)
-                .read(ldr, Access::TransferSrc)
-                .write(hdr_rb, Access::TransferDst)
-                .write(depth_rb, Access::TransferDst)
-                .write(ldr_rb, Access::TransferDst)
-                .record(move |pass, _| {
-                    let copies = [(hdr, hdr_rb), (view_depth, depth_rb), (ldr, ldr_rb)];
-                    let pairs = copies
-                        .iter()
-                        .map(|&(i, b)| Ok((pass.image(i)?, pass.buffer(b)?)))
-                        .collect::<Result<Vec<_>>>()?;
-                    for (image, buffer) in pairs {
-                        pass.cmd().copy_image_to_buffer(image, buffer);
-                    }
-                    Ok(())
-                });
-            for r in [hdr_rb, depth_rb, ldr_rb] {
-                graph.read_back(r);
+            let mut copies = vec![
+                (hdr, graph.import_buffers_per_frame(rb.hdr.clone())),
+                (view_depth, graph.import_buffers_per_frame(rb.depth.clone())),
+                (ldr, graph.import_buffers_per_frame(rb.ldr.clone())),
+            ];
+            if let (Some(image), Some(buffers)) = (weight, &rb.weight) {
+                copies.push((image, graph.import_buffers_per_frame(buffers.clone())));
+            }
+            let mut pass = graph.pass("readback").transfer();
+            for &(image, buffer) in &copies {
+                pass = pass.read(image, Access::TransferSrc).write(buffer, Access::TransferDst);
+            }
+            let recorded = copies.clone();
+            pass.record(move |pass, _| {
+                let pairs = recorded
+                    .iter()
+                    .map(|&(i, b)| Ok((pass.image(i)?, pass.buffer(b)?)))
+                    .collect::<Result<Vec<_>>>()?;
+                for (image, buffer) in pairs {
+                    pass.cmd().copy_image_to_buffer(image, buffer);
+                }
+                Ok(())
+            });
+            for &(_, buffer) in &copies {
+                graph.read_back(buffer);
             }
             Some(rb)
         } else {
@@ -210,6 +245,7 @@ impl Renderer {
             scene_sun: scene.sun_direction,
             snow_line: lo + (hi - lo) * 0.8,
             frames_rendered: 0,
+            points,
             _terrain: terrain,
         })
     }
@@ -264,6 +300,10 @@ impl Renderer {
             rgba8: rb.ldr[slot].mapped()?.to_vec(),
             hdr: floats(&rb.hdr[slot])?,
             depth: floats(&rb.depth[slot])?,
+            weight: match &rb.weight {
+                Some(w) => Some(floats(&w[slot])?),
+                None => None,
+            },
         })
     }
 
@@ -271,5 +311,15 @@ impl Renderer {
     pub fn finish(&mut self) -> Result<Vec<FrameProfile>> {
         self.graph.finish(&mut self.frames)?;
         Ok(self.graph.take_profiles())
+    }
+
+    /// Point statistics of the frames completed so far and not yet taken
+    /// (complete after [`Renderer::finish`]); empty without point objects.
+    pub fn take_point_stats(&mut self) -> Result<Vec<PointFrameStats>> {
+        self.graph.finish(&mut self.frames)?;
+        match &self.points {
+            Some(p) => p.take_stats(),
+            None => Ok(Vec::new()),
+        }
     }
 }

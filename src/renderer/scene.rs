@@ -1,17 +1,27 @@
-//! What is drawn: a height field and a sun. The built-in default scene is a
-//! procedural ridged-multifractal terrain (§6.1) under a low afternoon sun.
+//! What is drawn: a height field, point objects and a sun. The built-in
+//! default scene is a procedural ridged-multifractal terrain (§6.1) with
+//! procedural rocks (§6.1.4) scattered over it, under a low afternoon sun.
 
 use glam::{DVec2, DVec3, Vec3};
 
 use super::camera::Camera;
 use crate::error::Result;
 use crate::io::heightmap::HeightField;
+use crate::points::scene::{scatter_rocks, PointScene};
+use crate::points::spt::{epsilon_from_pixels, SptOptions};
 use crate::terrain::procedural::ProceduralTerrain;
+
+/// Rocks of the default scene: distinct shapes, surfels per shape, instances.
+pub const DEFAULT_ROCKS: (usize, usize, usize) = (4, 4000, 300);
 
 /// A terrain scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
     pub heights: HeightField,
+    /// Whether the terrain is drawn (false: point objects against the sky).
+    pub draw_terrain: bool,
+    /// Point objects (sequential point trees) and their instances.
+    pub points: PointScene,
     /// Unit direction towards the sun.
     pub sun_direction: Vec3,
 }
@@ -19,16 +29,61 @@ pub struct Scene {
 impl Scene {
     /// The default scene: 513² samples of the default procedural terrain at
     /// 20 m spacing (10.24 km square).
+    /// 20 m spacing (10.24 km square), with [`DEFAULT_ROCKS`] boulders.
     pub fn default_procedural() -> Result<Scene> {
+        let mut scene = Scene::default_terrain()?;
+        scene.add_rocks(DEFAULT_ROCKS.2)?;
+        Ok(scene)
+    }
+
+    /// The default terrain without rocks.
+    pub fn default_terrain() -> Result<Scene> {
         let heights = ProceduralTerrain::default().try_generate(513, 513, DVec2::splat(20.0))?;
         Ok(Scene::new(heights))
     }
 
-    /// A scene of `heights` with the default sun.
+    /// Scatters `count` procedural boulders (§6.1.4; [`DEFAULT_ROCKS`]
+    /// shapes and samples, 1–40 m) over the terrain, as instances of a few
+    /// trees built for a one-pixel error at 50° and 720 rows.
+    pub fn add_rocks(&mut self, count: usize) -> Result<()> {
+        let spt = SptOptions {
+            epsilon: epsilon_from_pixels(1.0, 50f32.to_radians(), 720)?,
+            ..SptOptions::default()
+        };
+        let (shapes, samples, _) = DEFAULT_ROCKS;
+        let rocks = scatter_rocks(&self.heights, shapes, samples, count, (3.0, 16.0), 0xA1BE, &spt)?;
+        let offset = self.points.objects.len();
+        self.points.objects.extend(rocks.objects);
+        self.points.instances.extend(rocks.instances.into_iter().map(|mut i| {
+            i.object += offset;
+            i
+        }));
+        Ok(())
+    }
+
+    /// A scene of `heights` with the default sun and no point objects.
     pub fn new(heights: HeightField) -> Scene {
         Scene {
             heights,
+            draw_terrain: true,
+            points: PointScene::default(),
             sun_direction: Vec3::new(-0.55, 0.45, 0.42).normalize(),
+        }
+    }
+
+    /// Point objects against the sky, without terrain (a flat 2×2 field
+    /// stands in for the height field).
+    pub fn points_only(points: PointScene) -> Scene {
+        let heights = HeightField {
+            columns: 2,
+            rows: 2,
+            spacing: DVec2::ONE,
+            heights: vec![0.0; 4],
+        };
+        Scene {
+            draw_terrain: false,
+            points,
+            ..Scene::new(heights)
         }
     }
 

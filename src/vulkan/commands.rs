@@ -195,15 +195,25 @@ impl CommandRecorder {
             })
             .collect();
         let depth_info = depth.map(|(image, clear)| {
+            // A depth buffer the graph declared read-only is neither cleared nor stored.
+            let read_only = image.state().layout == vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL;
             vk::RenderingAttachmentInfo::default()
                 .image_view(image.view)
-                .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+                .image_layout(if read_only {
+                    vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL
+                } else {
+                    vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL
+                })
                 .load_op(if clear.is_some() {
                     vk::AttachmentLoadOp::CLEAR
                 } else {
                     vk::AttachmentLoadOp::LOAD
                 })
-                .store_op(vk::AttachmentStoreOp::STORE)
+                .store_op(if read_only {
+                    vk::AttachmentStoreOp::NONE
+                } else {
+                    vk::AttachmentStoreOp::STORE
+                })
                 .clear_value(vk::ClearValue {
                     depth_stencil: vk::ClearDepthStencilValue {
                         depth: clear.unwrap_or(1.0),

@@ -44,7 +44,36 @@ pub struct DeviceInfo {
     pub timestamp_period_ns: f32,
     pub max_image_dimension_2d: u32,
     pub features: Vec<String>,
+    /// Optional features the device offers and alpenglow enabled.
+    pub optional_features: Vec<String>,
+    /// Largest point primitive side in pixels (1 without `largePoints`).
+    pub max_point_size: f32,
     pub validation: bool,
+}
+
+/// Features alpenglow uses when the device has them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OptionalFeatures {
+    /// `largePoints`: point primitives wider than one pixel (splat point primitives, §10.3).
+    pub large_points: bool,
+    /// `vertexPipelineStoresAndAtomics`: the vertex stage counts the splats it draws.
+    pub vertex_pipeline_stores_and_atomics: bool,
+}
+
+impl OptionalFeatures {
+    fn names(self) -> Vec<String> {
+        [
+            ("largePoints", self.large_points),
+            (
+                "vertexPipelineStoresAndAtomics",
+                self.vertex_pipeline_stores_and_atomics,
+            ),
+        ]
+        .iter()
+        .filter(|(_, on)| *on)
+        .map(|(n, _)| n.to_string())
+        .collect()
+    }
 }
 
 pub(crate) struct Shared {
@@ -231,7 +260,15 @@ impl Context {
             .dynamic_rendering(true)
             .synchronization2(true)
             .maintenance4(true);
-        let base = vk::PhysicalDeviceFeatures::default();
+        // SAFETY: plain query on a physical device of this instance.
+        let offered = unsafe { instance.get_physical_device_features(candidate.physical) };
+        let optional = OptionalFeatures {
+            large_points: offered.large_points == vk::TRUE,
+            vertex_pipeline_stores_and_atomics: offered.vertex_pipeline_stores_and_atomics == vk::TRUE,
+        };
+        let base = vk::PhysicalDeviceFeatures::default()
+            .large_points(optional.large_points)
+            .vertex_pipeline_stores_and_atomics(optional.vertex_pipeline_stores_and_atomics);
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_features(&base)
@@ -294,6 +331,12 @@ impl Context {
             timestamp_period_ns: props.limits.timestamp_period,
             max_image_dimension_2d: props.limits.max_image_dimension2_d,
             features: REQUIRED_FEATURES.iter().map(|s| s.to_string()).collect(),
+            optional_features: optional.names(),
+            max_point_size: if optional.large_points {
+                props.limits.point_size_range[1]
+            } else {
+                1.0
+            },
             validation: report.is_some(),
         };
         let shared = Shared {
@@ -328,6 +371,11 @@ impl Context {
     /// The validation report of this instance (None without validation).
     pub fn validation_report(&self) -> Option<Arc<ValidationReport>> {
         self.shared.report.clone()
+    }
+
+    /// Whether the optional feature `name` (as in [`DeviceInfo::optional_features`]) is enabled.
+    pub fn has_feature(&self, name: &str) -> bool {
+        self.shared.info.optional_features.iter().any(|f| f == name)
     }
 
     /// The largest 2-D image side the device accepts.

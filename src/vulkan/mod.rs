@@ -16,7 +16,7 @@ pub use ash::vk::{
     PrimitiveTopology,
 };
 pub use commands::{CommandRecorder, LoadOp};
-pub use context::{Context, ContextOptions, DeviceInfo};
+pub use context::{Context, ContextOptions, DeviceInfo, OptionalFeatures};
 pub use device_select::{DeviceSelector, REQUIRED_FEATURES};
 pub use frames::{CompletedFrame, FrameRing, RecordingFrame, FRAMES_IN_FLIGHT};
 pub use heap::{SamplerKind, PUSH_CONSTANT_BYTES};

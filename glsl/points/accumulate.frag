@@ -1,0 +1,19 @@
+#version 460
+// points.accumulate (dissertation §10.2.3, Table 10.1 pass 2): depth test
+// against the visibility pass (≤, no depth writes), additive blending of
+// w·(colour, 1) and w·(normal, view depth) into float targets.
+#include "../include/splat_fragment.glsl"
+
+layout(location = 0) out vec4 out_color_weight;
+layout(location = 1) out vec4 out_normal_depth;
+
+void main() {
+    SplatSample s;
+    if (!splat_sample(s)) {
+        discard;
+    }
+    gl_FragDepth = depth_of(s.position.z);
+    float w = s.weight;
+    out_color_weight = vec4(in_color.rgb * w, w);
+    out_normal_depth = vec4(in_normal.xyz * w, -s.position.z * w);
+}

@@ -1,0 +1,28 @@
+#version 460
+// points.normalize (dissertation §10.2.3, Table 10.1 pass 3): a full-screen
+// pass; per pixel colour = Σw·c / Σw, normal and view depth likewise, then
+// shading into the radiance and view-depth targets. Σw = 0 (no splat) keeps
+// what the terrain and sky passes wrote. Σw goes to the W target (cleared to 0).
+#include "../include/splat_shading.glsl"
+
+// Push constants (the splat passes' block, splat.glsl):
+//   handles = (accumulated colour+w, point frame, accumulated normal+depth (sampled), unused).
+layout(location = 0) out vec4 out_radiance;
+layout(location = 1) out float out_view_depth;
+layout(location = 2) out float out_weight;
+
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    vec4 cw = texelFetch(sampler2D(g_textures[pc.handles.x], g_samplers[SAMPLER_NEAREST_CLAMP]), p, 0);
+    if (!(cw.a > 0.0)) {
+        discard;
+    }
+    vec4 nd = texelFetch(sampler2D(g_textures[pc.handles.z], g_samplers[SAMPLER_NEAREST_CLAMP]), p, 0);
+    vec3 albedo = cw.rgb / cw.a;
+    float depth = nd.w / cw.a;
+    vec3 ray = pixel_ray(gl_FragCoord.xy);
+    vec3 position = ray * (depth / -ray.z);
+    out_radiance = vec4(shade_splat(albedo, nd.xyz, position), 1.0);
+    out_view_depth = depth;
+    out_weight = cw.a;
+}

@@ -1,0 +1,21 @@
+#version 460
+// points.opaque: the fast baseline splat mode — opaque discs (the kernel's
+// cut-off ellipse, i.e. the projected disk, §10.2.2) with ray–plane depth,
+// depth-tested and shaded directly, no blending.
+#include "../include/splat_fragment.glsl"
+#include "../include/splat_shading.glsl"
+
+layout(location = 0) out vec4 out_radiance;
+layout(location = 1) out float out_view_depth;
+layout(location = 2) out float out_weight;
+
+void main() {
+    SplatSample s;
+    if (!splat_sample(s)) {
+        discard;
+    }
+    gl_FragDepth = depth_of(s.position.z);
+    out_radiance = vec4(shade_splat(in_color.rgb, in_normal.xyz, s.position), 1.0);
+    out_view_depth = -s.position.z;
+    out_weight = 1.0;
+}

@@ -1,0 +1,183 @@
+//! What the points passes read on the GPU (`glsl/include/splat.glsl`): the
+//! splat lists of all objects in one buffer, and per frame the camera and
+//! the instances to draw.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DMat3, DMat4, DVec3, Vec3};
+
+use crate::points::spt::SequentialPointTree;
+use crate::renderer::camera::Camera;
+
+/// One splat: an SPT node (§10.1.3) as the vertex stage reads it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuSplat {
+    /// Object-space centre, r_min.
+    pub position_rmin: [f32; 4],
+    /// Object-space unit normal, r_max.
+    pub normal_rmax: [f32; 4],
+    /// Disk radius, sRGB colour (u32 bits `r | g << 8 | b << 16`), 0, 0.
+    pub radius_color: [f32; 4],
+    /// Clip lines (`crate::points::clip::ClipLines::packed`).
+    pub clip: [f32; 4],
+}
+
+/// The splat list of `tree`, in list order (decreasing r_max).
+pub fn pack_tree(tree: &SequentialPointTree) -> Vec<GpuSplat> {
+    tree.nodes
+        .iter()
+        .map(|n| {
+            let [r, g, b] = n.color;
+            let rgb = u32::from(r) | u32::from(g) << 8 | u32::from(b) << 16;
+            GpuSplat {
+                position_rmin: n.position.extend(n.r_min).to_array(),
+                normal_rmax: n.normal.extend(n.r_max).to_array(),
+                radius_color: [0.5 * n.diameter, f32::from_bits(rgb), 0.0, 0.0],
+                clip: n.clip.packed(),
+            }
+        })
+        .collect()
+}
+
+/// Per-frame constants (`PointFrame` in splat.glsl, before the instances).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameHeader {
+    /// Rows of K (camera → homogeneous pixel coordinates, pixel (0, 0) the
+    /// top-left corner of the image).
+    pub k: [[f32; 4]; 3],
+    /// Rows of K⁻¹.
+    pub k_inv: [[f32; 4]; 3],
+    /// P22, P32 (camera z → depth buffer value), visibility offset (in splat
+    /// radii), kernel cut-off F_G.
+    pub depth: [f32; 4],
+    /// Width, height, largest point size, near plane.
+    pub viewport: [f32; 4],
+    /// Sun direction in camera space; w = 1 shaded, 0 unlit (albedo).
+    pub sun_camera: [f32; 4],
+    /// Rows of the camera → world rotation.
+    pub camera_to_world: [[f32; 4]; 3],
+    /// World eye position; w = 1 two-sided splats, 0 back-facing splats culled.
+    pub eye: [f32; 4],
+}
+
+/// One drawn instance (`Instance` in splat.glsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuInstance {
+    /// Object → camera, column-major.
+    pub model_view: [f32; 16],
+    /// Scale, first splat (u32 bits), prefix length (u32 bits), 0.
+    pub params: [f32; 4],
+}
+
+/// Bytes of [`FrameHeader`].
+pub const HEADER_BYTES: u64 = std::mem::size_of::<FrameHeader>() as u64;
+/// Bytes of [`GpuInstance`].
+pub const INSTANCE_BYTES: u64 = std::mem::size_of::<GpuInstance>() as u64;
+
+/// Entries of the Gaussian lookup table (`GAUSSIAN_TABLE_SIZE` in splat.glsl).
+pub const GAUSSIAN_TABLE_SIZE: usize = 256;
+
+/// `exp(−r²/2)` at `r² = F_G²·i/(n−1)`, i = 0..n (§10.2.2: the weight comes
+/// from a lookup table).
+pub fn gaussian_table(cutoff: f32) -> Vec<f32> {
+    let n = GAUSSIAN_TABLE_SIZE;
+    (0..n)
+        .map(|i| (-0.5 * f64::from(cutoff * cutoff) * i as f64 / (n - 1) as f64).exp() as f32)
+        .collect()
+}
+
+/// The camera's view matrix (world → camera, right-handed, looking down −z)
+/// and the pinhole intrinsics K of a `width`×`height` image, both in f64.
+pub fn view_and_intrinsics(camera: &Camera, width: u32, height: u32) -> (DMat4, DMat3) {
+    let view = DMat4::look_at_rh(camera.eye, camera.target, camera.up);
+    let (w, h) = (f64::from(width), f64::from(height));
+    let fy = 0.5 * h / (0.5 * camera.fov_y_deg.to_radians()).tan();
+    // Square pixels (the projection's aspect is width / height):
+    // pixel x = w/2 + fy·X/(−Z), y = h/2 − fy·Y/(−Z) (row 0 at the top).
+    let fx = fy;
+    let k = DMat3::from_cols(
+        DVec3::new(fx, 0.0, 0.0),
+        DVec3::new(0.0, -fy, 0.0),
+        DVec3::new(-0.5 * w, -0.5 * h, -1.0),
+    );
+    (view, k)
+}
+
+/// The header of a frame.
+pub fn frame_header(
+    camera: &Camera,
+    (width, height): (u32, u32),
+    sun_world: Vec3,
+    (shaded, two_sided): (bool, bool),
+    visibility_offset: f32,
+    cutoff: f32,
+    max_point_size: f32,
+) -> FrameHeader {
+    let (view, k) = view_and_intrinsics(camera, width, height);
+    let k_inv = k.inverse();
+    let rows = |m: DMat3| {
+        let t = m.transpose();
+        [t.x_axis, t.y_axis, t.z_axis].map(|r| r.as_vec3().extend(0.0).to_array())
+    };
+    let view3 = DMat3::from_mat4(view);
+    let (near, far) = (camera.near, camera.far);
+    // glam's perspective_rh: depth = (far/(near−far)·z + near·far/(near−far)) / −z.
+    let p22 = far / (near - far);
+    let p32 = near * far / (near - far);
+    let sun = (view3 * sun_world.as_dvec3()).normalize_or_zero();
+    FrameHeader {
+        k: rows(k),
+        k_inv: rows(k_inv),
+        depth: [p22 as f32, p32 as f32, visibility_offset, cutoff],
+        viewport: [width as f32, height as f32, max_point_size, near as f32],
+        sun_camera: sun.as_vec3().extend(if shaded { 1.0 } else { 0.0 }).to_array(),
+        camera_to_world: rows(view3.transpose()),
+        eye: camera
+            .eye
+            .as_vec3()
+            .extend(if two_sided { 1.0 } else { 0.0 })
+            .to_array(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn intrinsics_agree_with_the_view_projection() {
+        let camera = Camera {
+            eye: DVec3::new(10.0, -20.0, 30.0),
+            target: DVec3::new(100.0, 50.0, 0.0),
+            up: DVec3::Z,
+            fov_y_deg: 50.0,
+            near: 0.5,
+            far: 5000.0,
+        };
+        let (w, h) = (640, 360);
+        let (view, k) = view_and_intrinsics(&camera, w, h);
+        let clip_of = camera.view_proj(w as f64 / h as f64).as_dmat4();
+        for p in [DVec3::new(120.0, 40.0, 5.0), DVec3::new(90.0, 80.0, 10.0)] {
+            let c = clip_of * p.extend(1.0);
+            let ndc = c.truncate() / c.w;
+            let expected = ((ndc.x + 1.0) * 0.5 * w as f64, (ndc.y + 1.0) * 0.5 * h as f64);
+            let x = k * view.transform_point3(p);
+            let got = (x.x / x.z, x.y / x.z);
+            assert!((got.0 - expected.0).abs() < 1e-3 && (got.1 - expected.1).abs() < 1e-3);
+            let z = view.transform_point3(p).z;
+            let header = frame_header(&camera, (w, h), Vec3::Z, (true, false), 1.0, 1.5, 64.0);
+            let depth = (f64::from(header.depth[0]) * z + f64::from(header.depth[1])) / -z;
+            assert!((depth - ndc.z).abs() < 1e-5, "{depth} vs {}", ndc.z);
+        }
+    }
+
+    #[test]
+    fn gaussian_table_spans_the_cutoff() {
+        let t = gaussian_table(1.5);
+        assert_eq!(t.len(), GAUSSIAN_TABLE_SIZE);
+        assert_eq!(t[0], 1.0);
+        assert!((t[GAUSSIAN_TABLE_SIZE - 1] - (-1.125f32).exp()).abs() < 1e-6);
+    }
+}

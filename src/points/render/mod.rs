@@ -1,0 +1,132 @@
+//! Rendering of sequential point trees with splats (dissertation §10.1.7,
+//! §10.2, §10.3; `ALGORITHMS.md` §7–8), as render-graph passes that follow
+//! the three passes of Table 10.1:
+//!
+//! | pass | mode | what |
+//! |---|---|---|
+//! | `points.visibility` | ewa | CPU prefix per instance ([`selection`]), then depth only: ray–plane depth pushed back by ε |
+//! | `points.accumulate` | ewa | depth test ≤ without writes, additive (w·colour, w), (w·normal, w·depth) into float targets |
+//! | `points.normalize` | ewa | full screen: divide by w, shade, write radiance, view depth and W |
+//! | `points.opaque` | opaque | CPU prefix, then opaque discs with ray–plane depth, shaded directly |
+//!
+//! The graph derives every barrier between them. Shaders: `glsl/points/`.
+
+pub mod gpu_layout;
+mod passes;
+pub mod selection;
+pub mod stats;
+
+use std::sync::{Arc, Mutex};
+
+pub use passes::{add_point_passes, PointPasses, SplatTargets};
+pub use stats::PointFrameStats;
+
+use crate::error::{Error, Result};
+
+/// How splats are drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SplatMode {
+    /// Opaque discs in one pass: the fast baseline.
+    Opaque,
+    /// Perspective-accurate EWA splatting in three passes (§10.2).
+    #[default]
+    Ewa,
+}
+
+/// The primitive that carries a splat (§10.3, Table 10.3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SplatPrimitive {
+    /// Point primitives covering the splat's bounding square; splats larger
+    /// than the device's largest point size fall back to quads.
+    Point,
+    /// Quads by vertex pulling: six vertices per splat read the same splat
+    /// record (no duplicated splat data).
+    #[default]
+    Quad,
+    /// Instanced quads: one instance of six vertices per splat.
+    Instanced,
+}
+
+impl SplatMode {
+    pub const ALL: [SplatMode; 2] = [SplatMode::Opaque, SplatMode::Ewa];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SplatMode::Opaque => "opaque",
+            SplatMode::Ewa => "ewa",
+        }
+    }
+}
+
+impl SplatPrimitive {
+    pub const ALL: [SplatPrimitive; 3] = [SplatPrimitive::Point, SplatPrimitive::Quad, SplatPrimitive::Instanced];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SplatPrimitive::Point => "point",
+            SplatPrimitive::Quad => "quad",
+            SplatPrimitive::Instanced => "instanced",
+        }
+    }
+}
+
+/// Settings of point rendering.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SplatSettings {
+    pub mode: SplatMode,
+    pub primitive: SplatPrimitive,
+    /// Kernel cut-off F_G in standard deviations (1 < F_G < 2, §10.2.2); the
+    /// cut-off ellipse is the splat's disk.
+    pub cutoff: f32,
+    /// Visibility pass offset ε along the view ray, in splat radii (§10.2.3).
+    pub visibility_offset: f32,
+    /// Shade splats (sun, sky, haze); false writes their albedo (tests, debugging).
+    pub shaded: bool,
+    /// Draw back-facing splats too (open surfaces such as leaves); by default
+    /// they are culled, as for the closed surfaces of scans and rocks.
+    pub two_sided: bool,
+    /// Error threshold ε of the trees (as [`crate::points::spt::SptOptions::epsilon`]);
+    /// None keeps the ε each tree was built with.
+    pub epsilon: Option<f32>,
+}
+
+impl Default for SplatSettings {
+    fn default() -> Self {
+        SplatSettings {
+            mode: SplatMode::Ewa,
+            primitive: SplatPrimitive::Quad,
+            cutoff: 1.5,
+            visibility_offset: 1.0,
+            shaded: true,
+            two_sided: false,
+            epsilon: None,
+        }
+    }
+}
+
+impl SplatSettings {
+    /// Checks the numbers.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.cutoff > 1.0 && self.cutoff < 2.0) {
+            return Err(Error::invalid(
+                "splat cut-off",
+                format!("{}; must be in (1, 2)", self.cutoff),
+            ));
+        }
+        if !(self.visibility_offset.is_finite() && self.visibility_offset >= 0.0) {
+            return Err(Error::invalid(
+                "visibility offset",
+                format!("{}; must be ≥ 0", self.visibility_offset),
+            ));
+        }
+        if let Some(e) = self.epsilon {
+            if !(e.is_finite() && e > 0.0) {
+                return Err(Error::invalid("--epsilon", format!("{e} is not a positive number")));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Statistics shared between the passes' recording and the renderer.
+pub(crate) type SharedStats = Arc<Mutex<stats::StatsLog>>;

@@ -1,0 +1,85 @@
+//! The CPU half of sequential point tree rendering (dissertation §10.1.7):
+//! per frame and instance, a lower bound r_lo of the eye distance over the
+//! object's bounding sphere, and the prefix of the splat list with
+//! `r_max ≥ r_lo` found by binary search. Instances whose bounding sphere is
+//! outside the view frustum are not drawn. The exact interval test runs in
+//! the vertex stage (`glsl/points/splat.vert`).
+
+use glam::{DMat4, DVec3, DVec4};
+
+use super::gpu_layout::GpuInstance;
+use crate::points::scene::PointScene;
+
+/// One instance to draw this frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct InstanceDraw {
+    /// Index into this frame's instance records.
+    pub record: u32,
+    /// Splats of the prefix.
+    pub count: u32,
+}
+
+/// What the CPU decided for one frame.
+#[derive(Clone, Debug, Default)]
+pub struct FramePlan {
+    pub records: Vec<GpuInstance>,
+    pub draws: Vec<InstanceDraw>,
+    /// Instances of the scene.
+    pub instances: usize,
+    /// Splats in the drawn prefixes.
+    pub prefix_splats: u64,
+    /// Splats of the drawn instances' whole lists.
+    pub list_splats: u64,
+}
+
+/// The world-space planes of the frustum of `view_proj` (Vulkan clip space,
+/// depth 0..1), as (n, d) with n·x + d ≥ 0 inside.
+fn frustum_planes(view_proj: DMat4) -> [DVec4; 6] {
+    let m = view_proj.transpose();
+    let (r0, r1, r2, r3) = (m.x_axis, m.y_axis, m.z_axis, m.w_axis);
+    [r3 + r0, r3 - r0, r3 + r1, r3 - r1, r2, r3 - r2].map(|p| p / p.truncate().length().max(1e-300))
+}
+
+/// Plans a frame: `view` world → camera, `view_proj` world → clip,
+/// `first_splat[o]` the offset of object o's list in the splat buffer.
+pub fn plan_frame(scene: &PointScene, first_splat: &[u32], eye: DVec3, view: DMat4, view_proj: DMat4) -> FramePlan {
+    let planes = frustum_planes(view_proj);
+    let mut plan = FramePlan {
+        instances: scene.instances.len(),
+        ..FramePlan::default()
+    };
+    for inst in &scene.instances {
+        let object = &scene.objects[inst.object];
+        let tree = &object.tree;
+        let model = inst.transform.matrix();
+        let scale = inst.transform.scale;
+        let centre = model.transform_point3(tree.bounds_centre.as_dvec3());
+        let radius = f64::from(tree.bounds_radius) * scale;
+        if planes.iter().any(|p| p.truncate().dot(centre) + p.w < -radius) {
+            continue;
+        }
+        // r_lo in object units: the tree's intervals are in object units.
+        let r_lo = (((eye - centre).length() - radius) / scale).max(0.0);
+        let count = tree.prefix_len(r_lo as f32) as u32;
+        if count == 0 {
+            continue;
+        }
+        let model_view = view * model;
+        plan.draws.push(InstanceDraw {
+            record: plan.records.len() as u32,
+            count,
+        });
+        plan.records.push(GpuInstance {
+            model_view: model_view.as_mat4().to_cols_array(),
+            params: [
+                scale as f32,
+                f32::from_bits(first_splat[inst.object]),
+                f32::from_bits(count),
+                0.0,
+            ],
+        });
+        plan.prefix_splats += u64::from(count);
+        plan.list_splats += tree.nodes.len() as u64;
+    }
+    plan
+}

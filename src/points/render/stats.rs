@@ -1,0 +1,117 @@
+//! Per-frame statistics of point rendering (dissertation §10.1.7: the text
+//! reports that the vertex stage culls 10–40 % of the prefix): splats in the
+//! CPU's prefixes, splats that passed the GPU's interval test (counted by
+//! the vertex stage with an atomic, when the device has
+//! `vertexPipelineStoresAndAtomics`), and the share culled on the GPU.
+
+use std::sync::Arc;
+
+use serde::Serialize;
+
+use crate::error::Result;
+use crate::vulkan::{Buffer, FRAMES_IN_FLIGHT};
+
+/// Point statistics of one frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct PointFrameStats {
+    pub frame: u64,
+    /// Instances in the scene.
+    pub instances: usize,
+    /// Instances inside the view frustum with a non-empty prefix.
+    pub instances_drawn: usize,
+    /// Splats of the drawn instances' whole lists (what drawing every node would cost).
+    pub list_splats: u64,
+    /// Splats in the prefixes sent to the GPU.
+    pub prefix_splats: u64,
+    /// Splats that passed the vertex stage's interval test r_min ≤ r < r_max
+    /// (None without `vertexPipelineStoresAndAtomics`).
+    pub interval_passed: Option<u64>,
+    /// Of those, splats drawn: not back-facing (unless two-sided), not
+    /// ill-conditioned, in front of the near plane.
+    pub drawn_splats: Option<u64>,
+    /// CPU time of the selection (prefix search, transforms), milliseconds.
+    pub cpu_ms: f64,
+}
+
+impl PointFrameStats {
+    /// Share of the prefixes the GPU's interval test culled, in [0, 1]
+    /// (the figure the text reports as 10–40 %).
+    pub fn gpu_culled_share(&self) -> Option<f64> {
+        let passed = self.interval_passed?;
+        (self.prefix_splats > 0).then(|| 1.0 - passed as f64 / self.prefix_splats as f64)
+    }
+
+    /// One line for logs and the CLI.
+    pub fn summary(&self) -> String {
+        let drawn = match (self.interval_passed, self.drawn_splats, self.gpu_culled_share()) {
+            (Some(p), Some(d), Some(c)) => format!(
+                "{p} pass the interval test ({:.1} % of the prefixes culled on the GPU), {d} drawn after back-face culling",
+                c * 100.0
+            ),
+            (Some(p), Some(d), None) => format!("{p} pass the interval test, {d} drawn"),
+            _ => "GPU counts unavailable (no vertexPipelineStoresAndAtomics)".into(),
+        };
+        format!(
+            "points: {}/{} instances, {} splats in prefixes of {} listed, {}; CPU {:.3} ms",
+            self.instances_drawn, self.instances, self.prefix_splats, self.list_splats, drawn, self.cpu_ms
+        )
+    }
+}
+
+/// Collects the statistics: the counter of a frame slot is read when the
+/// slot is recorded again (its previous frame has completed) or at the end.
+pub(crate) struct StatsLog {
+    /// One host-visible counter per frame slot (None: no GPU counting).
+    counters: Option<Vec<Arc<Buffer>>>,
+    pending: [Option<PointFrameStats>; FRAMES_IN_FLIGHT],
+    done: Vec<PointFrameStats>,
+}
+
+impl StatsLog {
+    pub fn new(counters: Option<Vec<Arc<Buffer>>>) -> StatsLog {
+        StatsLog {
+            counters,
+            pending: [None; FRAMES_IN_FLIGHT],
+            done: Vec::new(),
+        }
+    }
+
+    /// Fills in the GPU counts of `stats` from its slot's counter.
+    fn read(&self, slot: usize, stats: &mut PointFrameStats) -> Result<()> {
+        if let Some(c) = &self.counters {
+            let words: Vec<u32> = bytemuck::pod_collect_to_vec(&c[slot].mapped()?[..8]);
+            stats.interval_passed = Some(u64::from(words[0]));
+            stats.drawn_splats = Some(u64::from(words[1]));
+        }
+        Ok(())
+    }
+
+    /// Called while recording `stats.frame`, after its slot's previous frame
+    /// completed: finishes that frame's entry and zeroes the counter.
+    pub fn begin_frame(&mut self, stats: PointFrameStats) -> Result<()> {
+        let slot = (stats.frame % FRAMES_IN_FLIGHT as u64) as usize;
+        if let Some(mut previous) = self.pending[slot].take() {
+            self.read(slot, &mut previous)?;
+            self.done.push(previous);
+        }
+        if let Some(c) = &self.counters {
+            c[slot].write(0, &[0u8; 8])?;
+        }
+        self.pending[slot] = Some(stats);
+        Ok(())
+    }
+
+    /// Finishes every pending frame (call after all frames completed) and
+    /// returns the statistics gathered so far, in frame order.
+    pub fn take_all_completed(&mut self) -> Result<Vec<PointFrameStats>> {
+        for slot in 0..FRAMES_IN_FLIGHT {
+            if let Some(mut s) = self.pending[slot].take() {
+                self.read(slot, &mut s)?;
+                self.done.push(s);
+            }
+        }
+        let mut out = std::mem::take(&mut self.done);
+        out.sort_by_key(|s| s.frame);
+        Ok(out)
+    }
+}
