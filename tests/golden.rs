@@ -1,7 +1,8 @@
 //! Golden-image tests: frames compared with stored PNGs by FLIP: the
-//! default scene and the real Jacksboro DEM from three viewpoints (high and
-//! oblique, low and grazing, along a valley), all with the warped terrain
-//! and its procedural detail (§7.4).
+//! default scene (with its rocks) and the real Jacksboro DEM from three
+//! viewpoints (high and oblique, low and grazing, along a valley), all with
+//! the warped terrain and its procedural detail (§7.4); and the Stanford
+//! bunny as a sequential point tree with opaque and EWA splats (§10.1–10.2).
 //!
 //! Threshold: mean FLIP ≤ [`MEAN_FLIP_THRESHOLD`] (0.02; override with
 //! `ALPENGLOW_FLIP_THRESHOLD`). On the lavapipe that made the goldens the
@@ -18,8 +19,10 @@
 mod common;
 
 use alpenglow::io::image_out::write_png_rgba8;
+use alpenglow::points::render::{SplatMode, SplatSettings};
+use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointScene, PointTransform};
 use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
-use common::{assert_validation_clean, failure_dir, golden_dir, jacksboro_field, mean_flip, validated_context};
+use common::{assert_validation_clean, data, failure_dir, golden_dir, jacksboro_field, mean_flip, validated_context};
 use glam::DVec3;
 
 const MEAN_FLIP_THRESHOLD: f32 = 0.02;
@@ -34,6 +37,10 @@ fn threshold() -> f32 {
 }
 
 fn check_golden(name: &str, scene: &Scene, camera: &Camera) {
+    check_golden_with(name, scene, camera, SplatSettings::default());
+}
+
+fn check_golden_with(name: &str, scene: &Scene, camera: &Camera, points: SplatSettings) {
     let (ctx, report) = validated_context();
     let frame = {
         let settings = RenderSettings {
@@ -41,6 +48,7 @@ fn check_golden(name: &str, scene: &Scene, camera: &Camera) {
             height: HEIGHT,
             readback: true,
             terrain: Default::default(),
+            points,
         };
         let mut renderer = Renderer::new(&ctx, scene, settings).expect("renderer");
         let frame = renderer.render(camera).and_then(|f| renderer.read(&f)).expect("frame");
@@ -124,4 +132,45 @@ fn real_dem_along_valley_view_matches_golden() {
         far: 100000.0,
     };
     check_golden("jacksboro-valley", &scene, &camera);
+}
+
+fn bunny_scene() -> Scene {
+    let options = PointLoadOptions {
+        mesh_samples: 30_000,
+        ..PointLoadOptions::default()
+    };
+    let bunny = load_point_object(&data("models/stanford-bunny.obj"), &options).expect("bunny");
+    let mut points = PointScene::default();
+    // The model is y-up; stand it up in the z-up world.
+    points.add(bunny, PointTransform::parse("r=90,0,0").expect("transform"));
+    Scene::points_only(points)
+}
+
+fn bunny_camera() -> Camera {
+    Camera {
+        eye: DVec3::new(0.12, -0.3, 0.17),
+        target: DVec3::new(-0.02, 0.0, 0.09),
+        up: DVec3::Z,
+        fov_y_deg: 45.0,
+        near: 0.01,
+        far: 100.0,
+    }
+}
+
+#[test]
+fn bunny_ewa_matches_golden() {
+    let settings = SplatSettings {
+        mode: SplatMode::Ewa,
+        ..SplatSettings::default()
+    };
+    check_golden_with("bunny-ewa", &bunny_scene(), &bunny_camera(), settings);
+}
+
+#[test]
+fn bunny_opaque_matches_golden() {
+    let settings = SplatSettings {
+        mode: SplatMode::Opaque,
+        ..SplatSettings::default()
+    };
+    check_golden_with("bunny-opaque", &bunny_scene(), &bunny_camera(), settings);
 }

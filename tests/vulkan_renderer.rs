@@ -32,6 +32,7 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
             height: 64,
             readback: true,
             terrain: Default::default(),
+            points: Default::default(),
         };
         let mut renderer = Renderer::new(&ctx, &scene, settings).expect("renderer");
         assert_eq!(
@@ -84,6 +85,7 @@ fn renders_are_deterministic() {
             height: 48,
             readback: true,
             terrain: Default::default(),
+            points: Default::default(),
         };
         let camera = scene.default_camera();
         let mut first = Renderer::new(&ctx, &scene, settings).expect("renderer");
@@ -222,6 +224,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
                 height: 16,
                 readback: true,
                 terrain: Default::default(),
+                points: Default::default(),
             },
         )
         .unwrap();
@@ -243,6 +246,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
                 height: 16,
                 readback: false,
                 terrain: Default::default(),
+                points: Default::default(),
             }
         )
         .is_err());

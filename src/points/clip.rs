@@ -213,7 +213,7 @@ impl Creases {
         let (Some(&from), Some(&to)) = (self.start.get(triangle), self.start.get(triangle + 1)) else {
             return ClipLines::NONE;
         };
-        if from == to || !(radius > 0.0) {
+        if from == to || !(radius.is_finite() && radius > 0.0) {
             return ClipLines::NONE;
         }
         let (t, b) = tangent_frame(normal);
@@ -232,13 +232,13 @@ impl Creases {
             let (p2, q2) = (project(p), project(q));
             let d = q2 - p2;
             let length = d.length();
-            if !(length > 1e-6 * radius) {
+            if !(length.is_finite() && length > 1e-6 * radius) {
                 continue;
             }
             // Distance from the centre (origin) to the projected segment.
             let s = (-p2.dot(d) / (length * length)).clamp(0.0, 1.0);
             let distance = (p2 + s * d).length();
-            if !(distance < radius) {
+            if !(distance.is_finite() && distance < radius) {
                 continue;
             }
             let mut m = Vec2::new(d.y, -d.x) / length;

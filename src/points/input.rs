@@ -568,9 +568,9 @@ fn read_ply(source: impl Read, path: &Path) -> Result<PointInput> {
 /// the offset `+inf`, which, like offsets ≥ `f32::MAX`, means "no line".
 fn clip_lines(v: &PlyVertex, present: [bool; 2]) -> Option<ClipLines> {
     let mut lines = ClipLines::NONE;
-    for k in 0..2 {
+    for (k, &present) in present.iter().enumerate() {
         let (angle, offset) = (v.clip[2 * k], v.clip[2 * k + 1]);
-        if !present[k] || offset >= f32::MAX {
+        if !present || offset >= f32::MAX {
             continue;
         }
         if !(angle.is_finite() && offset.is_finite()) {
@@ -945,7 +945,7 @@ mod tests {
         let mesh_text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
                          property float z\nproperty float clip0_angle\nproperty float clip0_offset\n\
                          element face 1\nproperty list uchar int vertex_indices\nend_header\n\
-                         0 0 0 0 nan\n1 0 0 0 0\n0 1 0 0 0\n3 0 1 2\n";
+                         0 0 0 0 -7\n1 0 0 0 0\n0 1 0 0 0\n3 0 1 2\n";
         assert_eq!(mesh(parse(mesh_text.as_bytes()).unwrap()).triangles.len(), 1);
     }
 

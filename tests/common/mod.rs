@@ -75,3 +75,22 @@ pub fn mean_flip(reference_rgba: &[u8], test_rgba: &[u8], width: u32, height: u3
     (mean, heatmap)
 }
 pub mod cli;
+
+/// Per-pixel FLIP error between two sRGB RGBA8 images of the same size (alpha ignored).
+pub fn flip_errors(reference_rgba: &[u8], test_rgba: &[u8], width: u32, height: u32) -> Vec<f32> {
+    let rgb = |rgba: &[u8]| -> Vec<u8> { rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect() };
+    let reference = nv_flip::FlipImageRgb8::with_data(width, height, &rgb(reference_rgba));
+    let test = nv_flip::FlipImageRgb8::with_data(width, height, &rgb(test_rgba));
+    nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE).to_vec()
+}
+
+/// Linear RGB → sRGB8 code value (the transfer function of the tone mapper's output stage, no tone curve).
+pub fn linear_to_srgb8(c: f32) -> u8 {
+    let c = c.clamp(0.0, 1.0);
+    let s = if c <= 0.0031308 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0).round() as u8
+}
