@@ -74,3 +74,123 @@ fn bad_inputs_are_one_line_errors_without_output() {
     assert_no_files_left("--epsilon 0", &dir);
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+fn bunny_render_args(dir: &std::path::Path, extra: &[&str]) -> Vec<String> {
+    let bunny = data("models/stanford-bunny.obj");
+    let mut args: Vec<String> = [
+        "render",
+        "--validation",
+        "--no-terrain",
+        "--width",
+        "96",
+        "--height",
+        "64",
+        "--points-samples",
+        "4000",
+        "--points-transform",
+        "r=90,0,0",
+        "--eye",
+        "0.1,-0.3,0.17",
+        "--target",
+        "-0.02,0,0.09",
+        "--near",
+        "0.01",
+        "--far",
+        "10",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    args.push("--points".into());
+    args.push(bunny.display().to_string());
+    args.push("--out".into());
+    args.push(dir.join("o.png").display().to_string());
+    args.extend(extra.iter().map(|s| s.to_string()));
+    args
+}
+
+/// Both splat modes and all three primitives render the bunny under
+/// validation; the EXR carries W (positive on the bunny, 0 on the sky), and
+/// the statistics line reports the GPU's interval test.
+#[test]
+fn renders_points_in_every_mode_and_primitive_with_w_in_the_exr() {
+    let dir = fresh_dir("points-render");
+    let exr_path = dir.join("o.exr");
+    for (splat, primitive) in [
+        ("ewa", "quad"),
+        ("ewa", "instanced"),
+        ("ewa", "point"),
+        ("opaque", "quad"),
+        ("opaque", "point"),
+    ] {
+        let exr = exr_path.display().to_string();
+        let args = bunny_render_args(
+            &dir,
+            &["--splat", splat, "--splat-primitive", primitive, "--exr", &exr],
+        );
+        let out = run(&args);
+        assert_success(&format!("render --splat {splat} --splat-primitive {primitive}"), &out);
+        let stdout = text(&out.stdout);
+        assert!(stdout.contains("pass the interval test"), "{stdout}");
+        let image = exr::prelude::read_all_flat_layers_from_file(&exr_path).expect("EXR reads");
+        let layer = &image.layer_data[0];
+        let w = layer
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name.to_string() == "W")
+            .expect("channel W");
+        let values: Vec<f32> = w.sample_data.values_as_f32().collect();
+        let covered = values.iter().filter(|v| **v > 0.0).count();
+        assert!(covered > 200 && covered < values.len() / 2, "{splat}/{primitive}: W > 0 on {covered} pixels");
+        assert_eq!(values[0], 0.0, "the corner shows sky");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// An SPT file from `spt build` renders; bad point inputs and transforms
+/// are one-line errors naming the file or the option, and nothing is written.
+#[test]
+fn spt_files_render_and_bad_point_inputs_fail_cleanly() {
+    let dir = fresh_dir("points-bad");
+    let spt = dir.join("bunny.spt");
+    let bunny = data("models/stanford-bunny.obj");
+    let built = run(&[
+        "spt".as_ref(),
+        "build".as_ref(),
+        bunny.as_os_str(),
+        spt.as_os_str(),
+        "--samples".as_ref(),
+        "3000".as_ref(),
+    ]);
+    assert_success("spt build", &built);
+    let mut args = bunny_render_args(&dir, &[]);
+    let i = args.iter().position(|a| a.ends_with("stanford-bunny.obj")).unwrap();
+    args[i] = spt.display().to_string();
+    assert_success("render an SPT file", &run(&args));
+    std::fs::remove_file(dir.join("o.png")).unwrap();
+
+    for (file, needle) in [
+        ("points/short-count.ply", "short-count.ply"),
+        ("missing.obj", "missing.obj"),
+    ] {
+        let mut args = bunny_render_args(&dir, &[]);
+        args[i] = data(file).display().to_string();
+        assert_one_line_error(&format!("render --points {file}"), &run(&args), &[needle]);
+    }
+    for transform in ["s=0", "t=1,2", "q=1"] {
+        let mut args = bunny_render_args(&dir, &[]);
+        let t = args.iter().position(|a| a == "r=90,0,0").unwrap();
+        args[t] = transform.into();
+        assert_one_line_error(
+            &format!("--points-transform {transform}"),
+            &run(&args),
+            &["--points-transform"],
+        );
+    }
+    let args = bunny_render_args(&dir, &["--epsilon", "0"]);
+    assert_one_line_error("--epsilon 0", &run(&args), &["--epsilon"]);
+    std::fs::remove_file(&spt).unwrap();
+    assert_no_files_left("bad point inputs", &dir);
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -580,12 +580,6 @@ mod tests {
             seed: 1,
         };
         let surfels = sample_mesh(&mesh, &options).unwrap();
-        eprintln!("TEMP clipped {}", surfels.iter().filter(|s| s.clip != ClipLines::NONE).count());
-        for name in ["teapot.obj"] {
-            let m = load_obj(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/models").join(name)).unwrap();
-            let s = sample_mesh(&m, &options).unwrap();
-            eprintln!("TEMP {name} clipped {} twice {}", s.iter().filter(|s| s.clip != ClipLines::NONE).count(), s.iter().filter(|s| s.clip.0[1].is_some()).count());
-        }
         let tree = build_spt(&surfels, &SptOptions::default(), &mut |_| {}).unwrap();
         let c = cluster_normals(&tree);
         let (centre, radius) = (tree.bounds_centre, tree.bounds_radius);

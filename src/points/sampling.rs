@@ -116,7 +116,8 @@ pub struct SamplingOptions {
 }
 
 /// Samples `options.count` surfels evenly (area-weighted) over the mesh
-/// (§10.1; method, attributes and radius in the module docs).
+/// (§10.1; method, attributes and radius in the module docs), with clip
+/// lines along the mesh's creases (§10.2.4, [`super::clip`]).
 ///
 /// Errors when the count is 0, an index is out of range, vertex normals or
 /// colours do not match the vertex count, a used vertex is not finite, or the

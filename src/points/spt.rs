@@ -13,7 +13,8 @@
 //! # Build (§10.1.3, §10.1.4)
 //!
 //! The leaves are the input surfels (a surfel of radius ρ is a leaf disk of
-//! diameter 2ρ with zero error). The surfels are inserted into an octree over
+//! diameter 2ρ with zero error; it keeps the surfel's clip lines, §10.2.4,
+//! while inner nodes have none). The surfels are inserted into an octree over
 //! their bounding cube; a cell with more than [`SptOptions::leaf_size`]
 //! surfels is split into its eight octants until [`SptOptions::max_depth`]. A
 //! cell holding one surfel is that leaf; a cell holding 2..=`leaf_size`
