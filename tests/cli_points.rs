@@ -124,10 +124,7 @@ fn renders_points_in_every_mode_and_primitive_with_w_in_the_exr() {
         ("opaque", "point"),
     ] {
         let exr = exr_path.display().to_string();
-        let args = bunny_render_args(
-            &dir,
-            &["--splat", splat, "--splat-primitive", primitive, "--exr", &exr],
-        );
+        let args = bunny_render_args(&dir, &["--splat", splat, "--splat-primitive", primitive, "--exr", &exr]);
         let out = run(&args);
         assert_success(&format!("render --splat {splat} --splat-primitive {primitive}"), &out);
         let stdout = text(&out.stdout);
@@ -142,7 +139,10 @@ fn renders_points_in_every_mode_and_primitive_with_w_in_the_exr() {
             .expect("channel W");
         let values: Vec<f32> = w.sample_data.values_as_f32().collect();
         let covered = values.iter().filter(|v| **v > 0.0).count();
-        assert!(covered > 200 && covered < values.len() / 2, "{splat}/{primitive}: W > 0 on {covered} pixels");
+        assert!(
+            covered > 200 && covered < values.len() / 2,
+            "{splat}/{primitive}: W > 0 on {covered} pixels"
+        );
         assert_eq!(values[0], 0.0, "the corner shows sky");
     }
     std::fs::remove_dir_all(dir).unwrap();

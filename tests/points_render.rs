@@ -206,7 +206,7 @@ fn holes(frame: &FrameImages, covered: &[Option<f32>]) -> usize {
     let w = frame.weight.as_ref().expect("W channel");
     w.iter()
         .zip(covered)
-        .filter(|(w, c)| c.is_some() && !(**w > 0.0))
+        .filter(|(w, c)| c.is_some() && (**w <= 0.0 || w.is_nan()))
         .count()
 }
 

@@ -1,0 +1,171 @@
+//! Benchmark of point rendering (dissertation §10.1.7, §10.2, §10.3):
+//! `cargo run --release --example splat_bench [-- --quick]`.
+//!
+//! 1. Splats per second of each splat mode (opaque, three-pass EWA) and
+//!    primitive (point, quad by vertex pulling, instanced quad), as in
+//!    Table 10.3: the bunny sampled into ~100k surfels, every leaf drawn
+//!    (a flat list: no level of detail), framed in a 512² window.
+//! 2. The sequential point tree against drawing every leaf, at several
+//!    distances: splats in the prefix, splats drawn, GPU time.
+//! 3. CPU time of the per-frame selection per object instance: the default
+//!    scene's 300 rock instances.
+//!
+//! GPU times are the medians of the points passes' timestamps over the timed
+//! frames; splats/s = splats drawn (the vertex stage's count) / that time.
+
+use std::sync::Arc;
+
+use alpenglow::points::render::{SplatMode, SplatPrimitive, SplatSettings};
+use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointObject, PointScene, PointTransform};
+use alpenglow::points::spt::{epsilon_from_pixels, SequentialPointTree, ROOT_R_MAX};
+use alpenglow::profile::median;
+use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
+use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
+use glam::DVec3;
+
+const SIDE: u32 = 512;
+
+struct Measured {
+    gpu_ms: f64,
+    prefix: u64,
+    drawn: u64,
+    cpu_ms: f64,
+}
+
+fn measure(ctx: &Context, scene: &Scene, camera: &Camera, points: SplatSettings, frames: usize) -> Measured {
+    let settings = RenderSettings {
+        readback: false,
+        points,
+        ..RenderSettings::new(SIDE, SIDE)
+    };
+    let mut renderer = Renderer::new(ctx, scene, settings).expect("renderer");
+    let warmup = 2;
+    for _ in 0..warmup + frames {
+        renderer.render(camera).expect("frame");
+    }
+    let profiles = renderer.finish().expect("finish");
+    let stats = renderer.take_point_stats().expect("stats");
+    let gpu_ms = median(profiles.iter().skip(warmup).map(|p| {
+        p.passes
+            .iter()
+            .filter(|p| p.name.starts_with("points."))
+            .map(|p| p.gpu_ms)
+            .sum::<f64>()
+    }));
+    let last = stats.last().expect("point statistics");
+    Measured {
+        gpu_ms,
+        prefix: last.prefix_splats,
+        drawn: last.drawn_splats.unwrap_or(0),
+        cpu_ms: median(stats.iter().skip(warmup).map(|s| s.cpu_ms)),
+    }
+}
+
+/// The leaves of `tree` as a flat list drawn at every distance.
+fn all_leaves(tree: &SequentialPointTree) -> SequentialPointTree {
+    let mut flat = tree.clone();
+    flat.nodes.retain(|n| n.is_leaf);
+    for n in &mut flat.nodes {
+        n.r_min = 0.0;
+        n.r_max = ROOT_R_MAX;
+    }
+    flat
+}
+
+fn single(object: PointObject) -> Scene {
+    let mut points = PointScene::default();
+    points.add(object, PointTransform::parse("r=90,0,0").unwrap());
+    Scene::points_only(points)
+}
+
+fn camera_at(distance: f64) -> Camera {
+    Camera {
+        eye: DVec3::new(0.0, -distance, 0.1 + 0.2 * distance),
+        target: DVec3::new(-0.02, 0.0, 0.09),
+        up: DVec3::Z,
+        fov_y_deg: 40.0,
+        near: 0.01,
+        far: 1000.0,
+    }
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let frames = if quick { 3 } else { 10 };
+    let ctx = Context::new(&ContextOptions {
+        validation: false,
+        device: DeviceSelector::Best,
+    })
+    .expect("Vulkan context");
+    println!("device: {} ({})", ctx.info().name, ctx.info().driver_info);
+    let spt = alpenglow::points::spt::SptOptions {
+        epsilon: epsilon_from_pixels(1.0, 40f32.to_radians(), SIDE).unwrap(),
+        ..Default::default()
+    };
+    let options = PointLoadOptions {
+        mesh_samples: 100_000,
+        spt,
+        ..PointLoadOptions::default()
+    };
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/models/stanford-bunny.obj");
+    let bunny = load_point_object(&path, &options).expect("bunny");
+    let leaves = PointObject {
+        name: "bunny leaves".into(),
+        tree: Arc::new(all_leaves(&bunny.tree)),
+    };
+    let flat = single(leaves);
+    let close = camera_at(0.25);
+
+    println!(
+        "\n1. {} leaves as a flat list, {SIDE}² window, two-sided (every splat drawn):",
+        flat.points.total_splats()
+    );
+    println!("| mode | primitive | splats drawn | GPU ms (points passes) | M splats/s |");
+    println!("|---|---|---|---|---|");
+    for mode in SplatMode::ALL {
+        for primitive in SplatPrimitive::ALL {
+            let settings = SplatSettings {
+                mode,
+                primitive,
+                two_sided: true,
+                ..SplatSettings::default()
+            };
+            let m = measure(&ctx, &flat, &close, settings, frames);
+            println!(
+                "| {} | {} | {} | {:.1} | {:.2} |",
+                mode.name(),
+                primitive.name(),
+                m.drawn,
+                m.gpu_ms,
+                m.drawn as f64 / m.gpu_ms / 1e3
+            );
+        }
+    }
+
+    println!(
+        "\n2. Sequential point tree ({} nodes) against every leaf, EWA quads:",
+        bunny.tree.nodes.len()
+    );
+    println!("| eye distance (m) | SPT prefix | SPT drawn | SPT GPU ms | leaves drawn | leaves GPU ms |");
+    println!("|---|---|---|---|---|---|");
+    let tree_scene = single(bunny);
+    for distance in [0.25, 0.5, 1.0, 2.0, 4.0] {
+        let camera = camera_at(distance);
+        let settings = SplatSettings::default();
+        let s = measure(&ctx, &tree_scene, &camera, settings, frames);
+        let l = measure(&ctx, &flat, &camera, settings, frames);
+        println!(
+            "| {distance} | {} | {} | {:.1} | {} | {:.1} |",
+            s.prefix, s.drawn, s.gpu_ms, l.drawn, l.gpu_ms
+        );
+    }
+
+    println!("\n3. CPU selection per frame, default scene (300 rock instances):");
+    let scene = Scene::default_procedural().expect("default scene");
+    let m = measure(&ctx, &scene, &scene.default_camera(), SplatSettings::default(), frames);
+    println!(
+        "median {:.3} ms per frame, {:.2} µs per instance",
+        m.cpu_ms,
+        m.cpu_ms * 1e3 / scene.points.instances.len() as f64
+    );
+}
