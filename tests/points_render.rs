@@ -367,3 +367,45 @@ fn the_three_primitives_draw_the_same_splats() {
         );
     }
 }
+
+/// Normal clusters (§10.1.10) send fewer splats and draw the same image: the
+/// clusters they skip hold only back-facing splats, which the vertex stage
+/// would cull anyway.
+#[test]
+fn normal_clusters_skip_back_faces_without_changing_the_image() {
+    let mut points = PointScene::default();
+    points.add(bunny(), PointTransform::parse("r=90,0,0").unwrap());
+    let scene = Scene::points_only(points);
+    let camera = bunny_camera(0.6);
+    let (plain, plain_stats) = render(&scene, &camera, SplatSettings::default());
+    let clustered_settings = SplatSettings {
+        normal_clusters: true,
+        ..SplatSettings::default()
+    };
+    let (clustered, stats) = render(&scene, &camera, clustered_settings);
+    eprintln!(
+        "without clusters: {}\nwith clusters:    {}",
+        plain_stats.summary(),
+        stats.summary()
+    );
+    assert!(
+        (stats.prefix_splats as f64) < 0.85 * plain_stats.prefix_splats as f64,
+        "clusters must cut the prefix: {} vs {}",
+        stats.prefix_splats,
+        plain_stats.prefix_splats
+    );
+    assert_eq!(
+        stats.drawn_splats, plain_stats.drawn_splats,
+        "the same front-facing splats are drawn"
+    );
+    let differing = plain
+        .rgba8
+        .chunks_exact(4)
+        .zip(clustered.rgba8.chunks_exact(4))
+        .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| x.abs_diff(*y) > 2))
+        .count();
+    assert!(
+        differing * 1000 <= (WIDTH * HEIGHT) as usize,
+        "{differing} pixels differ"
+    );
+}

@@ -134,6 +134,9 @@ pub struct PointArgs {
     /// Draw back-facing splats (open surfaces); by default they are culled.
     #[arg(long = "two-sided")]
     pub two_sided: bool,
+    /// Normal clusters (§10.1.10): skip splats of clusters facing away (closed surfaces only).
+    #[arg(long = "normal-clusters")]
+    pub normal_clusters: bool,
     /// Procedural boulders scattered over the built-in terrain (0: none).
     #[arg(long, default_value_t = 300)]
     pub rocks: usize,

@@ -59,6 +59,7 @@ pub fn splat_settings(args: &PointArgs, fov_y_deg: f64, rows: u32) -> Result<Spl
         },
         shaded: args.shading == Switch::On,
         two_sided: args.two_sided,
+        normal_clusters: args.normal_clusters,
         epsilon: Some(
             epsilon_from_pixels(args.epsilon, fov_y_deg.to_radians() as f32, rows)
                 .with_context(|| format!("--epsilon {}", args.epsilon))?,

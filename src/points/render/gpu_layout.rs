@@ -5,7 +5,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat3, DMat4, DVec3, Vec3};
 
-use crate::points::spt::SequentialPointTree;
+use crate::points::spt::SptNode;
 use crate::renderer::camera::Camera;
 
 /// One splat: an SPT node (§10.1.3) as the vertex stage reads it.
@@ -22,9 +22,9 @@ pub struct GpuSplat {
     pub clip: [f32; 4],
 }
 
-/// The splat list of `tree`, in list order (decreasing r_max).
-pub fn pack_tree(tree: &SequentialPointTree) -> Vec<GpuSplat> {
-    tree.nodes
+/// The splat list of `nodes`, in list order (decreasing r_max, per normal cluster when clustered).
+pub fn pack_nodes(nodes: &[SptNode]) -> Vec<GpuSplat> {
+    nodes
         .iter()
         .map(|n| {
             let [r, g, b] = n.color;

@@ -85,6 +85,9 @@ pub struct SplatSettings {
     /// Draw back-facing splats too (open surfaces such as leaves); by default
     /// they are culled, as for the closed surfaces of scans and rocks.
     pub two_sided: bool,
+    /// Split every list into 128 normal clusters and skip clusters that face
+    /// away (§10.1.10); only for closed surfaces.
+    pub normal_clusters: bool,
     /// Error threshold ε of the trees (as [`crate::points::spt::SptOptions::epsilon`]);
     /// None keeps the ε each tree was built with.
     pub epsilon: Option<f32>,
@@ -99,6 +102,7 @@ impl Default for SplatSettings {
             visibility_offset: 1.0,
             shaded: true,
             two_sided: false,
+            normal_clusters: false,
             epsilon: None,
         }
     }
@@ -117,6 +121,12 @@ impl SplatSettings {
             return Err(Error::invalid(
                 "visibility offset",
                 format!("{}; must be ≥ 0", self.visibility_offset),
+            ));
+        }
+        if self.normal_clusters && self.two_sided {
+            return Err(Error::invalid(
+                "normal clusters",
+                "they cull back faces and cannot be combined with two-sided splats",
             ));
         }
         if let Some(e) = self.epsilon {

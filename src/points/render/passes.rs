@@ -6,12 +6,13 @@ use std::time::Instant;
 
 use bytemuck::{Pod, Zeroable};
 
-use super::gpu_layout::{frame_header, gaussian_table, pack_tree, HEADER_BYTES, INSTANCE_BYTES};
-use super::selection::{plan_frame, FramePlan};
+use super::gpu_layout::{frame_header, gaussian_table, pack_nodes, HEADER_BYTES, INSTANCE_BYTES};
+use super::selection::{plan_frame, FramePlan, ObjectLayout};
 use super::stats::{PointFrameStats, StatsLog};
 use super::{SharedStats, SplatMode, SplatPrimitive, SplatSettings};
 use crate::error::{Error, Result};
 use crate::graph::{Access, ImageInfo, PassContext, RenderGraph, ResourceId, Stage};
+use crate::points::clusters::{cluster_normals, CLUSTER_COUNT};
 use crate::points::scene::PointScene;
 use crate::renderer::FrameParams;
 use crate::shaders;
@@ -220,10 +221,17 @@ pub fn add_point_passes(
         }
     }
     let mut splats = Vec::with_capacity(scene.total_splats());
-    let mut first_splat = Vec::with_capacity(scene.objects.len());
+    let mut layouts = Vec::with_capacity(scene.objects.len());
     for object in &scene.objects {
-        first_splat.push(u32::try_from(splats.len()).map_err(|_| Error::invalid("points", "too many splats"))?);
-        splats.extend(pack_tree(&object.tree));
+        let first = u32::try_from(splats.len()).map_err(|_| Error::invalid("points", "too many splats"))?;
+        let clusters = settings
+            .normal_clusters
+            .then(|| Arc::new(cluster_normals(&object.tree)));
+        match &clusters {
+            Some(c) => splats.extend(pack_nodes(&c.nodes)),
+            None => splats.extend(pack_nodes(&object.tree.nodes)),
+        }
+        layouts.push(ObjectLayout { first, clusters });
     }
     if splats.len() > u32::MAX as usize / 6 {
         return Err(Error::invalid(
@@ -243,7 +251,8 @@ pub fn add_point_passes(
         BufferUsageFlags::STORAGE_BUFFER,
         bytemuck::cast_slice(&gaussian_table(settings.cutoff)),
     )?);
-    let frame_bytes = HEADER_BYTES + INSTANCE_BYTES * scene.instances.len().max(1) as u64;
+    let draws_per_instance = if settings.normal_clusters { CLUSTER_COUNT } else { 1 };
+    let frame_bytes = HEADER_BYTES + INSTANCE_BYTES * (scene.instances.len() * draws_per_instance).max(1) as u64;
     let frame_buffers = host_buffers(ctx, "point frame", frame_bytes)?;
     let counting = ctx.has_feature("vertexPipelineStoresAndAtomics");
     let counters = if counting {
@@ -262,9 +271,9 @@ pub fn add_point_passes(
 
     // The first pass plans the frame: prefixes, instance records, statistics.
     let scene = Arc::new(scene);
-    let first_splat = Arc::new(first_splat);
+    let layouts = Arc::new(layouts);
     let plan_frame_into = {
-        let (plan, stats, scene, first_splat) = (plan.clone(), stats.clone(), scene.clone(), first_splat.clone());
+        let (plan, stats, scene, layouts) = (plan.clone(), stats.clone(), scene.clone(), layouts.clone());
         move |pass: &mut PassContext<'_>, params: &FrameParams| -> Result<()> {
             let started = Instant::now();
             let camera = &params.camera;
@@ -279,14 +288,14 @@ pub fn add_point_passes(
             );
             let (view, _) = super::gpu_layout::view_and_intrinsics(camera, width, height);
             let view_proj = camera.view_proj_f64(params.aspect);
-            let new_plan = plan_frame(&scene, &first_splat, camera.eye, view, view_proj);
+            let new_plan = plan_frame(&scene, &layouts, camera.eye, view, view_proj);
             let buffer = pass.buffer(frame_id)?;
             buffer.write(0, bytemuck::bytes_of(&header))?;
             buffer.write(HEADER_BYTES, bytemuck::cast_slice(&new_plan.records))?;
             let frame_stats = PointFrameStats {
                 frame: pass.frame(),
                 instances: new_plan.instances,
-                instances_drawn: new_plan.draws.len(),
+                instances_drawn: new_plan.instances_drawn,
                 list_splats: new_plan.list_splats,
                 prefix_splats: new_plan.prefix_splats,
                 interval_passed: None,

@@ -4,11 +4,27 @@
 //! `r_max ≥ r_lo` found by binary search. Instances whose bounding sphere is
 //! outside the view frustum are not drawn. The exact interval test runs in
 //! the vertex stage (`glsl/points/splat.vert`).
+//!
+//! With normal clusters (§10.1.10) an object's list is cut into 128 sorted
+//! lists by normal direction; clusters whose every splat faces away from the
+//! eye are skipped and the others get their own prefix and draw.
+
+use std::sync::Arc;
 
 use glam::{DMat4, DVec3, DVec4};
 
 use super::gpu_layout::GpuInstance;
+use crate::points::clusters::ClusteredTree;
 use crate::points::scene::PointScene;
+
+/// Where an object's splats are in the splat buffer.
+#[derive(Clone, Debug)]
+pub struct ObjectLayout {
+    /// Index of its first splat.
+    pub first: u32,
+    /// Its normal clusters, when the list is clustered (the buffer then holds `clusters.nodes`).
+    pub clusters: Option<Arc<ClusteredTree>>,
+}
 
 /// One instance to draw this frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -30,6 +46,8 @@ pub struct FramePlan {
     pub prefix_splats: u64,
     /// Splats of the drawn instances' whole lists.
     pub list_splats: u64,
+    /// Instances with at least one draw.
+    pub instances_drawn: usize,
 }
 
 /// The world-space planes of the frustum of `view_proj` (Vulkan clip space,
@@ -41,16 +59,22 @@ fn frustum_planes(view_proj: DMat4) -> [DVec4; 6] {
 }
 
 /// Plans a frame: `view` world → camera, `view_proj` world → clip,
-/// `first_splat[o]` the offset of object o's list in the splat buffer.
-pub fn plan_frame(scene: &PointScene, first_splat: &[u32], eye: DVec3, view: DMat4, view_proj: DMat4) -> FramePlan {
+/// `objects[o]` where object o's list is.
+pub fn plan_frame(
+    scene: &PointScene,
+    objects: &[ObjectLayout],
+    eye: DVec3,
+    view: DMat4,
+    view_proj: DMat4,
+) -> FramePlan {
     let planes = frustum_planes(view_proj);
     let mut plan = FramePlan {
         instances: scene.instances.len(),
         ..FramePlan::default()
     };
     for inst in &scene.instances {
-        let object = &scene.objects[inst.object];
-        let tree = &object.tree;
+        let tree = &scene.objects[inst.object].tree;
+        let layout = &objects[inst.object];
         let model = inst.transform.matrix();
         let scale = inst.transform.scale;
         let centre = model.transform_point3(tree.bounds_centre.as_dvec3());
@@ -59,27 +83,38 @@ pub fn plan_frame(scene: &PointScene, first_splat: &[u32], eye: DVec3, view: DMa
             continue;
         }
         // r_lo in object units: the tree's intervals are in object units.
-        let r_lo = (((eye - centre).length() - radius) / scale).max(0.0);
-        let count = tree.prefix_len(r_lo as f32) as u32;
-        if count == 0 {
-            continue;
+        let r_lo = ((((eye - centre).length() - radius) / scale).max(0.0)) as f32;
+        let ranges: Vec<(u32, usize)> = match &layout.clusters {
+            None => vec![(layout.first, tree.prefix_len(r_lo))],
+            Some(clustered) => {
+                let eye_object = model.inverse().transform_point3(eye).as_vec3();
+                clustered
+                    .clusters
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, c)| !c.is_back_facing(eye_object, c.centre, c.radius))
+                    .map(|(k, c)| (layout.first + c.first, clustered.cluster_prefix_len(k, r_lo)))
+                    .collect()
+            }
+        };
+        let model_view = (view * model).as_mat4().to_cols_array();
+        let mut drawn = false;
+        for (first, count) in ranges.into_iter().filter(|&(_, n)| n > 0) {
+            plan.draws.push(InstanceDraw {
+                record: plan.records.len() as u32,
+                count: count as u32,
+            });
+            plan.records.push(GpuInstance {
+                model_view,
+                params: [scale as f32, f32::from_bits(first), f32::from_bits(count as u32), 0.0],
+            });
+            plan.prefix_splats += count as u64;
+            drawn = true;
         }
-        let model_view = view * model;
-        plan.draws.push(InstanceDraw {
-            record: plan.records.len() as u32,
-            count,
-        });
-        plan.records.push(GpuInstance {
-            model_view: model_view.as_mat4().to_cols_array(),
-            params: [
-                scale as f32,
-                f32::from_bits(first_splat[inst.object]),
-                f32::from_bits(count),
-                0.0,
-            ],
-        });
-        plan.prefix_splats += u64::from(count);
-        plan.list_splats += tree.nodes.len() as u64;
+        if drawn {
+            plan.instances_drawn += 1;
+            plan.list_splats += tree.nodes.len() as u64;
+        }
     }
     plan
 }
