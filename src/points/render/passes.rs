@@ -66,11 +66,15 @@ pub struct PointPasses {
 impl PointPasses {
     /// Statistics of every completed frame not yet taken (call after all frames completed).
     pub fn take_stats(&self) -> Result<Vec<PointFrameStats>> {
-        self.stats
-            .lock()
-            .map_err(|_| Error::Graph("point statistics lock poisoned".into()))?
-            .take_all_completed()
+        locked(&self.stats)?.take_all_completed()
     }
+}
+
+/// The value behind `mutex` (shared between the passes' recording closures).
+fn locked<T>(mutex: &Mutex<T>) -> Result<std::sync::MutexGuard<'_, T>> {
+    mutex
+        .lock()
+        .map_err(|_| Error::Graph("points pass state lock poisoned".into()))
 }
 
 fn pipeline(
@@ -302,13 +306,8 @@ pub fn add_point_passes(
                 drawn_splats: None,
                 cpu_ms: started.elapsed().as_secs_f64() * 1e3,
             };
-            stats
-                .lock()
-                .map_err(|_| Error::Graph("point statistics lock poisoned".into()))?
-                .begin_frame(frame_stats)?;
-            *plan
-                .lock()
-                .map_err(|_| Error::Graph("point plan lock poisoned".into()))? = new_plan;
+            locked(&stats)?.begin_frame(frame_stats)?;
+            *locked(&plan)? = new_plan;
             Ok(())
         }
     };
@@ -370,9 +369,7 @@ pub fn add_point_passes(
                     pass.image(targets.weight)?,
                     pass.image(targets.depth)?,
                 );
-                let plan = plan
-                    .lock()
-                    .map_err(|_| Error::Graph("point plan lock poisoned".into()))?;
+                let plan = locked(&plan)?;
                 let cmd = pass.cmd();
                 cmd.begin_rendering(
                     &[
@@ -453,9 +450,7 @@ pub fn add_point_passes(
                 plan_frame_into(pass, params)?;
                 let push = push_for(pass, PASS_VISIBILITY, true)?;
                 let depth = pass.image(targets.depth)?;
-                let plan = visibility_plan
-                    .lock()
-                    .map_err(|_| Error::Graph("point plan lock poisoned".into()))?;
+                let plan = locked(&visibility_plan)?;
                 let cmd = pass.cmd();
                 cmd.begin_rendering(&[], Some((depth, depth_load)));
                 visibility.draw(cmd, &plan, primitive, push)?;
@@ -479,9 +474,7 @@ pub fn add_point_passes(
                         pass.image(normal_depth)?,
                         pass.image(targets.depth)?,
                     );
-                    let plan = plan
-                        .lock()
-                        .map_err(|_| Error::Graph("point plan lock poisoned".into()))?;
+                    let plan = locked(&plan)?;
                     let cmd = pass.cmd();
                     cmd.begin_rendering(
                         &[(cw, LoadOp::Clear([0.0; 4])), (nd, LoadOp::Clear([0.0; 4]))],
