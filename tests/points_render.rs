@@ -21,7 +21,7 @@ use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointObject,
 use alpenglow::points::spt::{build_spt, epsilon_from_pixels, SptOptions};
 use alpenglow::points::Surfel;
 use alpenglow::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
-use common::{assert_validation_clean, data, flip_errors, linear_to_srgb8, validated_context};
+use common::{assert_validation_clean, data, flip_errors, linear_to_srgb8, srgb8_to_linear, validated_context};
 use glam::{DVec3, Vec3};
 
 const WIDTH: u32 = 320;
@@ -113,14 +113,7 @@ fn analytic_plane(camera: &Camera, n: usize, margin: f64, min_y: f64) -> Vec<Opt
     let aspect = WIDTH as f64 / HEIGHT as f64;
     let tan = (camera.fov_y_deg.to_radians() * 0.5).tan();
     let (f, r, u) = (camera.forward(), camera.right(), camera.image_up());
-    let albedo = |c: [u8; 3]| {
-        let s = c[0] as f32 / 255.0;
-        if s <= 0.04045 {
-            s / 12.92
-        } else {
-            ((s + 0.055) / 1.055).powf(2.4)
-        }
-    };
+    let albedo = |c: [u8; 3]| srgb8_to_linear(c[0]);
     let hit = |px: f64, py: f64| -> Option<(f64, f64)> {
         let x = (px / WIDTH as f64 * 2.0 - 1.0) * tan * aspect;
         let y = (1.0 - py / HEIGHT as f64 * 2.0) * tan;

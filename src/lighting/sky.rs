@@ -8,9 +8,7 @@ use crate::error::Result;
 use crate::graph::{Access, RenderGraph, ResourceId};
 use crate::renderer::FrameParams;
 use crate::shaders;
-use crate::vulkan::{
-    Blend, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, PrimitiveTopology,
-};
+use crate::vulkan::{Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp};
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -30,22 +28,11 @@ pub fn add_sky_pass(
 ) -> Result<()> {
     let pipeline = GraphicsPipeline::new(
         ctx,
-        &GraphicsPipelineDesc {
-            name: "sky",
-            vertex: shaders::SKY_VERT,
-            fragment: shaders::SKY_FRAG,
-            vertex_stride: 0,
-            vertex_attributes: Vec::new(),
-            topology: PrimitiveTopology::TRIANGLE_LIST,
-            cull_back_faces: false,
-            wireframe: false,
-            color_formats: vec![Format::R32G32B32A32_SFLOAT, Format::R32_SFLOAT],
-            blend: Blend::None,
-            depth_format: None,
-            depth_test: false,
-            depth_write: false,
-            depth_compare: CompareOp::ALWAYS,
-        },
+        &GraphicsPipelineDesc::full_screen(
+            "sky",
+            shaders::SKY_FRAG,
+            vec![Format::R32G32B32A32_SFLOAT, Format::R32_SFLOAT],
+        ),
     )?;
     graph
         .pass("sky")

@@ -113,6 +113,16 @@ impl PointScene {
         });
     }
 
+    /// Moves the objects and instances of `other` into this scene.
+    pub fn append(&mut self, other: PointScene) {
+        let offset = self.objects.len();
+        self.objects.extend(other.objects);
+        self.instances.extend(other.instances.into_iter().map(|mut i| {
+            i.object += offset;
+            i
+        }));
+    }
+
     /// Checks the instance indices and transforms.
     pub fn validate(&self) -> Result<()> {
         for (i, inst) in self.instances.iter().enumerate() {

@@ -125,21 +125,17 @@ pub fn validate_size(width: u32, height: u32) -> Result<()> {
     Ok(())
 }
 
+/// One readback buffer per frame slot.
 fn host_buffers(ctx: &Context, name: &str, size: u64) -> Result<Vec<Arc<Buffer>>> {
-    (0..FRAMES_IN_FLIGHT)
-        .map(|i| {
-            Buffer::new(
-                ctx,
-                BufferDesc {
-                    name: format!("{name} readback {i}"),
-                    size,
-                    usage: BufferUsageFlags::TRANSFER_DST,
-                    location: MemoryLocation::GpuToCpu,
-                },
-            )
-            .map(Arc::new)
-        })
-        .collect()
+    Buffer::per_frame(
+        ctx,
+        BufferDesc {
+            name: format!("{name} readback"),
+            size,
+            usage: BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuToCpu,
+        },
+    )
 }
 
 impl Renderer {

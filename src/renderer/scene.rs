@@ -52,12 +52,7 @@ impl Scene {
         };
         let (shapes, samples, _) = DEFAULT_ROCKS;
         let rocks = scatter_rocks(&self.heights, shapes, samples, count, (3.0, 16.0), 0xA1BE, &spt)?;
-        let offset = self.points.objects.len();
-        self.points.objects.extend(rocks.objects);
-        self.points.instances.extend(rocks.instances.into_iter().map(|mut i| {
-            i.object += offset;
-            i
-        }));
+        self.points.append(rocks);
         Ok(())
     }
 

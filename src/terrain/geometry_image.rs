@@ -25,7 +25,7 @@ use crate::terrain::lod::{DebugScalar, LodFrame, LodSettings};
 use crate::terrain::wavelet_noise;
 use crate::vulkan::{
     Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, Format, Image, ImageDesc, ImageUsageFlags,
-    MemoryLocation, FRAMES_IN_FLIGHT,
+    MemoryLocation,
 };
 
 /// Default output grid side (vertices), as in the text.
@@ -210,20 +210,15 @@ impl GeometryImage {
         let tile = wavelet_noise::noise_tile(settings.noise_seed, NOISE_TILE)?;
         let noise = image("wavelet noise tile", NOISE_TILE as u32, NOISE_TILE as u32, &tile)?;
         let n = settings.lod.sketch_side as u64;
-        let warp_uploads = (0..FRAMES_IN_FLIGHT)
-            .map(|i| {
-                Buffer::new(
-                    ctx,
-                    BufferDesc {
-                        name: format!("terrain warp upload {i}"),
-                        size: n * n * 16,
-                        usage: BufferUsageFlags::STORAGE_BUFFER,
-                        location: MemoryLocation::CpuToGpu,
-                    },
-                )
-                .map(Arc::new)
-            })
-            .collect::<Result<Vec<_>>>()?;
+        let warp_uploads = Buffer::per_frame(
+            ctx,
+            BufferDesc {
+                name: "terrain warp upload".into(),
+                size: n * n * 16,
+                usage: BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::CpuToGpu,
+            },
+        )?;
         let side = settings.grid_side;
         let vertices = Arc::new(Buffer::new(
             ctx,

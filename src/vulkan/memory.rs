@@ -1,13 +1,14 @@
 //! Typed GPU buffers and images on gpu-allocator, with staging uploads,
 //! readback and destruction deferred until the GPU is done with them.
 
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 pub use gpu_allocator::MemoryLocation;
 
 use super::context::{vk_err, Context, Shared};
+use super::frames::FRAMES_IN_FLIGHT;
 use super::heap::HeapKind;
 use crate::error::{Error, Result};
 
@@ -184,6 +185,19 @@ impl Buffer {
             storage_handle,
             state: Mutex::new(AccessState::UNUSED),
         })
+    }
+
+    /// One buffer per frame slot ([`FRAMES_IN_FLIGHT`]), named `"{desc.name} {slot}"`.
+    pub fn per_frame(ctx: &Context, desc: BufferDesc) -> Result<Vec<Arc<Buffer>>> {
+        (0..FRAMES_IN_FLIGHT)
+            .map(|i| {
+                let desc = BufferDesc {
+                    name: format!("{} {i}", desc.name),
+                    ..desc.clone()
+                };
+                Buffer::new(ctx, desc).map(Arc::new)
+            })
+            .collect()
     }
 
     /// Creates a device-local buffer filled with `data` through a staging copy.

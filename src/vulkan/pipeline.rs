@@ -111,6 +111,29 @@ pub struct GraphicsPipelineDesc {
     pub depth_compare: vk::CompareOp,
 }
 
+impl GraphicsPipelineDesc {
+    /// A full-screen pass: one triangle from `spirv/lighting/sky.vert` (no
+    /// vertex buffer), `fragment` writing `color_formats`, no blending, no depth.
+    pub fn full_screen(name: &'static str, fragment: SpirV, color_formats: Vec<vk::Format>) -> Self {
+        GraphicsPipelineDesc {
+            name,
+            vertex: crate::shaders::SKY_VERT,
+            fragment,
+            vertex_stride: 0,
+            vertex_attributes: Vec::new(),
+            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            cull_back_faces: false,
+            wireframe: false,
+            color_formats,
+            blend: Blend::None,
+            depth_format: None,
+            depth_test: false,
+            depth_write: false,
+            depth_compare: vk::CompareOp::ALWAYS,
+        }
+    }
+}
+
 /// A graphics pipeline for dynamic rendering.
 pub struct GraphicsPipeline {
     ctx: Context,

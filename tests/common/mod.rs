@@ -84,6 +84,16 @@ pub fn flip_errors(reference_rgba: &[u8], test_rgba: &[u8], width: u32, height: 
     nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE).to_vec()
 }
 
+/// sRGB8 code value → linear.
+pub fn srgb8_to_linear(c: u8) -> f32 {
+    let s = f32::from(c) / 255.0;
+    if s <= 0.04045 {
+        s / 12.92
+    } else {
+        ((s + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 /// Linear RGB → sRGB8 code value (the transfer function of the tone mapper's output stage, no tone curve).
 pub fn linear_to_srgb8(c: f32) -> u8 {
     let c = c.clamp(0.0, 1.0);

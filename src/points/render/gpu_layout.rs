@@ -5,6 +5,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat3, DMat4, DVec3, Vec3};
 
+use super::SplatSettings;
 use crate::points::spt::SptNode;
 use crate::renderer::camera::Camera;
 
@@ -105,16 +106,14 @@ pub fn view_and_intrinsics(camera: &Camera, width: u32, height: u32) -> (DMat4, 
     (view, k)
 }
 
-/// The header of a frame.
+/// The header of a frame, and the world → camera matrix it was built from.
 pub fn frame_header(
     camera: &Camera,
     (width, height): (u32, u32),
     sun_world: Vec3,
-    (shaded, two_sided): (bool, bool),
-    visibility_offset: f32,
-    cutoff: f32,
+    settings: &SplatSettings,
     max_point_size: f32,
-) -> FrameHeader {
+) -> (FrameHeader, DMat4) {
     let (view, k) = view_and_intrinsics(camera, width, height);
     let k_inv = k.inverse();
     let rows = |m: DMat3| {
@@ -127,19 +126,20 @@ pub fn frame_header(
     let p22 = far / (near - far);
     let p32 = near * far / (near - far);
     let sun = (view3 * sun_world.as_dvec3()).normalize_or_zero();
-    FrameHeader {
+    let header = FrameHeader {
         k: rows(k),
         k_inv: rows(k_inv),
-        depth: [p22 as f32, p32 as f32, visibility_offset, cutoff],
+        depth: [p22 as f32, p32 as f32, settings.visibility_offset, settings.cutoff],
         viewport: [width as f32, height as f32, max_point_size, near as f32],
-        sun_camera: sun.as_vec3().extend(if shaded { 1.0 } else { 0.0 }).to_array(),
+        sun_camera: sun.as_vec3().extend(if settings.shaded { 1.0 } else { 0.0 }).to_array(),
         camera_to_world: rows(view3.transpose()),
         eye: camera
             .eye
             .as_vec3()
-            .extend(if two_sided { 1.0 } else { 0.0 })
+            .extend(if settings.two_sided { 1.0 } else { 0.0 })
             .to_array(),
-    }
+    };
+    (header, view)
 }
 
 #[cfg(test)]
@@ -167,7 +167,7 @@ mod tests {
             let got = (x.x / x.z, x.y / x.z);
             assert!((got.0 - expected.0).abs() < 1e-3 && (got.1 - expected.1).abs() < 1e-3);
             let z = view.transform_point3(p).z;
-            let header = frame_header(&camera, (w, h), Vec3::Z, (true, false), 1.0, 1.5, 64.0);
+            let (header, _) = frame_header(&camera, (w, h), Vec3::Z, &SplatSettings::default(), 64.0);
             let depth = (f64::from(header.depth[0]) * z + f64::from(header.depth[1])) / -z;
             assert!((depth - ndc.z).abs() < 1e-5, "{depth} vs {}", ndc.z);
         }

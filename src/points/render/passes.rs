@@ -18,7 +18,7 @@ use crate::renderer::FrameParams;
 use crate::shaders;
 use crate::vulkan::{
     Blend, Buffer, BufferDesc, BufferUsageFlags, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline,
-    GraphicsPipelineDesc, LoadOp, MemoryLocation, PrimitiveTopology, FRAMES_IN_FLIGHT,
+    GraphicsPipelineDesc, LoadOp, MemoryLocation, PrimitiveTopology,
 };
 
 const PASS_VISIBILITY: u32 = 0;
@@ -187,21 +187,17 @@ impl PassPipelines {
     }
 }
 
+/// One host-written storage buffer per frame slot.
 fn host_buffers(ctx: &Context, name: &str, size: u64) -> Result<Vec<Arc<Buffer>>> {
-    (0..FRAMES_IN_FLIGHT)
-        .map(|i| {
-            Buffer::new(
-                ctx,
-                BufferDesc {
-                    name: format!("{name} {i}"),
-                    size,
-                    usage: BufferUsageFlags::STORAGE_BUFFER,
-                    location: MemoryLocation::CpuToGpu,
-                },
-            )
-            .map(Arc::new)
-        })
-        .collect()
+    Buffer::per_frame(
+        ctx,
+        BufferDesc {
+            name: name.into(),
+            size,
+            usage: BufferUsageFlags::STORAGE_BUFFER,
+            location: MemoryLocation::CpuToGpu,
+        },
+    )
 }
 
 /// Uploads the splat lists of `scene` and declares the points passes of
@@ -281,16 +277,7 @@ pub fn add_point_passes(
         move |pass: &mut PassContext<'_>, params: &FrameParams| -> Result<()> {
             let started = Instant::now();
             let camera = &params.camera;
-            let header = frame_header(
-                camera,
-                (width, height),
-                params.sun,
-                (settings.shaded, settings.two_sided),
-                settings.visibility_offset,
-                settings.cutoff,
-                max_point_size,
-            );
-            let (view, _) = super::gpu_layout::view_and_intrinsics(camera, width, height);
+            let (header, view) = frame_header(camera, (width, height), params.sun, &settings, max_point_size);
             let view_proj = camera.view_proj_f64(params.aspect);
             let new_plan = plan_frame(&scene, &layouts, camera.eye, view, view_proj);
             let buffer = pass.buffer(frame_id)?;
@@ -409,22 +396,11 @@ pub fn add_point_passes(
             })?;
             let normalize = GraphicsPipeline::new(
                 ctx,
-                &GraphicsPipelineDesc {
-                    name: "points.normalize",
-                    vertex: shaders::SKY_VERT,
-                    fragment: shaders::SPLAT_NORMALIZE_FRAG,
-                    vertex_stride: 0,
-                    vertex_attributes: Vec::new(),
-                    topology: PrimitiveTopology::TRIANGLE_LIST,
-                    cull_back_faces: false,
-                    wireframe: false,
-                    color_formats: vec![Format::R32G32B32A32_SFLOAT, Format::R32_SFLOAT, Format::R32_SFLOAT],
-                    blend: Blend::None,
-                    depth_format: None,
-                    depth_test: false,
-                    depth_write: false,
-                    depth_compare: CompareOp::ALWAYS,
-                },
+                &GraphicsPipelineDesc::full_screen(
+                    "points.normalize",
+                    shaders::SPLAT_NORMALIZE_FRAG,
+                    vec![Format::R32G32B32A32_SFLOAT, Format::R32_SFLOAT, Format::R32_SFLOAT],
+                ),
             )?;
             let color_weight = graph.create_image(
                 "splat colour·w, w",
