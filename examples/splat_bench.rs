@@ -109,10 +109,7 @@ fn main() {
     };
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/models/stanford-bunny.obj");
     let bunny = load_point_object(&path, &options).expect("bunny");
-    let leaves = PointObject {
-        name: "bunny leaves".into(),
-        tree: Arc::new(all_leaves(&bunny.tree)),
-    };
+    let leaves = PointObject::new("bunny leaves", all_leaves(&bunny.tree));
     let flat = single(leaves);
     let close = camera_at(0.25);
 

@@ -85,13 +85,7 @@ fn plane_scene(radius: f32) -> Scene {
     };
     let tree = build_spt(&surfels, &options, &mut |_| {}).expect("plane tree");
     let mut points = PointScene::default();
-    points.add(
-        PointObject {
-            name: "checkerboard".into(),
-            tree: Arc::new(tree),
-        },
-        PointTransform::default(),
-    );
+    points.add(PointObject::new("checkerboard", tree), PointTransform::default());
     Scene::points_only(points)
 }
 

@@ -6,6 +6,7 @@
 pub mod clip;
 pub mod clusters;
 pub mod estimate;
+pub mod hybrid;
 pub mod input;
 pub mod render;
 pub mod rocks;

@@ -123,6 +123,13 @@ pub struct SamplingOptions {
 /// colours do not match the vertex count, a used vertex is not finite, or the
 /// mesh has no area.
 pub fn sample_mesh(mesh: &TriangleMesh, options: &SamplingOptions) -> Result<Vec<Surfel>> {
+    Ok(sample_mesh_traced(mesh, options)?.0)
+}
+
+/// [`sample_mesh`], also returning for each surfel the index in
+/// `mesh.triangles` of the triangle it was sampled on (for hybrid
+/// point–polygon rendering, [`super::hybrid`]).
+pub fn sample_mesh_traced(mesh: &TriangleMesh, options: &SamplingOptions) -> Result<(Vec<Surfel>, Vec<u32>)> {
     let count = options.count;
     if count == 0 {
         return Err(Error::invalid("sample count", "must be positive"));
@@ -155,9 +162,9 @@ pub fn sample_mesh(mesh: &TriangleMesh, options: &SamplingOptions) -> Result<Vec
         .map(|Sample { mut surfel, triangle }| {
             surfel.radius = radius;
             surfel.clip = creases.lines(triangle as usize, surfel.position, surfel.normal, radius);
-            surfel
+            (surfel, prepared.triangles[triangle as usize].index)
         })
-        .collect())
+        .unzip())
 }
 
 /// A surfel (radius still 0) and the index of the triangle it lies in.
@@ -171,6 +178,8 @@ struct Sample {
 struct Triangle {
     vertices: [usize; 3],
     face_normal: Vec3,
+    /// Index in the mesh's triangle list.
+    index: u32,
 }
 
 /// The usable triangles with their cumulative areas.
@@ -221,7 +230,11 @@ impl<'a> Prepared<'a> {
                 continue;
             }
             total_area += area;
-            triangles.push(Triangle { vertices, face_normal });
+            triangles.push(Triangle {
+                vertices,
+                face_normal,
+                index: t as u32,
+            });
             cumulative.push(total_area);
         }
         if triangles.is_empty() || !(total_area > 0.0 && total_area.is_finite()) {

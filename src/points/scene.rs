@@ -8,6 +8,7 @@ use std::sync::Arc;
 use glam::{DMat4, DQuat, DVec3};
 
 use super::estimate::complete_cloud;
+use super::hybrid::{build_hybrid, HybridMesh};
 use super::input::{load_points_file, PointInput};
 use super::rocks::{generate_rock, rock_field};
 use super::sampling::{sample_mesh, SamplingMethod, SamplingOptions};
@@ -75,12 +76,53 @@ impl PointTransform {
     }
 }
 
-/// A point object: one sequential point tree.
+/// A point object: one sequential point tree, and for hybrid point–polygon
+/// rendering (§10.1.8) the mesh's triangles.
 #[derive(Clone, Debug)]
 pub struct PointObject {
     /// For messages and statistics (file name, "rock 3").
     pub name: String,
+    /// The splat list (for a hybrid object, with the floors of [`HybridMesh::point_tree`]).
     pub tree: Arc<SequentialPointTree>,
+    /// The triangles drawn where they are large in the image.
+    pub hybrid: Option<Arc<HybridMesh>>,
+}
+
+impl PointObject {
+    /// A points-only object.
+    pub fn new(name: impl Into<String>, tree: SequentialPointTree) -> PointObject {
+        PointObject {
+            name: name.into(),
+            tree: Arc::new(tree),
+            hybrid: None,
+        }
+    }
+
+    /// The same object for another threshold ε (unchanged when it already has it).
+    pub fn with_epsilon(&self, epsilon: f32) -> Result<PointObject> {
+        if self.tree.epsilon == epsilon {
+            return Ok(self.clone());
+        }
+        Ok(match &self.hybrid {
+            None => PointObject {
+                tree: Arc::new(self.tree.with_epsilon(epsilon)?),
+                ..self.clone()
+            },
+            Some(hybrid) => {
+                let (tree, hybrid) = hybrid.with_epsilon(epsilon)?;
+                PointObject {
+                    name: self.name.clone(),
+                    tree: Arc::new(tree),
+                    hybrid: Some(Arc::new(hybrid)),
+                }
+            }
+        })
+    }
+
+    /// Triangles of a hybrid object (0 otherwise).
+    pub fn triangle_count(&self) -> usize {
+        self.hybrid.as_ref().map_or(0, |h| h.triangles.len())
+    }
 }
 
 /// One placement of an object.
@@ -154,6 +196,9 @@ pub struct PointLoadOptions {
     pub sampling: SamplingMethod,
     pub seed: u64,
     pub spt: SptOptions,
+    /// Keep a mesh's triangles for hybrid point–polygon rendering (§10.1.8);
+    /// point clouds and SPT files have none and stay points only.
+    pub hybrid: bool,
 }
 
 impl Default for PointLoadOptions {
@@ -163,6 +208,7 @@ impl Default for PointLoadOptions {
             sampling: SamplingMethod::Stratified,
             seed: 1,
             spt: SptOptions::default(),
+            hybrid: false,
         }
     }
 }
@@ -178,28 +224,30 @@ pub fn load_point_object(path: &Path, options: &PointLoadOptions) -> Result<Poin
     let is_spt = path
         .extension()
         .is_some_and(|e| e.to_string_lossy().eq_ignore_ascii_case("spt"));
-    let tree = if is_spt {
-        read_spt(path)?
-    } else {
-        let surfels = match load_points_file(path)? {
-            PointInput::Mesh(mesh) => sample_mesh(
-                &mesh,
-                &SamplingOptions {
-                    count: options.mesh_samples,
-                    method: options.sampling,
-                    seed: options.seed,
-                },
-            ),
-            PointInput::Points(cloud) => complete_cloud(&cloud),
-        }
-        .map_err(|e| Error::invalid(path.display().to_string(), e.to_string()))?;
-        build_spt(&surfels, &options.spt, &mut |_| {})
-            .map_err(|e| Error::invalid(path.display().to_string(), e.to_string()))?
+    let in_file = |e: Error| Error::invalid(path.display().to_string(), e.to_string());
+    if is_spt {
+        return Ok(PointObject::new(name, read_spt(path)?));
+    }
+    let sampling = SamplingOptions {
+        count: options.mesh_samples,
+        method: options.sampling,
+        seed: options.seed,
     };
-    Ok(PointObject {
-        name,
-        tree: Arc::new(tree),
-    })
+    let surfels = match load_points_file(path)? {
+        PointInput::Mesh(mesh) if options.hybrid => {
+            let (tree, hybrid) = build_hybrid(&mesh, &sampling, &options.spt, &mut |_| {}).map_err(in_file)?;
+            return Ok(PointObject {
+                name,
+                tree: Arc::new(tree),
+                hybrid: Some(Arc::new(hybrid)),
+            });
+        }
+        PointInput::Mesh(mesh) => sample_mesh(&mesh, &sampling),
+        PointInput::Points(cloud) => complete_cloud(&cloud),
+    }
+    .map_err(in_file)?;
+    let tree = build_spt(&surfels, &options.spt, &mut |_| {}).map_err(in_file)?;
+    Ok(PointObject::new(name, tree))
 }
 
 /// Procedural rocks (§6.1.4) scattered over a height field as ground
@@ -231,10 +279,7 @@ pub fn scatter_rocks(
             },
         )?;
         let tree = build_spt(&surfels, spt, &mut |_| {})?;
-        scene.objects.push(PointObject {
-            name: format!("rock {i}"),
-            tree: Arc::new(tree),
-        });
+        scene.objects.push(PointObject::new(format!("rock {i}"), tree));
     }
     let extent = heights.extent();
     let mut rng = SplitMix64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15));

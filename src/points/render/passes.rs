@@ -215,9 +215,7 @@ pub fn add_point_passes(
     let mut scene = scene.clone();
     if let Some(epsilon) = settings.epsilon {
         for object in &mut scene.objects {
-            if object.tree.epsilon != epsilon {
-                object.tree = Arc::new(object.tree.with_epsilon(epsilon)?);
-            }
+            *object = object.with_epsilon(epsilon)?;
         }
     }
     let mut splats = Vec::with_capacity(scene.total_splats());
