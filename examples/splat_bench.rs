@@ -13,8 +13,6 @@
 //! GPU times are the medians of the points passes' timestamps over the timed
 //! frames; splats/s = splats drawn (the vertex stage's count) / that time.
 
-use std::sync::Arc;
-
 use alpenglow::points::render::{SplatMode, SplatPrimitive, SplatSettings};
 use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointObject, PointScene, PointTransform};
 use alpenglow::points::spt::{epsilon_from_pixels, SequentialPointTree, ROOT_R_MAX};

@@ -36,3 +36,11 @@ pub const SPLAT_ACCUMULATE_FRAG: SpirV = spirv!("points/accumulate.frag");
 pub const SPLAT_OPAQUE_FRAG: SpirV = spirv!("points/opaque.frag");
 /// points.normalize: divide by the weight and shade (full-screen fragment stage).
 pub const SPLAT_NORMALIZE_FRAG: SpirV = spirv!("points/normalize.frag");
+/// points.*, hybrid triangles (§10.1.8): vertex pulling and the test r < s/ε.
+pub const HYBRID_VERT: SpirV = spirv!("points/hybrid.vert");
+/// points.visibility, hybrid triangles: depth pushed back by the surfels' offset.
+pub const HYBRID_VISIBILITY_FRAG: SpirV = spirv!("points/hybrid_visibility.frag");
+/// points.accumulate, hybrid triangles: weight-1 colour, normal and depth.
+pub const HYBRID_ACCUMULATE_FRAG: SpirV = spirv!("points/hybrid_accumulate.frag");
+/// points.opaque, hybrid triangles: shaded directly.
+pub const HYBRID_OPAQUE_FRAG: SpirV = spirv!("points/hybrid_opaque.frag");

@@ -111,24 +111,32 @@ fn bunny_render_args(dir: &std::path::Path, extra: &[&str]) -> Vec<String> {
 
 /// Both splat modes and all three primitives render the bunny under
 /// validation; the EXR carries W (positive on the bunny, 0 on the sky), and
-/// the statistics line reports the GPU's interval test.
+/// the statistics line reports the GPU's interval test (and, with
+/// `--hybrid`, the triangles drawn up close).
 #[test]
 fn renders_points_in_every_mode_and_primitive_with_w_in_the_exr() {
     let dir = fresh_dir("points-render");
     let exr_path = dir.join("o.exr");
-    for (splat, primitive) in [
-        ("ewa", "quad"),
-        ("ewa", "instanced"),
-        ("ewa", "point"),
-        ("opaque", "quad"),
-        ("opaque", "point"),
+    for (splat, primitive, hybrid) in [
+        ("ewa", "quad", false),
+        ("ewa", "instanced", false),
+        ("ewa", "point", false),
+        ("opaque", "quad", false),
+        ("opaque", "point", false),
+        ("ewa", "quad", true),
+        ("opaque", "quad", true),
     ] {
         let exr = exr_path.display().to_string();
-        let args = bunny_render_args(&dir, &["--splat", splat, "--splat-primitive", primitive, "--exr", &exr]);
+        let mut extra = vec!["--splat", splat, "--splat-primitive", primitive, "--exr", &exr];
+        if hybrid {
+            extra.push("--hybrid");
+        }
+        let args = bunny_render_args(&dir, &extra);
         let out = run(&args);
-        assert_success(&format!("render --splat {splat} --splat-primitive {primitive}"), &out);
+        assert_success(&format!("render {}", extra.join(" ")), &out);
         let stdout = text(&out.stdout);
         assert!(stdout.contains("pass the interval test"), "{stdout}");
+        assert_eq!(stdout.contains("triangles in prefixes drawn"), hybrid, "{stdout}");
         let image = exr::prelude::read_all_flat_layers_from_file(&exr_path).expect("EXR reads");
         let layer = &image.layer_data[0];
         let w = layer

@@ -14,14 +14,13 @@
 
 mod common;
 
-use std::sync::Arc;
-
 use alpenglow::points::render::{PointFrameStats, SplatMode, SplatPrimitive, SplatSettings};
-use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointObject, PointScene, PointTransform};
+use alpenglow::points::scene::{PointObject, PointScene, PointTransform};
 use alpenglow::points::spt::{build_spt, epsilon_from_pixels, SptOptions};
 use alpenglow::points::Surfel;
-use alpenglow::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
-use common::{assert_validation_clean, data, flip_errors, linear_to_srgb8, srgb8_to_linear, validated_context};
+use alpenglow::renderer::{Camera, FrameImages, Scene};
+use common::points::{bunny_camera, bunny_object, render_points};
+use common::{flip_errors, linear_to_srgb8, srgb8_to_linear};
 use glam::{DVec3, Vec3};
 
 const WIDTH: u32 = 320;
@@ -36,21 +35,7 @@ const PLANE_FLIP_EWA: f32 = 0.16;
 const FAR_FIELD_Y: f64 = 4.0;
 
 fn render(scene: &Scene, camera: &Camera, points: SplatSettings) -> (FrameImages, PointFrameStats) {
-    let (ctx, report) = validated_context();
-    let out = {
-        let settings = RenderSettings {
-            points,
-            ..RenderSettings::new(WIDTH, HEIGHT)
-        };
-        let mut renderer = Renderer::new(&ctx, scene, settings).expect("renderer");
-        let frame = renderer.render(camera).and_then(|f| renderer.read(&f)).expect("frame");
-        renderer.finish().expect("finish");
-        let stats = renderer.take_point_stats().expect("stats");
-        (frame, *stats.last().expect("one frame of point statistics"))
-    };
-    drop(ctx);
-    assert_validation_clean(&report);
-    out
+    render_points(scene, camera, points, (WIDTH, HEIGHT))
 }
 
 /// Plane z = 0 over [0, SIDE]², surfels every SPACING, checker squares of SQUARE.
@@ -261,22 +246,7 @@ fn grazing_checkerboard_has_no_holes_and_no_moire() {
 }
 
 fn bunny() -> PointObject {
-    let options = PointLoadOptions {
-        mesh_samples: 20_000,
-        ..PointLoadOptions::default()
-    };
-    load_point_object(&data("models/stanford-bunny.obj"), &options).expect("bunny")
-}
-
-fn bunny_camera(distance: f64) -> Camera {
-    Camera {
-        eye: DVec3::new(0.0, -distance, 0.25 * distance + 0.1),
-        target: DVec3::new(-0.02, 0.0, 0.1),
-        up: DVec3::Z,
-        fov_y_deg: 40.0,
-        near: 0.01,
-        far: 100.0,
-    }
+    bunny_object(false)
 }
 
 #[test]

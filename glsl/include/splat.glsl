@@ -31,7 +31,7 @@ layout(set = 0, binding = 2, std430) readonly buffer PointFrame {
     vec4 eye;                 // world eye position, w: 1 = two-sided splats, 0 = back faces culled
     Instance instances[];
 } g_point_frame[];
-layout(set = 0, binding = 2, std430) buffer SplatCounter { uint interval_passed; uint drawn; } g_splat_counters[];
+layout(set = 0, binding = 2, std430) buffer SplatCounter { uint interval_passed; uint drawn; uint triangles; } g_splat_counters[];
 layout(set = 0, binding = 2, std430) readonly buffer GaussianTable { float g[]; } g_gaussian[];
 
 #define SPLAT_PASS_VISIBILITY 0u

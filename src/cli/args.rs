@@ -137,6 +137,10 @@ pub struct PointArgs {
     /// Normal clusters (§10.1.10): skip splats of clusters facing away (closed surfaces only).
     #[arg(long = "normal-clusters")]
     pub normal_clusters: bool,
+    /// Hybrid point–polygon rendering (§10.1.8): --points meshes keep their
+    /// triangles, drawn where they are larger than the error threshold.
+    #[arg(long)]
+    pub hybrid: bool,
     /// Procedural boulders scattered over the built-in terrain (0: none).
     #[arg(long, default_value_t = 300)]
     pub rocks: usize,

@@ -29,6 +29,7 @@ pub fn add_points(args: &PointArgs, scene: &mut Scene, builtin: bool) -> Result<
     }
     let options = PointLoadOptions {
         mesh_samples: args.samples,
+        hybrid: args.hybrid,
         ..PointLoadOptions::default()
     };
     for (i, path) in args.points.iter().enumerate() {

@@ -75,6 +75,7 @@ pub fn mean_flip(reference_rgba: &[u8], test_rgba: &[u8], width: u32, height: u3
     (mean, heatmap)
 }
 pub mod cli;
+pub mod points;
 
 /// Per-pixel FLIP error between two sRGB RGBA8 images of the same size (alpha ignored).
 pub fn flip_errors(reference_rgba: &[u8], test_rgba: &[u8], width: u32, height: u32) -> Vec<f32> {

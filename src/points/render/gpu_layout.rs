@@ -6,6 +6,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DMat3, DMat4, DVec3, Vec3};
 
 use super::SplatSettings;
+use crate::points::hybrid::HybridMesh;
 use crate::points::spt::SptNode;
 use crate::renderer::camera::Camera;
 
@@ -27,14 +28,40 @@ pub struct GpuSplat {
 pub fn pack_nodes(nodes: &[SptNode]) -> Vec<GpuSplat> {
     nodes
         .iter()
-        .map(|n| {
-            let [r, g, b] = n.color;
-            let rgb = u32::from(r) | u32::from(g) << 8 | u32::from(b) << 16;
-            GpuSplat {
-                position_rmin: n.position.extend(n.r_min).to_array(),
-                normal_rmax: n.normal.extend(n.r_max).to_array(),
-                radius_color: [0.5 * n.diameter, f32::from_bits(rgb), 0.0, 0.0],
-                clip: n.clip.packed(),
+        .map(|n| GpuSplat {
+            position_rmin: n.position.extend(n.r_min).to_array(),
+            normal_rmax: n.normal.extend(n.r_max).to_array(),
+            radius_color: [0.5 * n.diameter, color_bits(n.color), 0.0, 0.0],
+            clip: n.clip.packed(),
+        })
+        .collect()
+}
+
+/// One triangle of a hybrid object (§10.1.8; `HybridTriangle` in glsl/include/hybrid.glsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuTriangle {
+    /// Object-space corners; w: `r_max = s/ε`, the surfel radius, 0.
+    pub positions: [[f32; 4]; 3],
+    /// Object-space unit vertex normals; w: sRGB colour (u32 bits `r | g << 8 | b << 16`).
+    pub normals: [[f32; 4]; 3],
+}
+
+fn color_bits([r, g, b]: [u8; 3]) -> f32 {
+    f32::from_bits(u32::from(r) | u32::from(g) << 8 | u32::from(b) << 16)
+}
+
+/// The triangle list of a hybrid object at threshold `epsilon`, in its
+/// order (decreasing `r_max`).
+pub fn pack_triangles(hybrid: &HybridMesh, epsilon: f32) -> Vec<GpuTriangle> {
+    hybrid
+        .triangles
+        .iter()
+        .map(|t| {
+            let w = [HybridMesh::triangle_r_max(t, epsilon), hybrid.surfel_radius, 0.0];
+            GpuTriangle {
+                positions: [0, 1, 2].map(|i| t.positions[i].extend(w[i]).to_array()),
+                normals: [0, 1, 2].map(|i| t.normals[i].extend(color_bits(t.colors[i])).to_array()),
             }
         })
         .collect()
@@ -68,7 +95,7 @@ pub struct FrameHeader {
 pub struct GpuInstance {
     /// Object → camera, column-major.
     pub model_view: [f32; 16],
-    /// Scale, first splat (u32 bits), prefix length (u32 bits), 0.
+    /// Scale, first splat (u32 bits), prefix length (u32 bits), first hybrid triangle (u32 bits).
     pub params: [f32; 4],
 }
 

@@ -15,6 +15,7 @@ pub mod gpu_layout;
 mod passes;
 pub mod selection;
 pub mod stats;
+mod triangles;
 
 use std::sync::{Arc, Mutex};
 

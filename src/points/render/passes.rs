@@ -9,6 +9,7 @@ use bytemuck::{Pod, Zeroable};
 use super::gpu_layout::{frame_header, gaussian_table, pack_nodes, HEADER_BYTES, INSTANCE_BYTES};
 use super::selection::{plan_frame, FramePlan, ObjectLayout};
 use super::stats::{PointFrameStats, StatsLog};
+use super::triangles::{draw_triangles, TriangleBuffer};
 use super::{SharedStats, SplatMode, SplatPrimitive, SplatSettings};
 use crate::error::{Error, Result};
 use crate::graph::{Access, ImageInfo, PassContext, RenderGraph, ResourceId, Stage};
@@ -18,7 +19,7 @@ use crate::renderer::FrameParams;
 use crate::shaders;
 use crate::vulkan::{
     Blend, Buffer, BufferDesc, BufferUsageFlags, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline,
-    GraphicsPipelineDesc, LoadOp, MemoryLocation, PrimitiveTopology,
+    GraphicsPipelineDesc, LoadOp, MemoryLocation, PrimitiveTopology, SpirV,
 };
 
 const PASS_VISIBILITY: u32 = 0;
@@ -35,11 +36,11 @@ const NO_HANDLE: u32 = u32::MAX;
 /// Push constants of the points passes (`Push` in glsl/include/splat.glsl).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct SplatPush {
-    /// Splats, point frame, drawn counter, Gaussian table.
-    handles: [u32; 4],
+pub(super) struct SplatPush {
+    /// Splats (or hybrid triangles), point frame, drawn counter, Gaussian table.
+    pub handles: [u32; 4],
     /// Pass, primitive, size class, instance record.
-    mode: [u32; 4],
+    pub mode: [u32; 4],
 }
 
 /// The images the points passes draw into (declared by the renderer).
@@ -61,6 +62,7 @@ pub struct SplatTargets {
 pub struct PointPasses {
     pub(crate) stats: SharedStats,
     _splats: Arc<Buffer>,
+    _triangles: Option<Arc<Buffer>>,
 }
 
 impl PointPasses {
@@ -80,7 +82,7 @@ fn locked<T>(mutex: &Mutex<T>) -> Result<std::sync::MutexGuard<'_, T>> {
 fn pipeline(
     ctx: &Context,
     name: &'static str,
-    fragment: crate::vulkan::SpirV,
+    (vertex, fragment): (SpirV, SpirV),
     points: bool,
     color_formats: Vec<Format>,
     blend: Blend,
@@ -90,7 +92,7 @@ fn pipeline(
         ctx,
         &GraphicsPipelineDesc {
             name,
-            vertex: shaders::SPLAT_VERT,
+            vertex,
             fragment,
             vertex_stride: 0,
             vertex_attributes: Vec::new(),
@@ -218,9 +220,10 @@ pub fn add_point_passes(
             *object = object.with_epsilon(epsilon)?;
         }
     }
+    let triangle_buffer = TriangleBuffer::upload(ctx, &scene)?;
     let mut splats = Vec::with_capacity(scene.total_splats());
     let mut layouts = Vec::with_capacity(scene.objects.len());
-    for object in &scene.objects {
+    for (o, object) in scene.objects.iter().enumerate() {
         let first = u32::try_from(splats.len()).map_err(|_| Error::invalid("points", "too many splats"))?;
         let clusters = settings
             .normal_clusters
@@ -229,7 +232,11 @@ pub fn add_point_passes(
             Some(c) => splats.extend(pack_nodes(&c.nodes)),
             None => splats.extend(pack_nodes(&object.tree.nodes)),
         }
-        layouts.push(ObjectLayout { first, clusters });
+        layouts.push(ObjectLayout {
+            first,
+            clusters,
+            first_triangle: triangle_buffer.as_ref().map_or(0, |t| t.firsts[o]),
+        });
     }
     if splats.len() > u32::MAX as usize / 6 {
         return Err(Error::invalid(
@@ -264,6 +271,27 @@ pub fn add_point_passes(
     let table_id = graph.import_buffer(table);
     let frame_id = graph.import_buffers_per_frame(frame_buffers);
     let counter_id = counters.map(|c| graph.import_buffers_per_frame(c));
+    let triangles_id = triangle_buffer.as_ref().map(|t| graph.import_buffer(t.buffer.clone()));
+    // The hybrid triangles' pipeline of a pass (§10.1.8), when the scene has any.
+    let triangle_pipeline = |name: &'static str, fragment: SpirV, formats: Vec<Format>, blend, depth| {
+        triangles_id
+            .map(|_| {
+                pipeline(
+                    ctx,
+                    name,
+                    (shaders::HYBRID_VERT, fragment),
+                    false,
+                    formats,
+                    blend,
+                    depth,
+                )
+            })
+            .transpose()
+    };
+    // The triangle buffer's handle in a pass.
+    let triangle_handle = move |pass: &PassContext<'_>| -> Result<Option<u32>> {
+        triangles_id.map(|t| pass.storage_buffer(t)).transpose()
+    };
     let max_point_size = ctx.info().max_point_size;
     let plan = Arc::new(Mutex::new(FramePlan::default()));
 
@@ -287,6 +315,8 @@ pub fn add_point_passes(
                 instances_drawn: new_plan.instances_drawn,
                 list_splats: new_plan.list_splats,
                 prefix_splats: new_plan.prefix_splats,
+                prefix_triangles: new_plan.prefix_triangles,
+                triangles_drawn: None,
                 interval_passed: None,
                 drawn_splats: None,
                 cpu_ms: started.elapsed().as_secs_f64() * 1e3,
@@ -325,13 +355,20 @@ pub fn add_point_passes(
                 pipeline(
                     ctx,
                     "points.opaque",
-                    shaders::SPLAT_OPAQUE_FRAG,
+                    (shaders::SPLAT_VERT, shaders::SPLAT_OPAQUE_FRAG),
                     points,
                     vec![Format::R32G32B32A32_SFLOAT, Format::R32_SFLOAT, Format::R32_SFLOAT],
                     Blend::None,
                     (true, CompareOp::LESS),
                 )
             })?;
+            let opaque_triangles = triangle_pipeline(
+                "points.opaque.triangles",
+                shaders::HYBRID_OPAQUE_FRAG,
+                vec![Format::R32G32B32A32_SFLOAT, Format::R32_SFLOAT, Format::R32_SFLOAT],
+                Blend::None,
+                (true, CompareOp::LESS),
+            )?;
             let mut builder = graph
                 .pass("points.opaque")
                 .graphics()
@@ -345,9 +382,13 @@ pub fn add_point_passes(
             if let Some(c) = counter_id {
                 builder = builder.write(c, Access::StorageBufferReadWrite(Stage::Vertex));
             }
+            if let Some(t) = triangles_id {
+                builder = builder.read(t, Access::StorageBufferRead(Stage::Vertex));
+            }
             builder.record(move |pass, params| {
                 plan_frame_into(pass, params)?;
                 let push = push_for(pass, PASS_OPAQUE, true)?;
+                let triangles = triangle_handle(pass)?;
                 let (radiance, view_depth, weight, depth) = (
                     pass.image(targets.radiance)?,
                     pass.image(targets.view_depth)?,
@@ -365,6 +406,9 @@ pub fn add_point_passes(
                     Some((depth, depth_load)),
                 );
                 pipes.draw(cmd, &plan, primitive, push)?;
+                if let (Some(pipeline), Some(handle)) = (&opaque_triangles, triangles) {
+                    draw_triangles(cmd, pipeline, &plan, push, handle)?;
+                }
                 cmd.end_rendering();
                 Ok(())
             });
@@ -374,24 +418,38 @@ pub fn add_point_passes(
                 pipeline(
                     ctx,
                     "points.visibility",
-                    shaders::SPLAT_VISIBILITY_FRAG,
+                    (shaders::SPLAT_VERT, shaders::SPLAT_VISIBILITY_FRAG),
                     points,
                     Vec::new(),
                     Blend::None,
                     (true, CompareOp::LESS),
                 )
             })?;
+            let visibility_triangles = triangle_pipeline(
+                "points.visibility.triangles",
+                shaders::HYBRID_VISIBILITY_FRAG,
+                Vec::new(),
+                Blend::None,
+                (true, CompareOp::LESS),
+            )?;
             let accumulate = PassPipelines::new(ctx, primitive, |points| {
                 pipeline(
                     ctx,
                     "points.accumulate",
-                    shaders::SPLAT_ACCUMULATE_FRAG,
+                    (shaders::SPLAT_VERT, shaders::SPLAT_ACCUMULATE_FRAG),
                     points,
                     vec![Format::R32G32B32A32_SFLOAT, Format::R32G32B32A32_SFLOAT],
                     Blend::Additive,
                     (false, CompareOp::LESS_OR_EQUAL),
                 )
             })?;
+            let accumulate_triangles = triangle_pipeline(
+                "points.accumulate.triangles",
+                shaders::HYBRID_ACCUMULATE_FRAG,
+                vec![Format::R32G32B32A32_SFLOAT, Format::R32G32B32A32_SFLOAT],
+                Blend::Additive,
+                (false, CompareOp::LESS_OR_EQUAL),
+            )?;
             let normalize = GraphicsPipeline::new(
                 ctx,
                 &GraphicsPipelineDesc::full_screen(
@@ -419,20 +477,27 @@ pub fn add_point_passes(
             if let Some(c) = counter_id {
                 builder = builder.write(c, Access::StorageBufferReadWrite(Stage::Vertex));
             }
+            if let Some(t) = triangles_id {
+                builder = builder.read(t, Access::StorageBufferRead(Stage::Vertex));
+            }
             let visibility_plan = plan.clone();
             builder.record(move |pass, params| {
                 plan_frame_into(pass, params)?;
                 let push = push_for(pass, PASS_VISIBILITY, true)?;
+                let triangles = triangle_handle(pass)?;
                 let depth = pass.image(targets.depth)?;
                 let plan = locked(&visibility_plan)?;
                 let cmd = pass.cmd();
                 cmd.begin_rendering(&[], Some((depth, depth_load)));
+                if let (Some(pipeline), Some(handle)) = (&visibility_triangles, triangles) {
+                    draw_triangles(cmd, pipeline, &plan, push, handle)?;
+                }
                 visibility.draw(cmd, &plan, primitive, push)?;
                 cmd.end_rendering();
                 Ok(())
             });
 
-            graph
+            let mut builder = graph
                 .pass("points.accumulate")
                 .graphics()
                 .read(splats_id, Access::StorageBufferRead(Stage::Vertex))
@@ -440,24 +505,31 @@ pub fn add_point_passes(
                 .read(table_id, Access::StorageBufferRead(Stage::Fragment))
                 .read(targets.depth, Access::DepthAttachmentRead)
                 .write(color_weight, Access::ColorAttachmentWrite)
-                .write(normal_depth, Access::ColorAttachmentWrite)
-                .record(move |pass, _| {
-                    let push = push_for(pass, PASS_ACCUMULATE, false)?;
-                    let (cw, nd, depth) = (
-                        pass.image(color_weight)?,
-                        pass.image(normal_depth)?,
-                        pass.image(targets.depth)?,
-                    );
-                    let plan = locked(&plan)?;
-                    let cmd = pass.cmd();
-                    cmd.begin_rendering(
-                        &[(cw, LoadOp::Clear([0.0; 4])), (nd, LoadOp::Clear([0.0; 4]))],
-                        Some((depth, None)),
-                    );
-                    accumulate.draw(cmd, &plan, primitive, push)?;
-                    cmd.end_rendering();
-                    Ok(())
-                });
+                .write(normal_depth, Access::ColorAttachmentWrite);
+            if let Some(t) = triangles_id {
+                builder = builder.read(t, Access::StorageBufferRead(Stage::Vertex));
+            }
+            builder.record(move |pass, _| {
+                let push = push_for(pass, PASS_ACCUMULATE, false)?;
+                let triangles = triangle_handle(pass)?;
+                let (cw, nd, depth) = (
+                    pass.image(color_weight)?,
+                    pass.image(normal_depth)?,
+                    pass.image(targets.depth)?,
+                );
+                let plan = locked(&plan)?;
+                let cmd = pass.cmd();
+                cmd.begin_rendering(
+                    &[(cw, LoadOp::Clear([0.0; 4])), (nd, LoadOp::Clear([0.0; 4]))],
+                    Some((depth, None)),
+                );
+                accumulate.draw(cmd, &plan, primitive, push)?;
+                if let (Some(pipeline), Some(handle)) = (&accumulate_triangles, triangles) {
+                    draw_triangles(cmd, pipeline, &plan, push, handle)?;
+                }
+                cmd.end_rendering();
+                Ok(())
+            });
 
             graph
                 .pass("points.normalize")
@@ -503,5 +575,6 @@ pub fn add_point_passes(
     Ok(PointPasses {
         stats,
         _splats: splat_buffer,
+        _triangles: triangle_buffer.map(|t| t.buffer),
     })
 }

@@ -24,6 +24,8 @@ pub struct ObjectLayout {
     pub first: u32,
     /// Its normal clusters, when the list is clustered (the buffer then holds `clusters.nodes`).
     pub clusters: Option<Arc<ClusteredTree>>,
+    /// Index of its first triangle in the hybrid triangle buffer (hybrid objects, §10.1.8).
+    pub first_triangle: u32,
 }
 
 /// One instance to draw this frame.
@@ -48,6 +50,10 @@ pub struct FramePlan {
     pub list_splats: u64,
     /// Instances with at least one draw.
     pub instances_drawn: usize,
+    /// Triangle draws of hybrid objects (§10.1.8): record and triangles of the prefix.
+    pub triangle_draws: Vec<InstanceDraw>,
+    /// Triangles in the drawn prefixes.
+    pub prefix_triangles: u64,
 }
 
 /// The world-space planes of the frustum of `view_proj` (Vulkan clip space,
@@ -73,7 +79,8 @@ pub fn plan_frame(
         ..FramePlan::default()
     };
     for inst in &scene.instances {
-        let tree = &scene.objects[inst.object].tree;
+        let object = &scene.objects[inst.object];
+        let tree = &object.tree;
         let layout = &objects[inst.object];
         let model = inst.transform.matrix();
         let scale = inst.transform.scale;
@@ -98,17 +105,36 @@ pub fn plan_frame(
             }
         };
         let model_view = (view * model).as_mat4().to_cols_array();
+        let record = |first: u32, count: usize| GpuInstance {
+            model_view,
+            params: [
+                scale as f32,
+                f32::from_bits(first),
+                f32::from_bits(count as u32),
+                f32::from_bits(layout.first_triangle),
+            ],
+        };
+        let first_record = plan.records.len() as u32;
         let mut drawn = false;
         for (first, count) in ranges.into_iter().filter(|&(_, n)| n > 0) {
             plan.draws.push(InstanceDraw {
                 record: plan.records.len() as u32,
                 count: count as u32,
             });
-            plan.records.push(GpuInstance {
-                model_view,
-                params: [scale as f32, f32::from_bits(first), f32::from_bits(count as u32), 0.0],
-            });
+            plan.records.push(record(first, count));
             plan.prefix_splats += count as u64;
+            drawn = true;
+        }
+        let triangles = object.hybrid.as_ref().map_or(0, |h| h.prefix_len(r_lo, tree.epsilon));
+        if triangles > 0 {
+            if !drawn {
+                plan.records.push(record(layout.first, 0));
+            }
+            plan.triangle_draws.push(InstanceDraw {
+                record: first_record,
+                count: triangles as u32,
+            });
+            plan.prefix_triangles += triangles as u64;
             drawn = true;
         }
         if drawn {

@@ -11,6 +11,9 @@ use serde::Serialize;
 use crate::error::Result;
 use crate::vulkan::{Buffer, FRAMES_IN_FLIGHT};
 
+/// Bytes of the GPU counters (`SplatCounter` in glsl/include/splat.glsl).
+pub(crate) const COUNTER_BYTES: usize = 12;
+
 /// Point statistics of one frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct PointFrameStats {
@@ -29,6 +32,11 @@ pub struct PointFrameStats {
     /// Of those, splats drawn: not back-facing (unless two-sided), not
     /// ill-conditioned, in front of the near plane.
     pub drawn_splats: Option<u64>,
+    /// Hybrid triangles (§10.1.8) in the prefixes sent to the GPU.
+    pub prefix_triangles: u64,
+    /// Of those, triangles drawn: passing `r < s/ε` and not back-facing
+    /// (None without `vertexPipelineStoresAndAtomics`).
+    pub triangles_drawn: Option<u64>,
     /// CPU time of the selection (prefix search, transforms), milliseconds.
     pub cpu_ms: f64,
 }
@@ -51,8 +59,13 @@ impl PointFrameStats {
             (Some(p), Some(d), None) => format!("{p} pass the interval test, {d} drawn"),
             _ => "GPU counts unavailable (no vertexPipelineStoresAndAtomics)".into(),
         };
+        let triangles = match (self.prefix_triangles, self.triangles_drawn) {
+            (0, _) => String::new(),
+            (p, Some(d)) => format!("; hybrid: {d} of {p} triangles in prefixes drawn"),
+            (p, None) => format!("; hybrid: {p} triangles in prefixes"),
+        };
         format!(
-            "points: {}/{} instances, {} splats in prefixes of {} listed, {}; CPU {:.3} ms",
+            "points: {}/{} instances, {} splats in prefixes of {} listed, {}{triangles}; CPU {:.3} ms",
             self.instances_drawn, self.instances, self.prefix_splats, self.list_splats, drawn, self.cpu_ms
         )
     }
@@ -79,9 +92,10 @@ impl StatsLog {
     /// Fills in the GPU counts of `stats` from its slot's counter.
     fn read(&self, slot: usize, stats: &mut PointFrameStats) -> Result<()> {
         if let Some(c) = &self.counters {
-            let words: Vec<u32> = bytemuck::pod_collect_to_vec(&c[slot].mapped()?[..8]);
+            let words: Vec<u32> = bytemuck::pod_collect_to_vec(&c[slot].mapped()?[..COUNTER_BYTES]);
             stats.interval_passed = Some(u64::from(words[0]));
             stats.drawn_splats = Some(u64::from(words[1]));
+            stats.triangles_drawn = Some(u64::from(words[2]));
         }
         Ok(())
     }
@@ -95,7 +109,7 @@ impl StatsLog {
             self.done.push(previous);
         }
         if let Some(c) = &self.counters {
-            c[slot].write(0, &[0u8; 8])?;
+            c[slot].write(0, &[0u8; COUNTER_BYTES])?;
         }
         self.pending[slot] = Some(stats);
         Ok(())

@@ -1,0 +1,15 @@
+#version 460
+// points.opaque, hybrid triangles (dissertation §10.1.8): shaded directly
+// like the opaque discs, weight 1.
+#include "../include/hybrid_fragment.glsl"
+#include "../include/splat_shading.glsl"
+
+layout(location = 0) out vec4 out_radiance;
+layout(location = 1) out float out_view_depth;
+layout(location = 2) out float out_weight;
+
+void main() {
+    out_radiance = vec4(shade_splat(in_color, in_normal, in_position), 1.0);
+    out_view_depth = -in_position.z;
+    out_weight = 1.0;
+}
