@@ -9,6 +9,9 @@
 //!    distances: splats in the prefix, splats drawn, GPU time.
 //! 3. CPU time of the per-frame selection per object instance: the default
 //!    scene's 300 rock instances.
+//! 4. Hybrid point–polygon rendering (§10.1.8) against points only, at
+//!    several distances: splats and triangles drawn, GPU time
+//!    (`-- --hybrid` runs only this part).
 //!
 //! GPU times are the medians of the points passes' timestamps over the timed
 //! frames; splats/s = splats drawn (the vertex stage's count) / that time.
@@ -27,6 +30,7 @@ struct Measured {
     gpu_ms: f64,
     prefix: u64,
     drawn: u64,
+    triangles: u64,
     cpu_ms: f64,
 }
 
@@ -55,6 +59,7 @@ fn measure(ctx: &Context, scene: &Scene, camera: &Camera, points: SplatSettings,
         gpu_ms,
         prefix: last.prefix_splats,
         drawn: last.drawn_splats.unwrap_or(0),
+        triangles: last.triangles_drawn.unwrap_or(0),
         cpu_ms: median(stats.iter().skip(warmup).map(|s| s.cpu_ms)),
     }
 }
@@ -89,6 +94,7 @@ fn camera_at(distance: f64) -> Camera {
 
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
+    let hybrid_only = std::env::args().any(|a| a == "--hybrid");
     let frames = if quick { 3 } else { 10 };
     let ctx = Context::new(&ContextOptions {
         validation: false,
@@ -105,8 +111,12 @@ fn main() {
         spt,
         ..PointLoadOptions::default()
     };
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/models/stanford-bunny.obj");
-    let bunny = load_point_object(&path, &options).expect("bunny");
+    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/models");
+    if hybrid_only {
+        hybrid_against_points(&ctx, &options, &models, frames);
+        return;
+    }
+    let bunny = load_point_object(&models.join("stanford-bunny.obj"), &options).expect("bunny");
     let leaves = PointObject::new("bunny leaves", all_leaves(&bunny.tree));
     let flat = single(leaves);
     let close = camera_at(0.25);
@@ -163,4 +173,42 @@ fn main() {
         m.cpu_ms,
         m.cpu_ms * 1e3 / scene.points.instances.len() as f64
     );
+    hybrid_against_points(&ctx, &options, &models, frames);
+}
+
+/// Part 4: each model with and without its triangles (EWA quads).
+fn hybrid_against_points(ctx: &Context, options: &PointLoadOptions, models: &std::path::Path, frames: usize) {
+    // The teapot scaled to about the bunny's size.
+    for (file, transform) in [("stanford-bunny.obj", "r=90,0,0"), ("teapot.obj", "r=90,0,0;s=0.05")] {
+        let load = |hybrid| {
+            let options = PointLoadOptions {
+                hybrid,
+                ..options.clone()
+            };
+            let object = load_point_object(&models.join(file), &options).expect("model");
+            let mut points = PointScene::default();
+            points.add(object, PointTransform::parse(transform).unwrap());
+            Scene::points_only(points)
+        };
+        let (points, hybrid) = (load(false), load(true));
+        println!(
+            "\n4. Hybrid point–polygon against points only, {file} ({} triangles, {} nodes; {} nodes in the hybrid list), EWA quads:",
+            hybrid.points.objects[0].triangle_count(),
+            points.points.total_splats(),
+            hybrid.points.total_splats()
+        );
+        println!(
+            "| eye distance (m) | points: splats drawn | GPU ms | hybrid: splats drawn | triangles drawn | GPU ms |"
+        );
+        println!("|---|---|---|---|---|---|");
+        for distance in [0.25, 0.5, 1.0, 2.0, 4.0] {
+            let camera = camera_at(distance);
+            let p = measure(ctx, &points, &camera, SplatSettings::default(), frames);
+            let h = measure(ctx, &hybrid, &camera, SplatSettings::default(), frames);
+            println!(
+                "| {distance} | {} | {:.1} | {} | {} | {:.1} |",
+                p.drawn, p.gpu_ms, h.drawn, h.triangles, h.gpu_ms
+            );
+        }
+    }
 }
