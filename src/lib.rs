@@ -15,6 +15,7 @@ pub mod random;
 pub mod renderer;
 pub mod shaders;
 pub mod terrain;
+pub mod texturing;
 pub mod vulkan;
 
 pub use error::{Error, Result};

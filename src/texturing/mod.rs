@@ -1,0 +1,15 @@
+//! Cached procedural textures (dissertation §8.2; `ALGORITHMS.md` §4): a
+//! surface-layer tree evaluated on the GPU into tiles of texture atlases,
+//! chosen per frame from a quadtree over the height field and reused from
+//! frame to frame. Files follow the pipeline of §8.2:
+//!
+//! * [`layers`]: the surface-layer tree (TOML file, built-in default), hat
+//!   functions and coverage, the CPU reference evaluation;
+//! * [`quadtree`]: per frame, the nodes the view needs and their tile sizes;
+//! * [`atlas`]: tile slots in the atlases, least-recently-used eviction, the
+//!   per-frame generation plan under a cap, and the page table the terrain
+//!   shading reads.
+
+pub mod atlas;
+pub mod layers;
+pub mod quadtree;
