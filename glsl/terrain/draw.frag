@@ -9,6 +9,20 @@
 #include "../include/atmosphere.glsl"
 #include "../include/terrain_detail.glsl"
 #include "../include/terrain_draw.glsl"
+#include "../include/bspline_height.glsl"
+#include "../include/surface_layers.glsl"
+
+// Per-frame texturing constants (src/texturing/gpu_layout.rs, TexturingFrame).
+layout(set = 0, binding = 2, std430) readonly buffer TerrainTexturing {
+    uvec4 handles;        // layers (storage), height texture (sampled), noise tile (sampled), mode
+    uvec4 grid;           // columns, rows, layer count, 0
+    vec4 spacing_range;   // spacing x, y, lowest and highest height
+} g_texturing[];
+
+const uint TEXTURING_CLASSIC = 0u;
+const uint TEXTURING_DIRECT = 1u;
+// No extra input map bound: every hat on it gives 0.
+const vec3 NO_MAPS = vec3(-3.0e38);
 
 layout(location = 0) in vec3 in_world;
 layout(location = 1) in vec3 in_normal;
@@ -56,7 +70,9 @@ void main() {
     uint flags = draw_flags();
     uint view = flags & 7u;
     bool detail = (flags & 8u) != 0u;
-    uint tile = floatBitsToUint(pc.params.z);
+    uint handles = floatBitsToUint(pc.params.z);
+    uint tile = handles & 0xffffu;
+    uint texturing = handles >> 16;
     float d0 = pc.eye.w;
     vec3 sun = normalize(pc.sun.xyz);
     vec3 to_point = in_world - pc.eye.xyz;
@@ -77,7 +93,22 @@ void main() {
 
     vec3 radiance;
     if (view == VIEW_SHADED) {
-        vec3 a = albedo(n, in_world, tile);
+        vec3 a;
+        if (texturing != 0xffffu && g_texturing[texturing].handles.w == TEXTURING_DIRECT) {
+            // §8.2 evaluated per pixel: the reference of the atlas.
+            uvec4 th = g_texturing[texturing].handles;
+            vec4 sr = g_texturing[texturing].spacing_range;
+            vec2 base_grad;
+            float h = bspline_height(th.y, g_texturing[texturing].grid.xy, sr.xy, in_world.xy, base_grad);
+            vec2 grad;
+            a = evaluate_layers(th.x, g_texturing[texturing].grid.z, th.z, in_world.xy, h, base_grad, sr.zw, NO_MAPS,
+                                grad);
+            // The layers' displacement bumps the normal on top of the mesh's.
+            vec2 extra = grad - base_grad;
+            n = normalize(n + vec3(-extra, 0.0) * n.z);
+        } else {
+            a = albedo(n, in_world, tile);
+        }
         vec3 sky_ambient = mix(SKY_HORIZON, SKY_ZENITH, 0.5 + 0.5 * n.z) * (0.5 + 0.5 * n.z);
         radiance = a * (SUN_RADIANCE * max(dot(n, sun), 0.0) + sky_ambient);
         radiance = apply_haze(radiance, dist, to_point / max(dist, 1e-6), sun);

@@ -19,6 +19,7 @@
 // shared memory, so normals see displaced neighbours without a second pass.
 #include "../include/heap.glsl"
 #include "../include/terrain_detail.glsl"
+#include "../include/bspline_height.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -56,41 +57,6 @@ vec3 phi(ivec2 g) {
     return v;
 }
 
-float atlas(ivec2 q) {
-    q = clamp(q, ivec2(0), ivec2(pc.grid.zw) - 1);
-    return texelFetch(sampler2D(g_textures[pc.handles.x], g_samplers[SAMPLER_NEAREST_CLAMP]), q, 0).r;
-}
-
-// Uniform cubic B-spline weights and their derivatives for fraction t.
-void bspline(float t, out vec4 w, out vec4 dw) {
-    float t2 = t * t;
-    float t3 = t2 * t;
-    w = vec4((1.0 - t) * (1.0 - t) * (1.0 - t), 3.0 * t3 - 6.0 * t2 + 4.0, -3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0, t3) / 6.0;
-    dw = vec4(-(1.0 - t) * (1.0 - t), 3.0 * t2 - 4.0 * t, -3.0 * t2 + 2.0 * t + 1.0, t2) * 0.5;
-}
-
-// Height and world gradient of the sketch atlas at world xy.
-float atlas_height(vec2 xy, out vec2 grad) {
-    vec2 g = clamp(xy / pc.spacing.xy, vec2(0.0), vec2(pc.grid.zw - 1u));
-    vec2 base = floor(g);
-    vec2 t = g - base;
-    vec4 wx, wy, dx, dy;
-    bspline(t.x, wx, dx);
-    bspline(t.y, wy, dy);
-    ivec2 b = ivec2(base) - 1;
-    float h = 0.0;
-    grad = vec2(0.0);
-    for (int j = 0; j < 4; ++j) {
-        for (int i = 0; i < 4; ++i) {
-            float v = atlas(b + ivec2(i, j));
-            h += wx[i] * wy[j] * v;
-            grad += vec2(dx[i] * wy[j], wx[i] * dy[j]) * v;
-        }
-    }
-    grad /= pc.spacing.xy;
-    return h;
-}
-
 void main() {
     int side = int(pc.grid.x);
     ivec2 group = ivec2(gl_WorkGroupID.xy) * 8 - 1;
@@ -100,7 +66,7 @@ void main() {
         ivec2 g = clamp(group + local, ivec2(0), ivec2(side - 1));
         vec3 p = phi(g);
         vec2 grad;
-        float h = atlas_height(p.xy, grad);
+        float h = bspline_height(pc.handles.x, pc.grid.zw, pc.spacing.xy, p.xy, grad);
         // Largest distance to the four grid neighbours, heights from the
         // atlas gradient.
         float d2 = 0.0;

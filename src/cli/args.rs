@@ -224,6 +224,22 @@ pub struct TerrainArgs {
     /// Switch importance factors off (comma-separated), for debugging.
     #[arg(long = "importance-off", value_enum, value_delimiter = ',')]
     pub importance_off: Vec<FactorArg>,
+    /// Terrain colouring: classic surface types (§7.4.3) or the surface-layer
+    /// tree evaluated per pixel (direct, §8.2).
+    #[arg(long, value_enum, default_value = "classic")]
+    pub texturing: TexturingArg,
+    /// Surface-layer tree (TOML; default: the built-in tree).
+    #[arg(long)]
+    pub layers: Option<PathBuf>,
+}
+
+/// Terrain colouring.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TexturingArg {
+    /// Surface types from altitude, slope and orientation (§7.4.3).
+    Classic,
+    /// The surface-layer tree evaluated per pixel (§8.2 reference).
+    Direct,
 }
 
 #[derive(Args, Debug)]

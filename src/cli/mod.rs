@@ -146,6 +146,9 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
     let builtin = args.terrain.terrain.is_none() && args.heightmap.is_none();
     let mut scene = load_terrain(args)?;
     points::add_points(&args.points, &mut scene, builtin)?;
+    if let Some(path) = &args.terrain.layers {
+        scene.layers = alpenglow::texturing::layers::LayerTree::load(path)?;
+    }
     Ok(scene)
 }
 
@@ -157,6 +160,10 @@ fn render_settings(args: &SceneArgs, readback: bool) -> Result<RenderSettings> {
         readback,
         terrain: terrain_settings(&args.terrain)?,
         points: points::splat_settings(&args.points, args.fov_y, args.height)?,
+        texturing: match args.terrain.texturing {
+            args::TexturingArg::Classic => alpenglow::texturing::gpu_layout::TexturingMode::Classic,
+            args::TexturingArg::Direct => alpenglow::texturing::gpu_layout::TexturingMode::Direct,
+        },
     })
 }
 

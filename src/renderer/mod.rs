@@ -27,7 +27,8 @@ use crate::lighting::sky::add_sky_pass;
 use crate::points::render::{add_point_passes, PointFrameStats, PointPasses, SplatSettings, SplatTargets};
 use crate::profile::FrameProfile;
 use crate::terrain::geometry_image::{GeometryImage, TerrainSettings};
-use crate::terrain::shading::add_draw_pass;
+use crate::terrain::shading::{add_draw_pass, TerrainTexturing};
+use crate::texturing::gpu_layout::TexturingMode;
 use crate::vulkan::{
     Buffer, BufferDesc, BufferUsageFlags, Context, Format, FrameRing, MemoryLocation, FRAMES_IN_FLIGHT,
 };
@@ -60,6 +61,8 @@ pub struct RenderSettings {
     pub terrain: TerrainSettings,
     /// How point objects are splatted.
     pub points: SplatSettings,
+    /// How the terrain is coloured (§7.4.3 surface types or the §8.2 layer tree).
+    pub texturing: TexturingMode,
 }
 
 impl RenderSettings {
@@ -71,6 +74,7 @@ impl RenderSettings {
             readback: true,
             terrain: TerrainSettings::default(),
             points: SplatSettings::default(),
+            texturing: TexturingMode::default(),
         }
     }
 }
@@ -167,6 +171,10 @@ impl Renderer {
                 terrain_resources,
                 (hdr, view_depth, depth),
                 h,
+                &TerrainTexturing {
+                    mode: settings.texturing,
+                    layers: &scene.layers,
+                },
             )?;
             Some(terrain)
         } else {

@@ -24,6 +24,8 @@ pub struct Scene {
     pub points: PointScene,
     /// Unit direction towards the sun.
     pub sun_direction: Vec3,
+    /// The surface-layer tree of §8.2 (used with [`crate::texturing::gpu_layout::TexturingMode::Direct`]).
+    pub layers: crate::texturing::layers::LayerTree,
 }
 
 impl Scene {
@@ -63,6 +65,7 @@ impl Scene {
             draw_terrain: true,
             points: PointScene::default(),
             sun_direction: Vec3::new(-0.55, 0.45, 0.42).normalize(),
+            layers: crate::texturing::layers::LayerTree::default_tree(),
         }
     }
 

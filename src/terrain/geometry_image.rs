@@ -251,13 +251,14 @@ impl GeometryImage {
         self.field.spacing.x.min(self.field.spacing.y) as f32
     }
 
-    /// Declares `terrain.warp`. Returns the vertex buffer and the noise
-    /// tile as graph resources, for `terrain.draw`.
+    /// Declares `terrain.warp`. Returns the vertex buffer, the noise tile
+    /// and the sketch atlas (the height field) as graph resources, for
+    /// `terrain.draw`.
     pub fn add_warp_pass(
         &self,
         ctx: &Context,
         graph: &mut RenderGraph<FrameParams>,
-    ) -> Result<(ResourceId, ResourceId)> {
+    ) -> Result<(ResourceId, ResourceId, ResourceId)> {
         let atlas = graph.import_image(self.atlas.clone());
         let noise = graph.import_image(self.noise.clone());
         let upload = graph.import_buffers_per_frame(self.warp_uploads.clone());
@@ -317,7 +318,7 @@ impl GeometryImage {
                 cmd.dispatch(groups, groups, 1);
                 Ok(())
             });
-        Ok((vertices, noise))
+        Ok((vertices, noise, atlas))
     }
 }
 

@@ -7,14 +7,17 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::error::Error;
 use crate::error::Result;
 use crate::graph::{Access, RenderGraph, ResourceId, Stage};
 use crate::renderer::FrameParams;
 use crate::shaders;
 use crate::terrain::geometry_image::{GeometryImage, VERTEX_STRIDE};
+use crate::texturing::gpu_layout::{pack_layers, TexturingFrame, TexturingMode};
+use crate::texturing::layers::{LayerTree, INPUT_NAMES};
 use crate::vulkan::{
-    Blend, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, PrimitiveTopology,
-    VertexAttribute,
+    Blend, Buffer, BufferDesc, BufferUsageFlags, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc,
+    LoadOp, MemoryLocation, PrimitiveTopology, VertexAttribute,
 };
 
 /// Push constants of `terrain.draw` (`glsl/include/terrain_draw.glsl`).
@@ -28,20 +31,60 @@ struct TerrainDrawPush {
     forward: [f32; 4],
     /// xyz, w = snow line.
     sun: [f32; 4],
-    /// amplitude, H, noise tile handle (bits), flags (bits).
+    /// amplitude, H, handles (bits: noise tile | texturing constants << 16,
+    /// 0xffff: none), flags (bits).
     params: [f32; 4],
 }
 
+/// How `terrain.draw` colours the surface (§7.4.3 or §8.2).
+pub struct TerrainTexturing<'a> {
+    pub mode: TexturingMode,
+    pub layers: &'a LayerTree,
+}
+
 /// Declares `terrain.draw` into `color` and `view_depth` (loaded: the sky
-/// pass wrote them) with depth buffer `depth`.
+/// pass wrote them) with depth buffer `depth`; `heights` is the sketch atlas.
 pub fn add_draw_pass(
     ctx: &Context,
     graph: &mut RenderGraph<FrameParams>,
     terrain: &GeometryImage,
-    (vertices, noise): (ResourceId, ResourceId),
+    (vertices, noise, heights): (ResourceId, ResourceId, ResourceId),
     (color, view_depth, depth): (ResourceId, ResourceId, ResourceId),
     image_height: u32,
+    texturing: &TerrainTexturing,
 ) -> Result<()> {
+    if let Some(k) = (0..INPUT_NAMES.len()).find(|&k| texturing.layers.uses_input(k)) {
+        return Err(Error::invalid(
+            "surface layers",
+            format!(
+                "input map '{}' is used but input maps are not supported yet",
+                INPUT_NAMES[k]
+            ),
+        ));
+    }
+    let layer_count = texturing.layers.layers.len() as u32;
+    if layer_count == 0 {
+        return Err(Error::invalid("surface layers", "the tree has no layer"));
+    }
+    let layer_buffer = Buffer::with_data(
+        ctx,
+        "surface layers",
+        BufferUsageFlags::STORAGE_BUFFER,
+        bytemuck::cast_slice(&pack_layers(texturing.layers)),
+    )?;
+    let layers = graph.import_buffer(std::sync::Arc::new(layer_buffer));
+    let frames = graph.import_buffers_per_frame(Buffer::per_frame(
+        ctx,
+        BufferDesc {
+            name: "terrain texturing".into(),
+            size: std::mem::size_of::<TexturingFrame>() as u64,
+            usage: BufferUsageFlags::STORAGE_BUFFER,
+            location: MemoryLocation::CpuToGpu,
+        },
+    )?);
+    let mode = texturing.mode;
+    let field = terrain.field.clone();
+    let (lo, hi) = field.min_max();
     let pipeline = GraphicsPipeline::new(
         ctx,
         &GraphicsPipelineDesc {
@@ -83,12 +126,31 @@ pub fn add_draw_pass(
         .read(vertices, Access::VertexBuffer)
         .read(indices, Access::IndexBuffer)
         .read(noise, Access::SampledImage(Stage::Fragment))
+        .read(heights, Access::SampledImage(Stage::Fragment))
+        .read(layers, Access::StorageBufferRead(Stage::Fragment))
+        .read(frames, Access::StorageBufferRead(Stage::Fragment))
         .write(color, Access::ColorAttachmentReadWrite)
         .write(view_depth, Access::ColorAttachmentReadWrite)
         .write(depth, Access::DepthAttachmentWrite)
         .record(move |pass, params| {
             let camera = &params.camera;
             let pixel_footprint = 2.0 * (0.5 * camera.fov_y_deg.to_radians()).tan() / f64::from(image_height);
+            let noise_handle = pass.sampled(noise)?;
+            let frame = TexturingFrame {
+                handles: [
+                    pass.storage_buffer(layers)?,
+                    pass.sampled(heights)?,
+                    noise_handle,
+                    mode.code(),
+                ],
+                grid: [field.columns, field.rows, layer_count, 0],
+                spacing_range: [field.spacing.x as f32, field.spacing.y as f32, lo, hi],
+            };
+            let frame_handle = pass.storage_buffer(frames)?;
+            pass.buffer(frames)?.write(0, bytemuck::bytes_of(&frame))?;
+            if noise_handle > 0xffff || frame_handle >= 0xffff {
+                return Err(Error::Graph("terrain.draw: descriptor handles exceed 16 bits".into()));
+            }
             let push = TerrainDrawPush {
                 view_proj: camera.view_proj(params.aspect).to_cols_array(),
                 eye: camera.eye.as_vec3().extend(d0).to_array(),
@@ -97,7 +159,7 @@ pub fn add_draw_pass(
                 params: [
                     settings.detail_amplitude,
                     settings.detail_h,
-                    f32::from_bits(pass.sampled(noise)?),
+                    f32::from_bits(noise_handle | frame_handle << 16),
                     f32::from_bits(settings.draw_flags()),
                 ],
             };

@@ -70,8 +70,11 @@ pub struct Hat {
 }
 
 impl Hat {
-    /// F(a) (module docs).
+    /// F(a) (module docs); 0 for NaN (an absent input).
     pub fn eval(&self, a: f32) -> f32 {
+        if a.is_nan() {
+            return 0.0;
+        }
         if self.fuzz <= 0.0 {
             return if a >= self.min && a <= self.max { 1.0 } else { 0.0 };
         }
@@ -198,7 +201,10 @@ impl LayerTree {
     /// Parses TOML `text`; `origin` names it in errors.
     pub fn parse(text: &str, origin: &str) -> Result<LayerTree> {
         let file: TreeFile = toml::from_str(text).map_err(|e| {
-            let line = e.span().map(|s| format!("line {}: ", line_of(text, s.start))).unwrap_or_default();
+            let line = e
+                .span()
+                .map(|s| format!("line {}: ", line_of(text, s.start)))
+                .unwrap_or_default();
             Error::invalid(origin, format!("{line}{}", e.message().trim()))
         })?;
         let mut layers = Vec::new();
@@ -213,7 +219,9 @@ impl LayerTree {
 
     /// Whether any layer is constrained by input map `k` ([`INPUT_NAMES`]).
     pub fn uses_input(&self, k: usize) -> bool {
-        self.layers.iter().any(|l| l.layer.inputs.get(k).is_some_and(|h| h.is_some()))
+        self.layers
+            .iter()
+            .any(|l| l.layer.inputs.get(k).is_some_and(|h| h.is_some()))
     }
 }
 
@@ -436,7 +444,10 @@ mod tests {
         assert!((h.eval(95.0) - 0.25).abs() < 1e-6);
         // No fuzz: a box.
         let b = hat(0.0, 1.0, 0.0);
-        assert_eq!((b.eval(-0.1), b.eval(0.0), b.eval(1.0), b.eval(1.1)), (0.0, 1.0, 1.0, 0.0));
+        assert_eq!(
+            (b.eval(-0.1), b.eval(0.0), b.eval(1.0), b.eval(1.1)),
+            (0.0, 1.0, 1.0, 0.0)
+        );
         // A range narrower than the ramps peaks below 1.
         let narrow = hat(0.0, 0.0, 10.0);
         assert_eq!(narrow.eval(0.0), 0.5);
@@ -481,7 +492,7 @@ mod tests {
         assert_eq!(coverage(&l, &at(1000.0, 30.0), 0.5), 0.25);
         assert_eq!(coverage(&l, &at(500.0, 10.0), 1.0), 0.0);
         // Input maps: an absent map (NaN) fails its constraint.
-        l.inputs[0] = Some(hat(0.0, 1.0, 0.0));
+        l.inputs[0] = Some(hat(0.0, 1.0, 0.5));
         assert_eq!(coverage(&l, &at(2000.0, 10.0), 0.5), 0.0);
         let mut with_map = at(2000.0, 10.0);
         with_map.maps[0] = 0.5;
@@ -530,7 +541,8 @@ mod tests {
         assert_eq!(s.color, Vec3::ONE);
         // Below the snow line: rock 0.2 → grass half → dry a quarter.
         let s = evaluate(&tree, &at(90.0), &noise);
-        let expected = (Vec3::splat(0.2) * 0.5 + Vec3::new(0.0, 1.0, 0.0) * 0.5) * 0.75 + Vec3::new(1.0, 1.0, 0.0) * 0.25;
+        let expected =
+            (Vec3::splat(0.2) * 0.5 + Vec3::new(0.0, 1.0, 0.0) * 0.5) * 0.75 + Vec3::new(1.0, 1.0, 0.0) * 0.25;
         assert!((s.color - expected).length() < 1e-6, "{} vs {expected}", s.color);
     }
 
@@ -538,7 +550,15 @@ mod tests {
     fn the_default_tree_parses_with_the_issue_layers() {
         let tree = LayerTree::parse(DEFAULT_LAYERS, "built-in").unwrap();
         let names: Vec<&str> = tree.layers.iter().map(|l| l.layer.name.as_str()).collect();
-        for name in ["rock", "grass", "dark grass", "dry grass", "light grass", "sand", "snow"] {
+        for name in [
+            "rock",
+            "grass",
+            "dark grass",
+            "dry grass",
+            "light grass",
+            "sand",
+            "snow",
+        ] {
             assert!(names.contains(&name), "{name} missing from {names:?}");
         }
         assert_eq!(tree.layers[0].layer.name, "rock");
@@ -563,7 +583,10 @@ mod tests {
         ];
         for (text, needle) in cases {
             let err = LayerTree::parse(text, "layers.toml").unwrap_err().to_string();
-            assert!(err.contains("layers.toml") && err.contains(needle), "{err:?} lacks {needle:?}");
+            assert!(
+                err.contains("layers.toml") && err.contains(needle),
+                "{err:?} lacks {needle:?}"
+            );
             assert!(!err.contains('\n'), "one line: {err:?}");
         }
     }

@@ -11,5 +11,6 @@
 //!   shading reads.
 
 pub mod atlas;
+pub mod gpu_layout;
 pub mod layers;
 pub mod quadtree;

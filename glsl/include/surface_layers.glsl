@@ -1,0 +1,100 @@
+// The surface-layer tree (dissertation §8.2, Table 8.1; ALGORITHMS.md §4),
+// evaluated at a point of the base surface: hat-function constraints,
+// coverage with noise, depth-first colour blending, displacement feeding
+// the next layers' altitude and the normal. Same rules as the CPU reference
+// src/texturing/layers.rs (`evaluate`); layout as src/texturing/gpu_layout.rs.
+// Needs terrain_detail.glsl (wavelet noise) included first.
+#ifndef ALPENGLOW_SURFACE_LAYERS_GLSL
+#define ALPENGLOW_SURFACE_LAYERS_GLSL
+
+#include "heap.glsl"
+
+struct SurfaceLayer {
+    vec4 color_roughness;  // linear colour, roughness B_S (metres)
+    vec4 noise;            // c_S, n_S, coverage-noise wavelength, displacement-noise wavelength
+    vec4 hats[6];          // (min, max, fuzz, used): altitude, elevation, slope, rainfall, radiation, temperature
+    uvec4 tree;            // parent (0xffffffff: root), level
+};
+
+layout(set = 0, binding = 2, std430) readonly buffer SurfaceLayers { SurfaceLayer l[]; } g_surface_layers[];
+
+#define MAX_SURFACE_LAYERS 32
+
+// F(a) of a hat (min, max, fuzz, used); 1 when unused.
+float hat(vec4 h, float a) {
+    if (h.w == 0.0) {
+        return 1.0;
+    }
+    if (h.z <= 0.0) {
+        return (a >= h.x && a <= h.y) ? 1.0 : 0.0;
+    }
+    float f1 = (a - (h.x - h.z)) / (2.0 * h.z);
+    float f2 = ((h.y + h.z) - a) / (2.0 * h.z);
+    return clamp(min(f1, f2), 0.0, 1.0);
+}
+
+// Fractional Brownian motion of the wavelet noise tile at wavelength
+// `wavelength` (metres): three octaves, lacunarity 2, gain 1/2, scaled to
+// about [−1, 1]; `offset` decorrelates layers. Writes the world gradient.
+float layer_noise(uint tile, vec2 xy, float wavelength, vec2 offset, out vec2 grad) {
+    // The tile's noise has a wavelength of about 3 texels.
+    float freq = 3.0 / wavelength;
+    float value = 0.0;
+    float amplitude = 0.87;
+    grad = vec2(0.0);
+    for (int k = 0; k < 3; ++k) {
+        vec2 g;
+        value += amplitude * wavelet_noise(tile, xy * freq + offset * float(k + 1), g);
+        grad += amplitude * g * freq;
+        freq *= 2.0;
+        amplitude *= 0.5;
+    }
+    return value;
+}
+
+// Colour and gradient of the final height at world xy of the base surface
+// (height h, gradient grad); `range` the height field's lowest and highest
+// sample; `maps` the extra inputs (NaN: absent).
+vec3 evaluate_layers(uint layers, uint count, uint tile, vec2 xy, float h, vec2 grad, vec2 range, vec3 maps,
+                     out vec2 out_grad) {
+    float slope = degrees(atan(length(grad)));
+    // C_S per tree level: in depth-first order the last layer seen one
+    // level up is the parent.
+    vec4 level_coverage = vec4(1.0);
+    vec3 color = vec3(0.0);
+    out_grad = grad;
+    for (uint i = 0u; i < count && i < MAX_SURFACE_LAYERS; ++i) {
+        uint level = g_surface_layers[layers].l[i].tree.y;
+        vec4 color_roughness = g_surface_layers[layers].l[i].color_roughness;
+        vec4 noise = g_surface_layers[layers].l[i].noise;
+        float c_s = 1.0;
+        if (level > 0u) {
+            float product = hat(g_surface_layers[layers].l[i].hats[0], h) *
+                            hat(g_surface_layers[layers].l[i].hats[1], (h - range.x) / max(range.y - range.x, 1e-6)) *
+                            hat(g_surface_layers[layers].l[i].hats[2], slope) *
+                            hat(g_surface_layers[layers].l[i].hats[3], maps.x) *
+                            hat(g_surface_layers[layers].l[i].hats[4], maps.y) *
+                            hat(g_surface_layers[layers].l[i].hats[5], maps.z);
+            float parent = level_coverage[min(level - 1u, 3u)];
+            if (product > 0.0 && parent > 0.0) {
+                vec2 unused;
+                float n = noise.y != 0.0 ? layer_noise(tile, xy, noise.z, vec2(17.3, 41.9) * float(i + 1u), unused) : 0.0;
+                c_s = clamp((noise.x + noise.y * n) * product, 0.0, 1.0) * parent;
+            } else {
+                c_s = 0.0;
+            }
+        }
+        level_coverage[min(level, 3u)] = c_s;
+        color = mix(color, color_roughness.rgb, c_s);
+        if (color_roughness.w > 0.0 && c_s > 0.0) {
+            vec2 dg;
+            float d = layer_noise(tile, xy, noise.w, vec2(29.1, 7.7) * float(i + 1u), dg);
+            float amplitude = c_s * color_roughness.w;
+            h += amplitude * d;
+            out_grad += amplitude * dg;
+        }
+    }
+    return color;
+}
+
+#endif
