@@ -49,6 +49,7 @@ fn check_golden_with(name: &str, scene: &Scene, camera: &Camera, points: SplatSe
             readback: true,
             terrain: Default::default(),
             points,
+            texturing: Default::default(),
         };
         let mut renderer = Renderer::new(&ctx, scene, settings).expect("renderer");
         let frame = renderer.render(camera).and_then(|f| renderer.read(&f)).expect("frame");

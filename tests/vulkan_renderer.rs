@@ -33,6 +33,7 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
             readback: true,
             terrain: Default::default(),
             points: Default::default(),
+            texturing: Default::default(),
         };
         let mut renderer = Renderer::new(&ctx, &scene, settings).expect("renderer");
         assert_eq!(
@@ -86,6 +87,7 @@ fn renders_are_deterministic() {
             readback: true,
             terrain: Default::default(),
             points: Default::default(),
+            texturing: Default::default(),
         };
         let camera = scene.default_camera();
         let mut first = Renderer::new(&ctx, &scene, settings).expect("renderer");
@@ -225,6 +227,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
                 readback: true,
                 terrain: Default::default(),
                 points: Default::default(),
+                texturing: Default::default(),
             },
         )
         .unwrap();
@@ -247,6 +250,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
                 readback: false,
                 terrain: Default::default(),
                 points: Default::default(),
+                texturing: Default::default(),
             }
         )
         .is_err());
