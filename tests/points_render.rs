@@ -20,7 +20,7 @@ use alpenglow::points::spt::{build_spt, epsilon_from_pixels, SptOptions};
 use alpenglow::points::Surfel;
 use alpenglow::renderer::{Camera, FrameImages, Scene};
 use common::points::{bunny_camera, bunny_object, render_points};
-use common::{flip_errors, linear_to_srgb8, srgb8_to_linear};
+use common::{dump_pngs, flip_errors, linear_to_srgb8, srgb8_to_linear};
 use glam::{DVec3, Vec3};
 
 const WIDTH: u32 = 320;
@@ -151,12 +151,7 @@ fn plane_flip(frame: &FrameImages, reference: &[Option<f32>]) -> f32 {
             None => [t[0], t[1], t[2], 255],
         })
         .collect();
-    if let Ok(dir) = std::env::var("ALPENGLOW_DUMP") {
-        let dir = std::path::Path::new(&dir);
-        let n = std::fs::read_dir(dir).map(|d| d.count()).unwrap_or(0);
-        let _ = alpenglow::io::image_out::write_png_rgba8(&dir.join(format!("{n}-test.png")), &test, WIDTH, HEIGHT);
-        let _ = alpenglow::io::image_out::write_png_rgba8(&dir.join(format!("{n}-ref.png")), &expected, WIDTH, HEIGHT);
-    }
+    dump_pngs(&[("test", &test), ("ref", &expected)], WIDTH, HEIGHT);
     let errors = flip_errors(&expected, &test, WIDTH, HEIGHT);
     let (sum, n) = errors
         .iter()

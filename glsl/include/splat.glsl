@@ -68,6 +68,12 @@ vec3 srgb_to_linear(vec3 c) {
     return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
 }
 
+// Linear colour of an sRGB8 triple packed as uint bits r | g << 8 | b << 16 in a float.
+vec3 unpack_srgb(float bits) {
+    uint rgb = floatBitsToUint(bits);
+    return srgb_to_linear(vec3(float(rgb & 0xffu), float((rgb >> 8) & 0xffu), float((rgb >> 16) & 0xffu)) / 255.0);
+}
+
 // exp(−r²/2) for r² in [0, F_G²] from the lookup table (§10.2: "Gaussian from
 // a lookup table"), linearly interpolated; `cutoff2` = F_G².
 float gaussian(float r2, float cutoff2) {

@@ -19,11 +19,6 @@ void cull() {
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0);  // outside the clip volume
 }
 
-vec3 unpack_srgb(float bits) {
-    uint rgb = floatBitsToUint(bits);
-    return srgb_to_linear(vec3(float(rgb & 0xffu), float((rgb >> 8) & 0xffu), float((rgb >> 16) & 0xffu)) / 255.0);
-}
-
 void main() {
     uint triangle_index = uint(gl_VertexIndex) / 3u;
     uint corner = uint(gl_VertexIndex) % 3u;

@@ -145,8 +145,6 @@ void main() {
     gl_Position = vec4(pixel / viewport * 2.0 - 1.0, 0.5, 1.0);
     gl_PointSize = min(ceil(point_size), max_point);
 
-    uint rgb = floatBitsToUint(s.radius_color.y);
-    vec3 srgb = vec3(float(rgb & 0xffu), float((rgb >> 8) & 0xffu), float((rgb >> 16) & 0xffu)) / 255.0;
     float scale2 = scale * scale;
     out_conic = vec4(Vi[0][0], Vi[0][1], Vi[1][1], sqrt(det_cov / det_v));
     out_centre = vec4(x_t, radius * scale, 0.0);
@@ -155,5 +153,5 @@ void main() {
     out_tu = vec4(mv * t_o / scale2, 0.0);
     out_tv = vec4(mv * b_o / scale2, 0.0);
     out_clip = s.clip;
-    out_color = vec4(srgb_to_linear(srgb), 1.0);
+    out_color = vec4(unpack_srgb(s.radius_color.y), 1.0);
 }

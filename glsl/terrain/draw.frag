@@ -19,7 +19,6 @@ layout(set = 0, binding = 2, std430) readonly buffer TerrainTexturing {
     vec4 spacing_range;   // spacing x, y, lowest and highest height
 } g_texturing[];
 
-const uint TEXTURING_CLASSIC = 0u;
 const uint TEXTURING_DIRECT = 1u;
 // No extra input map bound: every hat on it gives 0.
 const vec3 NO_MAPS = vec3(-3.0e38);

@@ -121,7 +121,6 @@ pub struct Layer {
     pub slope: Option<Hat>,
     /// Constraints on the extra inputs, in [`INPUT_NAMES`] order.
     pub inputs: [Option<Hat>; 3],
-    pub children: Vec<Layer>,
 }
 
 /// A layer in depth-first order with its place in the tree.
@@ -297,7 +296,6 @@ fn flatten(
             elevation: f.elevation,
             slope: f.slope,
             inputs: [f.rainfall, f.radiation, f.temperature],
-            children: Vec::new(),
         },
         level,
         parent,
@@ -466,7 +464,6 @@ mod tests {
             elevation: None,
             slope: None,
             inputs: [None; 3],
-            children: Vec::new(),
         }
     }
 

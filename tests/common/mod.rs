@@ -77,6 +77,20 @@ pub fn mean_flip(reference_rgba: &[u8], test_rgba: &[u8], width: u32, height: u3
 pub mod cli;
 pub mod points;
 
+/// With `ALPENGLOW_DUMP=DIR` (an existing folder), writes each named RGBA8
+/// image as `DIR/<n>-<name>.png`, n the number of entries already there,
+/// for looking at what an image test compared.
+pub fn dump_pngs(images: &[(&str, &[u8])], width: u32, height: u32) {
+    let Ok(dir) = std::env::var("ALPENGLOW_DUMP") else {
+        return;
+    };
+    let dir = Path::new(&dir);
+    let n = std::fs::read_dir(dir).map(|d| d.count()).unwrap_or(0);
+    for (name, rgba) in images {
+        let _ = alpenglow::io::image_out::write_png_rgba8(&dir.join(format!("{n}-{name}.png")), rgba, width, height);
+    }
+}
+
 /// Per-pixel FLIP error between two sRGB RGBA8 images of the same size (alpha ignored).
 pub fn flip_errors(reference_rgba: &[u8], test_rgba: &[u8], width: u32, height: u32) -> Vec<f32> {
     let rgb = |rgba: &[u8]| -> Vec<u8> { rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect() };

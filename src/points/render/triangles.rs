@@ -30,11 +30,8 @@ impl TriangleBuffer {
         let mut triangles: Vec<GpuTriangle> = Vec::new();
         let mut firsts = Vec::with_capacity(scene.objects.len());
         for object in &scene.objects {
-            let first = u32::try_from(triangles.len())
-                .ok()
-                .filter(|&n| n <= u32::MAX / 3)
-                .ok_or_else(|| Error::invalid("points", "too many hybrid triangles"))?;
-            firsts.push(first);
+            // Bounded by the check below: firsts never exceed the total.
+            firsts.push(triangles.len() as u32);
             if let Some(hybrid) = &object.hybrid {
                 triangles.extend(pack_triangles(hybrid, object.tree.epsilon));
             }
