@@ -1,12 +1,14 @@
-//! Tile slots in texture atlases, reuse from frame to frame and the page
-//! table (dissertation §8.2).
+//! Tile slots in texture atlases and their reuse from frame to frame
+//! (dissertation §8.2).
 //!
 //! # Atlases
 //!
-//! Tiles live in the layers of an array texture of `size × size` texels.
-//! Every layer holds tiles of one size: layer `k` holds tiles of
-//! `min_tile·2^k` texels (border included), packed row-major into
-//! `(size/tile)²` slots.
+//! Tiles live in atlas textures of `size × size` texels. Every texture
+//! holds tiles of one size (border included), packed row-major into
+//! `(size/tile)²` slots. Each tile size from `min_tile` to `max_tile` gets
+//! enough textures for `min_slots` tiles (at least one, at most
+//! `max_textures_per_size`); textures are numbered size by size, smallest
+//! first, and a size's slots run through its textures in order.
 //!
 //! # Frame plan rules ([`TileCache::plan_frame`])
 //!
@@ -41,15 +43,8 @@
 
 use std::collections::{HashMap, HashSet};
 
-use bytemuck::Zeroable as _;
-
-use glam::DVec2;
-
 use crate::error::{Error, Result};
 use crate::texturing::quadtree::{NeededTile, NodeId, QuadtreeSettings};
-
-/// Deepest page table [`page_table`] builds: `4096²` cells (512 MiB).
-pub const MAX_TABLE_DEPTH: u32 = 12;
 
 /// Atlas size and the range of tile sizes it holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,6 +57,10 @@ pub struct AtlasSettings {
     pub min_tile: u32,
     /// Largest tile size, border included (power of two, ≤ `size`).
     pub max_tile: u32,
+    /// Slots wanted per tile size (the number of textures is rounded up).
+    pub min_slots: u32,
+    /// Most textures per tile size (≥ 1).
+    pub max_textures_per_size: u32,
 }
 
 impl Default for AtlasSettings {
@@ -71,6 +70,8 @@ impl Default for AtlasSettings {
             border: 4,
             min_tile: 16,
             max_tile: 512,
+            min_slots: 128,
+            max_textures_per_size: 2,
         }
     }
 }
@@ -84,6 +85,7 @@ impl AtlasSettings {
             border: quadtree.border,
             min_tile: quadtree.min_tile,
             max_tile: quadtree.max_tile,
+            ..AtlasSettings::default()
         }
     }
 
@@ -97,30 +99,59 @@ impl AtlasSettings {
             format!("need min_tile {min} ≤ max_tile {max} ≤ size {size}")
         } else if u64::from(border) * 2 >= u64::from(min) {
             format!("border {border} leaves no inner texels in min_tile {min}")
+        } else if self.max_textures_per_size == 0 || self.max_textures_per_size > 64 {
+            format!("max_textures_per_size {} must be in 1..=64", self.max_textures_per_size)
         } else {
             return Ok(());
         };
         Err(Error::invalid("texture atlas settings", why))
     }
 
-    /// Number of atlas layers: one per tile size from `min_tile` to `max_tile`.
-    pub fn layers(&self) -> u32 {
+    /// Number of tile sizes from `min_tile` to `max_tile`.
+    pub fn sizes(&self) -> u32 {
         let (min, max) = (self.min_tile.trailing_zeros(), self.max_tile.trailing_zeros());
         max.saturating_sub(min) + 1
     }
 
-    /// The layer holding tiles of `tile_size`, `None` for a size not in the atlas.
-    pub fn layer_of(&self, tile_size: u32) -> Option<u32> {
+    /// The tile size of size index `k` (0: `min_tile`).
+    pub fn tile_size(&self, k: u32) -> u32 {
+        self.min_tile << k
+    }
+
+    /// The size index of `tile_size`, `None` for a size not in the atlas.
+    pub fn size_index(&self, tile_size: u32) -> Option<u32> {
         let fits = tile_size.is_power_of_two() && (self.min_tile..=self.max_tile).contains(&tile_size);
         fits.then(|| tile_size.trailing_zeros() - self.min_tile.trailing_zeros())
     }
 
-    /// Slots of one layer for tiles of `tile_size`, 0 for a size not in the atlas.
-    pub fn slots_per_layer(&self, tile_size: u32) -> u32 {
-        match self.layer_of(tile_size) {
+    /// Slots of one texture for tiles of `tile_size`, 0 for a size not in the atlas.
+    pub fn slots_per_texture(&self, tile_size: u32) -> u32 {
+        match self.size_index(tile_size) {
             Some(_) => (self.size / tile_size).pow(2),
             None => 0,
         }
+    }
+
+    /// Textures holding tiles of `tile_size`, 0 for a size not in the atlas.
+    pub fn textures_of(&self, tile_size: u32) -> u32 {
+        match self.slots_per_texture(tile_size) {
+            0 => 0,
+            per => self.min_slots.div_ceil(per).clamp(1, self.max_textures_per_size.max(1)),
+        }
+    }
+
+    /// Index of the first texture of `tile_size`, `None` for a size not in the atlas.
+    pub fn first_texture(&self, tile_size: u32) -> Option<u32> {
+        let k = self.size_index(tile_size)?;
+        Some((0..k).map(|j| self.textures_of(self.tile_size(j))).sum())
+    }
+
+    /// All atlas textures: `(tile size)` of each, in texture order.
+    pub fn texture_tile_sizes(&self) -> Vec<u32> {
+        let sizes = (0..self.sizes()).map(|k| self.tile_size(k));
+        sizes
+            .flat_map(|s| std::iter::repeat(s).take(self.textures_of(s) as usize))
+            .collect()
     }
 
     /// `tile_size` clamped to the atlas's range and rounded up to a power of two.
@@ -129,12 +160,12 @@ impl AtlasSettings {
     }
 }
 
-/// Where a tile lies: atlas layer and texel origin of the tile (border
-/// included) in the layer.
+/// Where a tile lies: atlas texture and texel origin of the tile (border
+/// included) in it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct TileSlot {
-    /// Atlas layer (one per tile size).
-    pub layer: u32,
+    /// Atlas texture (see the module documentation for the numbering).
+    pub texture: u32,
     /// Texel column of the tile's first texel.
     pub x: u32,
     /// Texel row of the tile's first texel.
@@ -221,9 +252,9 @@ impl TileCache {
     /// An empty cache; errors on invalid settings.
     pub fn new(settings: AtlasSettings) -> Result<TileCache> {
         settings.validate()?;
-        let sizes = (0..settings.layers()).map(|k| settings.min_tile << k);
-        let layer = |s| vec![None; settings.slots_per_layer(s) as usize];
-        let slots = sizes.map(layer).collect();
+        let sizes = (0..settings.sizes()).map(|k| settings.tile_size(k));
+        let slots_of = |s| vec![None; (settings.slots_per_texture(s) * settings.textures_of(s)) as usize];
+        let slots = sizes.map(slots_of).collect();
         Ok(TileCache {
             settings,
             slots,
@@ -316,9 +347,10 @@ impl TileCache {
         self.index.len()
     }
 
-    /// GPU memory of all atlas layers at `bytes_per_texel`.
+    /// GPU memory of all atlas textures at `bytes_per_texel`.
     pub fn memory_bytes(&self, bytes_per_texel: u64) -> u64 {
-        let texels = u64::from(self.settings.size).pow(2) * u64::from(self.settings.layers());
+        let textures = self.settings.texture_tile_sizes().len() as u64;
+        let texels = u64::from(self.settings.size).pow(2) * textures;
         texels.saturating_mul(bytes_per_texel)
     }
 
@@ -330,10 +362,13 @@ impl TileCache {
 
     /// Where the resident tile `(node, size)` lies (callers check residency).
     fn slot(&self, node: NodeId, size: u32) -> TileSlot {
-        let (layer, index) = self.index.get(&(node, size)).copied().unwrap_or((0, 0));
-        let per_row = (self.settings.size / size).max(1);
-        let (x, y) = (index % per_row * size, index / per_row * size);
-        TileSlot { layer, x, y, size }
+        let (_, index) = self.index.get(&(node, size)).copied().unwrap_or((0, 0));
+        let settings = &self.settings;
+        let per_texture = settings.slots_per_texture(size).max(1);
+        let texture = settings.first_texture(size).unwrap_or(0) + index / per_texture;
+        let (local, per_row) = (index % per_texture, (settings.size / size).max(1));
+        let (x, y) = (local % per_row * size, local / per_row * size);
+        TileSlot { texture, x, y, size }
     }
 
     /// Marks `(node, size)` used in `frame`; whether it is resident.
@@ -361,7 +396,7 @@ impl TileCache {
     /// least recently used tile not used in `frame`), marked used in
     /// `frame`; `None` if every slot holds a tile used in `frame`.
     fn place(&mut self, node: NodeId, size: u32, frame: u64, stats: &mut TileStats) -> Option<TileSlot> {
-        let layer = self.settings.layer_of(size)?;
+        let layer = self.settings.size_index(size)?;
         let last_root = self.resident_sizes(NodeId::ROOT).count() <= 1;
         let evictable = |r: Resident| r.last_used < frame && !(last_root && r.node == NodeId::ROOT);
         let slots = &mut self.slots[layer as usize];
@@ -379,83 +414,9 @@ impl TileCache {
     }
 }
 
-/// One page-table cell: where the tile covering the cell lies. 32 bytes,
-/// laid out like the std430 struct
-/// `{ vec2 node_min; vec2 node_size; vec2 atlas_origin; float inner_texels; uint layer; }`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable, PartialEq)]
-pub struct PageEntry {
-    /// World corner (min x, min y) of the source node's rectangle, metres.
-    pub node_min: [f32; 2],
-    /// World size of the source node's rectangle, metres.
-    pub node_size: [f32; 2],
-    /// Texel coordinates in the layer of the inner region's corner (slot
-    /// origin + border).
-    pub atlas_origin: [f32; 2],
-    /// Inner texels across the tile: `size − 2·border`.
-    pub inner_texels: f32,
-    /// Atlas layer of the tile.
-    pub layer: u32,
-}
-
-impl PageEntry {
-    /// The entry of the tile of `node` in `slot`.
-    fn new(node: NodeId, slot: TileSlot, extent: DVec2, border: u32) -> PageEntry {
-        let (min, max) = node.rect(extent);
-        PageEntry {
-            node_min: min.as_vec2().to_array(),
-            node_size: (max - min).as_vec2().to_array(),
-            atlas_origin: [(slot.x + border) as f32, (slot.y + border) as f32],
-            inner_texels: slot.size.saturating_sub(2 * border) as f32,
-            layer: slot.layer,
-        }
-    }
-}
-
-/// The page table: `(2^table_depth)²` cells over the rectangle, row-major
-/// (cell `(i, j)` at index `j·2^table_depth + i`). Each cell holds the entry
-/// of the draw whose needed node contains it; cells outside every needed node
-/// (culled) hold the root tile's entry when one is resident, else zeros.
-/// Errors when `table_depth` exceeds [`MAX_TABLE_DEPTH`] or is shallower than
-/// the deepest needed level (each cell must lie in one needed node), or the
-/// extent is not finite and positive.
-pub fn page_table(plan: &TilePlan, extent: DVec2, table_depth: u32) -> Result<Vec<PageEntry>> {
-    let deepest = plan.draw.iter().map(|d| d.needed.level).max().unwrap_or(0);
-    let why = if table_depth > MAX_TABLE_DEPTH {
-        format!("depth {table_depth} exceeds {MAX_TABLE_DEPTH}")
-    } else if deepest > table_depth {
-        format!("depth {table_depth} is shallower than the deepest needed level {deepest}")
-    } else if !(extent.is_finite() && extent.x > 0.0 && extent.y > 0.0) {
-        format!("terrain extent {extent} must be finite and positive")
-    } else {
-        String::new()
-    };
-    if !why.is_empty() {
-        return Err(Error::invalid("page table", why));
-    }
-    let side = 1usize << table_depth;
-    let root = |s| PageEntry::new(NodeId::ROOT, s, extent, plan.border);
-    let fill = plan.root.map_or(PageEntry::zeroed(), root);
-    let mut table = vec![fill; side * side];
-    let mut draws: Vec<&DrawTile> = plan.draw.iter().collect();
-    draws.sort_by_key(|d| d.needed.level);
-    for d in draws {
-        let cells = side >> d.needed.level;
-        let (x0, y0) = (d.needed.x as usize * cells, d.needed.y as usize * cells);
-        if x0 >= side || y0 >= side {
-            continue;
-        }
-        let entry = PageEntry::new(d.source, d.slot, extent, plan.border);
-        for row in table.chunks_exact_mut(side).skip(y0).take(cells) {
-            row[x0..x0 + cells].fill(entry);
-        }
-    }
-    Ok(table)
-}
-
 #[cfg(test)]
 mod tests {
-    use glam::DVec3;
+    use glam::{DVec2, DVec3};
 
     use super::*;
     use crate::texturing::quadtree::{select_tiles, NodeBounds, View};
@@ -484,9 +445,11 @@ mod tests {
     }
 
     fn atlas(size: u32, border: u32, min_tile: u32, max_tile: u32) -> Result<TileCache> {
+        // One texture per size, so slot counts are easy to reason about.
         let mut settings = AtlasSettings {
             size,
             border,
+            max_textures_per_size: 1,
             ..AtlasSettings::default()
         };
         (settings.min_tile, settings.max_tile) = (min_tile, max_tile);
@@ -499,7 +462,7 @@ mod tests {
 
     #[test]
     fn identical_frames_hit_and_moving_eye_regenerates_only_changes() {
-        let mut cache = atlas(8192, 4, 16, 512).unwrap();
+        let mut cache = atlas(16384, 4, 16, 512).unwrap();
         let a = needed_from(DVec3::new(1000.0, 1000.0, 300.0));
         let first = cache.plan_frame(1, &a, usize::MAX).stats;
         // The root is not needed but generated as the fallback of last resort.
@@ -524,7 +487,7 @@ mod tests {
         let root_slot = first.generate[0].1;
         assert_eq!(first.generate.len(), 1);
         assert_eq!(
-            (root_slot.layer, root_slot.x, root_slot.y, root_slot.size),
+            (root_slot.texture, root_slot.x, root_slot.y, root_slot.size),
             (2, 0, 0, 64)
         );
         let mut needed = vec![tile(1, 0, 0, 64), tile(1, 0, 1, 64), tile(1, 1, 1, 64)];
@@ -563,35 +526,43 @@ mod tests {
     }
 
     #[test]
-    fn page_table_cells_map_to_nodes_and_atlas() {
-        let mut cache = TileCache::new(AtlasSettings::default()).unwrap();
-        let mut needed = vec![tile(1, 0, 0, 32), tile(1, 1, 0, 64)];
-        needed.extend([tile(2, 0, 2, 16), tile(2, 1, 2, 16)]);
-        let plan = cache.plan_frame(1, &needed, 10);
-        assert!(page_table(&plan, EXTENT, 1).is_err());
-        let table = page_table(&plan, EXTENT, 2).unwrap();
-        assert_eq!((table.len(), std::mem::size_of::<PageEntry>()), (16, 32));
-        let at = |i: usize, j: usize| table[j * 4 + i];
-        let slot = plan.draw[1].slot;
-        for (i, j) in [(2, 0), (3, 0), (2, 1), (3, 1)] {
-            let e = at(i, j);
-            assert_eq!((e.node_min, e.node_size), ([4000.0, 0.0], [4000.0, 2000.0]));
-            assert_eq!(e.atlas_origin, [(slot.x + 4) as f32, (slot.y + 4) as f32]);
-            assert_eq!((e.inner_texels, e.layer), (56.0, 2));
-        }
-        assert_eq!((at(1, 2).node_min, at(1, 2).inner_texels), ([2000.0, 2000.0], 8.0));
-        // Cells of the culled nodes (1, 1, 1) and (2, ·, 3) hold the root.
-        let root = PageEntry::new(NodeId::ROOT, plan.root.unwrap(), EXTENT, 4);
-        assert_eq!((at(3, 3), at(0, 3), root.node_size), (root, root, [8000.0, 4000.0]));
+    fn slots_run_through_several_textures_of_a_size() {
+        let mut settings = AtlasSettings {
+            size: 64,
+            border: 2,
+            min_tile: 16,
+            max_tile: 32,
+            min_slots: 8,
+            max_textures_per_size: 4,
+        };
+        // 16-texel tiles: one texture of 16 slots; 32-texel tiles: two of 4.
+        assert_eq!(settings.texture_tile_sizes(), [16, 32, 32]);
+        let mut cache = TileCache::new(settings).unwrap();
+        let needed: Vec<NeededTile> = (0..8).map(|i| tile(3, i, 0, 32)).collect();
+        let plan = cache.plan_frame(1, &needed, 100);
+        assert_eq!(plan.stats.deferred, 0);
+        let slots: HashSet<(u32, u32, u32)> = plan.draw.iter().map(|d| (d.slot.texture, d.slot.x, d.slot.y)).collect();
+        assert_eq!(slots.len(), 8, "distinct slots");
+        assert!(slots.iter().all(|&(t, x, y)| (1..=2).contains(&t) && x < 64 && y < 64));
+        settings.max_textures_per_size = 0;
+        assert!(TileCache::new(settings).is_err());
     }
 
     #[test]
     fn settings_layers_and_memory() {
         let s = AtlasSettings::default();
-        assert_eq!((s.layers(), s.layer_of(16), s.layer_of(512)), (6, Some(0), Some(5)));
-        assert_eq!((s.layer_of(24), s.layer_of(1024)), (None, None));
-        assert_eq!((s.slots_per_layer(256), s.slots_per_layer(16)), (16, 4096));
-        assert_eq!(TileCache::new(s).unwrap().memory_bytes(4), 6 * 1024 * 1024 * 4);
+        assert_eq!((s.sizes(), s.size_index(16), s.size_index(512)), (6, Some(0), Some(5)));
+        assert_eq!((s.size_index(24), s.size_index(1024)), (None, None));
+        assert_eq!((s.slots_per_texture(256), s.slots_per_texture(16)), (16, 4096));
+        // 128 slots wanted, at most 2 textures per size.
+        let textures = [16, 32, 64, 128, 256, 512].map(|t| s.textures_of(t));
+        assert_eq!(textures, [1, 1, 1, 2, 2, 2]);
+        assert_eq!(s.texture_tile_sizes(), [16, 32, 64, 128, 128, 256, 256, 512, 512]);
+        assert_eq!(
+            (s.first_texture(16), s.first_texture(256), s.first_texture(8)),
+            (Some(0), Some(5), None)
+        );
+        assert_eq!(TileCache::new(s).unwrap().memory_bytes(4), 9 * 1024 * 1024 * 4);
         assert!(atlas(1000, 4, 16, 512).is_err() && atlas(1024, 4, 16, 2048).is_err());
         assert!(atlas(1024, 4, 1024, 512).is_err() && atlas(1024, 8, 16, 512).is_err());
         assert_eq!(TileStats::default().hit_rate(), 1.0);

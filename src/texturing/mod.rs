@@ -7,10 +7,11 @@
 //!   functions and coverage, the CPU reference evaluation;
 //! * [`quadtree`]: per frame, the nodes the view needs and their tile sizes;
 //! * [`atlas`]: tile slots in the atlases, least-recently-used eviction, the
-//!   per-frame generation plan under a cap, and the page table the terrain
-//!   shading reads.
+//!   per-frame generation plan under a cap;
+//! * [`page_table`]: the per-frame indirection the terrain shading reads.
 
 pub mod atlas;
 pub mod gpu_layout;
 pub mod layers;
+pub mod page_table;
 pub mod quadtree;

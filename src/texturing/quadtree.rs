@@ -23,11 +23,12 @@
 //!    texels across, and its geometric error projects to
 //!    `geometric_error / (pixel_footprint · distance)` pixels;
 //! 3. **split** into its four children while `level < max_depth` and
-//!    `needed > aim_texels` or the projected error exceeds `pixel_error`;
+//!    `needed + 2·border > aim_texels` (the aim is the tile size, border
+//!    included) or the projected error exceeds `pixel_error`;
 //! 4. otherwise a **leaf** with size
 //!    `clamp(next_pow2(ceil(needed) + 2·border), min_tile, upper)`, where
 //!    `upper = max_tile` at `max_depth` and
-//!    `min(next_pow2(aim_texels + 2·border), max_tile)` above it.
+//!    `min(next_pow2(aim_texels), max_tile)` above it.
 //!
 //! The leaves partition the visible part of the rectangle exactly (no
 //! overlaps, no gaps except culled nodes) and are returned coarse to fine,
@@ -52,7 +53,8 @@ pub const MAX_PYRAMID_DEPTH: u32 = 10;
 /// How finely the quadtree refines and how large its tiles are.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct QuadtreeSettings {
-    /// Split a node while it needs more texels across than this.
+    /// Split a node while its tile (border included) would need more
+    /// texels across than this.
     pub aim_texels: u32,
     /// Smallest tile size in texels, border included (power of two).
     pub min_tile: u32,
@@ -83,9 +85,8 @@ impl Default for QuadtreeSettings {
 
 impl QuadtreeSettings {
     /// Checks: tile sizes are powers of two with `min_tile ≤ max_tile`,
-    /// `2·border < min_tile`, `max_depth ≤ 15`, `aim_texels ≥ min_tile −
-    /// 2·border` (the smallest inner size) and a finite positive
-    /// `pixel_error`.
+    /// `2·border < min_tile`, `max_depth ≤ 15`, `aim_texels ≥ min_tile`
+    /// and a finite positive `pixel_error`.
     pub fn validate(&self) -> Result<()> {
         let (min, max, border2) = (self.min_tile, self.max_tile, 2 * u64::from(self.border));
         let why = if !min.is_power_of_two() || !max.is_power_of_two() {
@@ -96,12 +97,8 @@ impl QuadtreeSettings {
             format!("2·border {border2} leaves no inner texels in min_tile {min}")
         } else if self.max_depth > 15 {
             format!("max_depth {} exceeds 15", self.max_depth)
-        } else if u64::from(self.aim_texels) < u64::from(min) - border2 {
-            format!(
-                "aim_texels {} is below the smallest inner size {}",
-                self.aim_texels,
-                u64::from(min) - border2
-            )
+        } else if self.aim_texels < min {
+            format!("aim_texels {} is below min_tile {min}", self.aim_texels)
         } else if !(self.pixel_error.is_finite() && self.pixel_error > 0.0) {
             format!("pixel_error {} must be finite and positive", self.pixel_error)
         } else {
@@ -112,8 +109,7 @@ impl QuadtreeSettings {
 
     /// The largest tile a node above `max_depth` can get.
     fn upper_tile(&self) -> u32 {
-        let want = u64::from(self.aim_texels) + 2 * u64::from(self.border);
-        want.next_power_of_two().min(u64::from(self.max_tile)) as u32
+        self.aim_texels.next_power_of_two().min(self.max_tile)
     }
 }
 
@@ -262,7 +258,8 @@ pub fn select_tiles(
         let per_metre = 1.0 / (footprint * distance);
         let needed = (hi - lo).max_element() * per_metre;
         let error_pixels = f64::from(b.geometric_error) * per_metre;
-        let coarse = needed > f64::from(settings.aim_texels) || error_pixels > f64::from(settings.pixel_error);
+        let coarse =
+            needed + border2 > f64::from(settings.aim_texels) || error_pixels > f64::from(settings.pixel_error);
         if node.level < settings.max_depth && coarse {
             stack.extend(node.children());
             continue;
