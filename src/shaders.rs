@@ -44,3 +44,9 @@ pub const HYBRID_VISIBILITY_FRAG: SpirV = spirv!("points/hybrid_visibility.frag"
 pub const HYBRID_ACCUMULATE_FRAG: SpirV = spirv!("points/hybrid_accumulate.frag");
 /// points.opaque, hybrid triangles: shaded directly.
 pub const HYBRID_OPAQUE_FRAG: SpirV = spirv!("points/hybrid_opaque.frag");
+/// texturing.upsample: the base surface at every texel of the dirty tiles (§8.2).
+pub const TEXTURING_UPSAMPLE: SpirV = spirv!("texturing/upsample.comp");
+/// texturing.layer*: one surface layer over every texel of the dirty tiles (§8.2).
+pub const TEXTURING_LAYER: SpirV = spirv!("texturing/layer.comp");
+/// texturing.finish: colour and displacement normal into the atlas (§8.2).
+pub const TEXTURING_FINISH: SpirV = spirv!("texturing/finish.comp");

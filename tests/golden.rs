@@ -50,6 +50,7 @@ fn check_golden_with(name: &str, scene: &Scene, camera: &Camera, points: SplatSe
             terrain: Default::default(),
             points,
             texturing: Default::default(),
+            texture_streaming: Default::default(),
         };
         let mut renderer = Renderer::new(&ctx, scene, settings).expect("renderer");
         let frame = renderer.render(camera).and_then(|f| renderer.read(&f)).expect("frame");

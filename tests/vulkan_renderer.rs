@@ -34,6 +34,7 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
             terrain: Default::default(),
             points: Default::default(),
             texturing: Default::default(),
+            texture_streaming: Default::default(),
         };
         let mut renderer = Renderer::new(&ctx, &scene, settings).expect("renderer");
         assert_eq!(
@@ -88,6 +89,7 @@ fn renders_are_deterministic() {
             terrain: Default::default(),
             points: Default::default(),
             texturing: Default::default(),
+            texture_streaming: Default::default(),
         };
         let camera = scene.default_camera();
         let mut first = Renderer::new(&ctx, &scene, settings).expect("renderer");
@@ -228,6 +230,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
                 terrain: Default::default(),
                 points: Default::default(),
                 texturing: Default::default(),
+                texture_streaming: Default::default(),
             },
         )
         .unwrap();
@@ -251,6 +254,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
                 terrain: Default::default(),
                 points: Default::default(),
                 texturing: Default::default(),
+                texture_streaming: Default::default(),
             }
         )
         .is_err());

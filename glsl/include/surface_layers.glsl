@@ -35,66 +35,95 @@ float hat(vec4 h, float a) {
 
 // Fractional Brownian motion of the wavelet noise tile at wavelength
 // `wavelength` (metres): three octaves, lacunarity 2, gain 1/2, scaled to
-// about [−1, 1]; `offset` decorrelates layers. Writes the world gradient.
-float layer_noise(uint tile, vec2 xy, float wavelength, vec2 offset, out vec2 grad) {
+// about [−1, 1]; `offset` decorrelates layers. Band-limited to the sample
+// spacing `footprint` (metres; 0: all octaves): an octave of wavelength λ
+// has weight clamp(λ / (2·footprint) − 1, 0, 1), full from four samples per
+// wavelength, none at two (Nyquist), so tiles and pixels filter alike.
+// Writes the world gradient.
+float layer_noise(uint tile, vec2 xy, float wavelength, vec2 offset, float footprint, out vec2 grad) {
     // The tile's noise has a wavelength of about 3 texels.
     float freq = 3.0 / wavelength;
     float value = 0.0;
     float amplitude = 0.87;
     grad = vec2(0.0);
     for (int k = 0; k < 3; ++k) {
+        float lambda = wavelength * exp2(-float(k));
+        float weight = footprint > 0.0 ? clamp(lambda / (2.0 * footprint) - 1.0, 0.0, 1.0) : 1.0;
+        if (weight <= 0.0) {
+            break;
+        }
         vec2 g;
-        value += amplitude * wavelet_noise(tile, xy * freq + offset * float(k + 1), g);
-        grad += amplitude * g * freq;
+        value += weight * amplitude * wavelet_noise(tile, xy * freq + offset * float(k + 1), g);
+        grad += weight * amplitude * g * freq;
         freq *= 2.0;
         amplitude *= 0.5;
     }
     return value;
 }
 
-// Colour and gradient of the final height at world xy of the base surface
-// (height h, gradient grad); `range` the height field's lowest and highest
-// sample; `maps` the extra inputs (NaN: absent).
-vec3 evaluate_layers(uint layers, uint count, uint tile, vec2 xy, float h, vec2 grad, vec2 range, vec3 maps,
-                     out vec2 out_grad) {
-    float slope = degrees(atan(length(grad)));
-    // C_S per tree level: in depth-first order the last layer seen one
-    // level up is the parent.
-    vec4 level_coverage = vec4(1.0);
-    vec3 color = vec3(0.0);
-    out_grad = grad;
-    for (uint i = 0u; i < count && i < MAX_SURFACE_LAYERS; ++i) {
-        uint level = g_surface_layers[layers].l[i].tree.y;
-        vec4 color_roughness = g_surface_layers[layers].l[i].color_roughness;
-        vec4 noise = g_surface_layers[layers].l[i].noise;
-        float c_s = 1.0;
-        if (level > 0u) {
-            float product = hat(g_surface_layers[layers].l[i].hats[0], h) *
-                            hat(g_surface_layers[layers].l[i].hats[1], (h - range.x) / max(range.y - range.x, 1e-6)) *
-                            hat(g_surface_layers[layers].l[i].hats[2], slope) *
-                            hat(g_surface_layers[layers].l[i].hats[3], maps.x) *
-                            hat(g_surface_layers[layers].l[i].hats[4], maps.y) *
-                            hat(g_surface_layers[layers].l[i].hats[5], maps.z);
-            float parent = level_coverage[min(level - 1u, 3u)];
-            if (product > 0.0 && parent > 0.0) {
-                vec2 unused;
-                float n = noise.y != 0.0 ? layer_noise(tile, xy, noise.z, vec2(17.3, 41.9) * float(i + 1u), unused) : 0.0;
-                c_s = clamp((noise.x + noise.y * n) * product, 0.0, 1.0) * parent;
-            } else {
-                c_s = 0.0;
-            }
-        }
-        level_coverage[min(level, 3u)] = c_s;
-        color = mix(color, color_roughness.rgb, c_s);
-        if (color_roughness.w > 0.0 && c_s > 0.0) {
-            vec2 dg;
-            float d = layer_noise(tile, xy, noise.w, vec2(29.1, 7.7) * float(i + 1u), dg);
-            float amplitude = c_s * color_roughness.w;
-            h += amplitude * d;
-            out_grad += amplitude * dg;
+// What the depth-first walk carries from layer to layer.
+struct LayerState {
+    float h;            // modified height (metres)
+    vec2 extra;         // gradient of the layers' displacement (added to the base gradient)
+    float slope;        // slope of the base surface (degrees)
+    vec3 color;         // blended linear colour so far
+    vec4 coverage;      // C_S of the last layer seen per tree level
+};
+
+// The state before the root: base height h with gradient grad.
+LayerState layer_state(float h, vec2 grad) {
+    return LayerState(h, vec2(0.0), degrees(atan(length(grad))), vec3(0.0), vec4(1.0));
+}
+
+// Layer i of the flat depth-first tree applied at world xy: coverage from
+// the hats (altitude and elevation of the modified height, base slope,
+// input maps `maps`), noise and the parent's coverage; colour blend;
+// displacement. `range`: the height field's lowest and highest sample.
+void apply_layer(uint layers, uint i, uint tile, vec2 xy, float footprint, vec2 range, vec3 maps, inout LayerState s) {
+    uint level = g_surface_layers[layers].l[i].tree.y;
+    vec4 color_roughness = g_surface_layers[layers].l[i].color_roughness;
+    vec4 noise = g_surface_layers[layers].l[i].noise;
+    float c_s = 1.0;
+    if (level > 0u) {
+        float product = hat(g_surface_layers[layers].l[i].hats[0], s.h) *
+                        hat(g_surface_layers[layers].l[i].hats[1], (s.h - range.x) / max(range.y - range.x, 1e-6)) *
+                        hat(g_surface_layers[layers].l[i].hats[2], s.slope) *
+                        hat(g_surface_layers[layers].l[i].hats[3], maps.x) *
+                        hat(g_surface_layers[layers].l[i].hats[4], maps.y) *
+                        hat(g_surface_layers[layers].l[i].hats[5], maps.z);
+        // In depth-first order the last layer seen one level up is the parent.
+        float parent = s.coverage[min(level - 1u, 3u)];
+        if (product > 0.0 && parent > 0.0) {
+            vec2 unused;
+            float n = noise.y != 0.0
+                          ? layer_noise(tile, xy, noise.z, vec2(17.3, 41.9) * float(i + 1u), footprint, unused)
+                          : 0.0;
+            c_s = clamp((noise.x + noise.y * n) * product, 0.0, 1.0) * parent;
+        } else {
+            c_s = 0.0;
         }
     }
-    return color;
+    s.coverage[min(level, 3u)] = c_s;
+    s.color = mix(s.color, color_roughness.rgb, c_s);
+    if (color_roughness.w > 0.0 && c_s > 0.0) {
+        vec2 dg;
+        float d = layer_noise(tile, xy, noise.w, vec2(29.1, 7.7) * float(i + 1u), footprint, dg);
+        float amplitude = c_s * color_roughness.w;
+        s.h += amplitude * d;
+        s.extra += amplitude * dg;
+    }
+}
+
+// The whole tree at world xy of the base surface (height h, gradient grad):
+// colour, and the displacement gradient in `extra`.
+vec3 evaluate_layers(uint layers, uint count, uint tile, vec2 xy, float footprint, float h, vec2 grad, vec2 range,
+                     vec3 maps, out vec2 extra) {
+    LayerState s = layer_state(h, grad);
+    for (uint i = 0u; i < count && i < MAX_SURFACE_LAYERS; ++i) {
+        apply_layer(layers, i, tile, xy, footprint, range, maps, s);
+    }
+    extra = s.extra;
+    return s.color;
 }
 
 #endif

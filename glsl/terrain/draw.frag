@@ -11,15 +11,8 @@
 #include "../include/terrain_draw.glsl"
 #include "../include/bspline_height.glsl"
 #include "../include/surface_layers.glsl"
+#include "../include/texture_atlas.glsl"
 
-// Per-frame texturing constants (src/texturing/gpu_layout.rs, TexturingFrame).
-layout(set = 0, binding = 2, std430) readonly buffer TerrainTexturing {
-    uvec4 handles;        // layers (storage), height texture (sampled), noise tile (sampled), mode
-    uvec4 grid;           // columns, rows, layer count, 0
-    vec4 spacing_range;   // spacing x, y, lowest and highest height
-} g_texturing[];
-
-const uint TEXTURING_DIRECT = 1u;
 // No extra input map bound: every hat on it gives 0.
 const vec3 NO_MAPS = vec3(-3.0e38);
 
@@ -93,17 +86,21 @@ void main() {
     vec3 radiance;
     if (view == VIEW_SHADED) {
         vec3 a;
-        if (texturing != 0xffffu && g_texturing[texturing].handles.w == TEXTURING_DIRECT) {
+        uint mode = texturing != 0xffffu ? g_texturing[texturing].handles.w : TEXTURING_CLASSIC;
+        vec2 extra;
+        if (mode == TEXTURING_ATLAS && sample_atlas(texturing, in_world.xy, a, extra)) {
+            // §8.2 from the atlas: colour and displacement normal of the tile.
+            n = normalize(n + vec3(-extra, 0.0) * n.z);
+        } else if (mode == TEXTURING_DIRECT) {
             // §8.2 evaluated per pixel: the reference of the atlas.
             uvec4 th = g_texturing[texturing].handles;
             vec4 sr = g_texturing[texturing].spacing_range;
             vec2 base_grad;
             float h = bspline_height(th.y, g_texturing[texturing].grid.xy, sr.xy, in_world.xy, base_grad);
-            vec2 grad;
-            a = evaluate_layers(th.x, g_texturing[texturing].grid.z, th.z, in_world.xy, h, base_grad, sr.zw, NO_MAPS,
-                                grad);
+            float footprint = max(depth, 1e-3) * pc.forward.w;
+            a = evaluate_layers(th.x, g_texturing[texturing].grid.z, th.z, in_world.xy, footprint, h, base_grad, sr.zw,
+                                NO_MAPS, extra);
             // The layers' displacement bumps the normal on top of the mesh's.
-            vec2 extra = grad - base_grad;
             n = normalize(n + vec3(-extra, 0.0) * n.z);
         } else {
             a = albedo(n, in_world, tile);

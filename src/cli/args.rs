@@ -224,10 +224,16 @@ pub struct TerrainArgs {
     /// Switch importance factors off (comma-separated), for debugging.
     #[arg(long = "importance-off", value_enum, value_delimiter = ',')]
     pub importance_off: Vec<FactorArg>,
-    /// Terrain colouring: classic surface types (§7.4.3) or the surface-layer
-    /// tree evaluated per pixel (direct, §8.2).
-    #[arg(long, value_enum, default_value = "classic")]
+    /// Terrain colouring: the surface-layer tree cached in a texture atlas
+    /// (atlas, §8.2), the same tree evaluated per pixel (direct, the atlas's
+    /// reference), or classic surface types (§7.4.3).
+    #[arg(long, value_enum, default_value = "atlas")]
     pub texturing: TexturingArg,
+    /// Most texture tiles generated per frame (atlas texturing); the texel
+    /// budget is this many 128² tiles. Still renders keep rendering until
+    /// every tile is ready.
+    #[arg(long = "tile-budget", default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub tile_budget: u32,
     /// Surface-layer tree (TOML; default: the built-in tree).
     #[arg(long)]
     pub layers: Option<PathBuf>,
@@ -240,6 +246,8 @@ pub enum TexturingArg {
     Classic,
     /// The surface-layer tree evaluated per pixel (§8.2 reference).
     Direct,
+    /// The surface-layer tree cached in atlas tiles (§8.2).
+    Atlas,
 }
 
 #[derive(Args, Debug)]

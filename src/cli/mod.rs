@@ -163,8 +163,22 @@ fn render_settings(args: &SceneArgs, readback: bool) -> Result<RenderSettings> {
         texturing: match args.terrain.texturing {
             args::TexturingArg::Classic => alpenglow::texturing::gpu_layout::TexturingMode::Classic,
             args::TexturingArg::Direct => alpenglow::texturing::gpu_layout::TexturingMode::Direct,
+            args::TexturingArg::Atlas => alpenglow::texturing::gpu_layout::TexturingMode::Atlas,
         },
+        texture_streaming: texture_streaming(&args.terrain),
     })
+}
+
+/// Atlas streaming with the tile budget of the arguments.
+fn texture_streaming(args: &args::TerrainArgs) -> alpenglow::texturing::generation::TextureStreaming {
+    let mut streaming = alpenglow::texturing::generation::TextureStreaming::default();
+    let tiles = args.tile_budget as usize;
+    let aim = u64::from(streaming.quadtree.aim_texels);
+    streaming.budget = alpenglow::texturing::atlas::GenerationBudget {
+        tiles,
+        texels: tiles as u64 * aim * aim,
+    };
+    streaming
 }
 
 fn load_terrain(args: &SceneArgs) -> Result<Scene> {
@@ -257,6 +271,9 @@ fn print_profile(device: &str, frame: &FrameProfile) {
     );
 }
 
+/// Most frames a still render takes to generate every texture tile.
+const MAX_SETTLE_FRAMES: u32 = 64;
+
 fn render(args: RenderArgs) -> Result<ExitCode> {
     check_output_path(&args.out, "PNG")?;
     check_output_path(&args.exr, "EXR")?;
@@ -270,11 +287,21 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
     let (images, profiles) = {
         let settings = render_settings(&args.scene, true)?;
         let mut renderer = Renderer::new(&ctx, &scene, settings)?;
-        let frame = renderer.render(&camera)?;
+        let frame = renderer.render_settled(&camera, MAX_SETTLE_FRAMES)?;
         let images = renderer.read(&frame)?;
         let profiles = renderer.finish()?;
         if let Some(stats) = renderer.take_point_stats()?.last() {
             println!("{}", stats.summary());
+        }
+        let textures = renderer.take_texture_stats()?;
+        if let Some(last) = textures.last() {
+            let generated: usize = textures.iter().map(|t| t.tiles.generated).sum();
+            println!(
+                "textures: {} tiles visible, {generated} generated over {} frame(s), {} resident",
+                last.tiles.visible,
+                textures.len(),
+                last.tiles.resident
+            );
         }
         (images, profiles)
     };

@@ -10,8 +10,7 @@ use super::{PassKind, ResourceId};
 use crate::error::{Error, Result};
 use crate::profile::{FrameProfile, PassTiming};
 use crate::vulkan::{
-    AccessFlags2, AccessState, Barrier, Buffer, CommandRecorder, CompletedFrame, FrameRing, Image, ImageLayout,
-    PipelineStageFlags2,
+    AccessFlags2, AccessState, Barrier, Buffer, CommandRecorder, CompletedFrame, FrameRing, Image, PipelineStageFlags2,
 };
 
 /// What a pass's recording closure gets: the command recorder and the
@@ -134,12 +133,13 @@ impl<P> BakedGraph<P> {
             let discard = !self.imported[r.0] && !touched[r.0];
             touched[r.0] = true;
             if let Some(mut b) = derive_barrier(&mut state, access, discard) {
-                if discard && access.is_image() && b.old_layout == ImageLayout::UNDEFINED {
-                    // First use of a transient image this frame: its contents are
-                    // discarded, so wait for everything before. Once per image and
-                    // frame, this costs little, and it keeps validation layers before
-                    // 1.3.268 quiet: they count every draw and dispatch as touching
-                    // every image of the bindless heap (KhronosGroup/Vulkan-ValidationLayers#3450).
+                if access.is_image() && b.old_layout != b.new_layout {
+                    // A layout transition (e.g. the first use of a transient image
+                    // this frame, or an atlas texture going from sampled to
+                    // storage) waits for everything before. A few per frame cost
+                    // little, and it keeps validation layers before 1.3.268
+                    // quiet: they count every draw and dispatch as touching every
+                    // image of the bindless heap (KhronosGroup/Vulkan-ValidationLayers#3450).
                     b.src_stages |= PipelineStageFlags2::ALL_COMMANDS;
                     b.src_access |= AccessFlags2::MEMORY_WRITE;
                 }

@@ -1,7 +1,7 @@
 //! The pinhole camera of the CLI contract: world right-handed, +Z up,
 //! vertical field of view, image row 0 at the top.
 
-use glam::{DMat4, DVec3, Mat4, Vec3};
+use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 
 use crate::error::{Error, Result};
 
@@ -92,6 +92,14 @@ impl Camera {
             self.forward().as_vec3(),
         )
     }
+}
+
+/// The world-space planes of the frustum of `view_proj` (Vulkan clip space,
+/// depth 0..1), as (n, d) with n·x + d ≥ 0 inside.
+pub fn frustum_planes(view_proj: DMat4) -> [DVec4; 6] {
+    let m = view_proj.transpose();
+    let (r0, r1, r2, r3) = (m.x_axis, m.y_axis, m.z_axis, m.w_axis);
+    [r3 + r0, r3 - r0, r3 + r1, r3 - r1, r2, r3 - r2].map(|p| p / p.truncate().length().max(1e-300))
 }
 
 #[cfg(test)]

@@ -28,6 +28,7 @@ use crate::points::render::{add_point_passes, PointFrameStats, PointPasses, Spla
 use crate::profile::FrameProfile;
 use crate::terrain::geometry_image::{GeometryImage, TerrainSettings};
 use crate::terrain::shading::{add_draw_pass, TerrainTexturing};
+use crate::texturing::generation::{AtlasResources, TextureFrameStats, TextureStreaming};
 use crate::texturing::gpu_layout::TexturingMode;
 use crate::vulkan::{
     Buffer, BufferDesc, BufferUsageFlags, Context, Format, FrameRing, MemoryLocation, FRAMES_IN_FLIGHT,
@@ -63,6 +64,8 @@ pub struct RenderSettings {
     pub points: SplatSettings,
     /// How the terrain is coloured (§7.4.3 surface types or the §8.2 layer tree).
     pub texturing: TexturingMode,
+    /// Tile streaming of [`TexturingMode::Atlas`].
+    pub texture_streaming: TextureStreaming,
 }
 
 impl RenderSettings {
@@ -75,6 +78,7 @@ impl RenderSettings {
             terrain: TerrainSettings::default(),
             points: SplatSettings::default(),
             texturing: TexturingMode::default(),
+            texture_streaming: TextureStreaming::default(),
         }
     }
 }
@@ -115,6 +119,8 @@ pub struct Renderer {
     frames_rendered: u64,
     /// Point passes' statistics (None without points).
     points: Option<PointPasses>,
+    /// The texture atlas's statistics (None unless texturing from the atlas).
+    atlas: Option<AtlasResources>,
     /// Kept alive for the graph's imported resources.
     _terrain: Option<GeometryImage>,
 }
@@ -161,10 +167,10 @@ impl Renderer {
         let ldr = graph.create_image("srgb", ImageInfo::new(w, h, Format::R8G8B8A8_UNORM));
 
         add_sky_pass(ctx, &mut graph, hdr, view_depth)?;
-        let terrain = if scene.draw_terrain {
+        let (terrain, atlas) = if scene.draw_terrain {
             let terrain = GeometryImage::new(ctx, Arc::new(scene.heights.clone()), settings.terrain)?;
             let terrain_resources = terrain.add_warp_pass(ctx, &mut graph)?;
-            add_draw_pass(
+            let atlas = add_draw_pass(
                 ctx,
                 &mut graph,
                 &terrain,
@@ -174,11 +180,12 @@ impl Renderer {
                 &TerrainTexturing {
                     mode: settings.texturing,
                     layers: &scene.layers,
+                    streaming: settings.texture_streaming,
                 },
             )?;
-            Some(terrain)
+            (Some(terrain), atlas)
         } else {
-            None
+            (None, None)
         };
         let (points, weight) = if scene.points.is_empty() {
             (None, None)
@@ -250,6 +257,7 @@ impl Renderer {
             snow_line: lo + (hi - lo) * 0.8,
             frames_rendered: 0,
             points,
+            atlas,
             _terrain: terrain,
         })
     }
@@ -277,6 +285,24 @@ impl Renderer {
         let outcome = self.graph.execute(&mut self.frames, &params)?;
         self.frames_rendered = outcome.frame + 1;
         Ok(outcome)
+    }
+
+    /// Renders `camera` until every texture tile the view needs is ready
+    /// (the atlas generates at most its budget per frame) and returns that
+    /// frame; at most `max_frames` frames, then errors. Same as
+    /// [`Renderer::render`] without the atlas.
+    pub fn render_settled(&mut self, camera: &Camera, max_frames: u32) -> Result<FrameOutcome> {
+        for _ in 0..max_frames.max(1) {
+            let outcome = self.render(camera)?;
+            match &self.atlas {
+                Some(atlas) if atlas.last_deferred()? > 0 => continue,
+                _ => return Ok(outcome),
+            }
+        }
+        Err(Error::invalid(
+            "texture atlas",
+            format!("tiles still missing after {max_frames} frames: raise the tile budget or the atlas size"),
+        ))
     }
 
     /// Waits for `frame` and copies its images out of the readback buffers.
@@ -315,6 +341,16 @@ impl Renderer {
     pub fn finish(&mut self) -> Result<Vec<FrameProfile>> {
         self.graph.finish(&mut self.frames)?;
         Ok(self.graph.take_profiles())
+    }
+
+    /// Texture atlas statistics of the frames recorded so far and not yet
+    /// taken (their GPU times are the `texturing.*` passes of
+    /// [`Renderer::finish`]'s profiles); empty unless texturing from the atlas.
+    pub fn take_texture_stats(&mut self) -> Result<Vec<TextureFrameStats>> {
+        match &self.atlas {
+            Some(a) => a.take_stats(),
+            None => Ok(Vec::new()),
+        }
     }
 
     /// Point statistics of the frames completed so far and not yet taken

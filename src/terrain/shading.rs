@@ -7,6 +7,8 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::texturing::generation::{add_generation_passes, locked, AtlasResources, GenerationInputs, TextureStreaming};
+
 use crate::error::Error;
 use crate::error::Result;
 use crate::graph::{Access, RenderGraph, ResourceId, Stage};
@@ -40,10 +42,14 @@ struct TerrainDrawPush {
 pub struct TerrainTexturing<'a> {
     pub mode: TexturingMode,
     pub layers: &'a LayerTree,
+    /// Atlas streaming (used by [`TexturingMode::Atlas`]).
+    pub streaming: TextureStreaming,
 }
 
 /// Declares `terrain.draw` into `color` and `view_depth` (loaded: the sky
 /// pass wrote them) with depth buffer `depth`; `heights` is the sketch atlas.
+/// In [`TexturingMode::Atlas`] the tile generation passes come first
+/// ([`add_generation_passes`]); their resources are returned.
 pub fn add_draw_pass(
     ctx: &Context,
     graph: &mut RenderGraph<FrameParams>,
@@ -52,7 +58,7 @@ pub fn add_draw_pass(
     (color, view_depth, depth): (ResourceId, ResourceId, ResourceId),
     image_height: u32,
     texturing: &TerrainTexturing,
-) -> Result<()> {
+) -> Result<Option<AtlasResources>> {
     if let Some(k) = (0..INPUT_NAMES.len()).find(|&k| texturing.layers.uses_input(k)) {
         return Err(Error::invalid(
             "surface layers",
@@ -73,6 +79,22 @@ pub fn add_draw_pass(
         bytemuck::cast_slice(&pack_layers(texturing.layers)),
     )?;
     let layers = graph.import_buffer(std::sync::Arc::new(layer_buffer));
+    let atlas = match texturing.mode {
+        TexturingMode::Atlas => Some(add_generation_passes(
+            ctx,
+            graph,
+            GenerationInputs {
+                field: terrain.field.clone(),
+                heights,
+                noise,
+                layers,
+                tree: texturing.layers,
+                image_height,
+            },
+            texturing.streaming,
+        )?),
+        _ => None,
+    };
     let frames = graph.import_buffers_per_frame(Buffer::per_frame(
         ctx,
         BufferDesc {
@@ -120,7 +142,7 @@ pub fn add_draw_pass(
     let index_count = (side - 1) * (side - 1) * 6;
     let settings = terrain.settings;
     let d0 = terrain.atlas_spacing();
-    graph
+    let mut pass = graph
         .pass("terrain.draw")
         .graphics()
         .read(vertices, Access::VertexBuffer)
@@ -128,15 +150,31 @@ pub fn add_draw_pass(
         .read(noise, Access::SampledImage(Stage::Fragment))
         .read(heights, Access::SampledImage(Stage::Fragment))
         .read(layers, Access::StorageBufferRead(Stage::Fragment))
-        .read(frames, Access::StorageBufferRead(Stage::Fragment))
-        .write(color, Access::ColorAttachmentReadWrite)
+        .read(frames, Access::StorageBufferRead(Stage::Fragment));
+    let extent = field.extent();
+    let atlas_inputs = atlas.as_ref().map(|a| {
+        (
+            a.colors.clone(),
+            a.normals.clone(),
+            a.page_table,
+            a.atlas_size,
+            a.state.clone(),
+        )
+    });
+    if let Some((colors, normals, page_table, _, _)) = &atlas_inputs {
+        pass = pass.read(*page_table, Access::StorageBufferRead(Stage::Fragment));
+        for &image in colors.iter().chain(normals) {
+            pass = pass.read(image, Access::SampledImage(Stage::Fragment));
+        }
+    }
+    pass.write(color, Access::ColorAttachmentReadWrite)
         .write(view_depth, Access::ColorAttachmentReadWrite)
         .write(depth, Access::DepthAttachmentWrite)
         .record(move |pass, params| {
             let camera = &params.camera;
             let pixel_footprint = 2.0 * (0.5 * camera.fov_y_deg.to_radians()).tan() / f64::from(image_height);
             let noise_handle = pass.sampled(noise)?;
-            let frame = TexturingFrame {
+            let mut frame = TexturingFrame {
                 handles: [
                     pass.storage_buffer(layers)?,
                     pass.sampled(heights)?,
@@ -145,7 +183,17 @@ pub fn add_draw_pass(
                 ],
                 grid: [field.columns, field.rows, layer_count, 0],
                 spacing_range: [field.spacing.x as f32, field.spacing.y as f32, lo, hi],
+                extent: [extent.x as f32, extent.y as f32, 0.0, 0.0],
+                ..TexturingFrame::zeroed()
             };
+            if let Some((colors, normals, page_table, atlas_size, state)) = &atlas_inputs {
+                let words = std::mem::take(&mut locked(state)?.page_words);
+                pass.buffer(*page_table)?.write(0, bytemuck::cast_slice(&words))?;
+                frame.atlas = [pass.storage_buffer(*page_table)?, colors.len() as u32, *atlas_size, 0];
+                for (k, (&c, &n)) in colors.iter().zip(normals).enumerate() {
+                    (frame.color[k], frame.normal[k]) = (pass.sampled(c)?, pass.sampled(n)?);
+                }
+            }
             let frame_handle = pass.storage_buffer(frames)?;
             pass.buffer(frames)?.write(0, bytemuck::bytes_of(&frame))?;
             if noise_handle > 0xffff || frame_handle >= 0xffff {
@@ -178,5 +226,5 @@ pub fn add_draw_pass(
             cmd.end_rendering();
             Ok(())
         });
-    Ok(())
+    Ok(atlas)
 }

@@ -191,6 +191,32 @@ pub struct TilePlan {
     pub border: u32,
 }
 
+/// How much one frame may generate: tiles and texels (border included).
+/// The root exception of the module documentation applies to both.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GenerationBudget {
+    pub tiles: usize,
+    pub texels: u64,
+}
+
+impl GenerationBudget {
+    /// No limit.
+    pub const UNLIMITED: GenerationBudget = GenerationBudget {
+        tiles: usize::MAX,
+        texels: u64::MAX,
+    };
+}
+
+impl From<usize> for GenerationBudget {
+    /// At most `tiles` tiles, any size.
+    fn from(tiles: usize) -> GenerationBudget {
+        GenerationBudget {
+            tiles,
+            texels: u64::MAX,
+        }
+    }
+}
+
 /// How one needed node is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DrawTile {
@@ -268,9 +294,11 @@ impl TileCache {
         self.index.clear();
     }
 
-    /// Plans one frame: `needed` from `select_tiles`; at most `cap` tiles are
-    /// (re)generated, by the rules in the module documentation.
-    pub fn plan_frame(&mut self, frame: u64, needed: &[NeededTile], cap: usize) -> TilePlan {
+    /// Plans one frame: `needed` from `select_tiles`; at most `cap` tiles
+    /// (a count, or a [`GenerationBudget`]) are (re)generated, by the rules
+    /// in the module documentation.
+    pub fn plan_frame(&mut self, frame: u64, needed: &[NeededTile], cap: impl Into<GenerationBudget>) -> TilePlan {
+        let GenerationBudget { tiles: cap, texels } = cap.into();
         let mut stats = TileStats::default();
         let mut generate = Vec::new();
         let settings = self.settings;
@@ -300,7 +328,14 @@ impl TileCache {
         missing.sort_by(|a, b| a.0.level.cmp(&b.0.level).then(a.2.total_cmp(&b.2)).then(a.0.cmp(&b.0)));
         let mut seen = HashSet::new();
         missing.retain(|m| seen.insert((m.0, m.1)));
-        let budget = cap.saturating_sub(generate.len()).min(missing.len());
+        let mut texels_left = texels.saturating_sub(generate.iter().map(|g| u64::from(g.1.size).pow(2)).sum());
+        let mut budget = 0;
+        for &(_, size, _) in missing.iter().take(cap.saturating_sub(generate.len())) {
+            let Some(rest) = texels_left.checked_sub(u64::from(size).pow(2)) else {
+                break;
+            };
+            (texels_left, budget) = (rest, budget + 1);
+        }
         for &(node, size, _) in &missing[budget..] {
             if let Some((source, source_size)) = self.fallback(node, size) {
                 self.touch(source, source_size, frame);
@@ -503,6 +538,27 @@ mod tests {
         let stats = next.stats;
         assert_eq!((stats.hits, stats.generated, stats.deferred), (3, 3, 1));
         assert_eq!(next.generate[0].0, NodeId { level: 2, x: 2, y: 0 });
+    }
+
+    #[test]
+    fn texel_budget_defers_in_priority_order() {
+        let mut cache = TileCache::new(AtlasSettings::default()).unwrap();
+        cache.plan_frame(1, &[tile(0, 0, 0, 16)], 1);
+        let needed = NodeId::ROOT.children().map(|n| tile(1, n.x, n.y, 64));
+        let budget = GenerationBudget {
+            tiles: 10,
+            texels: 2 * 64 * 64 + 100,
+        };
+        let plan = cache.plan_frame(2, &needed, budget);
+        assert_eq!((plan.stats.generated, plan.stats.deferred), (2, 2));
+        assert_eq!(
+            plan.generate.iter().map(|g| g.0).collect::<Vec<_>>(),
+            [needed[0].node, needed[2].node],
+            "nearest, then node id"
+        );
+        // An unlimited budget takes the rest.
+        let plan = cache.plan_frame(3, &needed, GenerationBudget::UNLIMITED);
+        assert_eq!((plan.stats.generated, plan.stats.hits), (2, 2));
     }
 
     #[test]

@@ -13,6 +13,9 @@ pub enum TexturingMode {
     Classic,
     /// The surface-layer tree evaluated per pixel (§8.2; the reference of the atlas).
     Direct,
+    /// The surface-layer tree evaluated into cached tiles of a texture atlas
+    /// (§8.2), sampled through a per-frame page table.
+    Atlas,
 }
 
 impl TexturingMode {
@@ -21,6 +24,7 @@ impl TexturingMode {
         match self {
             TexturingMode::Classic => 0,
             TexturingMode::Direct => 1,
+            TexturingMode::Atlas => 2,
         }
     }
 }
@@ -76,4 +80,12 @@ pub struct TexturingFrame {
     pub grid: [u32; 4],
     /// Sample spacing x, y (metres), lowest and highest height.
     pub spacing_range: [f32; 4],
+    /// Page table (storage), atlas texture count, atlas size (texels), 0.
+    pub atlas: [u32; 4],
+    /// Terrain rectangle x, y (metres), 0, 0.
+    pub extent: [f32; 4],
+    /// Sampled handles of the atlas colour textures, in texture order.
+    pub color: [u32; 16],
+    /// Sampled handles of the atlas normal textures.
+    pub normal: [u32; 16],
 }

@@ -8,9 +8,12 @@
 //! * [`quadtree`]: per frame, the nodes the view needs and their tile sizes;
 //! * [`atlas`]: tile slots in the atlases, least-recently-used eviction, the
 //!   per-frame generation plan under a cap;
+//! * [`generation`]: the GPU passes that evaluate the tree into the dirty
+//!   tiles of a frame, all at once, one pass per layer;
 //! * [`page_table`]: the per-frame indirection the terrain shading reads.
 
 pub mod atlas;
+pub mod generation;
 pub mod gpu_layout;
 pub mod layers;
 pub mod page_table;

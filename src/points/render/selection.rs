@@ -11,11 +11,12 @@
 
 use std::sync::Arc;
 
-use glam::{DMat4, DVec3, DVec4};
+use glam::{DMat4, DVec3};
 
 use super::gpu_layout::GpuInstance;
 use crate::points::clusters::ClusteredTree;
 use crate::points::scene::PointScene;
+use crate::renderer::camera::frustum_planes;
 
 /// Where an object's splats are in the splat buffer.
 #[derive(Clone, Debug)]
@@ -54,14 +55,6 @@ pub struct FramePlan {
     pub triangle_draws: Vec<InstanceDraw>,
     /// Triangles in the drawn prefixes.
     pub prefix_triangles: u64,
-}
-
-/// The world-space planes of the frustum of `view_proj` (Vulkan clip space,
-/// depth 0..1), as (n, d) with n·x + d ≥ 0 inside.
-fn frustum_planes(view_proj: DMat4) -> [DVec4; 6] {
-    let m = view_proj.transpose();
-    let (r0, r1, r2, r3) = (m.x_axis, m.y_axis, m.z_axis, m.w_axis);
-    [r3 + r0, r3 - r0, r3 + r1, r3 - r1, r2, r3 - r2].map(|p| p / p.truncate().length().max(1e-300))
 }
 
 /// Plans a frame: `view` world → camera, `view_proj` world → clip,

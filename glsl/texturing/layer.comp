@@ -1,0 +1,27 @@
+#version 460
+// texturing.layer.<name> (dissertation §8.2, Table 8.1; ALGORITHMS.md §4):
+// one layer of the surface-layer tree, in depth-first order, over every
+// texel of every dirty tile at once: coverage from hats, noise and the
+// parent level's coverage, colour blend, displacement passed on to the next
+// layer (surface_layers.glsl, the same code terrain.draw runs per pixel in
+// --texturing direct).
+#include "../include/heap.glsl"
+#include "../include/terrain_detail.glsl"
+#include "../include/surface_layers.glsl"
+#include "../include/texture_tiles.glsl"
+
+// No extra input map bound: every hat on it gives 0.
+const vec3 NO_MAPS = vec3(-3.0e38);
+
+void main() {
+    TileJob job;
+    uvec2 local;
+    vec2 xy;
+    if (!tile_texel(job, local, xy)) {
+        return;
+    }
+    uint texel = gl_GlobalInvocationID.x;
+    LayerState s = unpack_state(g_texel_states[pc.handles.y].t[texel]);
+    apply_layer(pc.handles.z, pc.counts.z, pc.handles.w, xy, texel_footprint(job), pc.spacing_range.zw, NO_MAPS, s);
+    g_texel_states[pc.handles.y].t[texel] = pack_state(s);
+}

@@ -1,0 +1,460 @@
+//! Tile generation on the GPU (dissertation §8.2, the pipeline of Fig. 8.x;
+//! `ALGORITHMS.md` §4 items 3–4), as render-graph passes over **all** dirty
+//! tiles of a frame at once:
+//!
+//! 1. CPU, in `texturing.upsample`'s recording: the quadtree picks the nodes
+//!    the view needs ([`select_tiles`]), the tile cache plans what to
+//!    generate within the [`GenerationBudget`] and what to draw from where
+//!    ([`TileCache::plan_frame`]), and the page table is built
+//!    ([`PageTable`]). The dirty tiles become [`TileJob`]s: one thread per
+//!    texel, border included, of all of them.
+//! 2. `texturing.upsample`: the base surface (the height field as a cubic
+//!    B-spline) at every texel: height and slope (`glsl/texturing/upsample.comp`).
+//! 3. `texturing.layer<i>.<name>`: one pass per layer in depth-first order
+//!    (`glsl/texturing/layer.comp`): coverage per tree level, colour blend,
+//!    displaced height passed on to the next layer; the per-texel state
+//!    lives in a scratch buffer.
+//! 4. `texturing.finish`: colour (sRGB-encoded) and the normal of the
+//!    layers' displacement into the atlas textures
+//!    (`glsl/texturing/finish.comp`).
+//!
+//! `terrain.draw` then samples the atlas through the page table.
+
+use std::sync::{Arc, Mutex};
+
+use bytemuck::{Pod, Zeroable};
+use glam::DVec2;
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::graph::{Access, BufferInfo, RenderGraph, ResourceId, Stage};
+use crate::io::heightmap::HeightField;
+use crate::renderer::camera::frustum_planes;
+use crate::renderer::FrameParams;
+use crate::shaders;
+use crate::texturing::atlas::{AtlasSettings, GenerationBudget, TileCache, TilePlan, TileStats};
+use crate::texturing::layers::LayerTree;
+use crate::texturing::page_table::PageTable;
+use crate::texturing::quadtree::{select_tiles, HeightBounds, NodeId, QuadtreeSettings, View};
+use crate::vulkan::{
+    Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, Format, Image, ImageDesc, ImageUsageFlags,
+    MemoryLocation,
+};
+
+/// Bytes of one texel's state in the scratch buffer (`TexelState`).
+pub const TEXEL_STATE_BYTES: u64 = 32;
+/// Capacity of the per-frame page-table buffer in 16-byte words.
+pub const PAGE_TABLE_WORDS: usize = 1 << 16;
+/// Most atlas textures (`MAX_ATLAS_TEXTURES` in texture_atlas.glsl).
+pub const MAX_ATLAS_TEXTURES: usize = 16;
+/// Texels per workgroup of the generation passes.
+const GROUP: u64 = 64;
+/// Most texels one frame generates: one-dimensional dispatches of 65 535 groups.
+pub const MAX_DISPATCH_TEXELS: u64 = 65_535 * GROUP;
+
+/// How textures stream: quadtree refinement, atlas layout and the
+/// per-frame generation budget.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureStreaming {
+    pub quadtree: QuadtreeSettings,
+    pub atlas: AtlasSettings,
+    /// Most tiles and texels generated per frame.
+    pub budget: GenerationBudget,
+}
+
+impl Default for TextureStreaming {
+    fn default() -> Self {
+        let quadtree = QuadtreeSettings {
+            // Texture resolution alone decides; the terrain mesh is independent.
+            pixel_error: f32::MAX,
+            ..QuadtreeSettings::default()
+        };
+        TextureStreaming {
+            quadtree,
+            atlas: AtlasSettings::for_quadtree(&quadtree),
+            budget: GenerationBudget {
+                tiles: 32,
+                texels: 32 * 128 * 128,
+            },
+        }
+    }
+}
+
+impl TextureStreaming {
+    /// Checks the settings and that the budget fits a scratch buffer.
+    pub fn validate(&self) -> Result<()> {
+        self.quadtree.validate()?;
+        self.atlas.validate()?;
+        let textures = self.atlas.texture_tile_sizes().len();
+        let why = if self.atlas.border != self.quadtree.border
+            || self.atlas.min_tile != self.quadtree.min_tile
+            || self.atlas.max_tile != self.quadtree.max_tile
+        {
+            "atlas and quadtree disagree on border or tile sizes".to_string()
+        } else if textures > MAX_ATLAS_TEXTURES {
+            format!("{textures} atlas textures exceed {MAX_ATLAS_TEXTURES}")
+        } else if self.budget.tiles == 0 || self.budget.texels < u64::from(self.atlas.min_tile).pow(2) {
+            format!("budget {:?} cannot generate one tile", self.budget)
+        } else if self.scratch_texels() > MAX_DISPATCH_TEXELS {
+            format!(
+                "budget of {} texels per frame exceeds {MAX_DISPATCH_TEXELS} with the largest tile",
+                self.budget.texels
+            )
+        } else {
+            return Ok(());
+        };
+        Err(Error::invalid("texture streaming", why))
+    }
+
+    /// Texels the scratch buffer holds: the budget, plus the largest tile
+    /// for the root exception (`crate::texturing::atlas`).
+    pub fn scratch_texels(&self) -> u64 {
+        let tiles = (self.budget.tiles as u64).saturating_add(1);
+        let biggest = u64::from(self.atlas.max_tile).pow(2);
+        self.budget
+            .texels
+            .min(tiles.saturating_mul(biggest))
+            .saturating_add(biggest)
+    }
+}
+
+/// One dirty tile (`TileJob` in glsl/include/texture_tiles.glsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct TileJob {
+    /// xy of texel (0, 0)'s centre, texel spacing x, y (metres).
+    pub world: [f32; 4],
+    /// First scratch texel, tile size (border included), slot x, slot y.
+    pub tile: [u32; 4],
+    /// Colour and normal textures (storage handles), 0, 0.
+    pub images: [u32; 4],
+}
+
+/// World position of texel `(i, j)` (border included) of the tile of
+/// `node` with `size` texels and `border`: texel centres, the inner
+/// `size − 2·border` texels covering the node exactly.
+pub fn texel_world(node: NodeId, size: u32, border: u32, extent: DVec2, (i, j): (u32, u32)) -> DVec2 {
+    let (min, max) = node.rect(extent);
+    let spacing = (max - min) / f64::from(size - 2 * border);
+    min + (DVec2::new(f64::from(i), f64::from(j)) - f64::from(border) + 0.5) * spacing
+}
+
+/// The jobs of `plan.generate`, texels numbered tile after tile, and the
+/// texel count; `images(texture)` gives the colour and normal storage
+/// handles of an atlas texture.
+pub fn tile_jobs(plan: &TilePlan, extent: DVec2, images: &dyn Fn(u32) -> [u32; 2]) -> (Vec<TileJob>, u64) {
+    let mut texels = 0u64;
+    let jobs = plan
+        .generate
+        .iter()
+        .map(|&(node, slot)| {
+            let origin = texel_world(node, slot.size, plan.border, extent, (0, 0));
+            let (min, max) = node.rect(extent);
+            let spacing = (max - min) / f64::from(slot.size - 2 * plan.border);
+            let [color, normal] = images(slot.texture);
+            let job = TileJob {
+                world: [origin.x as f32, origin.y as f32, spacing.x as f32, spacing.y as f32],
+                tile: [texels as u32, slot.size, slot.x, slot.y],
+                images: [color, normal, 0, 0],
+            };
+            texels += u64::from(slot.size).pow(2);
+            job
+        })
+        .collect();
+    (jobs, texels)
+}
+
+/// Texture statistics of one frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct TextureFrameStats {
+    pub frame: u64,
+    /// Tiles visible, hits, generated, evicted, deferred, resident.
+    #[serde(flatten)]
+    pub tiles: TileStats,
+    /// `hits / visible`.
+    pub hit_rate: f64,
+    /// Texels generated (borders included).
+    pub texels_generated: u64,
+    /// CPU time of selection, planning and the page table, milliseconds.
+    pub cpu_ms: f64,
+}
+
+/// What the generation passes and `terrain.draw` share.
+pub(crate) struct GenerationState {
+    cache: TileCache,
+    bounds: HeightBounds,
+    /// This frame's page table in words, written by `terrain.draw`.
+    pub(crate) page_words: Vec<[u32; 4]>,
+    jobs: u32,
+    texels: u64,
+    stats: Vec<TextureFrameStats>,
+}
+
+/// Shared between the passes' recording closures.
+pub(crate) type SharedGeneration = Arc<Mutex<GenerationState>>;
+
+pub(crate) fn locked(state: &SharedGeneration) -> Result<std::sync::MutexGuard<'_, GenerationState>> {
+    state
+        .lock()
+        .map_err(|_| Error::Graph("texture generation state lock poisoned".into()))
+}
+
+/// The atlas and page table the generation passes leave for `terrain.draw`.
+pub struct AtlasResources {
+    /// Colour (sRGB-encoded RGBA8) textures, in texture order.
+    pub colors: Vec<ResourceId>,
+    /// Displacement normal (RGBA8, n·½ + ½) textures.
+    pub normals: Vec<ResourceId>,
+    /// This frame's page table (host-written, per frame).
+    pub page_table: ResourceId,
+    /// Texels per atlas side.
+    pub atlas_size: u32,
+    pub(crate) state: SharedGeneration,
+}
+
+impl AtlasResources {
+    /// Needed tiles the last recorded frame drew from a coarser tile.
+    pub fn last_deferred(&self) -> Result<usize> {
+        Ok(locked(&self.state)?.stats.last().map_or(0, |s| s.tiles.deferred))
+    }
+
+    /// Texture statistics of the frames recorded so far and not yet taken.
+    pub fn take_stats(&self) -> Result<Vec<TextureFrameStats>> {
+        Ok(std::mem::take(&mut locked(&self.state)?.stats))
+    }
+}
+
+/// Push constants of every `texturing.*` pass (texture_tiles.glsl).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct TileGenerationPush {
+    handles: [u32; 4],
+    counts: [u32; 4],
+    grid: [u32; 4],
+    spacing_range: [f32; 4],
+}
+
+/// What the passes read besides their own resources.
+pub struct GenerationInputs<'a> {
+    pub field: Arc<HeightField>,
+    /// The height field as an R32F texture, the wavelet noise tile, the
+    /// layers buffer.
+    pub heights: ResourceId,
+    pub noise: ResourceId,
+    pub layers: ResourceId,
+    pub tree: &'a LayerTree,
+    /// Image rows (the pixel footprint).
+    pub image_height: u32,
+}
+
+/// Declares `texturing.upsample`, one `texturing.layer*` pass per layer and
+/// `texturing.finish` (module documentation).
+pub fn add_generation_passes(
+    ctx: &Context,
+    graph: &mut RenderGraph<FrameParams>,
+    inputs: GenerationInputs,
+    streaming: TextureStreaming,
+) -> Result<AtlasResources> {
+    streaming.validate()?;
+    let field = inputs.field.clone();
+    let extent = field.extent();
+    let state = Arc::new(Mutex::new(GenerationState {
+        cache: TileCache::new(streaming.atlas)?,
+        bounds: HeightBounds::new(&field, streaming.quadtree.max_depth)?,
+        page_words: Vec::new(),
+        jobs: 0,
+        texels: 0,
+        stats: Vec::new(),
+    }));
+    let atlas_size = streaming.atlas.size;
+    let mut colors = Vec::new();
+    let mut normals = Vec::new();
+    for (k, tile) in streaming.atlas.texture_tile_sizes().into_iter().enumerate() {
+        for (what, list) in [("colour", &mut colors), ("normal", &mut normals)] {
+            let image = Image::new(
+                ctx,
+                ImageDesc {
+                    name: format!("texture atlas {k} ({tile}² tiles, {what})"),
+                    width: atlas_size,
+                    height: atlas_size,
+                    format: Format::R8G8B8A8_UNORM,
+                    usage: ImageUsageFlags::STORAGE | ImageUsageFlags::SAMPLED,
+                },
+            )?;
+            list.push(graph.import_image(Arc::new(image)));
+        }
+    }
+    let max_jobs = streaming.budget.tiles.saturating_add(1).min(1 << 16);
+    let jobs = graph.import_buffers_per_frame(Buffer::per_frame(
+        ctx,
+        BufferDesc {
+            name: "texture tile jobs".into(),
+            size: (max_jobs * std::mem::size_of::<TileJob>()) as u64,
+            usage: BufferUsageFlags::STORAGE_BUFFER,
+            location: MemoryLocation::CpuToGpu,
+        },
+    )?);
+    let page_table = graph.import_buffers_per_frame(Buffer::per_frame(
+        ctx,
+        BufferDesc {
+            name: "texture page table".into(),
+            size: (PAGE_TABLE_WORDS * 16) as u64,
+            usage: BufferUsageFlags::STORAGE_BUFFER,
+            location: MemoryLocation::CpuToGpu,
+        },
+    )?);
+    let scratch_texels = streaming.scratch_texels();
+    let scratch = graph.create_buffer(
+        "texel states",
+        BufferInfo {
+            size: scratch_texels * TEXEL_STATE_BYTES,
+            location: MemoryLocation::GpuOnly,
+        },
+    );
+    let (lo, hi) = field.min_max();
+    let base_push = TileGenerationPush {
+        handles: [0; 4],
+        counts: [0; 4],
+        grid: [field.columns, field.rows, 0, 0],
+        spacing_range: [field.spacing.x as f32, field.spacing.y as f32, lo, hi],
+    };
+    let (heights, noise, layers) = (inputs.heights, inputs.noise, inputs.layers);
+
+    // texturing.upsample: plans the frame on the CPU, then the base surface.
+    let pipeline = ComputePipeline::new(ctx, shaders::TEXTURING_UPSAMPLE)?;
+    let shared = state.clone();
+    let (image_height, quadtree, budget) = (inputs.image_height, streaming.quadtree, streaming.budget);
+    let texture_handles: Vec<(ResourceId, ResourceId)> = colors.iter().copied().zip(normals.iter().copied()).collect();
+    let pass = graph
+        .pass("texturing.upsample")
+        .read(heights, Access::SampledImage(Stage::Compute))
+        .read(jobs, Access::StorageBufferRead(Stage::Compute))
+        .write(scratch, Access::StorageBufferWrite(Stage::Compute));
+    pass.record(move |pass, params| {
+        let start = std::time::Instant::now();
+        let camera = &params.camera;
+        let view = View {
+            eye: camera.eye,
+            pixel_footprint: View::pixel_footprint_for(camera.fov_y_deg.to_radians(), image_height),
+            frustum: Some(frustum_planes(camera.view_proj_f64(params.aspect))),
+        };
+        let mut s = locked(&shared)?;
+        let needed = select_tiles(extent, &view, &quadtree, &|n| s.bounds.bounds(n))?;
+        let frame = pass.frame();
+        let plan = s.cache.plan_frame(frame, &needed, budget);
+        let table = PageTable::build(&plan, extent)?;
+        s.page_words = table.words();
+        if s.page_words.len() > PAGE_TABLE_WORDS {
+            return Err(Error::invalid(
+                "texture page table",
+                format!("{} words exceed the capacity of {PAGE_TABLE_WORDS}", s.page_words.len()),
+            ));
+        }
+        let handles = texture_handles
+            .iter()
+            .map(|&(c, n)| Ok([pass.storage_image(c)?, pass.storage_image(n)?]))
+            .collect::<Result<Vec<_>>>()?;
+        let (tile_jobs, texels) = tile_jobs(&plan, extent, &|t| handles[t as usize]);
+        if texels > scratch_texels || tile_jobs.len() > max_jobs {
+            return Err(Error::Graph(format!(
+                "texturing: {} tiles of {texels} texels exceed the scratch buffer",
+                tile_jobs.len()
+            )));
+        }
+        pass.buffer(jobs)?.write(0, bytemuck::cast_slice(&tile_jobs))?;
+        (s.jobs, s.texels) = (tile_jobs.len() as u32, texels);
+        s.stats.push(TextureFrameStats {
+            frame,
+            tiles: plan.stats,
+            hit_rate: plan.stats.hit_rate(),
+            texels_generated: texels,
+            cpu_ms: start.elapsed().as_secs_f64() * 1e3,
+        });
+        let push = TileGenerationPush {
+            handles: [pass.storage_buffer(jobs)?, pass.storage_buffer(scratch)?, 0, 0],
+            counts: [s.jobs, texels as u32, 0, pass.sampled(heights)?],
+            ..base_push
+        };
+        drop(s);
+        dispatch(pass.cmd(), &pipeline, &push)
+    });
+
+    // texturing.layer<i>.<name>: one layer over every dirty texel.
+    let layer_pipeline = Arc::new(ComputePipeline::new(ctx, shaders::TEXTURING_LAYER)?);
+    for (i, flat) in inputs.tree.layers.iter().enumerate() {
+        let name = format!(
+            "texturing.layer{i}.{}",
+            flat.layer.name.replace(char::is_whitespace, "_")
+        );
+        let (shared, pipeline) = (state.clone(), layer_pipeline.clone());
+        graph
+            .pass(&name)
+            .read(jobs, Access::StorageBufferRead(Stage::Compute))
+            .read(layers, Access::StorageBufferRead(Stage::Compute))
+            .read(noise, Access::SampledImage(Stage::Compute))
+            .write(scratch, Access::StorageBufferReadWrite(Stage::Compute))
+            .record(move |pass, _| {
+                let (job_count, texels) = {
+                    let s = locked(&shared)?;
+                    (s.jobs, s.texels)
+                };
+                let push = TileGenerationPush {
+                    handles: [
+                        pass.storage_buffer(jobs)?,
+                        pass.storage_buffer(scratch)?,
+                        pass.storage_buffer(layers)?,
+                        pass.sampled(noise)?,
+                    ],
+                    counts: [job_count, texels as u32, i as u32, 0],
+                    ..base_push
+                };
+                dispatch(pass.cmd(), &pipeline, &push)
+            });
+    }
+
+    // texturing.finish: colour and normal into the atlas.
+    let pipeline = ComputePipeline::new(ctx, shaders::TEXTURING_FINISH)?;
+    let shared = state.clone();
+    let mut pass = graph
+        .pass("texturing.finish")
+        .read(jobs, Access::StorageBufferRead(Stage::Compute))
+        .read(scratch, Access::StorageBufferRead(Stage::Compute));
+    for &image in colors.iter().chain(&normals) {
+        pass = pass.write(image, Access::StorageImageReadWrite(Stage::Compute));
+    }
+    pass.record(move |pass, _| {
+        let (job_count, texels) = {
+            let s = locked(&shared)?;
+            (s.jobs, s.texels)
+        };
+        let push = TileGenerationPush {
+            handles: [pass.storage_buffer(jobs)?, pass.storage_buffer(scratch)?, 0, 0],
+            counts: [job_count, texels as u32, 0, 0],
+            ..base_push
+        };
+        dispatch(pass.cmd(), &pipeline, &push)
+    });
+    Ok(AtlasResources {
+        colors,
+        normals,
+        page_table,
+        atlas_size,
+        state,
+    })
+}
+
+/// One thread per dirty texel; nothing when no tile is dirty.
+fn dispatch(
+    cmd: &mut crate::vulkan::CommandRecorder,
+    pipeline: &ComputePipeline,
+    push: &TileGenerationPush,
+) -> Result<()> {
+    let groups = u64::from(push.counts[1]).div_ceil(GROUP);
+    if groups == 0 {
+        return Ok(());
+    }
+    cmd.bind_compute(pipeline);
+    cmd.push_constants(push)?;
+    cmd.dispatch(groups as u32, 1, 1);
+    Ok(())
+}
