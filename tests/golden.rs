@@ -1,8 +1,11 @@
 //! Golden-image tests: frames compared with stored PNGs by FLIP: the
 //! default scene (with its rocks) and the real Jacksboro DEM from three
 //! viewpoints (high and oblique, low and grazing, along a valley), all with
-//! the warped terrain and its procedural detail (§7.4); and the Stanford
-//! bunny as a sequential point tree with opaque and EWA splats (§10.1–10.2).
+//! the warped terrain and its procedural detail (§7.4) coloured from the
+//! texture atlas (§8.2; frames rendered until every tile is ready), the
+//! default scene also with the classic surface types (§7.4.3); and the
+//! Stanford bunny as a sequential point tree with opaque and EWA splats
+//! (§10.1–10.2).
 //!
 //! Threshold: mean FLIP ≤ [`MEAN_FLIP_THRESHOLD`] (0.02; override with
 //! `ALPENGLOW_FLIP_THRESHOLD`). On the lavapipe that made the goldens the
@@ -22,7 +25,11 @@ use alpenglow::io::image_out::write_png_rgba8;
 use alpenglow::points::render::{SplatMode, SplatSettings};
 use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointScene, PointTransform};
 use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
-use common::{assert_validation_clean, data, failure_dir, golden_dir, jacksboro_field, mean_flip, validated_context};
+use alpenglow::texturing::gpu_layout::TexturingMode;
+use common::{
+    assert_validation_clean, data, failure_dir, golden_dir, jacksboro_field, jacksboro_valley_camera, mean_flip,
+    validated_context,
+};
 use glam::DVec3;
 
 const MEAN_FLIP_THRESHOLD: f32 = 0.02;
@@ -36,11 +43,14 @@ fn threshold() -> f32 {
         .unwrap_or(MEAN_FLIP_THRESHOLD)
 }
 
+/// Frames a golden render may take until every texture tile is ready.
+const SETTLE_FRAMES: u32 = 16;
+
 fn check_golden(name: &str, scene: &Scene, camera: &Camera) {
-    check_golden_with(name, scene, camera, SplatSettings::default());
+    check_golden_with(name, scene, camera, SplatSettings::default(), TexturingMode::default());
 }
 
-fn check_golden_with(name: &str, scene: &Scene, camera: &Camera, points: SplatSettings) {
+fn check_golden_with(name: &str, scene: &Scene, camera: &Camera, points: SplatSettings, texturing: TexturingMode) {
     let (ctx, report) = validated_context();
     let frame = {
         let settings = RenderSettings {
@@ -49,11 +59,13 @@ fn check_golden_with(name: &str, scene: &Scene, camera: &Camera, points: SplatSe
             readback: true,
             terrain: Default::default(),
             points,
-            texturing: Default::default(),
+            texturing,
             texture_streaming: Default::default(),
         };
         let mut renderer = Renderer::new(&ctx, scene, settings).expect("renderer");
-        let frame = renderer.render(camera).and_then(|f| renderer.read(&f)).expect("frame");
+        let frame = (renderer.render_settled(camera, SETTLE_FRAMES))
+            .and_then(|f| renderer.read(&f))
+            .expect("frame");
         renderer.finish().expect("finish");
         frame
     };
@@ -96,6 +108,20 @@ fn default_scene_matches_golden() {
     check_golden("default-scene", &scene, &scene.default_camera());
 }
 
+/// The default scene with the §7.4.3 surface types instead of the atlas.
+#[test]
+fn default_scene_classic_texturing_matches_golden() {
+    let scene = Scene::default_procedural().expect("default scene");
+    let camera = scene.default_camera();
+    check_golden_with(
+        "default-scene-classic",
+        &scene,
+        &camera,
+        SplatSettings::default(),
+        TexturingMode::Classic,
+    );
+}
+
 /// The Jacksboro DEM seen high and oblique: the default camera, from
 /// beyond the southern edge and above the highest point.
 #[test]
@@ -125,15 +151,7 @@ fn real_dem_low_grazing_view_matches_golden() {
 #[test]
 fn real_dem_along_valley_view_matches_golden() {
     let scene = Scene::new(jacksboro_field());
-    let camera = Camera {
-        eye: DVec3::new(13600.0, 9600.0, 750.0),
-        target: DVec3::new(18500.0, 21500.0, 350.0),
-        up: DVec3::Z,
-        fov_y_deg: 50.0,
-        near: 5.0,
-        far: 100000.0,
-    };
-    check_golden("jacksboro-valley", &scene, &camera);
+    check_golden("jacksboro-valley", &scene, &jacksboro_valley_camera());
 }
 
 fn bunny_scene() -> Scene {
@@ -165,7 +183,13 @@ fn bunny_ewa_matches_golden() {
         mode: SplatMode::Ewa,
         ..SplatSettings::default()
     };
-    check_golden_with("bunny-ewa", &bunny_scene(), &bunny_camera(), settings);
+    check_golden_with(
+        "bunny-ewa",
+        &bunny_scene(),
+        &bunny_camera(),
+        settings,
+        TexturingMode::default(),
+    );
 }
 
 #[test]
@@ -174,5 +198,11 @@ fn bunny_opaque_matches_golden() {
         mode: SplatMode::Opaque,
         ..SplatSettings::default()
     };
-    check_golden_with("bunny-opaque", &bunny_scene(), &bunny_camera(), settings);
+    check_golden_with(
+        "bunny-opaque",
+        &bunny_scene(),
+        &bunny_camera(),
+        settings,
+        TexturingMode::default(),
+    );
 }

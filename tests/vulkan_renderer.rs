@@ -37,10 +37,12 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
             texture_streaming: Default::default(),
         };
         let mut renderer = Renderer::new(&ctx, &scene, settings).expect("renderer");
-        assert_eq!(
-            renderer.pass_names(),
-            ["sky", "terrain.warp", "terrain.draw", "tonemap", "readback"]
-        );
+        let layers = scene.layers.layers.iter().enumerate();
+        let layer_passes = layers.map(|(i, l)| format!("texturing.layer{i}.{}", l.layer.name.replace(' ', "_")));
+        let mut expected: Vec<String> = ["sky", "terrain.warp", "texturing.upsample"].map(String::from).to_vec();
+        expected.extend(layer_passes);
+        expected.extend(["texturing.finish", "terrain.draw", "tonemap", "readback"].map(String::from));
+        assert_eq!(renderer.pass_names(), expected);
         let camera = scene.default_camera();
         // Several frames, two in flight: exercises cross-frame barrier state.
         let mut last = None;
@@ -69,7 +71,7 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
         let profiles = renderer.finish().expect("timings");
         assert_eq!(profiles.len(), 6, "every frame's timestamps come back");
         for p in &profiles {
-            assert_eq!(p.passes.len(), 5);
+            assert_eq!(p.passes.len(), expected.len());
             assert!(p.passes.iter().all(|t| t.gpu_ms.is_finite() && t.gpu_ms >= 0.0));
         }
     }

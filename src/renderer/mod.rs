@@ -30,6 +30,7 @@ use crate::terrain::geometry_image::{GeometryImage, TerrainSettings};
 use crate::terrain::shading::{add_draw_pass, TerrainTexturing};
 use crate::texturing::generation::{AtlasResources, TextureFrameStats, TextureStreaming};
 use crate::texturing::gpu_layout::TexturingMode;
+use crate::texturing::page_table::PageTable;
 use crate::vulkan::{
     Buffer, BufferDesc, BufferUsageFlags, Context, Format, FrameRing, MemoryLocation, FRAMES_IN_FLIGHT,
 };
@@ -351,6 +352,12 @@ impl Renderer {
             Some(a) => a.take_stats(),
             None => Ok(Vec::new()),
         }
+    }
+
+    /// The texture page table of the last recorded frame (which atlas tile
+    /// colours which part of the terrain); None unless texturing from the atlas.
+    pub fn texture_page_table(&self) -> Result<Option<PageTable>> {
+        self.atlas.as_ref().map(AtlasResources::page_table).transpose()
     }
 
     /// Point statistics of the frames completed so far and not yet taken

@@ -185,6 +185,8 @@ pub(crate) struct GenerationState {
     bounds: HeightBounds,
     /// This frame's page table in words, written by `terrain.draw`.
     pub(crate) page_words: Vec<[u32; 4]>,
+    /// The last recorded frame's page table.
+    table: PageTable,
     jobs: u32,
     texels: u64,
     stats: Vec<TextureFrameStats>,
@@ -213,6 +215,11 @@ pub struct AtlasResources {
 }
 
 impl AtlasResources {
+    /// The page table of the last recorded frame.
+    pub fn page_table(&self) -> Result<PageTable> {
+        Ok(locked(&self.state)?.table.clone())
+    }
+
     /// Needed tiles the last recorded frame drew from a coarser tile.
     pub fn last_deferred(&self) -> Result<usize> {
         Ok(locked(&self.state)?.stats.last().map_or(0, |s| s.tiles.deferred))
@@ -262,6 +269,7 @@ pub fn add_generation_passes(
         cache: TileCache::new(streaming.atlas)?,
         bounds: HeightBounds::new(&field, streaming.quadtree.max_depth)?,
         page_words: Vec::new(),
+        table: PageTable::default(),
         jobs: 0,
         texels: 0,
         stats: Vec::new(),
@@ -344,6 +352,7 @@ pub fn add_generation_passes(
         let plan = s.cache.plan_frame(frame, &needed, budget);
         let table = PageTable::build(&plan, extent)?;
         s.page_words = table.words();
+        s.table = table;
         if s.page_words.len() > PAGE_TABLE_WORDS {
             return Err(Error::invalid(
                 "texture page table",

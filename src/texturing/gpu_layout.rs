@@ -9,12 +9,12 @@ use super::layers::{Hat, LayerTree};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum TexturingMode {
     /// Surface types from altitude, slope and orientation (§7.4.3 "Colour").
-    #[default]
     Classic,
     /// The surface-layer tree evaluated per pixel (§8.2; the reference of the atlas).
     Direct,
     /// The surface-layer tree evaluated into cached tiles of a texture atlas
     /// (§8.2), sampled through a per-frame page table.
+    #[default]
     Atlas,
 }
 

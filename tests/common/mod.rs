@@ -52,6 +52,19 @@ pub fn jacksboro_field() -> HeightField {
     load_heightmap(&data("jacksboro-fault.png"), &options).expect("real DEM")
 }
 
+/// Along the valley of the Jacksboro fault, from its south-western part
+/// towards the north-east, a few hundred metres above the valley floor.
+pub fn jacksboro_valley_camera() -> alpenglow::renderer::Camera {
+    alpenglow::renderer::Camera {
+        eye: glam::DVec3::new(13600.0, 9600.0, 750.0),
+        target: glam::DVec3::new(18500.0, 21500.0, 350.0),
+        up: glam::DVec3::Z,
+        fov_y_deg: 50.0,
+        near: 5.0,
+        far: 100000.0,
+    }
+}
+
 /// The directory holding golden images.
 pub fn golden_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden")
