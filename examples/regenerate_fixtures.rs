@@ -1,4 +1,4 @@
-//! Regenerates the small bad-input fixtures in `tests/data/` (the committed
+//! Regenerates the small fixtures in `tests/data/` (the committed
 //! files are what the tests read): `cargo run --example regenerate_fixtures`.
 
 use std::path::{Path, PathBuf};
@@ -29,6 +29,9 @@ fn main() {
         .flat_map(|r| (0..8u16).map(move |c| 1000 * r + 10 * c))
         .collect();
     write_grey16(&data("tiny-ramp.png"), 8, 6, &ramp);
+    // Rainfall input map: 0 on the western edge to 255 on the eastern one.
+    let rainfall = image::GrayImage::from_fn(33, 33, |x, _| image::Luma([(255.0 * x as f32 / 32.0).round() as u8]));
+    rainfall.save(data("rainfall.png")).unwrap();
 
     use exr::prelude::*;
     let mut y: Vec<f32> = (0..12).map(|i| 100.0 + i as f32).collect();

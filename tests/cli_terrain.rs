@@ -1,6 +1,7 @@
 //! End-to-end tests of the terrain options of the `alpenglow` binary
 //! (`--view`, `--lod`, `--terrain-detail`, `--terrain`, `--grid`,
-//! `--sketch`, `--importance-off`) and of the `fly` subcommand (orbit and
+//! `--sketch`, `--importance-off`, `--texturing`, `--layers`,
+//! `--input-map`, `--tile-budget`) and of the `fly` subcommand (orbit and
 //! keyframe paths, the frame directory, the JSON summary, error paths).
 //!
 //! Every command that creates a Vulkan device runs with `--validation`, so a
@@ -228,6 +229,78 @@ fn all_importance_factors_off_renders() {
         &["--importance-off", "distance,frustum,backface,surface"],
     );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+// ---------------------------------------------------------------- texturing
+
+/// A file in `tests/data` as an argument.
+fn data_arg(name: &str) -> String {
+    common::data(name).to_string_lossy().into_owned()
+}
+
+/// Every `--texturing` mode renders; classic differs from the layer tree;
+/// the rainfall input map changes the image.
+#[test]
+fn texturing_modes_and_input_maps_render() {
+    let dir = fresh_dir("texturing_modes");
+    let atlas = render_png(&dir, "atlas.png", SMALL_TERRAIN, &["--tile-budget", "4"]);
+    let direct = render_png(&dir, "direct.png", SMALL_TERRAIN, &["--texturing", "direct"]);
+    let classic = render_png(&dir, "classic.png", SMALL_TERRAIN, &["--texturing", "classic"]);
+    let (layers, map) = (
+        data_arg("layers-rainfall.toml"),
+        format!("rainfall={}", data_arg("rainfall.png")),
+    );
+    let rain = render_png(
+        &dir,
+        "rain.png",
+        SMALL_TERRAIN,
+        &["--layers", &layers, "--input-map", &map],
+    );
+    let pixels = (WIDTH * HEIGHT * 4) as usize;
+    assert!(
+        differing_bytes(&atlas, &classic) > pixels / 4,
+        "classic looks like the layer tree"
+    );
+    assert!(
+        differing_bytes(&atlas, &rain) > pixels / 4,
+        "the rainfall tree looks like the default tree"
+    );
+    let close = atlas.iter().zip(&direct).filter(|(a, b)| a.abs_diff(**b) <= 12).count();
+    assert!(
+        close > pixels * 9 / 10,
+        "atlas and direct differ in {} of {pixels} bytes",
+        pixels - close
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn layer_using_a_missing_input_map_is_refused() {
+    let layers = data_arg("layers-rainfall.toml");
+    let needles = ["input map 'rainfall'", "--input-map rainfall=FILE"];
+    expect_render_error(
+        "missing_input_map",
+        Some(SMALL_TERRAIN),
+        &["--layers", &layers],
+        &needles,
+    );
+}
+
+#[test]
+fn unknown_or_corrupt_input_map_is_refused() {
+    expect_render_error(
+        "unknown_input_map",
+        Some(SMALL_TERRAIN),
+        &["--input-map", "snow=x.png"],
+        &["snow", "rainfall"],
+    );
+    let map = format!("rainfall={}", data_arg("truncated.png"));
+    expect_render_error(
+        "corrupt_input_map",
+        Some(SMALL_TERRAIN),
+        &["--input-map", &map],
+        &["truncated.png"],
+    );
 }
 
 // ---------------------------------------------------------------- fly

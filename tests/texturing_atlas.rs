@@ -7,19 +7,22 @@
 //! * seams: pixels where neighbouring pixels are coloured from different
 //!   tiles (found through the frame's page table) are no worse than
 //!   [`MAX_SEAM_FLIP`] in mean FLIP against the reference;
+//! * extra input maps (rainfall) steer the layers in both modes;
 //! * streaming over a flythrough: no frame generates more than the budget,
 //!   the hit rate exceeds 95 %, and a small atlas evicts tiles and still
 //!   matches the reference once settled.
 
 mod common;
 
+use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
 use alpenglow::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
 use alpenglow::texturing::atlas::{AtlasSettings, GenerationBudget};
 use alpenglow::texturing::generation::{TextureFrameStats, TextureStreaming};
 use alpenglow::texturing::gpu_layout::TexturingMode;
+use alpenglow::texturing::layers::LayerTree;
 use alpenglow::texturing::page_table::PageTable;
 use common::{
-    assert_validation_clean, dump_pngs, flip_errors, jacksboro_field, jacksboro_valley_camera, mean_flip,
+    assert_validation_clean, data, dump_pngs, flip_errors, jacksboro_field, jacksboro_valley_camera, mean_flip,
     validated_context,
 };
 use glam::{DVec2, DVec3};
@@ -236,4 +239,26 @@ fn small_atlas_evicts_and_still_matches_reference() {
     let (mean, _) = mean_flip(&direct.rgba8, &atlas.rgba8, WIDTH, HEIGHT);
     eprintln!("small atlas: {evicted} tiles evicted; last frame mean FLIP {mean:.4} against direct");
     assert!(mean <= MAX_MEAN_FLIP, "mean FLIP {mean:.4}");
+}
+
+/// A tree whose layers follow the rainfall map (tests/data/rainfall.png:
+/// dry west, wet east): atlas and direct agree, and a reversed map changes
+/// the image.
+#[test]
+fn input_maps_drive_the_layers() {
+    let mut scene = Scene::new(jacksboro_field());
+    scene.layers = LayerTree::load(&data("layers-rainfall.toml")).expect("layers");
+    let rainfall = load_heightmap(&data("rainfall.png"), &HeightmapOptions::default()).expect("map");
+    scene.input_maps[0] = Some(rainfall.clone());
+    check_against_direct("rainfall", &scene, &scene.default_camera());
+    let (wet_east, _) = render(&scene, &scene.default_camera(), TexturingMode::Atlas);
+    let mut reversed = rainfall;
+    reversed.heights.iter_mut().for_each(|v| *v = 255.0 - *v);
+    scene.input_maps[0] = Some(reversed);
+    let (wet_west, _) = render(&scene, &scene.default_camera(), TexturingMode::Atlas);
+    let (mean, _) = mean_flip(&wet_east.rgba8, &wet_west.rgba8, WIDTH, HEIGHT);
+    assert!(
+        mean > 0.1,
+        "reversing the rainfall map changed little: mean FLIP {mean:.4}"
+    );
 }

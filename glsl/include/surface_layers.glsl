@@ -61,6 +61,24 @@ float layer_noise(uint tile, vec2 xy, float wavelength, vec2 offset, float footp
     return value;
 }
 
+// The extra input maps (rainfall, radiation, temperature) at uv (0..1 over
+// the terrain rectangle): bilinear in R32F textures whose corner samples
+// sit on the rectangle's corners; `maps` holds the sampled handles and in w
+// bit k when map k is present. An absent map reads −3e38, which every hat
+// rejects (the CPU checks that no layer uses an absent map).
+vec3 input_maps(uvec4 maps, vec2 uv) {
+    vec3 values = vec3(-3.0e38);
+    for (uint k = 0u; k < 3u; ++k) {
+        if ((maps.w & (1u << k)) != 0u) {
+            uint map = maps[k];
+            vec2 size = vec2(textureSize(sampler2D(g_textures[nonuniformEXT(map)], g_samplers[SAMPLER_LINEAR_CLAMP]), 0));
+            vec2 at = (clamp(uv, 0.0, 1.0) * (size - 1.0) + 0.5) / size;
+            values[k] = textureLod(sampler2D(g_textures[nonuniformEXT(map)], g_samplers[SAMPLER_LINEAR_CLAMP]), at, 0.0).r;
+        }
+    }
+    return values;
+}
+
 // What the depth-first walk carries from layer to layer.
 struct LayerState {
     float h;            // modified height (metres)

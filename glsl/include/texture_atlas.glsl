@@ -24,6 +24,7 @@ layout(set = 0, binding = 2, std430) readonly buffer TerrainTexturing {
     vec4 spacing_range;   // spacing x, y, lowest and highest height
     uvec4 atlas;          // page table (storage), atlas texture count, atlas size (texels), 0
     vec4 extent;          // terrain rectangle x, y (metres), 0, 0
+    uvec4 maps;           // input maps (sampled), w: bit k set when map k is present
     uvec4 color[MAX_ATLAS_TEXTURES / 4];   // sampled handles of the colour textures
     uvec4 normal[MAX_ATLAS_TEXTURES / 4];  // sampled handles of the normal textures
 } g_texturing[];

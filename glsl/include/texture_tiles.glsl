@@ -32,6 +32,8 @@ layout(push_constant) uniform Push {
     uvec4 counts;         // job count, texel count, layer index, heights (sampled)
     uvec4 grid;           // height-field columns, rows, 0, 0
     vec4 spacing_range;   // sample spacing x, y (metres), lowest and highest height
+    uvec4 maps;           // input maps (sampled), w: present bits (surface_layers.glsl)
+    vec4 extent;          // terrain rectangle x, y (metres), 0, 0
 } pc;
 
 // The job holding scratch texel `texel` (jobs are sorted by first texel).

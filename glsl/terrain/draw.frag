@@ -13,8 +13,6 @@
 #include "../include/surface_layers.glsl"
 #include "../include/texture_atlas.glsl"
 
-// No extra input map bound: every hat on it gives 0.
-const vec3 NO_MAPS = vec3(-3.0e38);
 
 layout(location = 0) in vec3 in_world;
 layout(location = 1) in vec3 in_normal;
@@ -98,8 +96,9 @@ void main() {
             vec2 base_grad;
             float h = bspline_height(th.y, g_texturing[texturing].grid.xy, sr.xy, in_world.xy, base_grad);
             float footprint = max(depth, 1e-3) * pc.forward.w;
+            vec3 maps = input_maps(g_texturing[texturing].maps, in_world.xy / g_texturing[texturing].extent.xy);
             a = evaluate_layers(th.x, g_texturing[texturing].grid.z, th.z, in_world.xy, footprint, h, base_grad, sr.zw,
-                                NO_MAPS, extra);
+                                maps, extra);
             // The layers' displacement bumps the normal on top of the mesh's.
             n = normalize(n + vec3(-extra, 0.0) * n.z);
         } else {

@@ -10,9 +10,6 @@
 #include "../include/surface_layers.glsl"
 #include "../include/texture_tiles.glsl"
 
-// No extra input map bound: every hat on it gives 0.
-const vec3 NO_MAPS = vec3(-3.0e38);
-
 void main() {
     TileJob job;
     uvec2 local;
@@ -22,6 +19,7 @@ void main() {
     }
     uint texel = gl_GlobalInvocationID.x;
     LayerState s = unpack_state(g_texel_states[pc.handles.y].t[texel]);
-    apply_layer(pc.handles.z, pc.counts.z, pc.handles.w, xy, texel_footprint(job), pc.spacing_range.zw, NO_MAPS, s);
+    vec3 maps = input_maps(pc.maps, xy / pc.extent.xy);
+    apply_layer(pc.handles.z, pc.counts.z, pc.handles.w, xy, texel_footprint(job), pc.spacing_range.zw, maps, s);
     g_texel_states[pc.handles.y].t[texel] = pack_state(s);
 }

@@ -237,6 +237,11 @@ pub struct TerrainArgs {
     /// Surface-layer tree (TOML; default: the built-in tree).
     #[arg(long)]
     pub layers: Option<PathBuf>,
+    /// Extra input map of the layers, NAME=FILE with NAME rainfall,
+    /// radiation or temperature (repeatable): a greyscale PNG or EXR whose
+    /// grid spans the terrain rectangle; the layers' hats use its raw values.
+    #[arg(long = "input-map", value_parser = parse_input_map)]
+    pub input_maps: Vec<(usize, PathBuf)>,
 }
 
 /// Terrain colouring.
@@ -381,4 +386,16 @@ fn parse_spacing(s: &str) -> Result<(f64, f64), String> {
     } else {
         Err(format!("'{s}': spacing must be positive"))
     }
+}
+
+/// `NAME=FILE` of `--input-map`.
+fn parse_input_map(s: &str) -> Result<(usize, PathBuf), String> {
+    let names = alpenglow::texturing::layers::INPUT_NAMES;
+    let (name, file) = s.split_once('=').ok_or_else(|| format!("'{s}': expected NAME=FILE"))?;
+    let k = (names.iter().position(|n| *n == name))
+        .ok_or_else(|| format!("'{name}': the input maps are {}", names.join(", ")))?;
+    if file.is_empty() {
+        return Err(format!("'{s}': no file"));
+    }
+    Ok((k, PathBuf::from(file)))
 }

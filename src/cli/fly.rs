@@ -6,6 +6,7 @@
 //! place when every frame was written: on any error no partial sequence is
 //! left behind.
 
+use alpenglow::texturing::stats::TextureSummary;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -103,6 +104,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     let report = ctx.validation_report();
     let device = ctx.info().name.clone();
     let mut wall_ms = Vec::with_capacity(cameras.len());
+    let texture_stats;
     let profiles = {
         let settings = render_settings(&args.scene, staging.is_some())?;
         let mut renderer = Renderer::new(&ctx, &scene, settings)?;
@@ -137,7 +139,9 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
             write(&images, index)?;
         }
         bar.finish_and_clear();
-        renderer.finish()?
+        let profiles = renderer.finish()?;
+        texture_stats = renderer.take_texture_stats()?;
+        profiles
     };
     drop(ctx);
     check_validation(report)?;
@@ -159,6 +163,11 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     println!("  GPU frame time   min {gmin:.3}  median {gmed:.3}  max {gmax:.3} ms");
     println!("  wall per frame   min {wmin:.3}  median {wmed:.3}  max {wmax:.3} ms");
     println!("  CPU warp         min {cmin:.3}  median {cmed:.3}  max {cmax:.3} ms");
+    let textures = (!texture_stats.is_empty()).then(|| TextureSummary::new(&texture_stats, &profiles));
+    if let Some(t) = &textures {
+        println!("  {}", t.line());
+        println!("  {}", t.per_pass_line());
+    }
 
     let mut outputs = OutputSet::default();
     if args.json.is_some() {
@@ -171,6 +180,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
             "cpu_warp_ms": {"min": cmin, "median": cmed, "max": cmax},
             "median_frame_gpu_ms": frame.median_gpu_ms,
             "passes": passes,
+            "textures": textures.as_ref().map(|t| serde_json::json!({"summary": t, "per_frame": texture_stats})),
         });
         let text = serde_json::to_string_pretty(&value)?;
         outputs.write(&args.json, |p| {

@@ -19,6 +19,7 @@ use alpenglow::renderer::{validate_size, Camera, RenderSettings, Renderer, Scene
 use alpenglow::terrain::geometry_image::{TerrainSettings, TerrainView};
 use alpenglow::terrain::lod::{ImportanceFactors, LodMode, LodSettings};
 use alpenglow::terrain::sketch_map::SketchAlignment;
+use alpenglow::texturing::stats::TextureSummary;
 use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector, ValidationReport};
 use args::{
     AlignArg, BenchArgs, Cli, Command, DeviceArgs, FactorArg, LodArg, RenderArgs, SceneArgs, Switch, TerrainArgs,
@@ -148,6 +149,13 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
     points::add_points(&args.points, &mut scene, builtin)?;
     if let Some(path) = &args.terrain.layers {
         scene.layers = alpenglow::texturing::layers::LayerTree::load(path)?;
+    }
+    for (k, path) in &args.terrain.input_maps {
+        let name = alpenglow::texturing::layers::INPUT_NAMES[*k];
+        if scene.input_maps[*k].is_some() {
+            bail!("--input-map {name} is given twice");
+        }
+        scene.input_maps[*k] = Some(load_heightmap(path, &HeightmapOptions::default())?);
     }
     Ok(scene)
 }
@@ -337,6 +345,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     let device = ctx.info().clone();
     let mut intervals = Vec::new();
     let point_stats;
+    let texture_stats;
     let profiles = {
         let settings = render_settings(&args.scene, false)?;
         let mut renderer = Renderer::new(&ctx, &scene, settings)?;
@@ -350,6 +359,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
         }
         let profiles = renderer.finish()?;
         point_stats = renderer.take_point_stats()?;
+        texture_stats = renderer.take_texture_stats()?;
         profiles
     };
     drop(ctx);
@@ -388,9 +398,16 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
             cpu / stats.instances.max(1) as f64
         );
     }
+    let texture_stats: Vec<_> = texture_stats.into_iter().skip(args.warmup as usize).collect();
+    let textures = (!texture_stats.is_empty()).then(|| TextureSummary::new(&texture_stats, &timed));
+    if let Some(t) = &textures {
+        println!("  {}", t.line());
+        println!("  {}", t.per_pass_line());
+    }
     let mut outputs = OutputSet::default();
     if args.json.is_some() {
         let value = serde_json::json!({
+            "textures": textures,
             "device": device,
             "width": args.scene.width,
             "height": args.scene.height,

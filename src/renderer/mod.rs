@@ -182,6 +182,7 @@ impl Renderer {
                     mode: settings.texturing,
                     layers: &scene.layers,
                     streaming: settings.texture_streaming,
+                    input_maps: &scene.input_maps,
                 },
             )?;
             (Some(terrain), atlas)

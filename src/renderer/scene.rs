@@ -24,13 +24,18 @@ pub struct Scene {
     pub points: PointScene,
     /// Unit direction towards the sun.
     pub sun_direction: Vec3,
-    /// The surface-layer tree of §8.2 (used with [`crate::texturing::gpu_layout::TexturingMode::Direct`]).
+    /// The surface-layer tree of §8.2 (atlas and direct texturing).
     pub layers: crate::texturing::layers::LayerTree,
+    /// Extra input maps of the layer tree (rainfall, radiation, temperature;
+    /// [`crate::texturing::layers::INPUT_NAMES`]), registered to the height
+    /// field: each grid spans the terrain rectangle corner to corner, at any
+    /// resolution (its spacing is ignored); values in the units the layers'
+    /// hats use.
+    pub input_maps: [Option<HeightField>; 3],
 }
 
 impl Scene {
     /// The default scene: 513² samples of the default procedural terrain at
-    /// 20 m spacing (10.24 km square).
     /// 20 m spacing (10.24 km square), with [`DEFAULT_ROCKS`] boulders.
     pub fn default_procedural() -> Result<Scene> {
         let mut scene = Scene::default_terrain()?;
@@ -66,6 +71,7 @@ impl Scene {
             points: PointScene::default(),
             sun_direction: Vec3::new(-0.55, 0.45, 0.42).normalize(),
             layers: crate::texturing::layers::LayerTree::default_tree(),
+            input_maps: [None, None, None],
         }
     }
 

@@ -12,11 +12,13 @@ use crate::texturing::generation::{add_generation_passes, locked, AtlasResources
 use crate::error::Error;
 use crate::error::Result;
 use crate::graph::{Access, RenderGraph, ResourceId, Stage};
+use crate::io::heightmap::HeightField;
 use crate::renderer::FrameParams;
 use crate::shaders;
 use crate::terrain::geometry_image::{GeometryImage, VERTEX_STRIDE};
 use crate::texturing::gpu_layout::{pack_layers, TexturingFrame, TexturingMode};
-use crate::texturing::layers::{LayerTree, INPUT_NAMES};
+use crate::texturing::input_maps::InputMaps;
+use crate::texturing::layers::LayerTree;
 use crate::vulkan::{
     Blend, Buffer, BufferDesc, BufferUsageFlags, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc,
     LoadOp, MemoryLocation, PrimitiveTopology, VertexAttribute,
@@ -44,6 +46,8 @@ pub struct TerrainTexturing<'a> {
     pub layers: &'a LayerTree,
     /// Atlas streaming (used by [`TexturingMode::Atlas`]).
     pub streaming: TextureStreaming,
+    /// Extra input maps of the layers ([`crate::renderer::Scene::input_maps`]).
+    pub input_maps: &'a [Option<HeightField>; 3],
 }
 
 /// Declares `terrain.draw` into `color` and `view_depth` (loaded: the sky
@@ -59,15 +63,7 @@ pub fn add_draw_pass(
     image_height: u32,
     texturing: &TerrainTexturing,
 ) -> Result<Option<AtlasResources>> {
-    if let Some(k) = (0..INPUT_NAMES.len()).find(|&k| texturing.layers.uses_input(k)) {
-        return Err(Error::invalid(
-            "surface layers",
-            format!(
-                "input map '{}' is used but input maps are not supported yet",
-                INPUT_NAMES[k]
-            ),
-        ));
-    }
+    let maps = InputMaps::import(ctx, graph, texturing.layers, texturing.input_maps)?;
     let layer_count = texturing.layers.layers.len() as u32;
     if layer_count == 0 {
         return Err(Error::invalid("surface layers", "the tree has no layer"));
@@ -88,6 +84,7 @@ pub fn add_draw_pass(
                 heights,
                 noise,
                 layers,
+                maps,
                 tree: texturing.layers,
                 image_height,
             },
@@ -161,6 +158,9 @@ pub fn add_draw_pass(
             a.state.clone(),
         )
     });
+    for map in maps.present() {
+        pass = pass.read(map, Access::SampledImage(Stage::Fragment));
+    }
     if let Some((colors, normals, page_table, _, _)) = &atlas_inputs {
         pass = pass.read(*page_table, Access::StorageBufferRead(Stage::Fragment));
         for &image in colors.iter().chain(normals) {
@@ -184,6 +184,7 @@ pub fn add_draw_pass(
                 grid: [field.columns, field.rows, layer_count, 0],
                 spacing_range: [field.spacing.x as f32, field.spacing.y as f32, lo, hi],
                 extent: [extent.x as f32, extent.y as f32, 0.0, 0.0],
+                maps: maps.handles(|id| pass.sampled(id))?,
                 ..TexturingFrame::zeroed()
             };
             if let Some((colors, normals, page_table, atlas_size, state)) = &atlas_inputs {

@@ -24,7 +24,6 @@ use std::sync::{Arc, Mutex};
 
 use bytemuck::{Pod, Zeroable};
 use glam::DVec2;
-use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::graph::{Access, BufferInfo, RenderGraph, ResourceId, Stage};
@@ -32,10 +31,12 @@ use crate::io::heightmap::HeightField;
 use crate::renderer::camera::frustum_planes;
 use crate::renderer::FrameParams;
 use crate::shaders;
-use crate::texturing::atlas::{AtlasSettings, GenerationBudget, TileCache, TilePlan, TileStats};
+use crate::texturing::atlas::{AtlasSettings, GenerationBudget, TileCache, TilePlan};
+use crate::texturing::input_maps::InputMaps;
 use crate::texturing::layers::LayerTree;
 use crate::texturing::page_table::PageTable;
 use crate::texturing::quadtree::{select_tiles, HeightBounds, NodeId, QuadtreeSettings, View};
+pub use crate::texturing::stats::TextureFrameStats;
 use crate::vulkan::{
     Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, Format, Image, ImageDesc, ImageUsageFlags,
     MemoryLocation,
@@ -164,21 +165,6 @@ pub fn tile_jobs(plan: &TilePlan, extent: DVec2, images: &dyn Fn(u32) -> [u32; 2
     (jobs, texels)
 }
 
-/// Texture statistics of one frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct TextureFrameStats {
-    pub frame: u64,
-    /// Tiles visible, hits, generated, evicted, deferred, resident.
-    #[serde(flatten)]
-    pub tiles: TileStats,
-    /// `hits / visible`.
-    pub hit_rate: f64,
-    /// Texels generated (borders included).
-    pub texels_generated: u64,
-    /// CPU time of selection, planning and the page table, milliseconds.
-    pub cpu_ms: f64,
-}
-
 /// What the generation passes and `terrain.draw` share.
 pub(crate) struct GenerationState {
     cache: TileCache,
@@ -239,6 +225,8 @@ struct TileGenerationPush {
     counts: [u32; 4],
     grid: [u32; 4],
     spacing_range: [f32; 4],
+    maps: [u32; 4],
+    extent: [f32; 4],
 }
 
 /// What the passes read besides their own resources.
@@ -249,6 +237,8 @@ pub struct GenerationInputs<'a> {
     pub heights: ResourceId,
     pub noise: ResourceId,
     pub layers: ResourceId,
+    /// The layers' extra input maps.
+    pub maps: InputMaps,
     pub tree: &'a LayerTree,
     /// Image rows (the pixel footprint).
     pub image_height: u32,
@@ -325,8 +315,10 @@ pub fn add_generation_passes(
         counts: [0; 4],
         grid: [field.columns, field.rows, 0, 0],
         spacing_range: [field.spacing.x as f32, field.spacing.y as f32, lo, hi],
+        maps: [0; 4],
+        extent: [extent.x as f32, extent.y as f32, 0.0, 0.0],
     };
-    let (heights, noise, layers) = (inputs.heights, inputs.noise, inputs.layers);
+    let (heights, noise, layers, maps) = (inputs.heights, inputs.noise, inputs.layers, inputs.maps);
 
     // texturing.upsample: plans the frame on the CPU, then the base surface.
     let pipeline = ComputePipeline::new(ctx, shaders::TEXTURING_UPSAMPLE)?;
@@ -396,12 +388,15 @@ pub fn add_generation_passes(
             flat.layer.name.replace(char::is_whitespace, "_")
         );
         let (shared, pipeline) = (state.clone(), layer_pipeline.clone());
-        graph
+        let mut pass = graph
             .pass(&name)
             .read(jobs, Access::StorageBufferRead(Stage::Compute))
             .read(layers, Access::StorageBufferRead(Stage::Compute))
-            .read(noise, Access::SampledImage(Stage::Compute))
-            .write(scratch, Access::StorageBufferReadWrite(Stage::Compute))
+            .read(noise, Access::SampledImage(Stage::Compute));
+        for map in maps.present() {
+            pass = pass.read(map, Access::SampledImage(Stage::Compute));
+        }
+        pass.write(scratch, Access::StorageBufferReadWrite(Stage::Compute))
             .record(move |pass, _| {
                 let (job_count, texels) = {
                     let s = locked(&shared)?;
@@ -415,6 +410,7 @@ pub fn add_generation_passes(
                         pass.sampled(noise)?,
                     ],
                     counts: [job_count, texels as u32, i as u32, 0],
+                    maps: maps.handles(|id| pass.sampled(id))?,
                     ..base_push
                 };
                 dispatch(pass.cmd(), &pipeline, &push)

@@ -84,6 +84,9 @@ pub struct TexturingFrame {
     pub atlas: [u32; 4],
     /// Terrain rectangle x, y (metres), 0, 0.
     pub extent: [f32; 4],
+    /// Input maps (sampled handles: rainfall, radiation, temperature), bit k
+    /// of w set when map k is present.
+    pub maps: [u32; 4],
     /// Sampled handles of the atlas colour textures, in texture order.
     pub color: [u32; 16],
     /// Sampled handles of the atlas normal textures.

@@ -5,16 +5,21 @@
 //!
 //! * [`layers`]: the surface-layer tree (TOML file, built-in default), hat
 //!   functions and coverage, the CPU reference evaluation;
+//! * [`input_maps`]: rainfall, radiation and temperature maps registered
+//!   to the height field;
 //! * [`quadtree`]: per frame, the nodes the view needs and their tile sizes;
 //! * [`atlas`]: tile slots in the atlases, least-recently-used eviction, the
 //!   per-frame generation plan under a cap;
 //! * [`generation`]: the GPU passes that evaluate the tree into the dirty
 //!   tiles of a frame, all at once, one pass per layer;
-//! * [`page_table`]: the per-frame indirection the terrain shading reads.
+//! * [`page_table`]: the per-frame indirection the terrain shading reads;
+//! * [`stats`]: streaming statistics per frame and over a run.
 
 pub mod atlas;
 pub mod generation;
 pub mod gpu_layout;
+pub mod input_maps;
 pub mod layers;
 pub mod page_table;
 pub mod quadtree;
+pub mod stats;

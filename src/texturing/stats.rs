@@ -1,0 +1,126 @@
+//! Streaming statistics of the texture atlas (dissertation §8.2): per frame
+//! the tiles visible, hit, generated, evicted and deferred, and over a run
+//! the hit rate, the most tiles one frame generated and the GPU time of the
+//! `texturing.*` passes.
+
+use serde::Serialize;
+
+use crate::profile::{median, FrameProfile};
+use crate::texturing::atlas::TileStats;
+
+/// Texture statistics of one frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct TextureFrameStats {
+    pub frame: u64,
+    /// Tiles visible, hits, generated, evicted, deferred, resident.
+    #[serde(flatten)]
+    pub tiles: TileStats,
+    /// `hits / visible`.
+    pub hit_rate: f64,
+    /// Texels generated (borders included).
+    pub texels_generated: u64,
+    /// CPU time of selection, planning and the page table, milliseconds.
+    pub cpu_ms: f64,
+}
+
+/// Texture streaming over a run of frames.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct TextureSummary {
+    pub frames: usize,
+    /// Hits / visible over all frames.
+    pub hit_rate: f64,
+    /// The most tiles one frame generated.
+    pub max_generated: usize,
+    pub generated: usize,
+    pub evicted: usize,
+    /// Frames that drew some tile from a coarser one.
+    pub frames_deferred: usize,
+    pub median_visible: f64,
+    /// GPU time of the `texturing.*` passes per frame: min, median, max (ms).
+    pub generation_gpu_ms: [f64; 3],
+    /// Per tile generated, GPU time of all `texturing.*` passes (median over
+    /// frames that generated any tile, ms).
+    pub gpu_ms_per_tile: f64,
+    /// The same per `texturing.*` pass (upsample, each layer, finish).
+    pub pass_ms_per_tile: Vec<(String, f64)>,
+}
+
+/// GPU time of a frame's `texturing.*` passes (ms).
+pub fn generation_gpu_ms(profile: &FrameProfile) -> f64 {
+    let passes = profile.passes.iter().filter(|p| p.name.starts_with("texturing."));
+    passes.map(|p| p.gpu_ms).sum()
+}
+
+impl TextureSummary {
+    /// The summary of `stats` with the GPU times of the `profiles` of the
+    /// same frames (matched by frame number).
+    pub fn new(stats: &[TextureFrameStats], profiles: &[FrameProfile]) -> TextureSummary {
+        let (hits, visible) = stats
+            .iter()
+            .fold((0, 0), |(h, v), s| (h + s.tiles.hits, v + s.tiles.visible));
+        let gpu: Vec<(u64, f64)> = profiles.iter().map(|p| (p.frame, generation_gpu_ms(p))).collect();
+        let times: Vec<f64> = gpu.iter().map(|g| g.1).collect();
+        let per_tile = stats.iter().filter(|s| s.tiles.generated > 0).filter_map(|s| {
+            let (_, ms) = gpu.iter().find(|g| g.0 == s.frame)?;
+            Some(ms / s.tiles.generated as f64)
+        });
+        let generating: Vec<(&TextureFrameStats, &FrameProfile)> = (stats.iter())
+            .filter(|s| s.tiles.generated > 0)
+            .filter_map(|s| Some((s, profiles.iter().find(|p| p.frame == s.frame)?)))
+            .collect();
+        let names = profiles
+            .first()
+            .map_or(Vec::new(), |p| p.passes.iter().map(|q| q.name.clone()).collect());
+        let pass_ms_per_tile = (names.into_iter())
+            .filter(|n| n.starts_with("texturing."))
+            .map(|name| {
+                let per_tile = generating.iter().filter_map(|(s, p)| {
+                    let pass = p.passes.iter().find(|q| q.name == name)?;
+                    Some(pass.gpu_ms / s.tiles.generated as f64)
+                });
+                let ms = median(per_tile);
+                (name, ms)
+            })
+            .collect();
+        TextureSummary {
+            pass_ms_per_tile,
+            frames: stats.len(),
+            hit_rate: if visible == 0 {
+                1.0
+            } else {
+                hits as f64 / visible as f64
+            },
+            max_generated: stats.iter().map(|s| s.tiles.generated).max().unwrap_or(0),
+            generated: stats.iter().map(|s| s.tiles.generated).sum(),
+            evicted: stats.iter().map(|s| s.tiles.evicted).sum(),
+            frames_deferred: stats.iter().filter(|s| s.tiles.deferred > 0).count(),
+            median_visible: median(stats.iter().map(|s| s.tiles.visible as f64)),
+            generation_gpu_ms: match times.is_empty() {
+                true => [0.0; 3],
+                false => [
+                    times.iter().copied().fold(f64::INFINITY, f64::min),
+                    median(times.iter().copied()),
+                    times.iter().copied().fold(0.0, f64::max),
+                ],
+            },
+            gpu_ms_per_tile: median(per_tile),
+        }
+    }
+
+    /// GPU time per tile of each pass, one line.
+    pub fn per_pass_line(&self) -> String {
+        let parts: Vec<String> = (self.pass_ms_per_tile.iter())
+            .map(|(name, ms)| format!("{} {ms:.3}", name.trim_start_matches("texturing.")))
+            .collect();
+        format!("texture generation GPU ms per tile: {}", parts.join(", "))
+    }
+
+    /// One line for the terminal.
+    pub fn line(&self) -> String {
+        let [lo, med, hi] = self.generation_gpu_ms;
+        format!(
+            "textures: hit rate {:.4} over {} frames, {:.0} tiles visible (median), {} generated (at most {} per frame), {} evicted, {} frames with deferred tiles; generation GPU min {lo:.3} median {med:.3} max {hi:.3} ms/frame, {:.3} ms per tile",
+            self.hit_rate, self.frames, self.median_visible, self.generated, self.max_generated, self.evicted, self.frames_deferred, self.gpu_ms_per_tile
+        )
+    }
+}
