@@ -65,10 +65,14 @@ pub struct TextureStreaming {
 
 impl Default for TextureStreaming {
     fn default() -> Self {
+        let defaults = QuadtreeSettings::default();
         let quadtree = QuadtreeSettings {
-            // Texture resolution alone decides; the terrain mesh is independent.
-            pixel_error: f32::MAX,
-            ..QuadtreeSettings::default()
+            // The geometric error (z_max − z_min)/2 of HeightBounds, in
+            // pixels, against half the aim: a node also splits while its
+            // height range needs more texels than the aim, so steep nodes,
+            // whose surface is larger than their plan, get finer tiles.
+            pixel_error: defaults.aim_texels as f32 / 2.0,
+            ..defaults
         };
         TextureStreaming {
             quadtree,
@@ -462,4 +466,134 @@ fn dispatch(
     cmd.push_constants(push)?;
     cmd.dispatch(groups as u32, 1, 1);
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::texturing::atlas::TileSlot;
+    use crate::texturing::page_table::PageEntry;
+
+    const EXTENT: DVec2 = DVec2::new(1000.0, 1000.0);
+    const BORDER: u32 = 4;
+
+    /// A smooth stand-in for the layer tree.
+    fn f(p: DVec2) -> f64 {
+        (p.x / 37.0).sin() + (p.y / 53.0).cos()
+    }
+
+    /// A tile of `node` generated as the shaders do: `f` at every texel.
+    struct Tile {
+        size: u32,
+        values: Vec<f64>,
+        entry: PageEntry,
+    }
+
+    impl Tile {
+        fn new(node: NodeId, size: u32) -> Tile {
+            let at = |(i, j)| f(texel_world(node, size, BORDER, EXTENT, (i, j)));
+            let values = (0..size).flat_map(|j| (0..size).map(move |i| (i, j))).map(at).collect();
+            let slot = TileSlot {
+                texture: 0,
+                x: 0,
+                y: 0,
+                size,
+            };
+            let entry = PageEntry::new(node, slot, EXTENT, BORDER);
+            Tile { size, values, entry }
+        }
+
+        /// Bilinear sample at world `p` as terrain.draw does (texel centres at
+        /// i + 0.5); panics if the footprint leaves the tile.
+        fn sample(&self, p: DVec2) -> f64 {
+            let t = self.entry.texel(p) - 0.5;
+            let last = f64::from(self.size - 1);
+            assert!(
+                t.min_element() >= 0.0 && t.max_element() <= last,
+                "{p} reads outside the tile: {t}"
+            );
+            let base = t.floor().min(DVec2::splat(last - 1.0));
+            let (fx, fy) = (t.x - base.x, t.y - base.y);
+            let at = |dx: f64, dy: f64| self.values[((base.y + dy) as u32 * self.size + (base.x + dx) as u32) as usize];
+            let top = at(0.0, 0.0) * (1.0 - fx) + at(1.0, 0.0) * fx;
+            let bottom = at(0.0, 1.0) * (1.0 - fx) + at(1.0, 1.0) * fx;
+            top * (1.0 - fy) + bottom * fy
+        }
+    }
+
+    /// Points along the shared vertical edge x = `x` over `[y0, y1]`.
+    fn edge(x: f64, y0: f64, y1: f64) -> impl Iterator<Item = DVec2> {
+        (0..=64).map(move |k| DVec2::new(x, y0 + (y1 - y0) * f64::from(k) / 64.0))
+    }
+
+    #[test]
+    fn equal_size_neighbours_share_border_texels_exactly() {
+        let (a, b) = (NodeId { level: 3, x: 2, y: 3 }, NodeId { level: 3, x: 3, y: 3 });
+        let inner = 32 - 2 * BORDER;
+        for j in 0..32 {
+            for k in 0..2 * BORDER {
+                // A's texel inner + k (its right border from k = BORDER on)
+                // is B's texel k.
+                let pa = texel_world(a, 32, BORDER, EXTENT, (inner + k, j));
+                let pb = texel_world(b, 32, BORDER, EXTENT, (k, j));
+                assert!(pa.distance(pb) < 1e-9, "{pa} vs {pb}");
+            }
+        }
+        let (ta, tb) = (Tile::new(a, 32), Tile::new(b, 32));
+        let (min, max) = b.rect(EXTENT);
+        for p in edge(min.x, min.y, max.y) {
+            assert!((ta.sample(p) - tb.sample(p)).abs() < 1e-9, "seam at {p}");
+        }
+    }
+
+    #[test]
+    fn different_size_neighbours_agree_within_interpolation_error() {
+        // A coarse tile and the finer tiles of its eastern neighbour's children.
+        let coarse = NodeId { level: 3, x: 2, y: 3 };
+        let fine = [NodeId { level: 4, x: 6, y: 6 }, NodeId { level: 4, x: 6, y: 7 }];
+        let ta = Tile::new(coarse, 32);
+        // Bilinear error ≤ h²/8 · max|f''| per direction, h the coarse spacing.
+        let h = (1000.0 / 8.0) / f64::from(32 - 2 * BORDER);
+        let bound = 2.0 * h * h / 8.0 * (1.0 / (37.0f64 * 37.0)).max(1.0 / (53.0 * 53.0));
+        let mut worst = 0.0f64;
+        for node in fine {
+            let tb = Tile::new(node, 64);
+            let (min, max) = node.rect(EXTENT);
+            for p in edge(min.x, min.y, max.y) {
+                let d = (ta.sample(p) - tb.sample(p)).abs();
+                worst = worst.max(d);
+                assert!(d <= 2.0 * bound, "seam of {d} at {p} (bound {bound})");
+                assert!((tb.sample(p) - f(p)).abs() <= bound, "fine tile off at {p}");
+            }
+        }
+        assert!(worst > 0.0, "different lattices should not agree exactly");
+    }
+
+    #[test]
+    fn jobs_number_texels_tile_after_tile() {
+        let mut cache = TileCache::new(AtlasSettings::default()).unwrap();
+        let needed = [
+            crate::texturing::quadtree::NeededTile {
+                node: NodeId { level: 1, x: 0, y: 0 },
+                size: 64,
+                distance: 1.0,
+            },
+            crate::texturing::quadtree::NeededTile {
+                node: NodeId { level: 1, x: 1, y: 0 },
+                size: 32,
+                distance: 2.0,
+            },
+        ];
+        let plan = cache.plan_frame(1, &needed, 10);
+        let (jobs, texels) = tile_jobs(&plan, EXTENT, &|t| [10 + t, 20 + t]);
+        // The root (16²) first, then the two needed tiles.
+        assert_eq!(texels, 16 * 16 + 64 * 64 + 32 * 32);
+        let firsts: Vec<u32> = jobs.iter().map(|j| j.tile[0]).collect();
+        assert_eq!(firsts, [0, 256, 256 + 4096]);
+        let slot = plan.generate[1].1;
+        assert_eq!(jobs[1].images, [10 + slot.texture, 20 + slot.texture, 0, 0]);
+        let origin = texel_world(NodeId { level: 1, x: 0, y: 0 }, 64, BORDER, EXTENT, (0, 0));
+        assert_eq!(jobs[1].world[..2], [origin.x as f32, origin.y as f32]);
+        assert!((f64::from(jobs[1].world[2]) - 500.0 / 56.0).abs() < 1e-4);
+    }
 }
