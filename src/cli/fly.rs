@@ -166,7 +166,9 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     let textures = (!texture_stats.is_empty()).then(|| TextureSummary::new(&texture_stats, &profiles));
     if let Some(t) = &textures {
         println!("  {}", t.line());
-        println!("  {}", t.per_pass_line());
+        if let Some(line) = t.per_pass_line() {
+            println!("  {line}");
+        }
     }
 
     let mut outputs = OutputSet::default();

@@ -402,7 +402,9 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     let textures = (!texture_stats.is_empty()).then(|| TextureSummary::new(&texture_stats, &timed));
     if let Some(t) = &textures {
         println!("  {}", t.line());
-        println!("  {}", t.per_pass_line());
+        if let Some(line) = t.per_pass_line() {
+            println!("  {line}");
+        }
     }
     let mut outputs = OutputSet::default();
     if args.json.is_some() {

@@ -339,6 +339,24 @@ impl Renderer {
         })
     }
 
+    /// Waits for `frame` and copies the colour atlas textures (sRGB-encoded
+    /// RGBA8, `atlas size²` texels each, in texture order) out of their
+    /// readback buffers; needs [`TextureStreaming::readback`]. Same
+    /// frames-in-flight rule as [`Renderer::read`].
+    pub fn read_texture_atlas(&mut self, frame: &FrameOutcome) -> Result<Vec<Vec<u8>>> {
+        let buffers = (self.atlas.as_ref().and_then(|a| a.readback.as_ref()))
+            .ok_or_else(|| Error::invalid("texture atlas readback", "the renderer was created without it"))?;
+        if self.frames_rendered > frame.frame + FRAMES_IN_FLIGHT as u64 {
+            return Err(Error::invalid(
+                "texture atlas readback",
+                format!("frame {} was overwritten", frame.frame),
+            ));
+        }
+        self.ctx.wait(frame.timeline)?;
+        let slot = frame.frame as usize % FRAMES_IN_FLIGHT;
+        buffers.iter().map(|b| Ok(b[slot].mapped()?.to_vec())).collect()
+    }
+
     /// Waits for all frames and returns the timings of those not yet taken.
     pub fn finish(&mut self) -> Result<Vec<FrameProfile>> {
         self.graph.finish(&mut self.frames)?;

@@ -61,6 +61,9 @@ pub struct TextureStreaming {
     pub atlas: AtlasSettings,
     /// Most tiles and texels generated per frame.
     pub budget: GenerationBudget,
+    /// Copy the colour atlas textures to the host every frame (for tests
+    /// and debugging: [`crate::renderer::Renderer::read_texture_atlas`]).
+    pub readback: bool,
 }
 
 impl Default for TextureStreaming {
@@ -72,15 +75,29 @@ impl Default for TextureStreaming {
             // height range needs more texels than the aim, so steep nodes,
             // whose surface is larger than their plan, get finer tiles.
             pixel_error: defaults.aim_texels as f32 / 2.0,
+            // Tiles of 16² to 128² only, nodes down to 1/4096 of the terrain
+            // (2.5 m on the default 10 km scene, 2 cm texels): views nearer
+            // than that magnify the finest tiles rather than holding
+            // 256² and 512² tiles few views use.
+            max_tile: 128,
+            max_depth: 12,
             ..defaults
+        };
+        let atlas = AtlasSettings {
+            // Room for 512 tiles of each size (128² tiles: 8 textures of
+            // 1024²); a 1280×720 view needs about 300 tiles.
+            min_slots: 512,
+            max_textures_per_size: 8,
+            ..AtlasSettings::for_quadtree(&quadtree)
         };
         TextureStreaming {
             quadtree,
-            atlas: AtlasSettings::for_quadtree(&quadtree),
+            atlas,
             budget: GenerationBudget {
                 tiles: 32,
                 texels: 32 * 128 * 128,
             },
+            readback: false,
         }
     }
 }
@@ -202,6 +219,9 @@ pub struct AtlasResources {
     /// Texels per atlas side.
     pub atlas_size: u32,
     pub(crate) state: SharedGeneration,
+    /// Host copies of the colour textures, per texture and frame slot
+    /// ([`TextureStreaming::readback`]).
+    pub(crate) readback: Option<Vec<Vec<Arc<Buffer>>>>,
 }
 
 impl AtlasResources {
@@ -271,6 +291,10 @@ pub fn add_generation_passes(
     let atlas_size = streaming.atlas.size;
     let mut colors = Vec::new();
     let mut normals = Vec::new();
+    let readback_usage = match streaming.readback {
+        true => ImageUsageFlags::TRANSFER_SRC,
+        false => ImageUsageFlags::empty(),
+    };
     for (k, tile) in streaming.atlas.texture_tile_sizes().into_iter().enumerate() {
         for (what, list) in [("colour", &mut colors), ("normal", &mut normals)] {
             let image = Image::new(
@@ -280,7 +304,7 @@ pub fn add_generation_passes(
                     width: atlas_size,
                     height: atlas_size,
                     format: Format::R8G8B8A8_UNORM,
-                    usage: ImageUsageFlags::STORAGE | ImageUsageFlags::SAMPLED,
+                    usage: ImageUsageFlags::STORAGE | ImageUsageFlags::SAMPLED | readback_usage,
                 },
             )?;
             list.push(graph.import_image(Arc::new(image)));
@@ -443,13 +467,58 @@ pub fn add_generation_passes(
         };
         dispatch(pass.cmd(), &pipeline, &push)
     });
+    let readback = match streaming.readback {
+        true => Some(add_atlas_readback(ctx, graph, &colors, atlas_size)?),
+        false => None,
+    };
     Ok(AtlasResources {
         colors,
         normals,
         page_table,
         atlas_size,
         state,
+        readback,
     })
+}
+
+/// `texturing.readback`: every colour texture into host buffers.
+fn add_atlas_readback(
+    ctx: &Context,
+    graph: &mut RenderGraph<FrameParams>,
+    colors: &[ResourceId],
+    atlas_size: u32,
+) -> Result<Vec<Vec<Arc<Buffer>>>> {
+    let mut copies = Vec::new();
+    let mut buffers = Vec::new();
+    for (k, &image) in colors.iter().enumerate() {
+        let per_frame = Buffer::per_frame(
+            ctx,
+            BufferDesc {
+                name: format!("texture atlas {k} readback"),
+                size: u64::from(atlas_size).pow(2) * 4,
+                usage: BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuToCpu,
+            },
+        )?;
+        copies.push((image, graph.import_buffers_per_frame(per_frame.clone())));
+        buffers.push(per_frame);
+    }
+    let mut pass = graph.pass("texturing.readback").transfer();
+    for &(image, buffer) in &copies {
+        pass = pass.read(image, Access::TransferSrc).write(buffer, Access::TransferDst);
+    }
+    let recorded = copies.clone();
+    pass.record(move |pass, _| {
+        for &(image, buffer) in &recorded {
+            let (image, buffer) = (pass.image(image)?, pass.buffer(buffer)?);
+            pass.cmd().copy_image_to_buffer(image, buffer);
+        }
+        Ok(())
+    });
+    for &(_, buffer) in &copies {
+        graph.read_back(buffer);
+    }
+    Ok(buffers)
 }
 
 /// One thread per dirty texel; nothing when no tile is dirty.

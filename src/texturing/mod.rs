@@ -13,7 +13,8 @@
 //! * [`generation`]: the GPU passes that evaluate the tree into the dirty
 //!   tiles of a frame, all at once, one pass per layer;
 //! * [`page_table`]: the per-frame indirection the terrain shading reads;
-//! * [`stats`]: streaming statistics per frame and over a run.
+//! * [`stats`]: streaming statistics per frame and over a run;
+//! * [`reference`]: the CPU twin of the shaders' evaluation, for tests.
 
 pub mod atlas;
 pub mod generation;
@@ -22,4 +23,5 @@ pub mod input_maps;
 pub mod layers;
 pub mod page_table;
 pub mod quadtree;
+pub mod reference;
 pub mod stats;

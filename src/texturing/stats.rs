@@ -107,20 +107,28 @@ impl TextureSummary {
         }
     }
 
-    /// GPU time per tile of each pass, one line.
-    pub fn per_pass_line(&self) -> String {
+    /// GPU time per tile of each pass, one line; None when no frame
+    /// generated a tile.
+    pub fn per_pass_line(&self) -> Option<String> {
+        if self.generated == 0 {
+            return None;
+        }
         let parts: Vec<String> = (self.pass_ms_per_tile.iter())
             .map(|(name, ms)| format!("{} {ms:.3}", name.trim_start_matches("texturing.")))
             .collect();
-        format!("texture generation GPU ms per tile: {}", parts.join(", "))
+        Some(format!("texture generation GPU ms per tile: {}", parts.join(", ")))
     }
 
     /// One line for the terminal.
     pub fn line(&self) -> String {
         let [lo, med, hi] = self.generation_gpu_ms;
+        let per_tile = match self.generated {
+            0 => String::new(),
+            _ => format!(", {:.3} ms per tile", self.gpu_ms_per_tile),
+        };
         format!(
-            "textures: hit rate {:.4} over {} frames, {:.0} tiles visible (median), {} generated (at most {} per frame), {} evicted, {} frames with deferred tiles; generation GPU min {lo:.3} median {med:.3} max {hi:.3} ms/frame, {:.3} ms per tile",
-            self.hit_rate, self.frames, self.median_visible, self.generated, self.max_generated, self.evicted, self.frames_deferred, self.gpu_ms_per_tile
+            "textures: hit rate {:.4} over {} frames, {:.0} tiles visible (median), {} generated (at most {} per frame), {} evicted, {} frames with deferred tiles; generation GPU min {lo:.3} median {med:.3} max {hi:.3} ms/frame{per_tile}",
+            self.hit_rate, self.frames, self.median_visible, self.generated, self.max_generated, self.evicted, self.frames_deferred
         )
     }
 }
