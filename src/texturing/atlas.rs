@@ -6,9 +6,10 @@
 //! Tiles live in atlas textures of `size × size` texels. Every texture
 //! holds tiles of one size (border included), packed row-major into
 //! `(size/tile)²` slots. Each tile size from `min_tile` to `max_tile` gets
-//! enough textures for `min_slots` tiles (at least one, at most
-//! `max_textures_per_size`); textures are numbered size by size, smallest
-//! first, and a size's slots run through its textures in order.
+//! its own number of textures ([`AtlasSettings::textures`]; by default most
+//! for the aim size, which most tiles have, §8.2.4); textures are numbered
+//! size by size, smallest first, and a size's slots run through its
+//! textures in order.
 //!
 //! # Frame plan rules ([`TileCache::plan_frame`])
 //!
@@ -57,11 +58,13 @@ pub struct AtlasSettings {
     pub min_tile: u32,
     /// Largest tile size, border included (power of two, ≤ `size`).
     pub max_tile: u32,
-    /// Slots wanted per tile size (the number of textures is rounded up).
-    pub min_slots: u32,
-    /// Most textures per tile size (≥ 1).
-    pub max_textures_per_size: u32,
+    /// Textures per tile size, `textures[k]` for tiles of `min_tile·2^k`
+    /// (1..=64 for every size in the range).
+    pub textures: [u32; MAX_TILE_SIZES],
 }
+
+/// Most distinct tile sizes (16² to 2048²).
+pub const MAX_TILE_SIZES: usize = 8;
 
 impl Default for AtlasSettings {
     fn default() -> Self {
@@ -70,8 +73,7 @@ impl Default for AtlasSettings {
             border: 4,
             min_tile: 16,
             max_tile: 512,
-            min_slots: 128,
-            max_textures_per_size: 2,
+            textures: AtlasSettings::textures_around(16, 128),
         }
     }
 }
@@ -80,13 +82,30 @@ impl AtlasSettings {
     /// Atlases of 1024² texels (larger if `max_tile` is) for the tiles of
     /// `quadtree`.
     pub fn for_quadtree(quadtree: &QuadtreeSettings) -> AtlasSettings {
+        let aim = quadtree.aim_texels.next_power_of_two();
         AtlasSettings {
             size: quadtree.max_tile.max(1024),
             border: quadtree.border,
             min_tile: quadtree.min_tile,
             max_tile: quadtree.max_tile,
-            ..AtlasSettings::default()
+            textures: AtlasSettings::textures_around(quadtree.min_tile, aim),
         }
+    }
+
+    /// Texture counts for a quadtree aiming at `aim_tile` (§8.2.4: medium
+    /// tiles of about 128² are the most frequent): eight textures for the
+    /// aim size, two for half of it, four for each larger size (only the
+    /// finest nodes near the viewer get those), one for the rest.
+    pub fn textures_around(min_tile: u32, aim_tile: u32) -> [u32; MAX_TILE_SIZES] {
+        std::array::from_fn(|k| {
+            let size = u64::from(min_tile) << k;
+            match size.cmp(&u64::from(aim_tile)) {
+                std::cmp::Ordering::Equal => 8,
+                std::cmp::Ordering::Greater => 4,
+                std::cmp::Ordering::Less if 2 * size == u64::from(aim_tile) => 2,
+                std::cmp::Ordering::Less => 1,
+            }
+        })
     }
 
     /// Checks: all sizes are powers of two, `min_tile ≤ max_tile ≤ size`,
@@ -99,8 +118,14 @@ impl AtlasSettings {
             format!("need min_tile {min} ≤ max_tile {max} ≤ size {size}")
         } else if u64::from(border) * 2 >= u64::from(min) {
             format!("border {border} leaves no inner texels in min_tile {min}")
-        } else if self.max_textures_per_size == 0 || self.max_textures_per_size > 64 {
-            format!("max_textures_per_size {} must be in 1..=64", self.max_textures_per_size)
+        } else if self.sizes() as usize > MAX_TILE_SIZES {
+            format!("{} tile sizes exceed {MAX_TILE_SIZES}", self.sizes())
+        } else if let Some(k) = (0..self.sizes() as usize).find(|&k| !(1..=64).contains(&self.textures[k])) {
+            format!(
+                "{} textures for {}² tiles; must be in 1..=64",
+                self.textures[k],
+                self.tile_size(k as u32)
+            )
         } else {
             return Ok(());
         };
@@ -134,10 +159,8 @@ impl AtlasSettings {
 
     /// Textures holding tiles of `tile_size`, 0 for a size not in the atlas.
     pub fn textures_of(&self, tile_size: u32) -> u32 {
-        match self.slots_per_texture(tile_size) {
-            0 => 0,
-            per => self.min_slots.div_ceil(per).clamp(1, self.max_textures_per_size.max(1)),
-        }
+        let k = self.size_index(tile_size);
+        k.and_then(|k| self.textures.get(k as usize)).copied().unwrap_or(0)
     }
 
     /// Index of the first texture of `tile_size`, `None` for a size not in the atlas.
@@ -484,7 +507,7 @@ mod tests {
         let mut settings = AtlasSettings {
             size,
             border,
-            max_textures_per_size: 1,
+            textures: [1; MAX_TILE_SIZES],
             ..AtlasSettings::default()
         };
         (settings.min_tile, settings.max_tile) = (min_tile, max_tile);
@@ -588,8 +611,7 @@ mod tests {
             border: 2,
             min_tile: 16,
             max_tile: 32,
-            min_slots: 8,
-            max_textures_per_size: 4,
+            textures: [1, 2, 0, 0, 0, 0, 0, 0],
         };
         // 16-texel tiles: one texture of 16 slots; 32-texel tiles: two of 4.
         assert_eq!(settings.texture_tile_sizes(), [16, 32, 32]);
@@ -600,7 +622,9 @@ mod tests {
         let slots: HashSet<(u32, u32, u32)> = plan.draw.iter().map(|d| (d.slot.texture, d.slot.x, d.slot.y)).collect();
         assert_eq!(slots.len(), 8, "distinct slots");
         assert!(slots.iter().all(|&(t, x, y)| (1..=2).contains(&t) && x < 64 && y < 64));
-        settings.max_textures_per_size = 0;
+        settings.textures[1] = 0;
+        assert!(TileCache::new(settings).is_err());
+        settings.textures[1] = 65;
         assert!(TileCache::new(settings).is_err());
     }
 
@@ -610,15 +634,19 @@ mod tests {
         assert_eq!((s.sizes(), s.size_index(16), s.size_index(512)), (6, Some(0), Some(5)));
         assert_eq!((s.size_index(24), s.size_index(1024)), (None, None));
         assert_eq!((s.slots_per_texture(256), s.slots_per_texture(16)), (16, 4096));
-        // 128 slots wanted, at most 2 textures per size.
+        // Aim 128: eight textures for 128², two for 64², four above.
         let textures = [16, 32, 64, 128, 256, 512].map(|t| s.textures_of(t));
-        assert_eq!(textures, [1, 1, 1, 2, 2, 2]);
-        assert_eq!(s.texture_tile_sizes(), [16, 32, 64, 128, 128, 256, 256, 512, 512]);
+        assert_eq!(textures, [1, 1, 2, 8, 4, 4]);
+        let sizes = s.texture_tile_sizes();
+        assert_eq!(
+            (sizes.len(), sizes[3], sizes[4], sizes[11], sizes[19]),
+            (20, 64, 128, 128, 512)
+        );
         assert_eq!(
             (s.first_texture(16), s.first_texture(256), s.first_texture(8)),
-            (Some(0), Some(5), None)
+            (Some(0), Some(12), None)
         );
-        assert_eq!(TileCache::new(s).unwrap().memory_bytes(4), 9 * 1024 * 1024 * 4);
+        assert_eq!(TileCache::new(s).unwrap().memory_bytes(4), 20 * 1024 * 1024 * 4);
         assert!(atlas(1000, 4, 16, 512).is_err() && atlas(1024, 4, 16, 2048).is_err());
         assert!(atlas(1024, 4, 1024, 512).is_err() && atlas(1024, 8, 16, 512).is_err());
         assert_eq!(TileStats::default().hit_rate(), 1.0);

@@ -1,4 +1,4 @@
-//! Tile generation on the GPU (dissertation §8.2, the pipeline of Fig. 8.x;
+//! Tile generation on the GPU (dissertation §8.2.2–8.2.4, Fig. 8.3–8.4;
 //! `ALGORITHMS.md` §4 items 3–4), as render-graph passes over **all** dirty
 //! tiles of a frame at once:
 //!
@@ -75,21 +75,17 @@ impl Default for TextureStreaming {
             // height range needs more texels than the aim, so steep nodes,
             // whose surface is larger than their plan, get finer tiles.
             pixel_error: defaults.aim_texels as f32 / 2.0,
-            // Tiles of 16² to 128² only, nodes down to 1/4096 of the terrain
-            // (2.5 m on the default 10 km scene, 2 cm texels): views nearer
-            // than that magnify the finest tiles rather than holding
-            // 256² and 512² tiles few views use.
-            max_tile: 128,
+            // Nodes down to 1/4096 of the terrain (2.5 m on the default
+            // 10 km scene: 2 cm texels in 128² tiles); only nodes that fine
+            // get larger tiles (§8.2.4), here up to 256² (f32 world
+            // coordinates keep well under a texel at that depth).
+            max_tile: 256,
             max_depth: 12,
             ..defaults
         };
-        let atlas = AtlasSettings {
-            // Room for 512 tiles of each size (128² tiles: 8 textures of
-            // 1024²); a 1280×720 view needs about 300 tiles.
-            min_slots: 512,
-            max_textures_per_size: 8,
-            ..AtlasSettings::for_quadtree(&quadtree)
-        };
+        // 16 textures of 1024² (128 MiB of colour and normal): 512 tiles of
+        // 128² and 64²; a 1280×720 view needs about 300 tiles.
+        let atlas = AtlasSettings::for_quadtree(&quadtree);
         TextureStreaming {
             quadtree,
             atlas,
