@@ -11,7 +11,7 @@
 #define MAX_PAGE_DEPTH 16
 #define PAGE_LEAF 0x80000000u
 #define PAGE_NONE 0xffffffffu
-#define MAX_ATLAS_TEXTURES 16
+#define MAX_ATLAS_TEXTURES 32
 
 const uint TEXTURING_CLASSIC = 0u;
 const uint TEXTURING_DIRECT = 1u;

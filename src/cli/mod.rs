@@ -173,14 +173,14 @@ fn render_settings(args: &SceneArgs, readback: bool) -> Result<RenderSettings> {
             args::TexturingArg::Direct => alpenglow::texturing::gpu_layout::TexturingMode::Direct,
             args::TexturingArg::Atlas => alpenglow::texturing::gpu_layout::TexturingMode::Atlas,
         },
-        texture_streaming: texture_streaming(&args.terrain),
+        texture_streaming: texture_streaming(args),
     })
 }
 
 /// Atlas streaming with the tile budget of the arguments.
-fn texture_streaming(args: &args::TerrainArgs) -> alpenglow::texturing::generation::TextureStreaming {
-    let mut streaming = alpenglow::texturing::generation::TextureStreaming::default();
-    let tiles = args.tile_budget as usize;
+fn texture_streaming(args: &SceneArgs) -> alpenglow::texturing::generation::TextureStreaming {
+    let mut streaming = alpenglow::texturing::generation::TextureStreaming::for_image(args.width, args.height);
+    let tiles = args.terrain.tile_budget as usize;
     let aim = u64::from(streaming.quadtree.aim_texels);
     streaming.budget = alpenglow::texturing::atlas::GenerationBudget {
         tiles,

@@ -79,7 +79,7 @@ impl RenderSettings {
             terrain: TerrainSettings::default(),
             points: SplatSettings::default(),
             texturing: TexturingMode::default(),
-            texture_streaming: TextureStreaming::default(),
+            texture_streaming: TextureStreaming::for_image(width, height),
         }
     }
 }

@@ -47,7 +47,7 @@ pub const TEXEL_STATE_BYTES: u64 = 32;
 /// Capacity of the per-frame page-table buffer in 16-byte words.
 pub const PAGE_TABLE_WORDS: usize = 1 << 16;
 /// Most atlas textures (`MAX_ATLAS_TEXTURES` in texture_atlas.glsl).
-pub const MAX_ATLAS_TEXTURES: usize = 16;
+pub const MAX_ATLAS_TEXTURES: usize = 32;
 /// Texels per workgroup of the generation passes.
 const GROUP: u64 = 64;
 /// Most texels one frame generates: one-dimensional dispatches of 65 535 groups.
@@ -66,8 +66,27 @@ pub struct TextureStreaming {
     pub readback: bool,
 }
 
+/// Screen pixels per visible tile: views of the default scene and of the
+/// Jacksboro DEM at 1280×720 need about 330 tiles, nearly all of the aim
+/// size (a node stops splitting once it needs ≤ 120 texels, so its tile
+/// needs 60–120: 128²); grazing views squash tiles on screen.
+pub const PIXELS_PER_TILE: u64 = 2800;
+
 impl Default for TextureStreaming {
+    /// [`TextureStreaming::for_image`] of 1280×720.
     fn default() -> Self {
+        TextureStreaming::for_image(1280, 720)
+    }
+}
+
+impl TextureStreaming {
+    /// Streaming for `width`×`height` images: the quadtree aims at 128²
+    /// tiles, 16² to 128², and only the finest nodes (level 12) get up to
+    /// 256² (§8.2.4); the atlas holds twice the tiles a view needs
+    /// ([`PIXELS_PER_TILE`]) of the aim size, in 1024² textures (2048²
+    /// above what [`MAX_ATLAS_TEXTURES`] allows), one texture for each
+    /// smaller size and four for 256²; at most 32 tiles generated per frame.
+    pub fn for_image(width: u32, height: u32) -> TextureStreaming {
         let defaults = QuadtreeSettings::default();
         let quadtree = QuadtreeSettings {
             // The geometric error (z_max − z_min)/2 of HeightBounds, in
@@ -76,16 +95,26 @@ impl Default for TextureStreaming {
             // whose surface is larger than their plan, get finer tiles.
             pixel_error: defaults.aim_texels as f32 / 2.0,
             // Nodes down to 1/4096 of the terrain (2.5 m on the default
-            // 10 km scene: 2 cm texels in 128² tiles); only nodes that fine
-            // get larger tiles (§8.2.4), here up to 256² (f32 world
-            // coordinates keep well under a texel at that depth).
+            // 10 km scene: 2 cm texels in 128² tiles); f32 world
+            // coordinates keep well under a texel at that depth.
             max_tile: 256,
             max_depth: 12,
             ..defaults
         };
-        // 16 textures of 1024² (128 MiB of colour and normal): 512 tiles of
-        // 128² and 64²; a 1280×720 view needs about 300 tiles.
-        let atlas = AtlasSettings::for_quadtree(&quadtree);
+        let mut atlas = AtlasSettings::for_quadtree(&quadtree);
+        let aim = quadtree.aim_texels.next_power_of_two();
+        let wanted = 2 * (u64::from(width) * u64::from(height)).div_ceil(PIXELS_PER_TILE);
+        for size in [1024, 2048] {
+            atlas.size = size;
+            atlas.textures = std::array::from_fn(|k| if (16u32 << k) > aim { 4 } else { 1 });
+            let per_texture = u64::from(atlas.slots_per_texture(aim).max(1));
+            if let Some(k) = atlas.size_index(aim) {
+                atlas.textures[k as usize] = wanted.div_ceil(per_texture).clamp(2, 64) as u32;
+            }
+            if atlas.texture_tile_sizes().len() <= MAX_ATLAS_TEXTURES {
+                break;
+            }
+        }
         TextureStreaming {
             quadtree,
             atlas,
@@ -96,9 +125,13 @@ impl Default for TextureStreaming {
             readback: false,
         }
     }
-}
 
-impl TextureStreaming {
+    /// Bytes of the atlas textures (colour and normal, RGBA8).
+    pub fn atlas_bytes(&self) -> u64 {
+        let textures = self.atlas.texture_tile_sizes().len() as u64;
+        textures * u64::from(self.atlas.size).pow(2) * 8
+    }
+
     /// Checks the settings and that the budget fits a scratch buffer.
     pub fn validate(&self) -> Result<()> {
         self.quadtree.validate()?;
@@ -632,6 +665,27 @@ mod tests {
             }
         }
         assert!(worst > 0.0, "different lattices should not agree exactly");
+    }
+
+    #[test]
+    fn atlas_grows_with_the_image() {
+        let textures_of_128 = |w, h| {
+            let s = TextureStreaming::for_image(w, h);
+            s.validate().unwrap();
+            (
+                s.atlas.size,
+                s.atlas.textures_of(128),
+                s.atlas.textures_of(256),
+                s.atlas_bytes() >> 20,
+            )
+        };
+        // 2·⌈pixels/2800⌉ tiles of 128², 64 per 1024² texture.
+        assert_eq!(textures_of_128(640, 360), (1024, 3, 4, 80));
+        assert_eq!(textures_of_128(1280, 720), (1024, 11, 4, 144));
+        assert_eq!(textures_of_128(1920, 1080), (1024, 24, 4, 248));
+        // 4K needs more than 32 textures of 1024²: 2048² instead.
+        assert_eq!(textures_of_128(3840, 2160), (2048, 24, 4, 992));
+        assert_eq!(TextureStreaming::default(), TextureStreaming::for_image(1280, 720));
     }
 
     #[test]

@@ -88,7 +88,7 @@ pub struct TexturingFrame {
     /// of w set when map k is present.
     pub maps: [u32; 4],
     /// Sampled handles of the atlas colour textures, in texture order.
-    pub color: [u32; 16],
+    pub color: [u32; 32],
     /// Sampled handles of the atlas normal textures.
-    pub normal: [u32; 16],
+    pub normal: [u32; 32],
 }
