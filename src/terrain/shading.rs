@@ -149,21 +149,10 @@ pub fn add_draw_pass(
         .read(layers, Access::StorageBufferRead(Stage::Fragment))
         .read(frames, Access::StorageBufferRead(Stage::Fragment));
     let extent = field.extent();
-    let atlas_inputs = atlas.as_ref().map(|a| {
-        (
-            a.colors.clone(),
-            a.normals.clone(),
-            a.page_table,
-            a.atlas_size,
-            a.state.clone(),
-        )
-    });
-    for map in maps.present() {
-        pass = pass.read(map, Access::SampledImage(Stage::Fragment));
-    }
-    if let Some((colors, normals, page_table, _, _)) = &atlas_inputs {
-        pass = pass.read(*page_table, Access::StorageBufferRead(Stage::Fragment));
-        for &image in colors.iter().chain(normals) {
+    let atlas_for_draw = atlas.clone();
+    if let Some(a) = &atlas_for_draw {
+        pass = pass.read(a.page_table, Access::StorageBufferRead(Stage::Fragment));
+        for &image in a.colors.iter().chain(&a.normals) {
             pass = pass.read(image, Access::SampledImage(Stage::Fragment));
         }
     }
@@ -187,11 +176,16 @@ pub fn add_draw_pass(
                 maps: maps.handles(|id| pass.sampled(id))?,
                 ..TexturingFrame::zeroed()
             };
-            if let Some((colors, normals, page_table, atlas_size, state)) = &atlas_inputs {
-                let words = std::mem::take(&mut locked(state)?.page_words);
-                pass.buffer(*page_table)?.write(0, bytemuck::cast_slice(&words))?;
-                frame.atlas = [pass.storage_buffer(*page_table)?, colors.len() as u32, *atlas_size, 0];
-                for (k, (&c, &n)) in colors.iter().zip(normals).enumerate() {
+            if let Some(a) = &atlas_for_draw {
+                let words = std::mem::take(&mut locked(&a.state)?.page_words);
+                pass.buffer(a.page_table)?.write(0, bytemuck::cast_slice(&words))?;
+                frame.atlas = [
+                    pass.storage_buffer(a.page_table)?,
+                    a.colors.len() as u32,
+                    a.atlas_size,
+                    0,
+                ];
+                for (k, (&c, &n)) in a.colors.iter().zip(&a.normals).enumerate() {
                     (frame.color[k], frame.normal[k]) = (pass.sampled(c)?, pass.sampled(n)?);
                 }
             }

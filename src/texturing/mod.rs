@@ -13,6 +13,8 @@
 //! * [`generation`]: the GPU passes that evaluate the tree into the dirty
 //!   tiles of a frame, all at once, one pass per layer;
 //! * [`page_table`]: the per-frame indirection the terrain shading reads;
+//! * [`streaming`]: quadtree, atlas and budget settings, sized from the
+//!   output image;
 //! * [`stats`]: streaming statistics per frame and over a run;
 //! * [`reference`]: the CPU twin of the shaders' evaluation, for tests.
 
@@ -25,3 +27,4 @@ pub mod page_table;
 pub mod quadtree;
 pub mod reference;
 pub mod stats;
+pub mod streaming;

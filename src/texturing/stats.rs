@@ -29,6 +29,11 @@ pub struct TextureSummary {
     pub frames: usize,
     /// Hits / visible over all frames.
     pub hit_rate: f64,
+    /// The first frame (index into the run) that drew every tile at its
+    /// needed size: the atlas had filled up.
+    pub settled_at: Option<usize>,
+    /// Hits / visible from `settled_at` on (the steady state of streaming).
+    pub steady_hit_rate: Option<f64>,
     /// The most tiles one frame generated.
     pub max_generated: usize,
     pub generated: usize,
@@ -82,7 +87,21 @@ impl TextureSummary {
                 (name, ms)
             })
             .collect();
+        let settled_at = stats.iter().position(|s| s.tiles.deferred == 0);
+        let steady_hit_rate = settled_at.map(|i| {
+            let rest = &stats[i..];
+            let (h, v) = rest
+                .iter()
+                .fold((0, 0), |(h, v), s| (h + s.tiles.hits, v + s.tiles.visible));
+            if v == 0 {
+                1.0
+            } else {
+                h as f64 / v as f64
+            }
+        });
         TextureSummary {
+            settled_at,
+            steady_hit_rate,
             pass_ms_per_tile,
             frames: stats.len(),
             hit_rate: if visible == 0 {
@@ -122,13 +141,74 @@ impl TextureSummary {
     /// One line for the terminal.
     pub fn line(&self) -> String {
         let [lo, med, hi] = self.generation_gpu_ms;
+        let steady = match (self.settled_at, self.steady_hit_rate) {
+            (Some(i), Some(r)) if i > 0 => format!(" ({r:.4} from frame {i} on, once the atlas had filled)"),
+            _ => String::new(),
+        };
         let per_tile = match self.generated {
             0 => String::new(),
             _ => format!(", {:.3} ms per tile", self.gpu_ms_per_tile),
         };
         format!(
-            "textures: hit rate {:.4} over {} frames, {:.0} tiles visible (median), {} generated (at most {} per frame), {} evicted, {} frames with deferred tiles; generation GPU min {lo:.3} median {med:.3} max {hi:.3} ms/frame{per_tile}",
+            "textures: hit rate {:.4}{steady} over {} frames, {:.0} tiles visible (median), {} generated (at most {} per frame), {} evicted, {} frames with deferred tiles; generation GPU min {lo:.3} median {med:.3} max {hi:.3} ms/frame{per_tile}",
             self.hit_rate, self.frames, self.median_visible, self.generated, self.max_generated, self.evicted, self.frames_deferred
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::profile::PassTiming;
+
+    fn frame(frame: u64, visible: usize, hits: usize, generated: usize, deferred: usize) -> TextureFrameStats {
+        TextureFrameStats {
+            frame,
+            tiles: TileStats {
+                visible,
+                hits,
+                generated,
+                deferred,
+                ..TileStats::default()
+            },
+            ..TextureFrameStats::default()
+        }
+    }
+
+    fn profile(frame: u64, layer_ms: f64) -> FrameProfile {
+        let pass = |name: &str, gpu_ms: f64| PassTiming {
+            name: name.into(),
+            gpu_ms,
+            cpu_ms: 0.0,
+            gpu_start_ms: 0.0,
+            cpu_start_ms: 0.0,
+        };
+        FrameProfile {
+            frame,
+            passes: vec![pass("terrain.draw", 100.0), pass("texturing.layer0.rock", layer_ms)],
+            gpu_ms: 100.0 + layer_ms,
+            cpu_ms: 1.0,
+            cpu_start_ms: 0.0,
+        }
+    }
+
+    #[test]
+    fn summary_counts_steady_state_and_cost_per_tile() {
+        let stats = [frame(0, 10, 0, 4, 6), frame(1, 10, 4, 6, 0), frame(2, 10, 10, 0, 0)];
+        let profiles = [profile(0, 8.0), profile(1, 12.0), profile(2, 0.5)];
+        let s = TextureSummary::new(&stats, &profiles);
+        assert_eq!(
+            (s.frames, s.generated, s.max_generated, s.frames_deferred),
+            (3, 10, 6, 1)
+        );
+        assert!((s.hit_rate - 14.0 / 30.0).abs() < 1e-12);
+        assert_eq!((s.settled_at, s.steady_hit_rate), (Some(1), Some(0.7)));
+        // Generating frames: 8 ms / 4 tiles and 12 ms / 6 tiles.
+        assert_eq!(s.gpu_ms_per_tile, 2.0);
+        assert_eq!(s.pass_ms_per_tile, [("texturing.layer0.rock".to_string(), 2.0)]);
+        assert_eq!(s.generation_gpu_ms, [0.5, 8.0, 12.0]);
+        assert!(s.line().contains("0.7000 from frame 1 on"), "{}", s.line());
+        let idle = TextureSummary::new(&stats[2..], &profiles[2..]);
+        assert!(idle.per_pass_line().is_none() && !idle.line().contains("per tile"));
     }
 }
