@@ -7,8 +7,6 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::texturing::generation::{add_generation_passes, locked, AtlasResources, GenerationInputs, TextureStreaming};
-
 use crate::error::Error;
 use crate::error::Result;
 use crate::graph::{Access, RenderGraph, ResourceId, Stage};
@@ -16,6 +14,7 @@ use crate::io::heightmap::HeightField;
 use crate::renderer::FrameParams;
 use crate::shaders;
 use crate::terrain::geometry_image::{GeometryImage, VERTEX_STRIDE};
+use crate::texturing::generation::{add_generation_passes, locked, AtlasResources, GenerationInputs, TextureStreaming};
 use crate::texturing::gpu_layout::{pack_layers, TexturingFrame, TexturingMode};
 use crate::texturing::input_maps::InputMaps;
 use crate::texturing::layers::LayerTree;
@@ -149,6 +148,9 @@ pub fn add_draw_pass(
         .read(layers, Access::StorageBufferRead(Stage::Fragment))
         .read(frames, Access::StorageBufferRead(Stage::Fragment));
     let extent = field.extent();
+    for map in maps.present() {
+        pass = pass.read(map, Access::SampledImage(Stage::Fragment));
+    }
     let atlas_for_draw = atlas.clone();
     if let Some(a) = &atlas_for_draw {
         pass = pass.read(a.page_table, Access::StorageBufferRead(Stage::Fragment));
