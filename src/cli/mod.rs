@@ -346,9 +346,12 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     let mut intervals = Vec::new();
     let point_stats;
     let texture_stats;
+    let settle_frames;
     let profiles = {
         let settings = render_settings(&args.scene, false)?;
         let mut renderer = Renderer::new(&ctx, &scene, settings)?;
+        // A still view: first every texture tile (untimed), then warm-up and timed frames.
+        settle_frames = renderer.render_settled(&camera, MAX_SETTLE_FRAMES)?.frame + 1;
         let mut last = std::time::Instant::now();
         for i in 0..args.warmup + args.frames {
             renderer.render(&camera)?;
@@ -364,8 +367,9 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     };
     drop(ctx);
     check_validation(report)?;
-    let point_stats: Vec<_> = point_stats.into_iter().skip(args.warmup as usize).collect();
-    let timed: Vec<FrameProfile> = profiles.into_iter().skip(args.warmup as usize).collect();
+    let untimed = (settle_frames + u64::from(args.warmup)) as usize;
+    let point_stats: Vec<_> = point_stats.into_iter().skip(untimed).collect();
+    let timed: Vec<FrameProfile> = profiles.into_iter().skip(untimed).collect();
     if timed.is_empty() {
         return Err(anyhow!("no frame timings were collected"));
     }
@@ -398,7 +402,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
             cpu / stats.instances.max(1) as f64
         );
     }
-    let texture_stats: Vec<_> = texture_stats.into_iter().skip(args.warmup as usize).collect();
+    let texture_stats: Vec<_> = texture_stats.into_iter().skip(untimed).collect();
     let textures = (!texture_stats.is_empty()).then(|| TextureSummary::new(&texture_stats, &timed));
     if let Some(t) = &textures {
         println!("  {}", t.line());
