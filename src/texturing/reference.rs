@@ -80,9 +80,12 @@ impl<'a> ReferenceSurface<'a> {
     /// Input map `k` at world `xy`: bilinear over its grid spanning the
     /// terrain rectangle; NaN when absent.
     pub fn input_map(&self, k: usize, xy: DVec2) -> f32 {
-        let Some(map) = &self.maps[k] else {
+        let Some(map) = self.maps.get(k).and_then(Option::as_ref) else {
             return f32::NAN;
         };
+        if map.columns < 2 || map.rows < 2 || map.heights.len() < (map.columns * map.rows) as usize {
+            return f32::NAN;
+        }
         let uv = (xy / self.field.extent()).clamp(DVec2::ZERO, DVec2::ONE);
         let g = uv * DVec2::new(f64::from(map.columns - 1), f64::from(map.rows - 1));
         let (c0, r0) = (
