@@ -31,11 +31,11 @@ use crate::io::heightmap::HeightField;
 use crate::renderer::camera::frustum_planes;
 use crate::renderer::FrameParams;
 use crate::shaders;
-use crate::texturing::atlas::{TileCache, TilePlan};
+use crate::texturing::atlas::{GenerationBudget, TileCache, TilePlan};
 use crate::texturing::input_maps::InputMaps;
 use crate::texturing::layers::LayerTree;
 use crate::texturing::page_table::PageTable;
-use crate::texturing::quadtree::{select_tiles, HeightBounds, NodeId, View};
+use crate::texturing::quadtree::{select_tiles, HeightBounds, NodeId, QuadtreeSettings, View};
 pub use crate::texturing::stats::TextureFrameStats;
 pub use crate::texturing::streaming::{TextureStreaming, MAX_ATLAS_TEXTURES};
 use crate::vulkan::{
@@ -109,6 +109,35 @@ pub(crate) struct GenerationState {
     jobs: u32,
     texels: u64,
     stats: Vec<TextureFrameStats>,
+}
+
+impl GenerationState {
+    /// Selects the needed tiles of `view`, plans the frame within `budget`,
+    /// builds the page table and the jobs of the dirty tiles
+    /// (`images(texture)`: its colour and normal storage handles).
+    fn plan(
+        &mut self,
+        frame: u64,
+        view: &View,
+        quadtree: &QuadtreeSettings,
+        budget: GenerationBudget,
+        extent: DVec2,
+        images: &dyn Fn(u32) -> [u32; 2],
+    ) -> Result<(TilePlan, Vec<TileJob>, u64)> {
+        let needed = select_tiles(extent, view, quadtree, &|n| self.bounds.bounds(n))?;
+        let plan = self.cache.plan_frame(frame, &needed, budget);
+        let table = PageTable::build(&plan, extent)?;
+        let words = table.words();
+        if words.len() > PAGE_TABLE_WORDS {
+            return Err(Error::invalid(
+                "texture page table",
+                format!("{} words exceed the capacity of {PAGE_TABLE_WORDS}", words.len()),
+            ));
+        }
+        (self.page_words, self.table) = (words, table);
+        let (jobs, texels) = tile_jobs(&plan, extent, images);
+        Ok((plan, jobs, texels))
+    }
 }
 
 /// Shared between the passes' recording closures.
@@ -279,30 +308,28 @@ pub fn add_generation_passes(
             pixel_footprint: View::pixel_footprint_for(camera.fov_y_deg.to_radians(), image_height),
             frustum: Some(frustum_planes(camera.view_proj_f64(params.aspect))),
         };
-        let mut s = locked(&shared)?;
-        let needed = select_tiles(extent, &view, &quadtree, &|n| s.bounds.bounds(n))?;
-        let frame = pass.frame();
-        let plan = s.cache.plan_frame(frame, &needed, budget);
-        let table = PageTable::build(&plan, extent)?;
-        s.page_words = table.words();
-        s.table = table;
-        if s.page_words.len() > PAGE_TABLE_WORDS {
-            return Err(Error::invalid(
-                "texture page table",
-                format!("{} words exceed the capacity of {PAGE_TABLE_WORDS}", s.page_words.len()),
-            ));
-        }
         let handles = texture_handles
             .iter()
             .map(|&(c, n)| Ok([pass.storage_image(c)?, pass.storage_image(n)?]))
             .collect::<Result<Vec<_>>>()?;
-        let (tile_jobs, texels) = tile_jobs(&plan, extent, &|t| handles[t as usize]);
-        if texels > scratch_texels || tile_jobs.len() > max_jobs {
-            return Err(Error::Graph(format!(
-                "texturing: {} tiles of {texels} texels exceed the scratch buffer",
-                tile_jobs.len()
-            )));
-        }
+        let mut s = locked(&shared)?;
+        let frame = pass.frame();
+        let planned = s.plan(frame, &view, &quadtree, budget, extent, &|t| handles[t as usize]);
+        let (plan, tile_jobs, texels) = match planned {
+            Ok(p) if p.2 <= scratch_texels && p.1.len() <= max_jobs => p,
+            // Tiles the plan marked resident will not be generated: forget
+            // them all, so the next frame starts afresh.
+            failed => {
+                s.cache.clear();
+                return Err(match failed {
+                    Err(e) => e,
+                    Ok((_, jobs, texels)) => Error::Graph(format!(
+                        "texturing: {} tiles of {texels} texels exceed the scratch buffer",
+                        jobs.len()
+                    )),
+                });
+            }
+        };
         pass.buffer(jobs)?.write(0, bytemuck::cast_slice(&tile_jobs))?;
         (s.jobs, s.texels) = (tile_jobs.len() as u32, texels);
         s.stats.push(TextureFrameStats {
