@@ -27,15 +27,7 @@ fn expect_render_error(test: &str, scene_args: &[&str], needles: &[&str]) {
         args.extend(["--height".into(), "32".into()]);
     }
     args.extend(scene_args.iter().map(|s| s.to_string()));
-    for (flag, file) in [
-        ("--out", "o.png"),
-        ("--exr", "o.exr"),
-        ("--profile", "p.json"),
-        ("--trace", "t.json"),
-    ] {
-        args.push(flag.into());
-        args.push(dir.join(file).to_string_lossy().into_owned());
-    }
+    args.extend(render_outputs(&dir, None));
     let out = run(&args);
     let what = format!("render {}", scene_args.join(" "));
     assert_one_line_error(&what, &out, needles);
@@ -122,26 +114,12 @@ fn near_beyond_far() {
 fn output_into_missing_directory() {
     let dir = fresh_dir("output_into_missing_directory");
     let missing = dir.join("does-not-exist");
-    for (flag, file) in [
-        ("--out", "o.png"),
-        ("--exr", "o.exr"),
-        ("--profile", "p.json"),
-        ("--trace", "t.json"),
-    ] {
+    for (flag, file) in RENDER_OUTPUTS {
         let mut args: Vec<String> = ["render", "--validation", "--width", "32", "--height", "32"]
             .iter()
             .map(|s| s.to_string())
             .collect();
-        for (f, name) in [
-            ("--out", "o.png"),
-            ("--exr", "o.exr"),
-            ("--profile", "p.json"),
-            ("--trace", "t.json"),
-        ] {
-            let base = if f == flag { &missing } else { &dir };
-            args.push(f.into());
-            args.push(base.join(name).to_string_lossy().into_owned());
-        }
+        args.extend(render_outputs(&dir, Some((flag, &missing))));
         let out = run(&args);
         let what = format!("render {flag} into a missing directory");
         assert_one_line_error(&what, &out, &["does-not-exist", file]);

@@ -85,15 +85,7 @@ fn expect_render_error(test: &str, terrain: Option<&str>, extra: &[&str], needle
         args.extend(os_args(&["--terrain", terrain]));
     }
     args.extend(extra.iter().map(OsString::from));
-    for (flag, file) in [
-        ("--out", "o.png"),
-        ("--exr", "o.exr"),
-        ("--profile", "p.json"),
-        ("--trace", "t.json"),
-    ] {
-        args.push(flag.into());
-        args.push(dir.join(file).into_os_string());
-    }
+    args.extend(render_outputs(&dir, None).into_iter().map(OsString::from));
     let out = run(&args);
     let what = format!("render --terrain {terrain:?} {}", extra.join(" "));
     assert_one_line_error(&what, &out, needles);

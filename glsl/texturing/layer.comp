@@ -19,7 +19,14 @@ void main() {
     }
     uint texel = gl_GlobalInvocationID.x;
     LayerState s = unpack_state(g_texel_states[pc.handles.y].t[texel]);
-    vec3 maps = input_maps(pc.maps, xy / pc.extent.xy);
+    // Sample the input maps only for a layer with hats on them.
+    uvec4 maps_used = pc.maps;
+    for (uint k = 0u; k < 3u; ++k) {
+        if (g_surface_layers[pc.handles.z].l[pc.counts.z].hats[3u + k].w == 0.0) {
+            maps_used.w &= ~(1u << k);
+        }
+    }
+    vec3 maps = input_maps(maps_used, xy / pc.extent.xy);
     apply_layer(pc.handles.z, pc.counts.z, pc.handles.w, xy, texel_footprint(job), pc.spacing_range.zw, maps, s);
     g_texel_states[pc.handles.y].t[texel] = pack_state(s);
 }

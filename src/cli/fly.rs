@@ -6,7 +6,6 @@
 //! place when every frame was written: on any error no partial sequence is
 //! left behind.
 
-use alpenglow::texturing::stats::TextureSummary;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -19,7 +18,9 @@ use alpenglow::renderer::camera_path::{load_keyframes, CameraPath, Orbit, DEFAUL
 use alpenglow::renderer::{FrameImages, Renderer, Scene};
 
 use super::args::FlyArgs;
-use super::{camera, check_output_path, check_validation, context, load_scene, render_settings, OutputSet};
+use super::{
+    camera, check_output_path, check_validation, context, load_scene, render_settings, report_textures, OutputSet,
+};
 
 /// The default path: one turn around the terrain's centre at 60 % of its
 /// half-size, 0.4 of its size above the highest point.
@@ -163,13 +164,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     println!("  GPU frame time   min {gmin:.3}  median {gmed:.3}  max {gmax:.3} ms");
     println!("  wall per frame   min {wmin:.3}  median {wmed:.3}  max {wmax:.3} ms");
     println!("  CPU warp         min {cmin:.3}  median {cmed:.3}  max {cmax:.3} ms");
-    let textures = (!texture_stats.is_empty()).then(|| TextureSummary::new(&texture_stats, &profiles));
-    if let Some(t) = &textures {
-        println!("  {}", t.line());
-        if let Some(line) = t.per_pass_line() {
-            println!("  {line}");
-        }
-    }
+    let textures = report_textures(&texture_stats, &profiles);
 
     let mut outputs = OutputSet::default();
     if args.json.is_some() {

@@ -403,13 +403,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
         );
     }
     let texture_stats: Vec<_> = texture_stats.into_iter().skip(untimed).collect();
-    let textures = (!texture_stats.is_empty()).then(|| TextureSummary::new(&texture_stats, &timed));
-    if let Some(t) = &textures {
-        println!("  {}", t.line());
-        if let Some(line) = t.per_pass_line() {
-            println!("  {line}");
-        }
-    }
+    let textures = report_textures(&texture_stats, &timed);
     let mut outputs = OutputSet::default();
     if args.json.is_some() {
         let value = serde_json::json!({
@@ -433,6 +427,20 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     outputs.write(&args.trace, |p| write_chrome_trace(p, &device.name, &timed))?;
     outputs.commit();
     Ok(ExitCode::SUCCESS)
+}
+
+/// Prints the texture streaming summary of `stats` with the GPU times of
+/// `profiles`; None (and nothing printed) without the atlas.
+fn report_textures(
+    stats: &[alpenglow::texturing::stats::TextureFrameStats],
+    profiles: &[FrameProfile],
+) -> Option<TextureSummary> {
+    let summary = (!stats.is_empty()).then(|| TextureSummary::new(stats, profiles))?;
+    println!("  {}", summary.line());
+    if let Some(line) = summary.per_pass_line() {
+        println!("  {line}");
+    }
+    Some(summary)
 }
 
 fn info(args: DeviceArgs) -> Result<ExitCode> {

@@ -32,6 +32,21 @@ pub struct HeightField {
 }
 
 impl HeightField {
+    /// A `columns×rows` field with `spacing` and height `f(c, r)` at
+    /// column `c`, row `r`.
+    pub fn from_fn(columns: u32, rows: u32, spacing: DVec2, f: impl Fn(u32, u32) -> f32) -> HeightField {
+        let heights = (0..rows)
+            .flat_map(|r| (0..columns).map(move |c| (c, r)))
+            .map(|(c, r)| f(c, r))
+            .collect();
+        HeightField {
+            columns,
+            rows,
+            spacing,
+            heights,
+        }
+    }
+
     /// Height at column `c`, row `r`. Coordinates outside the grid are
     /// clamped to the nearest edge sample, so neighbour look-ups at the
     /// border need no special case. Never panics: a field whose `heights`

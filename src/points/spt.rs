@@ -1262,13 +1262,7 @@ mod tests {
     #[test]
     fn perpendicular_error_of_stacked_and_tilted_disks() {
         // Two parallel disks 1 apart along their normal, leaf_size 2: e_p = 1.
-        let a = Surfel {
-            position: Vec3::ZERO,
-            normal: Vec3::Z,
-            radius: 0.5,
-            color: [0; 3],
-            clip: ClipLines::NONE,
-        };
+        let a = disk(0.0, [0; 3]);
         let b = Surfel {
             position: Vec3::new(0.0, 0.0, 1.0),
             ..a
@@ -1382,11 +1376,8 @@ mod tests {
     #[test]
     fn cancelling_normals_fall_back_to_largest_child() {
         let a = Surfel {
-            position: Vec3::ZERO,
-            normal: Vec3::Z,
             radius: 0.4,
-            color: [0; 3],
-            clip: ClipLines::NONE,
+            ..disk(0.0, [0; 3])
         };
         let b = Surfel {
             normal: -Vec3::Z,

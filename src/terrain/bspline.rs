@@ -167,22 +167,6 @@ pub fn sample_bspline_gradient(field: &HeightField, x: f64, y: f64) -> DVec2 {
 mod tests {
     use super::*;
 
-    /// A `columns×rows` field with `h(c, r) = f(c, r)`.
-    fn field(columns: u32, rows: u32, spacing: DVec2, f: impl Fn(u32, u32) -> f32) -> HeightField {
-        let mut heights = Vec::with_capacity((columns * rows) as usize);
-        for r in 0..rows {
-            for c in 0..columns {
-                heights.push(f(c, r));
-            }
-        }
-        HeightField {
-            columns,
-            rows,
-            spacing,
-            heights,
-        }
-    }
-
     fn ts() -> impl Iterator<Item = f64> {
         (0..1000).map(|k| f64::from(k) / 1000.0)
     }
@@ -218,7 +202,7 @@ mod tests {
 
     #[test]
     fn constant_field_gives_constant() {
-        let f = field(7, 5, DVec2::new(2.0, 3.0), |_, _| 42.5);
+        let f = HeightField::from_fn(7, 5, DVec2::new(2.0, 3.0), |_, _| 42.5);
         for k in 0..200 {
             let x = -3.0 + f64::from(k) * 0.097;
             let y = -2.0 + f64::from(k) * 0.083;
@@ -231,7 +215,7 @@ mod tests {
     fn plane_is_reproduced_in_the_interior() {
         let (a, b, k) = (2.0, -3.0, 100.0);
         let spacing = DVec2::new(1.5, 0.75);
-        let f = field(12, 10, spacing, |c, r| (a * f64::from(c) + b * f64::from(r) + k) as f32);
+        let f = HeightField::from_fn(12, 10, spacing, |c, r| (a * f64::from(c) + b * f64::from(r) + k) as f32);
         // Interior: at least one sample from each edge, so no tap is clamped.
         for i in 0..=40 {
             for j in 0..=40 {
@@ -250,7 +234,7 @@ mod tests {
     #[test]
     fn gradient_matches_finite_differences() {
         let spacing = DVec2::new(2.0, 1.25);
-        let f = field(9, 8, spacing, |c, r| {
+        let f = HeightField::from_fn(9, 8, spacing, |c, r| {
             let (c, r) = (f64::from(c), f64::from(r));
             ((c * 0.9).sin() * 5.0 + (r * 1.3).cos() * 3.0 + c * r * 0.1) as f32
         });
@@ -271,7 +255,7 @@ mod tests {
     #[test]
     fn clamps_outside_the_rectangle_and_matches_the_tap_convention() {
         let spacing = DVec2::new(1.0, 2.0);
-        let f = field(5, 4, spacing, |c, r| (c * 10 + r * r) as f32);
+        let f = HeightField::from_fn(5, 4, spacing, |c, r| (c * 10 + r * r) as f32);
         let ext = f.extent();
         // Outside: equal to the value on the nearest edge point, zero gradient across.
         assert_eq!(sample_bspline(&f, -5.0, 3.0), sample_bspline(&f, 0.0, 3.0));
@@ -303,7 +287,7 @@ mod tests {
 
     #[test]
     fn bad_input_gives_nan_not_a_panic() {
-        let mut f = field(4, 4, DVec2::ONE, |_, _| 1.0);
+        let mut f = HeightField::from_fn(4, 4, DVec2::ONE, |_, _| 1.0);
         assert!(sample_bspline(&f, f64::NAN, 1.0).is_nan());
         assert!(sample_bspline(&f, f64::INFINITY, 1.0).is_finite());
         f.heights.truncate(3);

@@ -437,18 +437,7 @@ mod tests {
     use crate::terrain::bspline::sample_bspline;
 
     fn field(columns: u32, rows: u32, spacing: DVec2, f: impl Fn(f64, f64) -> f64) -> HeightField {
-        let mut heights = Vec::with_capacity((columns * rows) as usize);
-        for r in 0..rows {
-            for c in 0..columns {
-                heights.push(f(f64::from(c), f64::from(r)) as f32);
-            }
-        }
-        HeightField {
-            columns,
-            rows,
-            spacing,
-            heights,
-        }
+        HeightField::from_fn(columns, rows, spacing, |c, r| f(f64::from(c), f64::from(r)) as f32)
     }
 
     /// Rolling hills with a few steep bumps, `c, r` in samples.

@@ -72,6 +72,13 @@ impl PageEntry {
     }
 }
 
+/// Where a ref is stored: the root ref, or child `.1` of inner node `.0`.
+#[derive(Clone, Copy)]
+enum RefSlot {
+    Root,
+    Child(u32, usize),
+}
+
 /// The page table of one frame.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PageTable {
@@ -121,60 +128,44 @@ impl PageTable {
             return Err(Error::invalid("page table", why));
         }
         let overlap = || Error::invalid("page table", format!("node {node:?} overlaps another needed node"));
-        // Inner nodes down to the needed node's parent, created as needed.
+        // One descent from the root, creating inner nodes down to the
+        // needed node's parent; `slot` is where the current ref is stored.
+        let mut slot = RefSlot::Root;
         for level in 0..node.level {
-            match self.ref_at(node, level) {
+            let index = match self.get(slot) {
                 NONE => {
                     let index = self.nodes.len() as u32;
                     self.nodes.push([NONE; 4]);
-                    self.set_ref(node, level, index);
+                    self.set(slot, index);
+                    index
                 }
                 r if r & LEAF != 0 => return Err(overlap()),
-                _ => {}
-            }
+                r => r,
+            };
+            let shift = node.level - level - 1;
+            let child = ((node.y >> shift) & 1) * 2 + ((node.x >> shift) & 1);
+            slot = RefSlot::Child(index, child as usize);
         }
-        if self.ref_at(node, node.level) != NONE {
+        if self.get(slot) != NONE {
             return Err(overlap());
         }
-        let leaf = LEAF | self.entries.len() as u32;
+        self.set(slot, LEAF | self.entries.len() as u32);
         self.entries.push(PageEntry::new(d.source, d.slot, extent, border));
-        self.set_ref(node, node.level, leaf);
         Ok(())
     }
 
-    /// The ref stored for `node`'s ancestor at `level` (the root at 0).
-    fn ref_at(&self, node: NodeId, level: u32) -> u32 {
-        self.walk(node, level).map_or(NONE, |(parent, child)| match parent {
-            None => self.root,
-            Some(p) => self.nodes[p as usize][child],
-        })
-    }
-
-    fn set_ref(&mut self, node: NodeId, level: u32, value: u32) {
-        match self.walk(node, level) {
-            Some((None, _)) => self.root = value,
-            Some((Some(p), child)) => self.nodes[p as usize][child] = value,
-            None => {}
+    fn get(&self, slot: RefSlot) -> u32 {
+        match slot {
+            RefSlot::Root => self.root,
+            RefSlot::Child(node, child) => self.nodes[node as usize][child],
         }
     }
 
-    /// The inner node holding the ref of `node`'s ancestor at `level` and
-    /// the child index in it (`None` for the root ref); `None` when an
-    /// ancestor above is missing or a leaf.
-    fn walk(&self, node: NodeId, level: u32) -> Option<(Option<u32>, usize)> {
-        let mut r = self.root;
-        let mut parent = None;
-        let mut child = 0;
-        for l in 0..level {
-            if r == NONE || r & LEAF != 0 {
-                return None;
-            }
-            let shift = node.level - l - 1;
-            child = (((node.y >> shift) & 1) * 2 + ((node.x >> shift) & 1)) as usize;
-            parent = Some(r);
-            r = self.nodes[r as usize][child];
+    fn set(&mut self, slot: RefSlot, value: u32) {
+        match slot {
+            RefSlot::Root => self.root = value,
+            RefSlot::Child(node, child) => self.nodes[node as usize][child] = value,
         }
-        Some((parent, child))
     }
 
     /// The entry covering world `xy` (the CPU twin of the shader's walk):

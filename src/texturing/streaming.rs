@@ -62,7 +62,7 @@ impl TextureStreaming {
         let wanted = 2 * (u64::from(width) * u64::from(height)).div_ceil(PIXELS_PER_TILE);
         for size in [1024, 2048] {
             atlas.size = size;
-            atlas.textures = std::array::from_fn(|k| if (16u32 << k) > aim { 4 } else { 1 });
+            atlas.textures = std::array::from_fn(|k| if atlas.tile_size(k as u32) > aim { 4 } else { 1 });
             let per_texture = u64::from(atlas.slots_per_texture(aim).max(1));
             if let Some(k) = atlas.size_index(aim) {
                 atlas.textures[k as usize] = wanted.div_ceil(per_texture).clamp(2, 64) as u32;

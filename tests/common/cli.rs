@@ -94,6 +94,29 @@ pub fn finite_ms(value: &Value, key: &str, what: &str) -> f64 {
     v
 }
 
+/// Every output option of `render` with its file name.
+pub const RENDER_OUTPUTS: [(&str, &str); 4] = [
+    ("--out", "o.png"),
+    ("--exr", "o.exr"),
+    ("--profile", "p.json"),
+    ("--trace", "t.json"),
+];
+
+/// Every output option of `render`, each into `dir` (or into `other` for
+/// the option named `redirect`).
+pub fn render_outputs(dir: &Path, redirect: Option<(&str, &Path)>) -> Vec<String> {
+    RENDER_OUTPUTS
+        .iter()
+        .flat_map(|&(flag, file)| {
+            let base = match redirect {
+                Some((f, other)) if f == flag => other,
+                _ => dir,
+            };
+            [flag.to_string(), base.join(file).to_string_lossy().into_owned()]
+        })
+        .collect()
+}
+
 /// Fails unless `dir` is empty (a failed command must leave no file).
 pub fn assert_no_files_left(what: &str, dir: &Path) {
     let left = entries(dir);
