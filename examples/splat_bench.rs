@@ -16,9 +16,9 @@
 //! GPU times are the medians of the points passes' timestamps over the timed
 //! frames; splats/s = splats drawn (the vertex stage's count) / that time.
 
+use alpenglow::points::build::spt::{epsilon_from_pixels, SequentialPointTree, ROOT_R_MAX};
 use alpenglow::points::render::{SplatMode, SplatPrimitive, SplatSettings};
 use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointObject, PointScene, PointTransform};
-use alpenglow::points::spt::{epsilon_from_pixels, SequentialPointTree, ROOT_R_MAX};
 use alpenglow::profile::median;
 use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
 use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
@@ -102,7 +102,7 @@ fn main() {
     })
     .expect("Vulkan context");
     println!("device: {} ({})", ctx.info().name, ctx.info().driver_info);
-    let spt = alpenglow::points::spt::SptOptions {
+    let spt = alpenglow::points::build::spt::SptOptions {
         epsilon: epsilon_from_pixels(1.0, 40f32.to_radians(), SIDE).unwrap(),
         ..Default::default()
     };

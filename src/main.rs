@@ -1,4 +1,5 @@
 //! The `alpenglow` command line: `render`, `info`, `bench`.
+#![forbid(unsafe_code)]
 
 mod cli;
 

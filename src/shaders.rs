@@ -20,8 +20,8 @@ pub const TERRAIN_WARP: SpirV = spirv!("terrain/warp.comp");
 pub const TERRAIN_DRAW_VERT: SpirV = spirv!("terrain/draw.vert");
 /// terrain.draw: fragment stage.
 pub const TERRAIN_DRAW_FRAG: SpirV = spirv!("terrain/draw.frag");
-/// sky: full-screen triangle.
-pub const SKY_VERT: SpirV = spirv!("lighting/sky.vert");
+/// Every full-screen pass (sky, points.normalize): one triangle covering the screen.
+pub const FULL_SCREEN_VERT: SpirV = spirv!("post/full_screen.vert");
 /// sky: analytic sky radiance.
 pub const SKY_FRAG: SpirV = spirv!("lighting/sky.frag");
 /// tonemap: HDR → sRGB8.

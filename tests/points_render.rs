@@ -14,9 +14,9 @@
 
 mod common;
 
+use alpenglow::points::build::spt::{build_spt, epsilon_from_pixels, SptOptions};
 use alpenglow::points::render::{PointFrameStats, SplatMode, SplatPrimitive, SplatSettings};
 use alpenglow::points::scene::{PointObject, PointScene, PointTransform};
-use alpenglow::points::spt::{build_spt, epsilon_from_pixels, SptOptions};
 use alpenglow::points::Surfel;
 use alpenglow::renderer::{Camera, FrameImages, Scene};
 use common::points::{bunny_camera, bunny_object, render_points};

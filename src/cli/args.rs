@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
 
-use alpenglow::renderer::camera_path::{parse_orbit, Orbit};
-use alpenglow::terrain::terrain_spec::TerrainSpec;
+use crate::cli::terrain_spec::TerrainSpec;
+use alpenglow::view::camera_path::{parse_orbit, Orbit};
 
 /// alpenglow: a Vulkan renderer for large outdoor scenes.
 #[derive(Parser, Debug)]

@@ -14,8 +14,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use alpenglow::io::image_out::write_png_rgba8;
 use alpenglow::profile::{median, summarize, write_chrome_trace};
-use alpenglow::renderer::camera_path::{load_keyframes, CameraPath, Orbit, DEFAULT_START_ANGLE_DEG};
 use alpenglow::renderer::{FrameImages, Renderer, Scene};
+use alpenglow::view::camera_path::{load_keyframes, CameraPath, Orbit, DEFAULT_START_ANGLE_DEG};
 
 use super::args::FlyArgs;
 use super::{

@@ -4,6 +4,7 @@ mod args;
 mod fly;
 mod points;
 mod spt;
+mod terrain_spec;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

@@ -4,9 +4,9 @@
 
 use anyhow::{bail, Context as _, Result};
 
+use alpenglow::points::build::spt::epsilon_from_pixels;
 use alpenglow::points::render::{SplatMode, SplatPrimitive, SplatSettings};
 use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointTransform};
-use alpenglow::points::spt::epsilon_from_pixels;
 use alpenglow::renderer::Scene;
 
 use super::args::{PointArgs, SplatArg, SplatPrimitiveArg, Switch};

@@ -8,11 +8,11 @@ use std::time::Instant;
 use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
 
-use alpenglow::points::estimate::complete_cloud;
-use alpenglow::points::input::{load_points_file, PointInput};
-use alpenglow::points::sampling::{sample_mesh, SamplingMethod, SamplingOptions};
-use alpenglow::points::spt::{build_spt, epsilon_from_pixels, SptOptions};
-use alpenglow::points::spt_file::write_spt;
+use alpenglow::points::build::estimate::complete_cloud;
+use alpenglow::points::build::input::{load_points_file, PointInput};
+use alpenglow::points::build::sampling::{sample_mesh, SamplingMethod, SamplingOptions};
+use alpenglow::points::build::spt::{build_spt, epsilon_from_pixels, SptOptions};
+use alpenglow::points::build::spt_file::write_spt;
 
 use super::args::{SamplingArg, SptBuildArgs};
 

@@ -6,8 +6,8 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
 use crate::graph::{Access, RenderGraph, ResourceId};
-use crate::renderer::FrameParams;
 use crate::shaders;
+use crate::view::FrameParams;
 use crate::vulkan::{Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp};
 
 #[repr(C)]
@@ -30,7 +30,7 @@ pub fn add_sky_pass(
         ctx,
         &GraphicsPipelineDesc::full_screen(
             "sky",
-            shaders::SKY_FRAG,
+            (shaders::FULL_SCREEN_VERT, shaders::SKY_FRAG),
             vec![Format::R32G32B32A32_SFLOAT, Format::R32_SFLOAT],
         ),
     )?;

@@ -1,23 +1,18 @@
 //! Points: sequential point trees and EWA splatting (dissertation §10.1–10.3;
 //! `ALGORITHMS.md` §7–8) for vegetation, rocks and scans. Files follow the
-//! pipeline of chapter 10: inputs (PLY, OBJ) → surface samples (surfels) →
-//! SPT build and file → rendering.
+//! pipeline of chapter 10, in two folders: [`build`] is the offline
+//! preparation (inputs (PLY, OBJ) → surface samples (surfels) → normals and
+//! radii → SPT build and file; rocks, hybrid meshes, normal clusters), run
+//! once at load or by `alpenglow spt build`; [`render`] is the per-frame
+//! part (selection in `prepare`, then the splatting passes).
 
-pub mod clip;
-pub mod clusters;
-pub mod estimate;
-pub mod hybrid;
-pub mod input;
+pub mod build;
 pub mod render;
-pub mod rocks;
-pub mod sampling;
 pub mod scene;
-pub mod spt;
-pub mod spt_file;
 
 use glam::Vec3;
 
-use clip::ClipLines;
+use build::clip::ClipLines;
 
 /// A surface sample: an oriented disk with a colour.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,7 +25,7 @@ pub struct Surfel {
     /// sRGB colour.
     pub color: [u8; 3],
     /// Clip lines for sharp features (§10.2.4), in the tangent frame
-    /// [`clip::tangent_frame`] of `normal`; [`ClipLines::NONE`] for none.
+    /// [`build::clip::tangent_frame`] of `normal`; [`ClipLines::NONE`] for none.
     pub clip: ClipLines,
 }
 

@@ -7,13 +7,13 @@ use std::sync::Arc;
 
 use glam::{DMat4, DQuat, DVec3};
 
-use super::estimate::complete_cloud;
-use super::hybrid::{build_hybrid, HybridMesh};
-use super::input::{load_points_file, PointInput};
-use super::rocks::{generate_rock, rock_field};
-use super::sampling::{sample_mesh, SamplingMethod, SamplingOptions};
-use super::spt::{build_spt, SequentialPointTree, SptOptions};
-use super::spt_file::read_spt;
+use super::build::estimate::complete_cloud;
+use super::build::hybrid::{build_hybrid, HybridMesh};
+use super::build::input::{load_points_file, PointInput};
+use super::build::rocks::{generate_rock, rock_field};
+use super::build::sampling::{sample_mesh, SamplingMethod, SamplingOptions};
+use super::build::spt::{build_spt, SequentialPointTree, SptOptions};
+use super::build::spt_file::read_spt;
 use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
 use crate::random::SplitMix64;

@@ -9,16 +9,13 @@
 //! splats, or `points.opaque`; see [`crate::points::render`]) → `tonemap`
 //! (compute) → `readback` (transfer).
 
-pub mod camera;
-pub mod camera_path;
 pub mod scene;
-pub mod tonemap;
 
 use std::sync::Arc;
 
 use glam::Vec3;
 
-pub use camera::Camera;
+pub use crate::view::{Camera, FrameParams};
 pub use scene::Scene;
 
 use crate::error::{Error, Result};
@@ -37,20 +34,6 @@ use crate::vulkan::{
 
 /// Largest accepted image side (the device limit may be lower).
 pub const MAX_IMAGE_SIDE: u32 = 16384;
-
-/// What every pass of a frame may read: the view and the lighting.
-#[derive(Clone, Copy, Debug)]
-pub struct FrameParams {
-    pub camera: Camera,
-    /// Width / height.
-    pub aspect: f64,
-    /// Unit direction towards the sun.
-    pub sun: Vec3,
-    /// Multiplier applied to radiance before tone mapping.
-    pub exposure: f32,
-    /// Altitude (m) above which flat ground is snow-covered.
-    pub snow_line: f32,
-}
 
 /// Output size, whether frames are read back to the host, and the
 /// terrain's LOD and detail settings.
@@ -203,7 +186,7 @@ impl Renderer {
             let passes = add_point_passes(ctx, &mut graph, &scene.points, settings.points, targets, (w, h))?;
             (Some(passes), Some(weight))
         };
-        tonemap::add_tonemap_pass(ctx, &mut graph, hdr, ldr, (w, h))?;
+        crate::post::tonemap::add_tonemap_pass(ctx, &mut graph, hdr, ldr, (w, h))?;
 
         let pixels = w as u64 * h as u64;
         let readback = if settings.readback {

@@ -4,12 +4,12 @@
 
 use glam::{DVec2, DVec3, Vec3};
 
-use super::camera::Camera;
 use crate::error::Result;
 use crate::io::heightmap::HeightField;
+use crate::points::build::spt::{epsilon_from_pixels, SptOptions};
 use crate::points::scene::{scatter_rocks, PointScene};
-use crate::points::spt::{epsilon_from_pixels, SptOptions};
 use crate::terrain::procedural::ProceduralTerrain;
+use crate::view::camera::Camera;
 
 /// Rocks of the default scene: distinct shapes, surfels per shape, instances.
 pub const DEFAULT_ROCKS: (usize, usize, usize) = (4, 4000, 300);

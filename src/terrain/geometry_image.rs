@@ -19,10 +19,10 @@ use bytemuck::{Pod, Zeroable};
 use crate::error::{Error, Result};
 use crate::graph::{Access, RenderGraph, ResourceId, Stage};
 use crate::io::heightmap::HeightField;
-use crate::renderer::FrameParams;
 use crate::shaders;
 use crate::terrain::lod::{DebugScalar, LodFrame, LodSettings};
 use crate::terrain::wavelet_noise;
+use crate::view::FrameParams;
 use crate::vulkan::{
     Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, Format, Image, ImageDesc, ImageUsageFlags,
     MemoryLocation,

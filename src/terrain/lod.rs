@@ -8,10 +8,10 @@ use glam::DVec3;
 
 use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
-use crate::renderer::Camera;
 use crate::terrain::importance::{importance_map, smoothstep, Backface, Frustum, ImportanceParams};
 use crate::terrain::sketch_map::{SketchAlignment, SketchMap, DEFAULT_SKETCH_SIDE};
 use crate::terrain::warp::{bilinear, density_ratio, warp_into, PassOrder, WarpOptions, WarpResult};
+use crate::view::Camera;
 
 /// How the output grid is placed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

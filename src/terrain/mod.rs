@@ -8,7 +8,6 @@ pub mod procedural;
 pub mod raycast;
 pub mod shading;
 pub mod sketch_map;
-pub mod terrain_spec;
 pub mod warp;
 pub mod wavelet_noise;
 pub mod zoom;

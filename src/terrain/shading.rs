@@ -11,13 +11,13 @@ use crate::error::Error;
 use crate::error::Result;
 use crate::graph::{Access, RenderGraph, ResourceId, Stage};
 use crate::io::heightmap::HeightField;
-use crate::renderer::FrameParams;
 use crate::shaders;
 use crate::terrain::geometry_image::{GeometryImage, VERTEX_STRIDE};
 use crate::texturing::generation::{add_generation_passes, locked, AtlasResources, GenerationInputs, TextureStreaming};
 use crate::texturing::gpu_layout::{pack_layers, TexturingFrame, TexturingMode};
 use crate::texturing::input_maps::InputMaps;
 use crate::texturing::layers::LayerTree;
+use crate::view::FrameParams;
 use crate::vulkan::{
     Blend, Buffer, BufferDesc, BufferUsageFlags, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc,
     LoadOp, MemoryLocation, PrimitiveTopology, VertexAttribute,

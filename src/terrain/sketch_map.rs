@@ -28,8 +28,8 @@ use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
-use crate::renderer::Camera;
 use crate::terrain::bspline::sample_bspline;
+use crate::view::Camera;
 
 /// Default sketch map side (texels), as in the text.
 pub const DEFAULT_SKETCH_SIDE: usize = 128;

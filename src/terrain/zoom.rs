@@ -10,9 +10,9 @@ use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
-use crate::renderer::Camera;
 use crate::terrain::bspline::sample_bspline;
 use crate::terrain::warp::bilinear;
+use crate::view::Camera;
 
 /// Vertex positions of the `side×side` output grid: `Φ` (the `n×n` warped
 /// sketch map, world `(x, y, ·)`) bilinearly interpolated, clamped onto the

@@ -28,8 +28,6 @@ use glam::DVec2;
 use crate::error::{Error, Result};
 use crate::graph::{Access, BufferInfo, RenderGraph, ResourceId, Stage};
 use crate::io::heightmap::HeightField;
-use crate::renderer::camera::frustum_planes;
-use crate::renderer::FrameParams;
 use crate::shaders;
 use crate::texturing::atlas::{GenerationBudget, TileCache, TilePlan};
 use crate::texturing::input_maps::InputMaps;
@@ -38,6 +36,8 @@ use crate::texturing::page_table::PageTable;
 use crate::texturing::quadtree::{select_tiles, HeightBounds, NodeId, QuadtreeSettings, View};
 pub use crate::texturing::stats::TextureFrameStats;
 pub use crate::texturing::streaming::{TextureStreaming, MAX_ATLAS_TEXTURES};
+use crate::view::camera::frustum_planes;
+use crate::view::FrameParams;
 use crate::vulkan::{
     Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, Format, Image, ImageDesc, ImageUsageFlags,
     MemoryLocation,

@@ -112,12 +112,12 @@ pub struct GraphicsPipelineDesc {
 }
 
 impl GraphicsPipelineDesc {
-    /// A full-screen pass: one triangle from `spirv/lighting/sky.vert` (no
-    /// vertex buffer), `fragment` writing `color_formats`, no blending, no depth.
-    pub fn full_screen(name: &'static str, fragment: SpirV, color_formats: Vec<vk::Format>) -> Self {
+    /// A full-screen pass: `vertex` draws one triangle covering the screen
+    /// (no vertex buffer), `fragment` writes `color_formats`; no blending, no depth.
+    pub fn full_screen(name: &'static str, (vertex, fragment): (SpirV, SpirV), color_formats: Vec<vk::Format>) -> Self {
         GraphicsPipelineDesc {
             name,
-            vertex: crate::shaders::SKY_VERT,
+            vertex,
             fragment,
             vertex_stride: 0,
             vertex_attributes: Vec::new(),

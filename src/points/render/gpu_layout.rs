@@ -6,9 +6,9 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DMat3, DMat4, DVec3, Vec3};
 
 use super::SplatSettings;
-use crate::points::hybrid::HybridMesh;
-use crate::points::spt::SptNode;
-use crate::renderer::camera::Camera;
+use crate::points::build::hybrid::HybridMesh;
+use crate::points::build::spt::SptNode;
+use crate::view::camera::Camera;
 
 /// One splat: an SPT node (§10.1.3) as the vertex stage reads it.
 #[repr(C)]
@@ -20,7 +20,7 @@ pub struct GpuSplat {
     pub normal_rmax: [f32; 4],
     /// Disk radius, sRGB colour (u32 bits `r | g << 8 | b << 16`), 0, 0.
     pub radius_color: [f32; 4],
-    /// Clip lines (`crate::points::clip::ClipLines::packed`).
+    /// Clip lines (`crate::points::build::clip::ClipLines::packed`).
     pub clip: [f32; 4],
 }
 

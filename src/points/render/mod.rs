@@ -89,7 +89,7 @@ pub struct SplatSettings {
     /// Split every list into 128 normal clusters and skip clusters that face
     /// away (§10.1.10); only for closed surfaces.
     pub normal_clusters: bool,
-    /// Error threshold ε of the trees (as [`crate::points::spt::SptOptions::epsilon`]);
+    /// Error threshold ε of the trees (as [`crate::points::build::spt::SptOptions::epsilon`]);
     /// None keeps the ε each tree was built with.
     pub epsilon: Option<f32>,
 }

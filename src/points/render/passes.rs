@@ -13,10 +13,10 @@ use super::triangles::{draw_triangles, TriangleBuffer};
 use super::{SharedStats, SplatMode, SplatPrimitive, SplatSettings};
 use crate::error::{Error, Result};
 use crate::graph::{Access, ImageInfo, PassContext, RenderGraph, ResourceId, Stage};
-use crate::points::clusters::{cluster_normals, CLUSTER_COUNT};
+use crate::points::build::clusters::{cluster_normals, CLUSTER_COUNT};
 use crate::points::scene::PointScene;
-use crate::renderer::FrameParams;
 use crate::shaders;
+use crate::view::FrameParams;
 use crate::vulkan::{
     Blend, Buffer, BufferDesc, BufferUsageFlags, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline,
     GraphicsPipelineDesc, LoadOp, MemoryLocation, PrimitiveTopology, SpirV,
@@ -454,7 +454,7 @@ pub fn add_point_passes(
                 ctx,
                 &GraphicsPipelineDesc::full_screen(
                     "points.normalize",
-                    shaders::SPLAT_NORMALIZE_FRAG,
+                    (shaders::FULL_SCREEN_VERT, shaders::SPLAT_NORMALIZE_FRAG),
                     vec![Format::R32G32B32A32_SFLOAT, Format::R32_SFLOAT, Format::R32_SFLOAT],
                 ),
             )?;

@@ -14,9 +14,9 @@ use std::sync::Arc;
 use glam::{DMat4, DVec3};
 
 use super::gpu_layout::GpuInstance;
-use crate::points::clusters::ClusteredTree;
+use crate::points::build::clusters::ClusteredTree;
 use crate::points::scene::PointScene;
-use crate::renderer::camera::frustum_planes;
+use crate::view::camera::frustum_planes;
 
 /// Where an object's splats are in the splat buffer.
 #[derive(Clone, Debug)]

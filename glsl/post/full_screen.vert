@@ -1,5 +1,5 @@
 #version 460
-// sky: one triangle covering the screen.
+// One triangle covering the screen (sky, points.normalize and any full-screen pass).
 layout(location = 0) out vec2 out_ndc;
 
 void main() {

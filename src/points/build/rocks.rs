@@ -49,8 +49,8 @@ use std::collections::{HashMap, HashSet};
 
 use glam::{DVec3, Vec3};
 
-use super::TriangleMesh;
 use crate::error::{Error, Result};
+use crate::points::TriangleMesh;
 use crate::random::SplitMix64;
 
 /// How many point sets [`generate_rock`] draws (sub-seeds) before it gives up

@@ -44,8 +44,8 @@ use std::collections::BinaryHeap;
 use glam::Vec3;
 
 use super::clip::ClipLines;
-use super::{PointCloud, Surfel};
 use crate::error::{Error, Result};
+use crate::points::{PointCloud, Surfel};
 
 /// Neighbourhood size for normals in [`complete_cloud`] (the point included).
 pub const DEFAULT_NORMAL_K: usize = 8;
@@ -939,7 +939,7 @@ mod tests {
         let mut radii = vec![0.5; 500];
         radii[9] = f32::NAN;
         let colors: Vec<[u8; 3]> = (0..500).map(|i| [i as u8, 1, 2]).collect();
-        let line = |angle: f32| crate::points::clip::ClipLine { angle, offset: 0.01 };
+        let line = |angle: f32| crate::points::build::clip::ClipLine { angle, offset: 0.01 };
         let clip: Vec<ClipLines> = (0..500).map(|i| ClipLines([Some(line(i as f32)), None])).collect();
         let surfels = complete_cloud(&PointCloud {
             positions: points.clone(),

@@ -17,9 +17,9 @@ use std::str::FromStr;
 
 use glam::DVec2;
 
-use super::procedural::{ProceduralTerrain, TerrainModel};
-use crate::error::{Error, Result};
-use crate::io::heightmap::HeightField;
+use alpenglow::error::{Error, Result};
+use alpenglow::io::heightmap::HeightField;
+use alpenglow::terrain::procedural::{ProceduralTerrain, TerrainModel};
 
 /// The prefix every spec starts with.
 pub const PREFIX: &str = "procedural:";

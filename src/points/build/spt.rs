@@ -137,8 +137,8 @@
 use glam::{DMat3, DVec3, Vec3};
 
 use super::clip::ClipLines;
-use super::Surfel;
 use crate::error::{Error, Result};
+use crate::points::Surfel;
 
 /// `parent` of the root node.
 pub const NO_PARENT: u32 = u32::MAX;
@@ -1527,7 +1527,7 @@ mod tests {
         }
         // A tree loaded from elsewhere: leaves keep their clip lines.
         let mut surfels = plane(200, 9);
-        let line = crate::points::clip::ClipLine {
+        let line = crate::points::build::clip::ClipLine {
             angle: 1.0,
             offset: 0.1,
         };

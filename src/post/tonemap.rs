@@ -4,8 +4,8 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
 use crate::graph::{Access, RenderGraph, ResourceId, Stage};
-use crate::renderer::FrameParams;
 use crate::shaders;
+use crate::view::FrameParams;
 use crate::vulkan::{ComputePipeline, Context};
 
 #[repr(C)]

@@ -326,7 +326,7 @@ pub fn read_spt(path: &Path) -> Result<SequentialPointTree> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::points::spt::{build_spt, SptOptions};
+    use crate::points::build::spt::{build_spt, SptOptions};
     use crate::points::Surfel;
     use std::path::PathBuf;
 

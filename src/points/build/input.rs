@@ -67,8 +67,8 @@ use ply_rs_bw::parser::{Parser, Reader};
 use ply_rs_bw::ply::{Header, Property, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType};
 
 use super::clip::{ClipLine, ClipLines};
-use super::{PointCloud, TriangleMesh};
 use crate::error::{Error, Result};
+use crate::points::{PointCloud, TriangleMesh};
 
 /// The contents of a point input file (§10.1): a mesh to be sampled into
 /// surfels, or points that already are surface samples.

@@ -67,8 +67,8 @@ use glam::Vec3;
 
 use super::clip::{ClipLines, Creases};
 use super::estimate::KdTree;
-use super::{Surfel, TriangleMesh};
 use crate::error::{Error, Result};
+use crate::points::{Surfel, TriangleMesh};
 use crate::random::SplitMix64;
 
 /// Disk radius factor over `sqrt(A/(π·N))` for [`SamplingMethod::Stratified`]
@@ -761,7 +761,7 @@ mod tests {
 
     #[test]
     fn cube_edges_clip_the_surfels_near_them() {
-        use crate::points::clip::tangent_frame;
+        use crate::points::build::clip::tangent_frame;
         for split in [false, true] {
             let mesh = cube(split);
             for method in [SamplingMethod::Stratified, SamplingMethod::BlueNoise] {
@@ -843,7 +843,7 @@ mod tests {
                     let near = s.position.x < s.radius;
                     assert_eq!(s.clip != ClipLines::NONE, near, "{s:?}");
                     if near {
-                        let (t, b) = crate::points::clip::tangent_frame(s.normal);
+                        let (t, b) = crate::points::build::clip::tangent_frame(s.normal);
                         let across = Vec3::new(-s.position.x - 1e-3, 0.0, 0.0);
                         assert!(!s.clip.keeps(across.dot(t), across.dot(b)));
                         assert!(s.clip.0[1].is_none());

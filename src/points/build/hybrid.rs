@@ -46,8 +46,8 @@ use glam::Vec3;
 
 use super::sampling::{sample_mesh_traced, SamplingOptions, DEFAULT_COLOR};
 use super::spt::{build_spt, SequentialPointTree, SptOptions, NO_PARENT};
-use super::{Surfel, TriangleMesh};
 use crate::error::{Error, Result};
+use crate::points::{Surfel, TriangleMesh};
 
 /// One triangle of a hybrid object, object space.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -314,8 +314,8 @@ impl HybridMesh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::points::sampling::SamplingMethod;
-    use crate::points::spt::epsilon_from_pixels;
+    use crate::points::build::sampling::SamplingMethod;
+    use crate::points::build::spt::epsilon_from_pixels;
 
     /// A unit square in z = 0: two large triangles on the left half, a fan
     /// of small ones on the right.

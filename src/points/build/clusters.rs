@@ -331,8 +331,8 @@ impl ClusteredTree {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::points::clip::ClipLines;
-    use crate::points::spt::{build_spt, SptOptions};
+    use crate::points::build::clip::ClipLines;
+    use crate::points::build::spt::{build_spt, SptOptions};
     use crate::points::Surfel;
     use crate::random::SplitMix64;
 
@@ -570,8 +570,8 @@ mod tests {
 
     #[test]
     fn bunny_back_face_culling_saves_points() {
-        use crate::points::input::load_obj;
-        use crate::points::sampling::{sample_mesh, SamplingMethod, SamplingOptions};
+        use crate::points::build::input::load_obj;
+        use crate::points::build::sampling::{sample_mesh, SamplingMethod, SamplingOptions};
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/models/stanford-bunny.obj");
         let mesh = load_obj(&path).unwrap();
         let options = SamplingOptions {

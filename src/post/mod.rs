@@ -1,0 +1,3 @@
+//! Post-processing: what turns the frame's HDR radiance into its outputs.
+
+pub mod tonemap;
