@@ -36,17 +36,33 @@ pub struct PassTiming {
     pub cpu_start_ms: f64,
 }
 
+/// A CPU stage of a frame before its passes are recorded: a technique's
+/// `prepare` (LOD, tile and point planning), named `prepare.<technique>`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct StageTiming {
+    pub name: String,
+    /// CPU time of the stage.
+    #[serde(deserialize_with = "f64_or_nan")]
+    pub cpu_ms: f64,
+    /// CPU begin, relative to the frame's CPU start.
+    #[serde(deserialize_with = "f64_or_nan")]
+    pub cpu_start_ms: f64,
+}
+
 /// Timings of one frame.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct FrameProfile {
     /// Frame index.
     pub frame: u64,
+    /// CPU stages before recording, in order (techniques' `prepare`).
+    #[serde(default)]
+    pub prepare: Vec<StageTiming>,
     /// Passes in submission order.
     pub passes: Vec<PassTiming>,
     /// GPU time from the first begin to the last end timestamp.
     #[serde(deserialize_with = "f64_or_nan")]
     pub gpu_ms: f64,
-    /// CPU time of the frame (recording and submission).
+    /// CPU time of the frame (prepare, recording and submission).
     #[serde(deserialize_with = "f64_or_nan")]
     pub cpu_ms: f64,
     /// CPU start of this frame, relative to the first frame's start.
@@ -179,8 +195,18 @@ fn complete(name: &str, cat: &str, tid: u32, start_ns: i64, dur_ns: i64, args: V
     })
 }
 
-/// Appends one frame's events on one track. `spans` are (pass, start, dur)
-/// in ns relative to `frame_start`. Passes are laid out in start order and
+/// One event of a track: name, args, start and duration (ns, relative to
+/// the frame's start).
+type Span<'a> = (&'a str, Value, i64, i64);
+
+/// A pass's span on the CPU or GPU track.
+fn pass_span<'a>(frame: &FrameProfile, pass: &'a PassTiming, start: i64, dur: i64) -> Span<'a> {
+    let args = json!({ "frame": frame.frame, "gpu_ms": pass.gpu_ms, "cpu_ms": pass.cpu_ms });
+    (&pass.name, args, start, dur)
+}
+
+/// Appends one frame's events on one track. `spans` are (name, args,
+/// start, dur) in ns relative to `frame_start`. Passes are laid out in start order and
 /// clipped so they never overlap (the trace format nests events on a
 /// thread; partial overlaps would be misdrawn); the frame event is widened
 /// to enclose them. The raw values stay in each event's `args`.
@@ -190,17 +216,21 @@ fn push_track(
     frame: &FrameProfile,
     frame_start: i64,
     frame_dur: i64,
-    spans: Vec<(&PassTiming, i64, i64)>,
+    spans: Vec<Span<'_>>,
 ) -> i64 {
     let mut spans = spans;
-    spans.sort_by_key(|s| s.1);
+    spans.sort_by_key(|s| s.2);
     let mut cursor = frame_start;
     let mut pass_events = Vec::with_capacity(spans.len());
-    for (pass, start, dur) in spans {
+    for (name, args, start, dur) in spans {
         let begin = (frame_start + start).max(cursor);
         let end = (frame_start + start + dur).max(begin);
-        let args = json!({ "frame": frame.frame, "gpu_ms": pass.gpu_ms, "cpu_ms": pass.cpu_ms });
-        pass_events.push(complete(&pass.name, "pass", tid, begin, end - begin, args));
+        let cat = if name.starts_with("prepare.") {
+            "prepare"
+        } else {
+            "pass"
+        };
+        pass_events.push(complete(name, cat, tid, begin, end - begin, args));
         cursor = end;
     }
     let end = (frame_start + frame_dur).max(cursor);
@@ -214,7 +244,7 @@ fn push_track(
 /// Writes a Chrome Trace Event Format file:
 /// `{"traceEvents": [...], "displayTimeUnit": "ms"}` with complete events
 /// (`ph: "X"`, `ts`/`dur` in microseconds) in process 1 "alpenglow", thread
-/// 1 "CPU (record)" and thread 2 "GPU (`device_name`)", named by `M` metadata
+/// 1 "CPU (prepare, record)" and thread 2 "GPU (`device_name`)", named by `M` metadata
 /// events. Each track has one "frame N" event per frame enclosing one event
 /// per pass.
 ///
@@ -226,7 +256,7 @@ pub fn write_chrome_trace(path: &Path, device_name: &str, frames: &[FrameProfile
         |name: &str, tid: u32, args: Value| json!({ "name": name, "ph": "M", "pid": PID, "tid": tid, "args": args });
     let mut events = vec![
         meta("process_name", 0, json!({ "name": "alpenglow" })),
-        meta("thread_name", CPU_TID, json!({ "name": "CPU (record)" })),
+        meta("thread_name", CPU_TID, json!({ "name": "CPU (prepare, record)" })),
         meta("thread_sort_index", CPU_TID, json!({ "sort_index": 1 })),
         meta(
             "thread_name",
@@ -239,17 +269,24 @@ pub fn write_chrome_trace(path: &Path, device_name: &str, frames: &[FrameProfile
     let mut gpu_end = 0i64;
     for frame in frames {
         let cpu_start = ns(frame.cpu_start_ms).max(cpu_end);
-        let cpu_spans = frame
-            .passes
-            .iter()
-            .map(|p| (p, ns(p.cpu_start_ms), ns(p.cpu_ms)))
+        let prepare = frame.prepare.iter().map(|s| {
+            let args = json!({ "frame": frame.frame, "cpu_ms": s.cpu_ms });
+            (s.name.as_str(), args, ns(s.cpu_start_ms), ns(s.cpu_ms))
+        });
+        let cpu_spans = prepare
+            .chain(
+                frame
+                    .passes
+                    .iter()
+                    .map(|p| pass_span(frame, p, ns(p.cpu_start_ms), ns(p.cpu_ms))),
+            )
             .collect();
         cpu_end = push_track(&mut events, CPU_TID, frame, cpu_start, ns(frame.cpu_ms), cpu_spans);
         let gpu_start = cpu_start.max(gpu_end);
         let gpu_spans = frame
             .passes
             .iter()
-            .map(|p| (p, ns(p.gpu_start_ms), ns(p.gpu_ms)))
+            .map(|p| pass_span(frame, p, ns(p.gpu_start_ms), ns(p.gpu_ms)))
             .collect();
         gpu_end = push_track(&mut events, GPU_TID, frame, gpu_start, ns(frame.gpu_ms), gpu_spans);
     }
@@ -274,6 +311,7 @@ mod tests {
         (0..3)
             .map(|i| FrameProfile {
                 frame: i,
+                prepare: Vec::new(),
                 passes: vec![
                     pass("shadow", 0.0, 1.0 + i as f64, 0.0, 0.1),
                     // Overlaps the previous pass and has a bogus negative time.
@@ -339,7 +377,7 @@ mod tests {
             .filter(|e| e["ph"] == "M" && e["name"] == "thread_name")
             .map(|e| e["args"]["name"].as_str().unwrap())
             .collect();
-        assert_eq!(thread_names, ["CPU (record)", "GPU (Test GPU)"]);
+        assert_eq!(thread_names, ["CPU (prepare, record)", "GPU (Test GPU)"]);
         let complete: Vec<&Value> = events.iter().filter(|e| e["ph"] == "X").collect();
         // Per frame and track: one frame event plus three passes.
         assert_eq!(complete.len(), 3 * 2 * 4);

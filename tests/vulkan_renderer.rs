@@ -6,7 +6,7 @@ mod common;
 
 use std::sync::Arc;
 
-use alpenglow::graph::{Access, BufferInfo, ImageInfo, RenderGraph, Stage};
+use alpenglow::graph::{BufferAccess, BufferInfo, ImageAccess, ImageInfo, RenderGraph, Stage};
 use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
 use alpenglow::terrain::procedural::ProceduralTerrain;
 use alpenglow::vulkan::{
@@ -138,14 +138,14 @@ fn graph_culls_unused_passes_and_writes_a_storage_buffer_drawn_by_the_next_pass(
         let result = graph.import_buffer(target.clone());
         graph
             .pass("never used")
-            .read(scratch, Access::StorageBufferRead(Stage::Compute))
-            .write(unused, Access::StorageImageWrite(Stage::Compute))
+            .read(scratch, BufferAccess::StorageRead(Stage::Compute))
+            .write(unused, ImageAccess::StorageWrite(Stage::Compute))
             .record(|_, _| panic!("a culled pass must not record"));
         graph
             .pass("copy")
             .transfer()
-            .read(scratch, Access::TransferSrc)
-            .write(result, Access::TransferDst)
+            .read(scratch, BufferAccess::TransferSrc)
+            .write(result, BufferAccess::TransferDst)
             .record(move |pass, _| {
                 let (src, dst) = (pass.buffer(scratch)?, pass.buffer(result)?);
                 pass.cmd().copy_buffer(src, dst, 256);
@@ -158,7 +158,7 @@ fn graph_culls_unused_passes_and_writes_a_storage_buffer_drawn_by_the_next_pass(
         assert!(baked.image(unused).is_none(), "a culled transient is not created");
         let mut frames = FrameRing::new(&ctx).unwrap();
         for _ in 0..3 {
-            baked.execute(&mut frames, &()).unwrap();
+            baked.execute(&mut frames, &(), &[]).unwrap();
         }
         baked.finish(&mut frames).unwrap();
         assert_eq!(baked.take_profiles().len(), 3);

@@ -27,6 +27,7 @@ layout(set = 0, binding = 2, std430) readonly buffer TerrainTexturing {
     uvec4 maps;           // input maps (sampled), w: bit k set when map k is present
     uvec4 color[MAX_ATLAS_TEXTURES / 4];   // sampled handles of the colour textures
     uvec4 normal[MAX_ATLAS_TEXTURES / 4];  // sampled handles of the normal textures
+    uvec4 draw;           // terrain.draw: view (VIEW_*), detail on (0/1), grid side N, 0
 } g_texturing[];
 
 layout(set = 0, binding = 2, std430) readonly buffer PageTable { uvec4 w[]; } g_page_tables[];

@@ -57,12 +57,11 @@ vec3 albedo(vec3 n, vec3 p, uint tile) {
 }
 
 void main() {
-    uint flags = draw_flags();
-    uint view = flags & 7u;
-    bool detail = (flags & 8u) != 0u;
-    uint handles = floatBitsToUint(pc.params.z);
-    uint tile = handles & 0xffffu;
-    uint texturing = handles >> 16;
+    uint texturing = pc.texturing_frame;
+    uvec4 draw = g_texturing[texturing].draw;
+    uint view = draw.x;
+    bool detail = draw.y != 0u;
+    uint tile = pc.noise_tile;
     float d0 = pc.eye.w;
     vec3 sun = normalize(pc.sun.xyz);
     vec3 to_point = in_world - pc.eye.xyz;
@@ -77,7 +76,7 @@ void main() {
         float footprint = max(depth, 1e-3) * pc.forward.w;
         float o_pixel = clamp(log2(d0 / footprint), 0.0, float(MAX_DETAIL_OCTAVES));
         vec2 grad;
-        detail_octaves(tile, in_world.xy, d0, pc.params.x, pc.params.y, in_split, max(o_pixel, in_split), grad);
+        detail_octaves(tile, in_world.xy, d0, pc.detail_amplitude, pc.detail_h, in_split, max(o_pixel, in_split), grad);
         n = normalize(n + vec3(-grad, 0.0) * n.z);
     }
 

@@ -7,6 +7,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::alias::{assign_slots, AliasSlot};
+use super::uploads::{UploadArena, UploadWriter};
 use super::{Access, ImageInfo, PassDecl, PassKind, RenderGraph, ResourceDecl, ResourceId};
 use crate::error::{Error, Result};
 use crate::profile::FrameProfile;
@@ -53,6 +54,8 @@ pub(crate) struct PendingFrame {
     pub cpu_ms: f64,
     /// Per pass: CPU start (ms from frame start) and CPU recording time.
     pub cpu_passes: Vec<(f64, f64)>,
+    /// The CPU stages before recording (techniques' `prepare`).
+    pub prepare: Vec<crate::profile::StageTiming>,
 }
 
 /// A baked render graph: passes in execution order with their resources,
@@ -71,6 +74,8 @@ pub struct BakedGraph<P> {
     pub(crate) pending: VecDeque<PendingFrame>,
     pub(crate) profiles: Vec<FrameProfile>,
     pub(crate) epoch: Instant,
+    /// The upload arena, when a region was declared.
+    pub(crate) uploads: Option<UploadArena>,
 }
 
 impl<P> BakedGraph<P> {
@@ -85,8 +90,18 @@ impl<P> BakedGraph<P> {
     }
 
     /// The physical image behind a transient or imported image (slot 0).
-    pub fn image(&self, id: ResourceId) -> Option<&Arc<Image>> {
-        self.physical.get(id.0).and_then(|p| p.image(0))
+    pub fn image(&self, id: super::ImageId) -> Option<&Arc<Image>> {
+        self.physical.get(id.0 .0).and_then(|p| p.image(0))
+    }
+
+    /// The upload regions of frame `frame` (the next frame, once
+    /// [`crate::vulkan::FrameRing::wait_for_next`] returned it): what a
+    /// technique's `prepare` writes before the frame is recorded.
+    pub fn uploads(&self, frame: u64) -> UploadWriter<'_> {
+        match &self.uploads {
+            Some(u) => u.writer(frame),
+            None => UploadWriter::empty(),
+        }
     }
 }
 
@@ -134,6 +149,12 @@ fn validate<P>(graph: &RenderGraph<P>) -> Result<()> {
                 .resources
                 .get(r.0)
                 .ok_or_else(|| Error::Graph(format!("pass '{}' uses an unknown resource #{}", pass.name, r.0)))?;
+            if matches!(decl, ResourceDecl::Uploads) && *a != Access::StorageBufferRead(access_stage(*a)) {
+                return Err(Error::Graph(format!(
+                    "pass '{}' declares {a:?} on the upload arena, which shaders only read",
+                    pass.name
+                )));
+            }
             let fits = if decl.is_image() { a.is_image() } else { a.is_buffer() };
             if !fits {
                 return Err(Error::Graph(format!(
@@ -160,6 +181,14 @@ fn validate<P>(graph: &RenderGraph<P>) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The stage of a storage-buffer access (Compute for any other).
+fn access_stage(a: Access) -> super::Stage {
+    match a {
+        Access::StorageBufferRead(s) | Access::StorageBufferWrite(s) | Access::StorageBufferReadWrite(s) => s,
+        _ => super::Stage::Compute,
+    }
 }
 
 fn transient_image_desc(name: String, info: &ImageInfo, usage: ImageUsageFlags) -> ImageDesc {
@@ -244,6 +273,10 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
         }
     }
     let (alias_of, blocks) = plan_aliasing(&graph, &live, &image_usage, ctx)?;
+    let uploads = match graph.upload_arena {
+        Some(_) => Some(UploadArena::new(ctx, &graph.upload_regions)?),
+        None => None,
+    };
     let mut physical = Vec::with_capacity(graph.resources.len());
     let mut imported = Vec::with_capacity(graph.resources.len());
     for (i, decl) in graph.resources.into_iter().enumerate() {
@@ -301,6 +334,10 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
                 }
                 Physical::Buffer(buffers)
             }
+            ResourceDecl::Uploads => match &uploads {
+                Some(u) => Physical::Buffer(u.buffers.clone()),
+                None => Physical::Unused,
+            },
         };
         physical.push(p);
     }
@@ -340,13 +377,14 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
         pending: VecDeque::new(),
         profiles: Vec::new(),
         epoch: Instant::now(),
+        uploads,
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::graph::{ImageInfo, Stage};
+    use crate::graph::{ImageAccess, ImageInfo, Stage};
     use crate::vulkan::Format;
 
     #[test]
@@ -356,15 +394,15 @@ mod tests {
         let b = g.create_image("b", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
         let unused = g.create_image("unused", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
         g.pass("write a")
-            .write(a, Access::StorageImageWrite(Stage::Compute))
+            .write(a, ImageAccess::StorageWrite(Stage::Compute))
             .record(|_, _| Ok(()));
         g.pass("write unused")
-            .read(a, Access::SampledImage(Stage::Compute))
-            .write(unused, Access::StorageImageWrite(Stage::Compute))
+            .read(a, ImageAccess::Sampled(Stage::Compute))
+            .write(unused, ImageAccess::StorageWrite(Stage::Compute))
             .record(|_, _| Ok(()));
         g.pass("a to b")
-            .read(a, Access::SampledImage(Stage::Compute))
-            .write(b, Access::StorageImageWrite(Stage::Compute))
+            .read(a, ImageAccess::Sampled(Stage::Compute))
+            .write(b, ImageAccess::StorageWrite(Stage::Compute))
             .record(|_, _| Ok(()));
         g.keep(b);
         assert_eq!(live_passes(&g), vec![true, false, true]);
@@ -375,7 +413,7 @@ mod tests {
         let mut g: RenderGraph<()> = RenderGraph::new();
         let a = g.create_image("a", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
         g.pass("bad")
-            .read(a, Access::ColorAttachmentWrite)
+            .read(a, ImageAccess::ColorAttachmentWrite)
             .record(|_, _| Ok(()));
         let err = validate(&g).unwrap_err().to_string();
         assert!(
@@ -390,19 +428,36 @@ mod tests {
         let a = g.create_image("a", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
         let out = g.create_image("out", ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
         g.pass("overwritten")
-            .write(a, Access::StorageImageWrite(Stage::Compute))
+            .write(a, ImageAccess::StorageWrite(Stage::Compute))
             .record(|_, _| Ok(()));
         g.pass("rewrite")
-            .write(a, Access::StorageImageWrite(Stage::Compute))
+            .write(a, ImageAccess::StorageWrite(Stage::Compute))
             .record(|_, _| Ok(()));
         g.pass("accumulate")
-            .write(a, Access::StorageImageReadWrite(Stage::Compute))
+            .write(a, ImageAccess::StorageReadWrite(Stage::Compute))
             .record(|_, _| Ok(()));
         g.pass("use")
-            .read(a, Access::SampledImage(Stage::Fragment))
-            .write(out, Access::ColorAttachmentWrite)
+            .read(a, ImageAccess::Sampled(Stage::Fragment))
+            .write(out, ImageAccess::ColorAttachmentWrite)
             .record(|_, _| Ok(()));
         g.keep(out);
         assert_eq!(live_passes(&g), vec![false, true, true, true]);
+    }
+
+    #[test]
+    fn upload_regions_are_read_only() {
+        let mut g: RenderGraph<()> = RenderGraph::new();
+        let region = g.upload_region("constants", 64);
+        g.pass("writes an upload")
+            .write(region, crate::graph::BufferAccess::StorageWrite(Stage::Compute))
+            .record(|_, _| Ok(()));
+        let err = validate(&g).unwrap_err().to_string();
+        assert!(err.contains("upload arena"), "{err}");
+        let mut g: RenderGraph<()> = RenderGraph::new();
+        let region = g.upload_region("constants", 64);
+        g.pass("reads an upload")
+            .read(region, crate::graph::BufferAccess::StorageRead(Stage::Fragment))
+            .record(|_, _| Ok(()));
+        assert!(validate(&g).is_ok());
     }
 }

@@ -2,13 +2,14 @@
 //! barriers derived from the declared accesses and the tracked state of each
 //! resource, the pass's commands, and an end timestamp.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use super::access::{derive_barrier, write_access_bits};
 use super::bake::{BakedGraph, PendingFrame, Physical};
-use super::{PassKind, ResourceId};
+use super::uploads::{UploadArena, UploadRegion};
+use super::{BufferId, ImageId, PassKind, ResourceId};
 use crate::error::{Error, Result};
-use crate::profile::{FrameProfile, PassTiming};
+use crate::profile::{FrameProfile, PassTiming, StageTiming};
 use crate::vulkan::{
     AccessFlags2, AccessState, Barrier, Buffer, CommandRecorder, CompletedFrame, FrameRing, Image, PipelineStageFlags2,
 };
@@ -18,7 +19,31 @@ use crate::vulkan::{
 pub struct PassContext<'a> {
     cmd: &'a mut CommandRecorder,
     physical: &'a [Physical],
+    uploads: Option<&'a UploadArena>,
     frame: u64,
+}
+
+/// A CPU stage of a frame before recording (a technique's `prepare`), for
+/// the profile and the trace.
+#[derive(Clone, Debug)]
+pub struct CpuStage {
+    pub name: String,
+    pub start: Instant,
+    pub duration: Duration,
+}
+
+impl CpuStage {
+    /// Runs `f` as the stage `name`, appending its timing to `stages`.
+    pub fn time<T>(stages: &mut Vec<CpuStage>, name: &str, f: impl FnOnce() -> T) -> T {
+        let start = Instant::now();
+        let value = f();
+        stages.push(CpuStage {
+            name: name.into(),
+            start,
+            duration: start.elapsed(),
+        });
+        value
+    }
 }
 
 impl<'a> PassContext<'a> {
@@ -33,42 +58,55 @@ impl<'a> PassContext<'a> {
     }
 
     /// The image behind `id` this frame.
-    pub fn image(&self, id: ResourceId) -> Result<&'a Image> {
+    pub fn image(&self, id: ImageId) -> Result<&'a Image> {
+        let ResourceId(r) = id.0;
         self.physical
-            .get(id.0)
+            .get(r)
             .and_then(|p| p.image(self.frame))
             .map(|i| &**i)
-            .ok_or_else(|| Error::Graph(format!("resource #{} is not an image of this graph", id.0)))
+            .ok_or_else(|| Error::Graph(format!("image #{r} is not of this graph")))
     }
 
     /// The buffer behind `id` this frame.
-    pub fn buffer(&self, id: ResourceId) -> Result<&'a Buffer> {
+    pub fn buffer(&self, id: BufferId) -> Result<&'a Buffer> {
+        let ResourceId(r) = id.0;
         self.physical
-            .get(id.0)
+            .get(r)
             .and_then(|p| p.buffer(self.frame))
             .map(|b| &**b)
-            .ok_or_else(|| Error::Graph(format!("resource #{} is not a buffer of this graph", id.0)))
+            .ok_or_else(|| Error::Graph(format!("buffer #{r} is not of this graph")))
     }
 
     /// Heap handle for sampling the image `id`.
-    pub fn sampled(&self, id: ResourceId) -> Result<u32> {
-        self.image(id)?
+    pub fn sampled(&self, id: ImageId) -> Result<u32> {
+        let image = self.image(id)?;
+        image
             .sampled_handle()
-            .ok_or_else(|| Error::Graph(format!("resource #{} is not sampled", id.0)))
+            .ok_or_else(|| Error::Graph(format!("image '{}' is not sampled", image.desc().name)))
     }
 
     /// Heap handle of the storage image `id`.
-    pub fn storage_image(&self, id: ResourceId) -> Result<u32> {
-        self.image(id)?
+    pub fn storage_image(&self, id: ImageId) -> Result<u32> {
+        let image = self.image(id)?;
+        image
             .storage_handle()
-            .ok_or_else(|| Error::Graph(format!("resource #{} is not a storage image", id.0)))
+            .ok_or_else(|| Error::Graph(format!("image '{}' is not a storage image", image.desc().name)))
     }
 
     /// Heap handle of the storage buffer `id`.
-    pub fn storage_buffer(&self, id: ResourceId) -> Result<u32> {
-        self.buffer(id)?
+    pub fn storage_buffer(&self, id: BufferId) -> Result<u32> {
+        let buffer = self.buffer(id)?;
+        buffer
             .storage_handle()
-            .ok_or_else(|| Error::Graph(format!("resource #{} is not a storage buffer", id.0)))
+            .ok_or_else(|| Error::Graph(format!("buffer '{}' is not a storage buffer", buffer.desc().name)))
+    }
+
+    /// Heap handle of the upload region `region` this frame (shaders read
+    /// it from offset 0).
+    pub fn upload(&self, region: UploadRegion) -> Result<u32> {
+        self.uploads
+            .ok_or_else(|| Error::Graph("the graph has no upload arena".into()))?
+            .handle(region, self.frame)
     }
 }
 
@@ -162,13 +200,22 @@ impl<P> BakedGraph<P> {
         cmd.barriers(&buffers, &images);
     }
 
-    /// Records and submits one frame. Returns once the frame is submitted; its
-    /// GPU timings arrive in [`BakedGraph::take_profiles`] when the GPU is done.
-    pub fn execute(&mut self, frames: &mut FrameRing, params: &P) -> Result<FrameOutcome> {
+    /// Records and submits one frame from its prepared data `params`;
+    /// `prepare` are the CPU stages that prepared it (for the profile).
+    /// Returns once the frame is submitted; its GPU timings arrive in
+    /// [`BakedGraph::take_profiles`] when the GPU is done.
+    pub fn execute(&mut self, frames: &mut FrameRing, params: &P, prepare: &[CpuStage]) -> Result<FrameOutcome> {
         let query_count = 2 * self.passes.len() as u32;
-        // Waits for the frame slot (the GPU) first; CPU times start after it.
+        // Waits for the frame slot (the GPU) first; CPU times start after it,
+        // or with the first prepare stage.
         let (mut recording, completed) = frames.begin(query_count)?;
-        let frame_start = Instant::now();
+        let record_start = Instant::now();
+        let frame_start = prepare
+            .iter()
+            .map(|s| s.start)
+            .min()
+            .unwrap_or(record_start)
+            .min(record_start);
         if let Some(c) = completed {
             self.complete(c);
         }
@@ -176,9 +223,9 @@ impl<P> BakedGraph<P> {
         let pool = recording.query_pool();
         let mut touched = vec![false; self.physical.len()];
         let mut cpu_passes = Vec::with_capacity(self.passes.len());
-        let mut passes = std::mem::take(&mut self.passes);
+        let passes = std::mem::take(&mut self.passes);
         let mut result = Ok(());
-        for (i, pass) in passes.iter_mut().enumerate() {
+        for (i, pass) in passes.iter().enumerate() {
             let pass_start = Instant::now();
             let cmd = &mut recording.recorder;
             cmd.begin_label(&pass.name, label_color(pass.kind));
@@ -187,6 +234,7 @@ impl<P> BakedGraph<P> {
             let mut ctx = PassContext {
                 cmd,
                 physical: &self.physical,
+                uploads: self.uploads.as_ref(),
                 frame,
             };
             if let Err(e) = (pass.record)(&mut ctx, params) {
@@ -209,11 +257,20 @@ impl<P> BakedGraph<P> {
         // Submit even after a failed pass so the frame slot stays consistent.
         let timeline = recording.submit()?;
         result?;
+        let ms_since = |t: Instant| t.saturating_duration_since(frame_start).as_secs_f64() * 1e3;
         self.pending.push_back(PendingFrame {
             frame,
-            cpu_start_ms: (frame_start - self.epoch).as_secs_f64() * 1e3,
+            cpu_start_ms: frame_start.saturating_duration_since(self.epoch).as_secs_f64() * 1e3,
             cpu_ms: frame_start.elapsed().as_secs_f64() * 1e3,
             cpu_passes,
+            prepare: prepare
+                .iter()
+                .map(|s| StageTiming {
+                    name: s.name.clone(),
+                    cpu_ms: s.duration.as_secs_f64() * 1e3,
+                    cpu_start_ms: ms_since(s.start),
+                })
+                .collect(),
         });
         Ok(FrameOutcome { frame, timeline })
     }
@@ -247,6 +304,7 @@ impl<P> BakedGraph<P> {
             let last = ts.iter().copied().fold(0.0, f64::max);
             self.profiles.push(FrameProfile {
                 frame: p.frame,
+                prepare: p.prepare,
                 passes,
                 gpu_ms: if first.is_finite() { (last - first) / 1e6 } else { 0.0 },
                 cpu_ms: p.cpu_ms,

@@ -3,31 +3,42 @@
 //! and returns a [`BakedGraph`] that records and times every frame, deriving
 //! each barrier and layout transition from the declared accesses.
 //!
+//! Handles are typed: an [`ImageId`] takes an [`ImageAccess`], a
+//! [`BufferId`] a [`BufferAccess`], so a buffer cannot be declared as an image
+//! access. Host-written per-frame data goes into one upload arena per frame
+//! slot ([`RenderGraph::upload_region`], [`UploadRegion`]), written before
+//! recording ([`BakedGraph::uploads`]); recording closures are `Fn + Send +
+//! Sync` and only read the frame's prepared data `P`.
+//!
 //! ```text
 //! let mut graph = RenderGraph::new();
 //! let vertices = graph.import_buffer(vertex_buffer);
 //! let hdr = graph.create_image("hdr", ImageInfo::new(w, h, Format::R32G32B32A32_SFLOAT));
 //! graph.pass("terrain.grid")
-//!     .write(vertices, Access::StorageBufferWrite(Stage::Compute))
-//!     .record(move |pass, params: &FrameParams| { /* bind, push, dispatch */ Ok(()) });
-//! graph.pass("terrain.draw")
-//!     .read(vertices, Access::VertexBuffer)
-//!     .write(hdr, Access::ColorAttachmentWrite)
-//!     .record(move |pass, params| { /* begin_rendering, draw */ Ok(()) });
+//!     .write(vertices, BufferAccess::StorageWrite(Stage::Compute))
+//!     .record(move |pass, frame: &Frame| { /* bind, push, dispatch */ Ok(()) });
+//! graph.pass("terrain.draw").graphics()
+//!     .read(vertices, BufferAccess::Vertex)
+//!     .write(hdr, ImageAccess::ColorAttachmentWrite)
+//!     .record(move |pass, frame| { /* begin_rendering, draw */ Ok(()) });
 //! let mut baked = graph.bake(&ctx)?;
-//! baked.execute(&mut frames, &params)?;
+//! baked.execute(&mut frames, &frame, &[])?;
 //! ```
 
 pub mod access;
 mod alias;
 mod bake;
 mod execute;
+mod typed;
+mod uploads;
 
 use std::sync::Arc;
 
 pub use access::{derive_barrier, Access, Stage};
 pub use bake::BakedGraph;
-pub use execute::{FrameOutcome, PassContext};
+pub use execute::{CpuStage, FrameOutcome, PassContext};
+pub use typed::{BufferAccess, BufferId, ImageAccess, ImageId, Resource};
+pub use uploads::{UploadRegion, UploadWriter};
 
 use crate::error::Result;
 use crate::vulkan::{Buffer, Format, Image, MemoryLocation};
@@ -70,11 +81,17 @@ pub(crate) enum ResourceDecl {
     /// One physical image per frame slot (or one shared by all).
     ImportedImages(Vec<Arc<Image>>),
     ImportedBuffers(Vec<Arc<Buffer>>),
+    /// The upload arena: one host-visible buffer per frame slot, created at
+    /// bake time from the regions declared.
+    Uploads,
 }
 
 impl ResourceDecl {
     pub(crate) fn is_imported(&self) -> bool {
-        matches!(self, ResourceDecl::ImportedImages(_) | ResourceDecl::ImportedBuffers(_))
+        matches!(
+            self,
+            ResourceDecl::ImportedImages(_) | ResourceDecl::ImportedBuffers(_) | ResourceDecl::Uploads
+        )
     }
 
     pub(crate) fn is_image(&self) -> bool {
@@ -89,13 +106,14 @@ impl ResourceDecl {
             ResourceDecl::TransientImage { name, .. } | ResourceDecl::TransientBuffer { name, .. } => name.clone(),
             ResourceDecl::ImportedImages(i) => i.first().map(|i| i.desc().name.clone()).unwrap_or_default(),
             ResourceDecl::ImportedBuffers(b) => b.first().map(|b| b.desc().name.clone()).unwrap_or_default(),
+            ResourceDecl::Uploads => "upload arena".into(),
         }
     }
 }
 
 /// The recording closure of a pass: gets the pass context and the frame's
-/// parameters.
-pub type RecordFn<P> = Box<dyn FnMut(&mut PassContext<'_>, &P) -> Result<()>>;
+/// prepared data. `Fn`, not `FnMut`: recording reads, it never plans.
+pub type RecordFn<P> = Box<dyn Fn(&mut PassContext<'_>, &P) -> Result<()> + Send + Sync>;
 
 /// What kind of queue work a pass records (for labels and timestamps).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -124,6 +142,10 @@ pub struct RenderGraph<P> {
     pub(crate) outputs: Vec<(ResourceId, Option<Access>)>,
     /// Let transient images whose uses do not overlap share memory.
     pub(crate) alias_transients: bool,
+    /// Regions of the upload arena: (name, size in bytes).
+    pub(crate) upload_regions: Vec<(String, u64)>,
+    /// The upload arena's resource, once a region was declared.
+    pub(crate) upload_arena: Option<ResourceId>,
 }
 
 impl<P> Default for RenderGraph<P> {
@@ -133,6 +155,8 @@ impl<P> Default for RenderGraph<P> {
             passes: Vec::new(),
             outputs: Vec::new(),
             alias_transients: true,
+            upload_regions: Vec::new(),
+            upload_arena: None,
         }
     }
 }
@@ -144,44 +168,67 @@ impl<P: 'static> RenderGraph<P> {
     }
 
     /// A transient image, created at bake time and reused every frame.
-    pub fn create_image(&mut self, name: &str, info: ImageInfo) -> ResourceId {
-        self.resources.push(ResourceDecl::TransientImage {
+    pub fn create_image(&mut self, name: &str, info: ImageInfo) -> ImageId {
+        ImageId(self.declare(ResourceDecl::TransientImage {
             name: name.into(),
             info,
-        });
+        }))
+    }
+
+    fn declare(&mut self, decl: ResourceDecl) -> ResourceId {
+        self.resources.push(decl);
         ResourceId(self.resources.len() - 1)
     }
 
     /// A transient buffer, created at bake time and reused every frame.
-    pub fn create_buffer(&mut self, name: &str, info: BufferInfo) -> ResourceId {
-        self.resources.push(ResourceDecl::TransientBuffer {
+    pub fn create_buffer(&mut self, name: &str, info: BufferInfo) -> BufferId {
+        BufferId(self.declare(ResourceDecl::TransientBuffer {
             name: name.into(),
             info,
-        });
-        ResourceId(self.resources.len() - 1)
+        }))
     }
 
     /// A persistent image owned outside the graph; its state is tracked across
     /// frames (and across graphs).
-    pub fn import_image(&mut self, image: Arc<Image>) -> ResourceId {
+    pub fn import_image(&mut self, image: Arc<Image>) -> ImageId {
         self.import_images_per_frame(vec![image])
     }
 
     /// One persistent image per frame in flight, used round-robin.
-    pub fn import_images_per_frame(&mut self, images: Vec<Arc<Image>>) -> ResourceId {
-        self.resources.push(ResourceDecl::ImportedImages(images));
-        ResourceId(self.resources.len() - 1)
+    pub fn import_images_per_frame(&mut self, images: Vec<Arc<Image>>) -> ImageId {
+        ImageId(self.declare(ResourceDecl::ImportedImages(images)))
     }
 
     /// A persistent buffer owned outside the graph (vertex buffers, atlases).
-    pub fn import_buffer(&mut self, buffer: Arc<Buffer>) -> ResourceId {
+    pub fn import_buffer(&mut self, buffer: Arc<Buffer>) -> BufferId {
         self.import_buffers_per_frame(vec![buffer])
     }
 
     /// One persistent buffer per frame in flight (readback targets).
-    pub fn import_buffers_per_frame(&mut self, buffers: Vec<Arc<Buffer>>) -> ResourceId {
-        self.resources.push(ResourceDecl::ImportedBuffers(buffers));
-        ResourceId(self.resources.len() - 1)
+    pub fn import_buffers_per_frame(&mut self, buffers: Vec<Arc<Buffer>>) -> BufferId {
+        BufferId(self.declare(ResourceDecl::ImportedBuffers(buffers)))
+    }
+
+    /// `size` bytes of the per-frame upload arena: host-written before each
+    /// frame is recorded ([`BakedGraph::uploads`]), read by shaders through
+    /// their own heap handle ([`PassContext::upload`]) from offset 0. Every
+    /// region of every technique lives in one host-visible buffer per frame
+    /// slot.
+    pub fn upload_region(&mut self, name: &str, size: u64) -> UploadRegion {
+        let arena = match self.upload_arena {
+            Some(arena) => arena,
+            None => {
+                let arena = self.declare(ResourceDecl::Uploads);
+                self.upload_arena = Some(arena);
+                arena
+            }
+        };
+        self.upload_regions.push((name.into(), size.max(4)));
+        UploadRegion {
+            index: self.upload_regions.len() - 1,
+            size: size.max(4),
+            arena,
+        }
     }
 
     /// Whether transient images whose uses within a frame do not overlap may
@@ -191,14 +238,14 @@ impl<P: 'static> RenderGraph<P> {
     }
 
     /// Keeps the passes that produce `resource` even if no pass reads it.
-    pub fn keep(&mut self, resource: ResourceId) {
-        self.outputs.push((resource, None));
+    pub fn keep(&mut self, resource: impl Resource) {
+        self.outputs.push((resource.id(), None));
     }
 
-    /// The host reads `resource` after the frame: a final barrier makes the
+    /// The host reads `buffer` after the frame: a final barrier makes the
     /// GPU's writes visible to the host.
-    pub fn read_back(&mut self, resource: ResourceId) {
-        self.outputs.push((resource, Some(Access::HostRead)));
+    pub fn read_back(&mut self, buffer: BufferId) {
+        self.outputs.push((buffer.0, Some(Access::HostRead)));
     }
 
     /// Starts declaring a compute pass.
@@ -246,7 +293,8 @@ impl<P: 'static> PassBuilder<'_, P> {
     }
 
     /// Declares a read of `resource` (`access` must not write).
-    pub fn read(mut self, resource: ResourceId, access: Access) -> Self {
+    pub fn read<R: Resource>(mut self, resource: R, access: R::Access) -> Self {
+        let (resource, access) = (resource.id(), access.into());
         if access.writes() {
             self.decl
                 .misdeclared
@@ -257,7 +305,8 @@ impl<P: 'static> PassBuilder<'_, P> {
     }
 
     /// Declares a write (or read-write) of `resource` (`access` must write).
-    pub fn write(mut self, resource: ResourceId, access: Access) -> Self {
+    pub fn write<R: Resource>(mut self, resource: R, access: R::Access) -> Self {
+        let (resource, access) = (resource.id(), access.into());
         if !access.writes() {
             self.decl
                 .misdeclared
@@ -268,7 +317,7 @@ impl<P: 'static> PassBuilder<'_, P> {
     }
 
     /// Finishes the pass with the closure that records its commands.
-    pub fn record(mut self, record: impl FnMut(&mut PassContext<'_>, &P) -> Result<()> + 'static) {
+    pub fn record(mut self, record: impl Fn(&mut PassContext<'_>, &P) -> Result<()> + Send + Sync + 'static) {
         self.decl.record = Some(Box::new(record));
         self.graph.passes.push(self.decl);
     }

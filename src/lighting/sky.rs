@@ -5,56 +5,72 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
-use crate::graph::{Access, RenderGraph, ResourceId};
+use crate::graph::{ImageAccess, RenderGraph};
 use crate::shaders;
-use crate::view::FrameParams;
-use crate::vulkan::{Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp};
+use crate::view::{pass_name, Frame, SceneTargets, TargetFormats, View, ViewIndex};
+use crate::vulkan::{Context, GraphicsPipeline, GraphicsPipelineDesc, LoadOp};
 
+/// Push constants of `sky` (`glsl/lighting/sky.frag`): the view ray basis
+/// and the sun.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct SkyPush {
+    /// Right axis scaled by the half-width of the image plane at distance 1.
     right: [f32; 4],
+    /// Image up axis scaled by the half-height.
     up: [f32; 4],
     forward: [f32; 4],
+    /// Unit direction towards the sun.
     sun: [f32; 4],
 }
 
-/// Declares the `sky` pass writing `color` (HDR radiance) and `view_depth`.
-pub fn add_sky_pass(
-    ctx: &Context,
-    graph: &mut RenderGraph<FrameParams>,
-    color: ResourceId,
-    view_depth: ResourceId,
-) -> Result<()> {
-    let pipeline = GraphicsPipeline::new(
-        ctx,
-        &GraphicsPipelineDesc::full_screen(
-            "sky",
-            (shaders::FULL_SCREEN_VERT, shaders::SKY_FRAG),
-            vec![Format::R32G32B32A32_SFLOAT, Format::R32_SFLOAT],
-        ),
-    )?;
-    graph
-        .pass("sky")
-        .graphics()
-        .write(color, Access::ColorAttachmentWrite)
-        .write(view_depth, Access::ColorAttachmentWrite)
-        .record(move |pass, params| {
-            let (right, up, forward) = params.camera.ray_basis(params.aspect);
-            let push = SkyPush {
-                right: right.extend(0.0).to_array(),
-                up: up.extend(0.0).to_array(),
-                forward: forward.extend(0.0).to_array(),
-                sun: params.sun.extend(0.0).to_array(),
-            };
-            let (color, view_depth) = (pass.image(color)?, pass.image(view_depth)?);
-            let cmd = pass.cmd();
-            cmd.begin_rendering(&[(color, LoadOp::DontCare), (view_depth, LoadOp::DontCare)], None);
-            cmd.bind_graphics(&pipeline);
-            cmd.push_constants(&push)?;
-            cmd.draw(3, 1);
-            cmd.end_rendering();
-            Ok(())
-        });
-    Ok(())
+/// The sky: a pipeline, and one `sky` pass per view.
+pub struct Sky {
+    pipeline: std::sync::Arc<GraphicsPipeline>,
+}
+
+impl Sky {
+    /// Builds the pipeline for targets of `formats`.
+    pub fn new(ctx: &Context, formats: &TargetFormats) -> Result<Sky> {
+        let pipeline = GraphicsPipeline::new(
+            ctx,
+            &GraphicsPipelineDesc::full_screen(
+                "sky",
+                (shaders::FULL_SCREEN_VERT, shaders::SKY_FRAG),
+                vec![formats.radiance, formats.view_depth],
+            ),
+        )?;
+        Ok(Sky {
+            pipeline: std::sync::Arc::new(pipeline),
+        })
+    }
+
+    /// Declares `sky` for view `index`: writes its radiance and view depth.
+    pub fn declare(&self, graph: &mut RenderGraph<Frame>, (index, view): (ViewIndex, &View), targets: &SceneTargets) {
+        let pipeline = self.pipeline.clone();
+        let (radiance, view_depth) = (targets.radiance, targets.view_depth);
+        graph
+            .pass(&pass_name("sky", &view.name))
+            .graphics()
+            .write(radiance, ImageAccess::ColorAttachmentWrite)
+            .write(view_depth, ImageAccess::ColorAttachmentWrite)
+            .record(move |pass, frame| {
+                let view = frame.view(index)?;
+                let (right, up, forward) = view.camera.ray_basis(view.aspect());
+                let push = SkyPush {
+                    right: right.extend(0.0).to_array(),
+                    up: up.extend(0.0).to_array(),
+                    forward: forward.extend(0.0).to_array(),
+                    sun: frame.lighting.sun.extend(0.0).to_array(),
+                };
+                let (radiance, view_depth) = (pass.image(radiance)?, pass.image(view_depth)?);
+                let cmd = pass.cmd();
+                cmd.begin_rendering(&[(radiance, LoadOp::DontCare), (view_depth, LoadOp::DontCare)], None);
+                cmd.bind_graphics(&pipeline);
+                cmd.push_constants(&push)?;
+                cmd.draw(3, 1);
+                cmd.end_rendering();
+                Ok(())
+            });
+    }
 }

@@ -1,45 +1,66 @@
 //! `tonemap`: HDR radiance → 8-bit sRGB (exposure, ACES fit, sRGB curve).
 
+use std::sync::Arc;
+
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
-use crate::graph::{Access, RenderGraph, ResourceId, Stage};
+use crate::graph::{ImageAccess, RenderGraph, Stage};
 use crate::shaders;
-use crate::view::FrameParams;
+use crate::view::{pass_name, Frame, SceneTargets, View};
 use crate::vulkan::{ComputePipeline, Context};
 
+/// Push constants of `tonemap` (`glsl/post/tonemap.comp`).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct TonemapPush {
-    handles: [u32; 4],
-    size: [u32; 4],
-    exposure: [f32; 4],
+    /// Storage image handles: HDR radiance (read), sRGB (written).
+    radiance: u32,
+    display: u32,
+    _pad: [u32; 2],
+    width: u32,
+    height: u32,
+    _pad2: [u32; 2],
+    /// Multiplier applied to radiance before the tone curve.
+    exposure: f32,
+    _pad3: [f32; 3],
 }
 
-/// Declares the `tonemap` pass from `hdr` (RGBA32F) into `ldr` (RGBA8).
-pub fn add_tonemap_pass(
-    ctx: &Context,
-    graph: &mut RenderGraph<FrameParams>,
-    hdr: ResourceId,
-    ldr: ResourceId,
-    size: (u32, u32),
-) -> Result<()> {
-    let pipeline = ComputePipeline::new(ctx, shaders::TONEMAP)?;
-    graph
-        .pass("tonemap")
-        .read(hdr, Access::StorageImageRead(Stage::Compute))
-        .write(ldr, Access::StorageImageWrite(Stage::Compute))
-        .record(move |pass, params| {
-            let push = TonemapPush {
-                handles: [pass.storage_image(hdr)?, pass.storage_image(ldr)?, 0, 0],
-                size: [size.0, size.1, 0, 0],
-                exposure: [params.exposure, 0.0, 0.0, 0.0],
-            };
-            let cmd = pass.cmd();
-            cmd.bind_compute(&pipeline);
-            cmd.push_constants(&push)?;
-            cmd.dispatch(size.0.div_ceil(8), size.1.div_ceil(8), 1);
-            Ok(())
-        });
-    Ok(())
+/// Tone mapping: a pipeline, and one `tonemap` pass per view.
+pub struct Tonemap {
+    pipeline: Arc<ComputePipeline>,
+}
+
+impl Tonemap {
+    /// Builds the pipeline.
+    pub fn new(ctx: &Context) -> Result<Tonemap> {
+        Ok(Tonemap {
+            pipeline: Arc::new(ComputePipeline::new(ctx, shaders::TONEMAP)?),
+        })
+    }
+
+    /// Declares `tonemap` for `view`: its radiance into its display image.
+    pub fn declare(&self, graph: &mut RenderGraph<Frame>, view: &View, targets: &SceneTargets) {
+        let pipeline = self.pipeline.clone();
+        let (radiance, display, width, height) = (targets.radiance, targets.display, targets.width, targets.height);
+        graph
+            .pass(&pass_name("tonemap", &view.name))
+            .read(radiance, ImageAccess::StorageRead(Stage::Compute))
+            .write(display, ImageAccess::StorageWrite(Stage::Compute))
+            .record(move |pass, frame| {
+                let push = TonemapPush {
+                    radiance: pass.storage_image(radiance)?,
+                    display: pass.storage_image(display)?,
+                    width,
+                    height,
+                    exposure: frame.lighting.exposure,
+                    ..TonemapPush::zeroed()
+                };
+                let cmd = pass.cmd();
+                cmd.bind_compute(&pipeline);
+                cmd.push_constants(&push)?;
+                cmd.dispatch(width.div_ceil(8), height.div_ceil(8), 1);
+                Ok(())
+            });
+    }
 }

@@ -1,39 +1,39 @@
-//! The renderer: builds the frame graph of a scene once, then renders views
-//! of it, headless, into HDR radiance, view-space depth and tone-mapped sRGB.
+//! The renderer: composition only. It builds the frame graph of a scene
+//! once from the techniques (each declares its passes per view), then
+//! renders views of it, headless, into HDR radiance, view-space depth and
+//! tone-mapped sRGB. A frame is *prepare, then record*: every technique's
+//! `prepare` does its CPU work for the frame's views (profile stages
+//! `prepare.terrain`, `prepare.texturing`, `prepare.points`), then the baked
+//! graph records the passes, which only read what was prepared.
 //!
 //! Frame graph of the default scene:
-//! `sky` (graphics) → `terrain.warp` (compute: CPU warp of the sketch map,
-//! then warp and zoom on the GPU into the vertex buffer, §7.4) →
-//! `terrain.draw` (graphics, reads the vertex buffer) → the points passes
-//! (`points.visibility` → `points.accumulate` → `points.normalize` for EWA
-//! splats, or `points.opaque`; see [`crate::points::render`]) → `tonemap`
-//! (compute) → `readback` (transfer).
+//! `sky` (graphics) → `terrain.warp` (compute: warp and zoom into the
+//! vertex buffer, §7.4) → `texturing.*` (compute: the dirty atlas tiles,
+//! §8.2) → `terrain.draw` (graphics, reads the vertex buffer) → the points
+//! passes (`points.visibility` → `points.accumulate` → `points.normalize`
+//! for EWA splats, or `points.opaque`; see [`crate::points::render`]) →
+//! `tonemap` (compute) → `readback` (transfer).
 
 pub mod scene;
 
 use std::sync::Arc;
 
-use glam::Vec3;
-
-pub use crate::view::{Camera, FrameParams};
+pub use crate::view::{validate_size, Camera, MAX_IMAGE_SIDE};
 pub use scene::Scene;
 
 use crate::error::{Error, Result};
-use crate::graph::{Access, BakedGraph, FrameOutcome, ImageInfo, RenderGraph};
-use crate::lighting::sky::add_sky_pass;
-use crate::points::render::{add_point_passes, PointFrameStats, PointPasses, SplatSettings, SplatTargets};
+use crate::graph::{BakedGraph, BufferAccess, BufferId, FrameOutcome, ImageAccess, ImageId, RenderGraph};
+use crate::lighting::sky::Sky;
+use crate::points::render::{PointFrameStats, PointRenderer, SplatSettings};
+use crate::post::tonemap::Tonemap;
 use crate::profile::FrameProfile;
-use crate::terrain::geometry_image::{GeometryImage, TerrainSettings};
-use crate::terrain::shading::{add_draw_pass, TerrainTexturing};
-use crate::texturing::generation::{AtlasResources, TextureFrameStats, TextureStreaming};
+use crate::terrain::geometry_image::TerrainSettings;
+use crate::terrain::{Terrain, TerrainTexturing};
+use crate::texturing::generation::{TextureAtlas, TextureFrameStats, TextureStreaming};
 use crate::texturing::gpu_layout::TexturingMode;
 use crate::texturing::page_table::PageTable;
-use crate::vulkan::{
-    Buffer, BufferDesc, BufferUsageFlags, Context, Format, FrameRing, MemoryLocation, FRAMES_IN_FLIGHT,
-};
-
-/// Largest accepted image side (the device limit may be lower).
-pub const MAX_IMAGE_SIDE: u32 = 16384;
+use crate::view::{Frame, Lighting, SceneTargets, View};
+use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Context, FrameRing, MemoryLocation, FRAMES_IN_FLIGHT};
 
 /// Output size, whether frames are read back to the host, and the
 /// terrain's LOD and detail settings.
@@ -90,33 +90,26 @@ struct Readback {
     weight: Option<Vec<Arc<Buffer>>>,
 }
 
-/// Renders one scene, frame after frame.
+/// The techniques of a scene, each with its persistent state.
+/// (The sky and tone mapping prepare nothing: their passes own their pipelines.)
+struct Techniques {
+    terrain: Option<Terrain>,
+    atlas: Option<TextureAtlas>,
+    points: Option<PointRenderer>,
+}
+
+/// Renders one scene, frame after frame. `Send`: a simulator may hand it to
+/// its render thread.
 pub struct Renderer {
     ctx: Context,
     frames: FrameRing,
-    graph: BakedGraph<FrameParams>,
+    graph: BakedGraph<Frame>,
     settings: RenderSettings,
     readback: Option<Readback>,
-    scene_sun: Vec3,
-    snow_line: f32,
+    lighting: Lighting,
     /// Frames rendered so far.
     frames_rendered: u64,
-    /// Point passes' statistics (None without points).
-    points: Option<PointPasses>,
-    /// The texture atlas's statistics (None unless texturing from the atlas).
-    atlas: Option<AtlasResources>,
-    /// Kept alive for the graph's imported resources.
-    _terrain: Option<GeometryImage>,
-}
-
-/// Checks an output size.
-pub fn validate_size(width: u32, height: u32) -> Result<()> {
-    for (what, v) in [("--width", width), ("--height", height)] {
-        if v == 0 || v > MAX_IMAGE_SIDE {
-            return Err(Error::invalid(what, format!("{v}; must be in 1..={MAX_IMAGE_SIDE}")));
-        }
-    }
-    Ok(())
+    techniques: Techniques,
 }
 
 /// One readback buffer per frame slot.
@@ -132,8 +125,49 @@ fn host_buffers(ctx: &Context, name: &str, size: u64) -> Result<Vec<Arc<Buffer>>
     )
 }
 
+/// Declares `readback`: the view's images into per-frame host buffers.
+fn declare_readback(ctx: &Context, graph: &mut RenderGraph<Frame>, targets: &SceneTargets) -> Result<Readback> {
+    let pixels = u64::from(targets.width) * u64::from(targets.height);
+    let rb = Readback {
+        hdr: host_buffers(ctx, "hdr", pixels * 16)?,
+        depth: host_buffers(ctx, "depth", pixels * 4)?,
+        ldr: host_buffers(ctx, "srgb", pixels * 4)?,
+        weight: match targets.weight {
+            Some(_) => Some(host_buffers(ctx, "splat weight", pixels * 4)?),
+            None => None,
+        },
+    };
+    let mut copies: Vec<(ImageId, BufferId)> = vec![
+        (targets.radiance, graph.import_buffers_per_frame(rb.hdr.clone())),
+        (targets.view_depth, graph.import_buffers_per_frame(rb.depth.clone())),
+        (targets.display, graph.import_buffers_per_frame(rb.ldr.clone())),
+    ];
+    if let (Some(image), Some(buffers)) = (targets.weight, &rb.weight) {
+        copies.push((image, graph.import_buffers_per_frame(buffers.clone())));
+    }
+    let mut pass = graph.pass("readback").transfer();
+    for &(image, buffer) in &copies {
+        pass = pass
+            .read(image, ImageAccess::TransferSrc)
+            .write(buffer, BufferAccess::TransferDst);
+    }
+    let recorded = copies.clone();
+    pass.record(move |pass, _| {
+        for &(image, buffer) in &recorded {
+            let (image, buffer) = (pass.image(image)?, pass.buffer(buffer)?);
+            pass.cmd().copy_image_to_buffer(image, buffer);
+        }
+        Ok(())
+    });
+    for &(_, buffer) in &copies {
+        graph.read_back(buffer);
+    }
+    Ok(rb)
+}
+
 impl Renderer {
-    /// Uploads the scene and bakes its frame graph.
+    /// Uploads the scene, declares every technique's passes for the view
+    /// and bakes the frame graph.
     pub fn new(ctx: &Context, scene: &Scene, settings: RenderSettings) -> Result<Renderer> {
         validate_size(settings.width, settings.height)?;
         let (w, h) = (settings.width, settings.height);
@@ -145,90 +179,34 @@ impl Renderer {
             ));
         }
         let mut graph = RenderGraph::new();
-        let hdr = graph.create_image("hdr radiance", ImageInfo::new(w, h, Format::R32G32B32A32_SFLOAT));
-        let view_depth = graph.create_image("view depth", ImageInfo::new(w, h, Format::R32_SFLOAT));
-        let depth = graph.create_image("depth buffer", ImageInfo::new(w, h, Format::D32_SFLOAT));
-        let ldr = graph.create_image("srgb", ImageInfo::new(w, h, Format::R8G8B8A8_UNORM));
-
-        add_sky_pass(ctx, &mut graph, hdr, view_depth)?;
-        let (terrain, atlas) = if scene.draw_terrain {
-            let terrain = GeometryImage::new(ctx, Arc::new(scene.heights.clone()), settings.terrain)?;
-            let terrain_resources = terrain.add_warp_pass(ctx, &mut graph)?;
-            let atlas = add_draw_pass(
-                ctx,
-                &mut graph,
-                &terrain,
-                terrain_resources,
-                (hdr, view_depth, depth),
-                h,
-                &TerrainTexturing {
-                    mode: settings.texturing,
-                    layers: &scene.layers,
-                    streaming: settings.texture_streaming,
-                    input_maps: &scene.input_maps,
-                },
-            )?;
-            (Some(terrain), atlas)
-        } else {
-            (None, None)
+        // The view the graph is declared for; every frame brings its camera.
+        let view = View::new(scene.default_camera(), w, h);
+        let targets = SceneTargets::declare(&mut graph, &view, !scene.points.is_empty());
+        let sky = Sky::new(ctx, &targets.formats)?;
+        sky.declare(&mut graph, (0, &view), &targets);
+        let (terrain, atlas) = match scene.draw_terrain {
+            true => {
+                let (terrain, atlas) = declare_terrain(ctx, &mut graph, scene, &settings, (&view, &targets))?;
+                (Some(terrain), atlas)
+            }
+            false => (None, None),
         };
-        let (points, weight) = if scene.points.is_empty() {
-            (None, None)
-        } else {
-            let weight = graph.create_image("splat weight", ImageInfo::new(w, h, Format::R32_SFLOAT));
-            let targets = SplatTargets {
-                radiance: hdr,
-                view_depth,
-                depth,
-                weight,
-                clear_depth: !scene.draw_terrain,
-            };
-            let passes = add_point_passes(ctx, &mut graph, &scene.points, settings.points, targets, (w, h))?;
-            (Some(passes), Some(weight))
+        let points = match scene.points.is_empty() {
+            true => None,
+            false => {
+                let mut points = PointRenderer::new(ctx, &scene.points, settings.points)?;
+                points.declare(ctx, &mut graph, (0, &view), &targets, !scene.draw_terrain)?;
+                Some(points)
+            }
         };
-        crate::post::tonemap::add_tonemap_pass(ctx, &mut graph, hdr, ldr, (w, h))?;
-
-        let pixels = w as u64 * h as u64;
-        let readback = if settings.readback {
-            let rb = Readback {
-                hdr: host_buffers(ctx, "hdr", pixels * 16)?,
-                depth: host_buffers(ctx, "depth", pixels * 4)?,
-                ldr: host_buffers(ctx, "srgb", pixels * 4)?,
-                weight: match weight {
-                    Some(_) => Some(host_buffers(ctx, "splat weight", pixels * 4)?),
-                    None => None,
-                },
-            };
-            let mut copies = vec![
-                (hdr, graph.import_buffers_per_frame(rb.hdr.clone())),
-                (view_depth, graph.import_buffers_per_frame(rb.depth.clone())),
-                (ldr, graph.import_buffers_per_frame(rb.ldr.clone())),
-            ];
-            if let (Some(image), Some(buffers)) = (weight, &rb.weight) {
-                copies.push((image, graph.import_buffers_per_frame(buffers.clone())));
+        let tonemap = Tonemap::new(ctx)?;
+        tonemap.declare(&mut graph, &view, &targets);
+        let readback = match settings.readback {
+            true => Some(declare_readback(ctx, &mut graph, &targets)?),
+            false => {
+                graph.keep(targets.display);
+                None
             }
-            let mut pass = graph.pass("readback").transfer();
-            for &(image, buffer) in &copies {
-                pass = pass.read(image, Access::TransferSrc).write(buffer, Access::TransferDst);
-            }
-            let recorded = copies.clone();
-            pass.record(move |pass, _| {
-                let pairs = recorded
-                    .iter()
-                    .map(|&(i, b)| Ok((pass.image(i)?, pass.buffer(b)?)))
-                    .collect::<Result<Vec<_>>>()?;
-                for (image, buffer) in pairs {
-                    pass.cmd().copy_image_to_buffer(image, buffer);
-                }
-                Ok(())
-            });
-            for &(_, buffer) in &copies {
-                graph.read_back(buffer);
-            }
-            Some(rb)
-        } else {
-            graph.keep(ldr);
-            None
         };
         let graph = graph.bake(ctx)?;
         let (lo, hi) = scene.height_range();
@@ -238,12 +216,13 @@ impl Renderer {
             graph,
             settings,
             readback,
-            scene_sun: scene.sun_direction,
-            snow_line: lo + (hi - lo) * 0.8,
+            lighting: Lighting {
+                sun: scene.sun_direction,
+                exposure: 1.0,
+                snow_line: lo + (hi - lo) * 0.8,
+            },
             frames_rendered: 0,
-            points,
-            atlas,
-            _terrain: terrain,
+            techniques: Techniques { terrain, atlas, points },
         })
     }
 
@@ -257,17 +236,26 @@ impl Renderer {
         self.graph.pass_names()
     }
 
-    /// Records and submits a frame of `camera`.
+    /// Prepares, records and submits a frame of `camera`.
     pub fn render(&mut self, camera: &Camera) -> Result<FrameOutcome> {
         camera.validate()?;
-        let params = FrameParams {
-            camera: *camera,
-            aspect: self.settings.width as f64 / self.settings.height as f64,
-            sun: self.scene_sun,
-            exposure: 1.0,
-            snow_line: self.snow_line,
-        };
-        let outcome = self.graph.execute(&mut self.frames, &params)?;
+        let view = View::new(*camera, self.settings.width, self.settings.height);
+        // The slot's previous frame must be done before prepare writes its uploads.
+        let index = self.frames.wait_for_next()?;
+        let mut frame = Frame::new(index, vec![view], self.lighting);
+        let mut stages = Vec::new();
+        let mut uploads = self.graph.uploads(index);
+        let t = &mut self.techniques;
+        if let Some(terrain) = &mut t.terrain {
+            frame.prepare(terrain, &mut uploads, &mut stages)?;
+        }
+        if let Some(atlas) = &mut t.atlas {
+            frame.prepare(atlas, &mut uploads, &mut stages)?;
+        }
+        if let Some(points) = &mut t.points {
+            frame.prepare(points, &mut uploads, &mut stages)?;
+        }
+        let outcome = self.graph.execute(&mut self.frames, &frame, &stages)?;
         self.frames_rendered = outcome.frame + 1;
         Ok(outcome)
     }
@@ -279,8 +267,8 @@ impl Renderer {
     pub fn render_settled(&mut self, camera: &Camera, max_frames: u32) -> Result<FrameOutcome> {
         for _ in 0..max_frames.max(1) {
             let outcome = self.render(camera)?;
-            match &self.atlas {
-                Some(atlas) if atlas.last_deferred()? > 0 => continue,
+            match &self.techniques.atlas {
+                Some(atlas) if atlas.last_deferred() > 0 => continue,
                 _ => return Ok(outcome),
             }
         }
@@ -327,7 +315,7 @@ impl Renderer {
     /// readback buffers; needs [`TextureStreaming::readback`]. Same
     /// frames-in-flight rule as [`Renderer::read`].
     pub fn read_texture_atlas(&mut self, frame: &FrameOutcome) -> Result<Vec<Vec<u8>>> {
-        let buffers = (self.atlas.as_ref().and_then(|a| a.readback.as_ref()))
+        let buffers = (self.techniques.atlas.as_ref().and_then(|a| a.readback()))
             .ok_or_else(|| Error::invalid("texture atlas readback", "the renderer was created without it"))?;
         if self.frames_rendered > frame.frame + FRAMES_IN_FLIGHT as u64 {
             return Err(Error::invalid(
@@ -350,25 +338,55 @@ impl Renderer {
     /// taken (their GPU times are the `texturing.*` passes of
     /// [`Renderer::finish`]'s profiles); empty unless texturing from the atlas.
     pub fn take_texture_stats(&mut self) -> Result<Vec<TextureFrameStats>> {
-        match &self.atlas {
+        Ok(match &mut self.techniques.atlas {
             Some(a) => a.take_stats(),
-            None => Ok(Vec::new()),
-        }
+            None => Vec::new(),
+        })
     }
 
     /// The texture page table of the last recorded frame (which atlas tile
     /// colours which part of the terrain); None unless texturing from the atlas.
     pub fn texture_page_table(&self) -> Result<Option<PageTable>> {
-        self.atlas.as_ref().map(AtlasResources::page_table).transpose()
+        Ok(self.techniques.atlas.as_ref().map(|a| a.page_table().clone()))
     }
 
     /// Point statistics of the frames completed so far and not yet taken
     /// (complete after [`Renderer::finish`]); empty without point objects.
     pub fn take_point_stats(&mut self) -> Result<Vec<PointFrameStats>> {
         self.graph.finish(&mut self.frames)?;
-        match &self.points {
+        match &mut self.techniques.points {
             Some(p) => p.take_stats(),
             None => Ok(Vec::new()),
         }
     }
+}
+
+/// The terrain of `scene` and, when texturing from the atlas, the texture
+/// atlas: `terrain.warp`, the generation passes, then `terrain.draw`.
+fn declare_terrain(
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame>,
+    scene: &Scene,
+    settings: &RenderSettings,
+    (view, targets): (&View, &SceneTargets),
+) -> Result<(Terrain, Option<TextureAtlas>)> {
+    let texturing = TerrainTexturing {
+        mode: settings.texturing,
+        layers: &scene.layers,
+        input_maps: &scene.input_maps,
+    };
+    let field = Arc::new(scene.heights.clone());
+    let mut terrain = Terrain::new(ctx, graph, field, settings.terrain, &texturing)?;
+    terrain.declare_warp(ctx, graph, (0, view))?;
+    let atlas = match settings.texturing {
+        TexturingMode::Atlas => Some(TextureAtlas::declare(
+            ctx,
+            graph,
+            terrain.generation_inputs(&scene.layers),
+            settings.texture_streaming,
+        )?),
+        _ => None,
+    };
+    terrain.declare_draw(ctx, graph, (0, view), targets, atlas.as_ref().map(|a| a.bindings()))?;
+    Ok((terrain, atlas))
 }

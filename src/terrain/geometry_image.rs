@@ -8,21 +8,21 @@
 //!
 //! Frame graph: `terrain.warp` (compute: reads the atlas, the noise tile and
 //! this frame's warp upload; writes the vertex buffer) → `terrain.draw`
-//! (vertex input). The CPU stage runs inside `terrain.warp`'s record
-//! callback, after the frame slot's previous use has finished, so the
-//! profile's CPU time of that pass is the CPU warp.
+//! (vertex input). The CPU stage runs in [`crate::terrain::Terrain`]'s
+//! `prepare`, before the frame is recorded (the profile's
+//! `prepare.terrain`).
 
 use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::{Error, Result};
-use crate::graph::{Access, RenderGraph, ResourceId, Stage};
+use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, RenderGraph, Stage, UploadRegion};
 use crate::io::heightmap::HeightField;
 use crate::shaders;
-use crate::terrain::lod::{DebugScalar, LodFrame, LodSettings};
+use crate::terrain::lod::{DebugScalar, LodSettings};
 use crate::terrain::wavelet_noise;
-use crate::view::FrameParams;
+use crate::view::{pass_name, Frame, ViewIndex};
 use crate::vulkan::{
     Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, Format, Image, ImageDesc, ImageUsageFlags,
     MemoryLocation,
@@ -61,7 +61,7 @@ impl TerrainView {
         self as u32
     }
 
-    fn debug_scalar(self) -> DebugScalar {
+    pub(crate) fn debug_scalar(self) -> DebugScalar {
         match self {
             TerrainView::Importance => DebugScalar::Importance,
             TerrainView::DensityRatio => DebugScalar::DensityRatio,
@@ -107,13 +107,13 @@ impl TerrainSettings {
     pub fn validate(&self) -> Result<()> {
         if !(2..=2048).contains(&self.grid_side) {
             return Err(Error::invalid(
-                "--grid",
+                "terrain.grid_side",
                 format!("{} (must be 2..=2048)", self.grid_side),
             ));
         }
         if !(4..=1024).contains(&self.lod.sketch_side) {
             return Err(Error::invalid(
-                "--sketch",
+                "terrain.lod.sketch_side",
                 format!("{} (must be 4..=1024)", self.lod.sketch_side),
             ));
         }
@@ -132,19 +132,26 @@ impl TerrainSettings {
         Ok(())
     }
 
-    /// The `terrain.draw` flags word: view, detail bit, grid side.
-    pub fn draw_flags(&self) -> u32 {
-        self.view.code() | (u32::from(self.detail) << 3) | (self.grid_side << 8)
+    /// What `terrain.draw` reads of the settings (`TerrainTexturing.draw`):
+    /// view, detail on (0/1), grid side.
+    pub fn draw_constants(&self) -> [u32; 4] {
+        [self.view.code(), u32::from(self.detail), self.grid_side, 0]
     }
 }
 
+/// Push constants of `terrain.warp` (`glsl/terrain/warp.comp`).
 #[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct WarpPush {
-    handles: [u32; 4],
-    grid: [u32; 4],
-    spacing: [f32; 4],
-    extent: [f32; 4],
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct WarpPush {
+    /// Sketch atlas (sampled), warp upload (storage), vertices (storage),
+    /// noise tile (sampled).
+    pub handles: [u32; 4],
+    /// Grid side N, sketch side, height-field columns, rows.
+    pub grid: [u32; 4],
+    /// Sample spacing x, y (metres), detail amplitude, detail H.
+    pub spacing: [f32; 4],
+    /// Terrain rectangle x, y (metres), d0, detail on (1) or off (0).
+    pub extent: [f32; 4],
 }
 
 /// Indices of the two triangles of every grid cell, counter-clockwise seen
@@ -161,7 +168,8 @@ pub fn grid_indices(columns: u32, rows: u32) -> Vec<u32> {
     indices
 }
 
-/// GPU resources of the warped terrain.
+/// GPU resources of the warped terrain shared by every view: the height
+/// field as the sketch atlas, the noise tile and the grid's indices.
 pub struct GeometryImage {
     pub field: Arc<HeightField>,
     pub settings: TerrainSettings,
@@ -169,17 +177,12 @@ pub struct GeometryImage {
     pub atlas: Arc<Image>,
     /// Wavelet noise tile (R32F, `NOISE_TILE`²).
     pub noise: Arc<Image>,
-    /// Per frame slot: the warped sketch map `(Φx, Φy, debug, 0)`.
-    pub warp_uploads: Vec<Arc<Buffer>>,
-    /// The geometry image as vertex buffer (`grid_side`² vertices).
-    pub vertices: Arc<Buffer>,
     /// Fixed grid topology, built once.
     pub indices: Arc<Buffer>,
 }
 
 impl GeometryImage {
-    /// Uploads the atlas and the noise tile, creates the vertex and index
-    /// buffers.
+    /// Uploads the atlas and the noise tile, creates the index buffer.
     pub fn new(ctx: &Context, field: Arc<HeightField>, settings: TerrainSettings) -> Result<GeometryImage> {
         settings.validate()?;
         let max = ctx.max_image_dimension();
@@ -209,26 +212,7 @@ impl GeometryImage {
         let atlas = image("sketch atlas", field.columns, field.rows, &field.heights)?;
         let tile = wavelet_noise::noise_tile(settings.noise_seed, NOISE_TILE)?;
         let noise = image("wavelet noise tile", NOISE_TILE as u32, NOISE_TILE as u32, &tile)?;
-        let n = settings.lod.sketch_side as u64;
-        let warp_uploads = Buffer::per_frame(
-            ctx,
-            BufferDesc {
-                name: "terrain warp upload".into(),
-                size: n * n * 16,
-                usage: BufferUsageFlags::STORAGE_BUFFER,
-                location: MemoryLocation::CpuToGpu,
-            },
-        )?;
         let side = settings.grid_side;
-        let vertices = Arc::new(Buffer::new(
-            ctx,
-            BufferDesc {
-                name: "terrain geometry image (vertices)".into(),
-                size: u64::from(side) * u64::from(side) * u64::from(VERTEX_STRIDE),
-                usage: BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::VERTEX_BUFFER,
-                location: MemoryLocation::GpuOnly,
-            },
-        )?);
         let indices = Arc::new(Buffer::with_data(
             ctx,
             "terrain grid indices",
@@ -240,8 +224,6 @@ impl GeometryImage {
             settings,
             atlas,
             noise,
-            warp_uploads,
-            vertices,
             indices,
         })
     }
@@ -251,75 +233,92 @@ impl GeometryImage {
         self.field.spacing.x.min(self.field.spacing.y) as f32
     }
 
-    /// Declares `terrain.warp`. Returns the vertex buffer, the noise tile
-    /// and the sketch atlas (the height field) as graph resources, for
-    /// `terrain.draw`.
-    pub fn add_warp_pass(
-        &self,
-        ctx: &Context,
-        graph: &mut RenderGraph<FrameParams>,
-    ) -> Result<(ResourceId, ResourceId, ResourceId)> {
-        let atlas = graph.import_image(self.atlas.clone());
-        let noise = graph.import_image(self.noise.clone());
-        let upload = graph.import_buffers_per_frame(self.warp_uploads.clone());
-        let vertices = graph.import_buffer(self.vertices.clone());
-        let pipeline = ComputePipeline::new(ctx, shaders::TERRAIN_WARP)?;
-        let field = self.field.clone();
-        let settings = self.settings;
-        let d0 = self.atlas_spacing();
-        let mut frame = LodFrame::default();
-        graph
-            .pass("terrain.warp")
-            .read(atlas, Access::SampledImage(Stage::Compute))
-            .read(noise, Access::SampledImage(Stage::Compute))
-            .read(upload, Access::StorageBufferRead(Stage::Compute))
-            .write(vertices, Access::StorageBufferWrite(Stage::Compute))
-            .record(move |pass, params| {
-                // The CPU stage: sketch map, importance map, warp (§7.4.2).
-                frame.plan(
-                    &field,
-                    &params.camera,
-                    params.aspect,
-                    &settings.lod,
-                    settings.view.debug_scalar(),
-                )?;
-                pass.buffer(upload)?.write(0, bytemuck::cast_slice(&frame.upload))?;
-                let extent = field.extent();
-                let push = WarpPush {
-                    handles: [
-                        pass.sampled(atlas)?,
-                        pass.storage_buffer(upload)?,
-                        pass.storage_buffer(vertices)?,
-                        pass.sampled(noise)?,
-                    ],
-                    grid: [
-                        settings.grid_side,
-                        settings.lod.sketch_side as u32,
-                        field.columns,
-                        field.rows,
-                    ],
-                    spacing: [
-                        field.spacing.x as f32,
-                        field.spacing.y as f32,
-                        settings.detail_amplitude,
-                        settings.detail_h,
-                    ],
-                    extent: [
-                        extent.x as f32,
-                        extent.y as f32,
-                        d0,
-                        if settings.detail { 1.0 } else { 0.0 },
-                    ],
-                };
-                let cmd = pass.cmd();
-                cmd.bind_compute(&pipeline);
-                cmd.push_constants(&push)?;
-                let groups = settings.grid_side.div_ceil(8);
-                cmd.dispatch(groups, groups, 1);
-                Ok(())
-            });
-        Ok((vertices, noise, atlas))
+    /// Bytes of one view's warp upload (the warped sketch map).
+    pub fn warp_upload_bytes(&self) -> u64 {
+        (self.settings.lod.sketch_side as u64).pow(2) * 16
     }
+
+    /// A view's geometry image: the vertex buffer `terrain.warp` writes
+    /// and `terrain.draw` reads (`grid_side`² vertices).
+    pub fn vertex_buffer(&self, ctx: &Context, view_name: &str) -> Result<Arc<Buffer>> {
+        let side = u64::from(self.settings.grid_side);
+        Ok(Arc::new(Buffer::new(
+            ctx,
+            BufferDesc {
+                name: pass_name("terrain geometry image (vertices)", view_name),
+                size: side * side * u64::from(VERTEX_STRIDE),
+                usage: BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::VERTEX_BUFFER,
+                location: MemoryLocation::GpuOnly,
+            },
+        )?))
+    }
+
+    /// The push constants of `terrain.warp` but for its handles.
+    pub fn warp_push(&self) -> WarpPush {
+        let (field, settings) = (&self.field, &self.settings);
+        let extent = field.extent();
+        WarpPush {
+            handles: [0; 4],
+            grid: [
+                settings.grid_side,
+                settings.lod.sketch_side as u32,
+                field.columns,
+                field.rows,
+            ],
+            spacing: [
+                field.spacing.x as f32,
+                field.spacing.y as f32,
+                settings.detail_amplitude,
+                settings.detail_h,
+            ],
+            extent: [
+                extent.x as f32,
+                extent.y as f32,
+                self.atlas_spacing(),
+                if settings.detail { 1.0 } else { 0.0 },
+            ],
+        }
+    }
+}
+
+/// What one view's `terrain.warp` reads and writes.
+#[derive(Clone, Copy, Debug)]
+pub struct WarpPass {
+    pub view: ViewIndex,
+    /// Sketch atlas and noise tile.
+    pub atlas: ImageId,
+    pub noise: ImageId,
+    /// This frame's warped sketch map (written by `prepare`).
+    pub upload: UploadRegion,
+    /// The view's geometry image.
+    pub vertices: BufferId,
+    /// Grid side N.
+    pub grid_side: u32,
+}
+
+/// Declares `terrain.warp` for one view (§7.4.2 "Warp and Zoom"): the
+/// prepared warp of the sketch map, bilinearly to N×N, heights re-sampled
+/// from the atlas, detail displacement, normals; into the vertex buffer.
+/// Its push constants come from the view's [`crate::terrain::TerrainFrame`].
+pub fn declare_warp_pass(ctx: &Context, graph: &mut RenderGraph<Frame>, name: &str, pass: WarpPass) -> Result<()> {
+    let pipeline = ComputePipeline::new(ctx, shaders::TERRAIN_WARP)?;
+    graph
+        .pass(name)
+        .read(pass.atlas, ImageAccess::Sampled(Stage::Compute))
+        .read(pass.noise, ImageAccess::Sampled(Stage::Compute))
+        .read(pass.upload, BufferAccess::StorageRead(Stage::Compute))
+        .write(pass.vertices, BufferAccess::StorageWrite(Stage::Compute))
+        .record(move |ctx, frame| {
+            let prepared = frame.prepared::<crate::terrain::TerrainFrame>()?;
+            let push = prepared.view(pass.view)?.warp;
+            let cmd = ctx.cmd();
+            cmd.bind_compute(&pipeline);
+            cmd.push_constants(&push)?;
+            let groups = pass.grid_side.div_ceil(8);
+            cmd.dispatch(groups, groups, 1);
+            Ok(())
+        });
+    Ok(())
 }
 
 #[cfg(test)]
@@ -343,8 +342,9 @@ mod tests {
         }
         .validate()
         .is_err());
-        assert_eq!(ok.draw_flags() & 7, 0);
-        assert_eq!(ok.draw_flags() >> 8, DEFAULT_GRID_SIDE);
-        assert_ne!(ok.draw_flags() & 8, 0);
+        assert_eq!(
+            ok.draw_constants(),
+            [TerrainView::Shaded.code(), 1, DEFAULT_GRID_SIDE, 0]
+        );
     }
 }

@@ -1,4 +1,8 @@
-//! Terrain: procedural height fields (§6.1) and the terrain passes.
+//! Terrain: procedural height fields (§6.1) and terrain LOD by geometry
+//! image warping (§7.4). The files follow Fig. 7.8: [`sketch_map`] →
+//! [`importance`] → [`warp`] (combined per frame by [`lod`], in
+//! [`Terrain`]'s `prepare`) → [`geometry_image`] (`terrain.warp`) →
+//! [`shading`] (`terrain.draw`); [`technique`] ties them into the frame.
 
 pub mod bspline;
 pub mod geometry_image;
@@ -8,6 +12,9 @@ pub mod procedural;
 pub mod raycast;
 pub mod shading;
 pub mod sketch_map;
+pub mod technique;
 pub mod warp;
 pub mod wavelet_noise;
 pub mod zoom;
+
+pub use technique::{Terrain, TerrainFrame, TerrainTexturing, TerrainViewFrame};

@@ -2,7 +2,7 @@
 //! `ALGORITHMS.md` §4 items 3–4), as render-graph passes over **all** dirty
 //! tiles of a frame at once:
 //!
-//! 1. CPU, in `texturing.upsample`'s recording: the quadtree picks the nodes
+//! 1. CPU, in [`TextureAtlas`]'s `prepare` (before recording): the quadtree picks the nodes
 //!    the view needs ([`select_tiles`]), the tile cache plans what to
 //!    generate within the [`GenerationBudget`] and what to draw from where
 //!    ([`TileCache::plan_frame`]), and the page table is built
@@ -20,24 +20,23 @@
 //!
 //! `terrain.draw` then samples the atlas through the page table.
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use glam::DVec2;
 
 use crate::error::{Error, Result};
-use crate::graph::{Access, BufferInfo, RenderGraph, ResourceId, Stage};
+use crate::graph::{BufferAccess, BufferId, BufferInfo, ImageAccess, ImageId, RenderGraph, Stage, UploadRegion};
 use crate::io::heightmap::HeightField;
 use crate::shaders;
-use crate::texturing::atlas::{GenerationBudget, TileCache, TilePlan};
+use crate::texturing::atlas::{TileCache, TilePlan};
 use crate::texturing::input_maps::InputMaps;
 use crate::texturing::layers::LayerTree;
 use crate::texturing::page_table::PageTable;
-use crate::texturing::quadtree::{select_tiles, HeightBounds, NodeId, QuadtreeSettings, View};
+use crate::texturing::quadtree::{select_tiles, HeightBounds, NodeId, View};
 pub use crate::texturing::stats::TextureFrameStats;
 pub use crate::texturing::streaming::{TextureStreaming, MAX_ATLAS_TEXTURES};
-use crate::view::camera::frustum_planes;
-use crate::view::FrameParams;
+use crate::view::{frustum_planes, Frame, FrameContext, Technique};
 use crate::vulkan::{
     Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, Format, Image, ImageDesc, ImageUsageFlags,
     MemoryLocation,
@@ -98,100 +97,68 @@ pub fn tile_jobs(plan: &TilePlan, extent: DVec2, images: &dyn Fn(u32) -> [u32; 2
     (jobs, texels)
 }
 
-/// What the generation passes and `terrain.draw` share.
-pub(crate) struct GenerationState {
+/// The texture atlas (§8.2): the tile cache and the atlas textures that
+/// persist from frame to frame, the generation passes declared once, and a
+/// `prepare` step that plans each frame (quadtree, cache, page table, jobs)
+/// before it is recorded.
+pub struct TextureAtlas {
+    streaming: TextureStreaming,
+    extent: DVec2,
     cache: TileCache,
     bounds: HeightBounds,
-    /// This frame's page table in words, written by `terrain.draw`.
-    pub(crate) page_words: Vec<[u32; 4]>,
-    /// The last recorded frame's page table.
+    /// Storage handles (colour, normal) of each atlas texture.
+    storage: Vec<[u32; 2]>,
+    bindings: AtlasBindings,
+    jobs: UploadRegion,
+    max_jobs: usize,
+    scratch_texels: u64,
+    /// The last prepared frame's page table.
     table: PageTable,
-    jobs: u32,
-    texels: u64,
     stats: Vec<TextureFrameStats>,
+    /// Host copies of the colour textures, per texture and frame slot
+    /// ([`TextureStreaming::readback`]).
+    readback: Option<Vec<Vec<Arc<Buffer>>>>,
 }
 
-impl GenerationState {
-    /// Selects the needed tiles of `view`, plans the frame within `budget`,
-    /// builds the page table and the jobs of the dirty tiles
-    /// (`images(texture)`: its colour and normal storage handles).
-    fn plan(
-        &mut self,
-        frame: u64,
-        view: &View,
-        quadtree: &QuadtreeSettings,
-        budget: GenerationBudget,
-        extent: DVec2,
-        images: &dyn Fn(u32) -> [u32; 2],
-    ) -> Result<(TilePlan, Vec<TileJob>, u64)> {
-        let needed = select_tiles(extent, view, quadtree, &|n| self.bounds.bounds(n))?;
-        let plan = self.cache.plan_frame(frame, &needed, budget);
-        let table = PageTable::build(&plan, extent)?;
-        let words = table.words();
-        if words.len() > PAGE_TABLE_WORDS {
-            return Err(Error::invalid(
-                "texture page table",
-                format!("{} words exceed the capacity of {PAGE_TABLE_WORDS}", words.len()),
-            ));
-        }
-        (self.page_words, self.table) = (words, table);
-        let (jobs, texels) = tile_jobs(&plan, extent, images);
-        Ok((plan, jobs, texels))
-    }
-}
-
-/// Shared between the passes' recording closures.
-pub(crate) type SharedGeneration = Arc<Mutex<GenerationState>>;
-
-pub(crate) fn locked(state: &SharedGeneration) -> Result<std::sync::MutexGuard<'_, GenerationState>> {
-    state
-        .lock()
-        .map_err(|_| Error::Graph("texture generation state lock poisoned".into()))
+/// What the generation passes read this frame (prepared by [`TextureAtlas`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TextureFrame {
+    /// Dirty tiles and their texels.
+    pub jobs: u32,
+    pub texels: u64,
 }
 
 /// The atlas and page table the generation passes leave for `terrain.draw`.
-#[derive(Clone)]
-pub struct AtlasResources {
-    /// Colour (sRGB-encoded RGBA8) textures, in texture order.
-    pub colors: Vec<ResourceId>,
+#[derive(Clone, Debug)]
+pub struct AtlasBindings {
+    /// Colour (sRGB-encoded RGBA8) textures, in texture order, with their
+    /// sampled heap handles.
+    pub colors: Vec<(ImageId, u32)>,
     /// Displacement normal (RGBA8, n·½ + ½) textures.
-    pub normals: Vec<ResourceId>,
-    /// This frame's page table (host-written, per frame).
-    pub page_table: ResourceId,
+    pub normals: Vec<(ImageId, u32)>,
+    /// This frame's page table (an upload region, written by `prepare`).
+    pub page_table: UploadRegion,
     /// Texels per atlas side.
     pub atlas_size: u32,
-    pub(crate) state: SharedGeneration,
-    /// Host copies of the colour textures, per texture and frame slot
-    /// ([`TextureStreaming::readback`]).
-    pub(crate) readback: Option<Vec<Vec<Arc<Buffer>>>>,
 }
 
-impl AtlasResources {
-    /// The page table of the last recorded frame.
-    pub fn page_table(&self) -> Result<PageTable> {
-        Ok(locked(&self.state)?.table.clone())
-    }
-
-    /// Needed tiles the last recorded frame drew from a coarser tile.
-    pub fn last_deferred(&self) -> Result<usize> {
-        Ok(locked(&self.state)?.stats.last().map_or(0, |s| s.tiles.deferred))
-    }
-
-    /// Texture statistics of the frames recorded so far and not yet taken.
-    pub fn take_stats(&self) -> Result<Vec<TextureFrameStats>> {
-        Ok(std::mem::take(&mut locked(&self.state)?.stats))
-    }
-}
-
-/// Push constants of every `texturing.*` pass (texture_tiles.glsl).
+/// Push constants of every `texturing.*` pass (`Push` in
+/// glsl/include/texture_tiles.glsl).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct TileGenerationPush {
+    /// Tile jobs, texel states (storage buffers), layers (storage buffer),
+    /// noise tile (sampled).
     handles: [u32; 4],
+    /// Jobs, texels, layer index, height field (sampled).
     counts: [u32; 4],
+    /// Height-field columns, rows.
     grid: [u32; 4],
+    /// Sample spacing x, y (metres), lowest and highest height.
     spacing_range: [f32; 4],
+    /// Input maps ([`InputMaps::handles`]).
     maps: [u32; 4],
+    /// Terrain rectangle x, y (metres).
     extent: [f32; 4],
 }
 
@@ -200,237 +167,337 @@ pub struct GenerationInputs<'a> {
     pub field: Arc<HeightField>,
     /// The height field as an R32F texture, the wavelet noise tile, the
     /// layers buffer.
-    pub heights: ResourceId,
-    pub noise: ResourceId,
-    pub layers: ResourceId,
+    pub heights: ImageId,
+    pub noise: ImageId,
+    pub layers: BufferId,
     /// The layers' extra input maps.
     pub maps: InputMaps,
     pub tree: &'a LayerTree,
-    /// Image rows (the pixel footprint).
-    pub image_height: u32,
 }
 
-/// Declares `texturing.upsample`, one `texturing.layer*` pass per layer and
-/// `texturing.finish` (module documentation).
-pub fn add_generation_passes(
+/// The atlas textures, imported into `graph`: (colour, normal) per texture.
+fn atlas_textures(
     ctx: &Context,
-    graph: &mut RenderGraph<FrameParams>,
-    inputs: GenerationInputs,
-    streaming: TextureStreaming,
-) -> Result<AtlasResources> {
-    streaming.validate()?;
-    let field = inputs.field.clone();
-    let extent = field.extent();
-    let state = Arc::new(Mutex::new(GenerationState {
-        cache: TileCache::new(streaming.atlas)?,
-        bounds: HeightBounds::new(&field, streaming.quadtree.max_depth)?,
-        page_words: Vec::new(),
-        table: PageTable::default(),
-        jobs: 0,
-        texels: 0,
-        stats: Vec::new(),
-    }));
-    let atlas_size = streaming.atlas.size;
-    let mut colors = Vec::new();
-    let mut normals = Vec::new();
+    graph: &mut RenderGraph<Frame>,
+    streaming: &TextureStreaming,
+) -> Result<Vec<[(ImageId, Arc<Image>); 2]>> {
     let readback_usage = match streaming.readback {
         true => ImageUsageFlags::TRANSFER_SRC,
         false => ImageUsageFlags::empty(),
     };
+    let size = streaming.atlas.size;
+    let mut textures = Vec::new();
     for (k, tile) in streaming.atlas.texture_tile_sizes().into_iter().enumerate() {
-        for (what, list) in [("colour", &mut colors), ("normal", &mut normals)] {
-            let image = Image::new(
+        let mut image = |what: &str| -> Result<(ImageId, Arc<Image>)> {
+            let image = Arc::new(Image::new(
                 ctx,
                 ImageDesc {
                     name: format!("texture atlas {k} ({tile}² tiles, {what})"),
-                    width: atlas_size,
-                    height: atlas_size,
+                    width: size,
+                    height: size,
                     format: Format::R8G8B8A8_UNORM,
                     usage: ImageUsageFlags::STORAGE | ImageUsageFlags::SAMPLED | readback_usage,
                 },
-            )?;
-            list.push(graph.import_image(Arc::new(image)));
-        }
+            )?);
+            Ok((graph.import_image(image.clone()), image))
+        };
+        textures.push([image("colour")?, image("normal")?]);
     }
-    let max_jobs = streaming.budget.tiles.saturating_add(1).min(1 << 16);
-    let jobs = graph.import_buffers_per_frame(Buffer::per_frame(
-        ctx,
-        BufferDesc {
-            name: "texture tile jobs".into(),
-            size: (max_jobs * std::mem::size_of::<TileJob>()) as u64,
-            usage: BufferUsageFlags::STORAGE_BUFFER,
-            location: MemoryLocation::CpuToGpu,
-        },
-    )?);
-    let page_table = graph.import_buffers_per_frame(Buffer::per_frame(
-        ctx,
-        BufferDesc {
-            name: "texture page table".into(),
-            size: (PAGE_TABLE_WORDS * 16) as u64,
-            usage: BufferUsageFlags::STORAGE_BUFFER,
-            location: MemoryLocation::CpuToGpu,
-        },
-    )?);
-    let scratch_texels = streaming.scratch_texels();
-    let scratch = graph.create_buffer(
-        "texel states",
-        BufferInfo {
-            size: scratch_texels * TEXEL_STATE_BYTES,
-            location: MemoryLocation::GpuOnly,
-        },
-    );
+    Ok(textures)
+}
+
+/// A heap handle `handle` of `image`, or an error naming it.
+fn handle(image: &Image, handle: Option<u32>, what: &str) -> Result<u32> {
+    handle.ok_or_else(|| Error::Graph(format!("'{}' has no {what} handle", image.desc().name)))
+}
+
+impl TextureAtlas {
+    /// Creates the atlas and declares `texturing.upsample`, one
+    /// `texturing.layer*` pass per layer and `texturing.finish` (module
+    /// documentation), and `texturing.readback` when asked for.
+    pub fn declare(
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame>,
+        inputs: GenerationInputs,
+        streaming: TextureStreaming,
+    ) -> Result<TextureAtlas> {
+        streaming.validate()?;
+        let field = inputs.field.clone();
+        let textures = atlas_textures(ctx, graph, &streaming)?;
+        let mut storage = Vec::new();
+        let (mut colors, mut normals) = (Vec::new(), Vec::new());
+        for [(color, color_image), (normal, normal_image)] in &textures {
+            storage.push([
+                handle(color_image, color_image.storage_handle(), "storage")?,
+                handle(normal_image, normal_image.storage_handle(), "storage")?,
+            ]);
+            colors.push((*color, handle(color_image, color_image.sampled_handle(), "sampled")?));
+            normals.push((*normal, handle(normal_image, normal_image.sampled_handle(), "sampled")?));
+        }
+        let max_jobs = streaming.budget.tiles.saturating_add(1).min(1 << 16);
+        let jobs = graph.upload_region("texture tile jobs", (max_jobs * std::mem::size_of::<TileJob>()) as u64);
+        let page_table = graph.upload_region("texture page table", (PAGE_TABLE_WORDS * 16) as u64);
+        let scratch_texels = streaming.scratch_texels();
+        let scratch = graph.create_buffer(
+            "texel states",
+            BufferInfo {
+                size: scratch_texels * TEXEL_STATE_BYTES,
+                location: MemoryLocation::GpuOnly,
+            },
+        );
+        let images: Vec<ImageId> = colors.iter().chain(&normals).map(|(id, _)| *id).collect();
+        let passes = GenerationPasses {
+            jobs,
+            scratch,
+            base_push: base_push(&field),
+        };
+        passes.declare_upsample(ctx, graph, inputs.heights)?;
+        passes.declare_layers(ctx, graph, &inputs)?;
+        passes.declare_finish(ctx, graph, &images)?;
+        let readback = match streaming.readback {
+            true => Some(add_atlas_readback(ctx, graph, &colors, streaming.atlas.size)?),
+            false => None,
+        };
+        Ok(TextureAtlas {
+            extent: field.extent(),
+            cache: TileCache::new(streaming.atlas)?,
+            bounds: HeightBounds::new(&field, streaming.quadtree.max_depth)?,
+            storage,
+            bindings: AtlasBindings {
+                colors,
+                normals,
+                page_table,
+                atlas_size: streaming.atlas.size,
+            },
+            jobs,
+            max_jobs,
+            scratch_texels,
+            table: PageTable::default(),
+            stats: Vec::new(),
+            readback,
+            streaming,
+        })
+    }
+
+    /// What `terrain.draw` samples.
+    pub fn bindings(&self) -> &AtlasBindings {
+        &self.bindings
+    }
+
+    /// The page table of the last prepared frame.
+    pub fn page_table(&self) -> &PageTable {
+        &self.table
+    }
+
+    /// Needed tiles the last prepared frame drew from a coarser tile.
+    pub fn last_deferred(&self) -> usize {
+        self.stats.last().map_or(0, |s| s.tiles.deferred)
+    }
+
+    /// Texture statistics of the frames prepared so far and not yet taken.
+    pub fn take_stats(&mut self) -> Vec<TextureFrameStats> {
+        std::mem::take(&mut self.stats)
+    }
+
+    /// Host copies of the colour textures, per texture and frame slot.
+    pub fn readback(&self) -> Option<&[Vec<Arc<Buffer>>]> {
+        self.readback.as_deref()
+    }
+
+    /// Selects the needed tiles of `view`, plans the frame within the
+    /// budget, builds the page table and the jobs of the dirty tiles.
+    fn plan(&mut self, frame: u64, view: &View) -> Result<(TilePlan, PageTable, Vec<TileJob>, u64)> {
+        let extent = self.extent;
+        let needed = select_tiles(extent, view, &self.streaming.quadtree, &|n| self.bounds.bounds(n))?;
+        let plan = self.cache.plan_frame(frame, &needed, self.streaming.budget);
+        let table = PageTable::build(&plan, extent)?;
+        let storage = &self.storage;
+        let (jobs, texels) = tile_jobs(&plan, extent, &|t| storage[t as usize]);
+        if texels > self.scratch_texels || jobs.len() > self.max_jobs {
+            return Err(Error::Graph(format!(
+                "texturing: {} tiles of {texels} texels exceed the scratch buffer",
+                jobs.len()
+            )));
+        }
+        Ok((plan, table, jobs, texels))
+    }
+}
+
+impl Technique for TextureAtlas {
+    type Prepared = TextureFrame;
+
+    fn name(&self) -> &'static str {
+        "texturing"
+    }
+
+    /// Plans the frame (module documentation, step 1) and uploads its jobs
+    /// and page table. A frame whose plan cannot be generated forgets the
+    /// cache, so that no tile stays marked resident without being generated.
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<TextureFrame> {
+        let start = std::time::Instant::now();
+        let [view] = frame.views else {
+            return Err(Error::invalid(
+                "views",
+                format!("the texture atlas serves one view per frame, not {}", frame.views.len()),
+            ));
+        };
+        let camera = &view.camera;
+        let quadtree_view = View {
+            eye: camera.eye,
+            pixel_footprint: View::pixel_footprint_for(camera.fov_y_deg.to_radians(), view.height),
+            frustum: Some(frustum_planes(camera.view_proj_f64(view.aspect()))),
+        };
+        let planned = self
+            .plan(frame.index, &quadtree_view)
+            .and_then(|(plan, table, jobs, texels)| {
+                let words = table.words();
+                if words.len() > PAGE_TABLE_WORDS {
+                    return Err(Error::invalid(
+                        "texture page table",
+                        format!("{} words exceed the capacity of {PAGE_TABLE_WORDS}", words.len()),
+                    ));
+                }
+                frame.uploads.write(self.jobs, bytemuck::cast_slice(&jobs))?;
+                frame
+                    .uploads
+                    .write(self.bindings.page_table, bytemuck::cast_slice(&words))?;
+                Ok((plan, table, jobs.len() as u32, texels))
+            });
+        let (plan, table, jobs, texels) = match planned {
+            Ok(p) => p,
+            Err(e) => {
+                self.cache.clear();
+                return Err(e);
+            }
+        };
+        self.table = table;
+        self.stats.push(TextureFrameStats {
+            frame: frame.index,
+            tiles: plan.stats,
+            hit_rate: plan.stats.hit_rate(),
+            texels_generated: texels,
+            cpu_ms: start.elapsed().as_secs_f64() * 1e3,
+        });
+        Ok(TextureFrame { jobs, texels })
+    }
+}
+
+/// The push constants every generation pass starts from.
+fn base_push(field: &HeightField) -> TileGenerationPush {
     let (lo, hi) = field.min_max();
-    let base_push = TileGenerationPush {
+    let extent = field.extent();
+    TileGenerationPush {
         handles: [0; 4],
         counts: [0; 4],
         grid: [field.columns, field.rows, 0, 0],
         spacing_range: [field.spacing.x as f32, field.spacing.y as f32, lo, hi],
         maps: [0; 4],
         extent: [extent.x as f32, extent.y as f32, 0.0, 0.0],
-    };
-    let (heights, noise, layers, maps) = (inputs.heights, inputs.noise, inputs.layers, inputs.maps);
+    }
+}
 
-    // texturing.upsample: plans the frame on the CPU, then the base surface.
-    let pipeline = ComputePipeline::new(ctx, shaders::TEXTURING_UPSAMPLE)?;
-    let shared = state.clone();
-    let (image_height, quadtree, budget) = (inputs.image_height, streaming.quadtree, streaming.budget);
-    let texture_handles: Vec<(ResourceId, ResourceId)> = colors.iter().copied().zip(normals.iter().copied()).collect();
-    let pass = graph
-        .pass("texturing.upsample")
-        .read(heights, Access::SampledImage(Stage::Compute))
-        .read(jobs, Access::StorageBufferRead(Stage::Compute))
-        .write(scratch, Access::StorageBufferWrite(Stage::Compute));
-    pass.record(move |pass, params| {
-        let start = std::time::Instant::now();
-        let camera = &params.camera;
-        let view = View {
-            eye: camera.eye,
-            pixel_footprint: View::pixel_footprint_for(camera.fov_y_deg.to_radians(), image_height),
-            frustum: Some(frustum_planes(camera.view_proj_f64(params.aspect))),
-        };
-        let handles = texture_handles
-            .iter()
-            .map(|&(c, n)| Ok([pass.storage_image(c)?, pass.storage_image(n)?]))
-            .collect::<Result<Vec<_>>>()?;
-        let mut s = locked(&shared)?;
-        let frame = pass.frame();
-        let planned = s.plan(frame, &view, &quadtree, budget, extent, &|t| handles[t as usize]);
-        let (plan, tile_jobs, texels) = match planned {
-            Ok(p) if p.2 <= scratch_texels && p.1.len() <= max_jobs => p,
-            // Tiles the plan marked resident will not be generated: forget
-            // them all, so the next frame starts afresh.
-            failed => {
-                s.cache.clear();
-                return Err(match failed {
-                    Err(e) => e,
-                    Ok((_, jobs, texels)) => Error::Graph(format!(
-                        "texturing: {} tiles of {texels} texels exceed the scratch buffer",
-                        jobs.len()
-                    )),
-                });
-            }
-        };
-        pass.buffer(jobs)?.write(0, bytemuck::cast_slice(&tile_jobs))?;
-        (s.jobs, s.texels) = (tile_jobs.len() as u32, texels);
-        s.stats.push(TextureFrameStats {
-            frame,
-            tiles: plan.stats,
-            hit_rate: plan.stats.hit_rate(),
-            texels_generated: texels,
-            cpu_ms: start.elapsed().as_secs_f64() * 1e3,
-        });
-        let push = TileGenerationPush {
-            handles: [pass.storage_buffer(jobs)?, pass.storage_buffer(scratch)?, 0, 0],
-            counts: [s.jobs, texels as u32, 0, pass.sampled(heights)?],
-            ..base_push
-        };
-        drop(s);
-        dispatch(pass.cmd(), &pipeline, &push)
-    });
+/// The resources every generation pass shares.
+struct GenerationPasses {
+    jobs: UploadRegion,
+    scratch: BufferId,
+    base_push: TileGenerationPush,
+}
 
-    // texturing.layer<i>.<name>: one layer over every dirty texel.
-    let layer_pipeline = Arc::new(ComputePipeline::new(ctx, shaders::TEXTURING_LAYER)?);
-    for (i, flat) in inputs.tree.layers.iter().enumerate() {
-        let name = format!(
-            "texturing.layer{i}.{}",
-            flat.layer.name.replace(char::is_whitespace, "_")
-        );
-        let (shared, pipeline) = (state.clone(), layer_pipeline.clone());
-        let mut pass = graph
-            .pass(&name)
-            .read(jobs, Access::StorageBufferRead(Stage::Compute))
-            .read(layers, Access::StorageBufferRead(Stage::Compute))
-            .read(noise, Access::SampledImage(Stage::Compute));
-        for map in maps.present() {
-            pass = pass.read(map, Access::SampledImage(Stage::Compute));
-        }
-        pass.write(scratch, Access::StorageBufferReadWrite(Stage::Compute))
-            .record(move |pass, _| {
-                let (job_count, texels) = {
-                    let s = locked(&shared)?;
-                    (s.jobs, s.texels)
-                };
+impl GenerationPasses {
+    /// `texturing.upsample`: the base surface at every dirty texel.
+    fn declare_upsample(&self, ctx: &Context, graph: &mut RenderGraph<Frame>, heights: ImageId) -> Result<()> {
+        let pipeline = ComputePipeline::new(ctx, shaders::TEXTURING_UPSAMPLE)?;
+        let (jobs, scratch, base_push) = (self.jobs, self.scratch, self.base_push);
+        graph
+            .pass("texturing.upsample")
+            .read(heights, ImageAccess::Sampled(Stage::Compute))
+            .read(jobs, BufferAccess::StorageRead(Stage::Compute))
+            .write(scratch, BufferAccess::StorageWrite(Stage::Compute))
+            .record(move |pass, frame| {
+                let tiles = frame.prepared::<TextureFrame>()?;
                 let push = TileGenerationPush {
-                    handles: [
-                        pass.storage_buffer(jobs)?,
-                        pass.storage_buffer(scratch)?,
-                        pass.storage_buffer(layers)?,
-                        pass.sampled(noise)?,
-                    ],
-                    counts: [job_count, texels as u32, i as u32, 0],
-                    maps: maps.handles(|id| pass.sampled(id))?,
+                    handles: [pass.upload(jobs)?, pass.storage_buffer(scratch)?, 0, 0],
+                    counts: [tiles.jobs, tiles.texels as u32, 0, pass.sampled(heights)?],
                     ..base_push
                 };
                 dispatch(pass.cmd(), &pipeline, &push)
             });
+        Ok(())
     }
 
-    // texturing.finish: colour and normal into the atlas.
-    let pipeline = ComputePipeline::new(ctx, shaders::TEXTURING_FINISH)?;
-    let shared = state.clone();
-    let mut pass = graph
-        .pass("texturing.finish")
-        .read(jobs, Access::StorageBufferRead(Stage::Compute))
-        .read(scratch, Access::StorageBufferRead(Stage::Compute));
-    for &image in colors.iter().chain(&normals) {
-        pass = pass.write(image, Access::StorageImageReadWrite(Stage::Compute));
+    /// `texturing.layer<i>.<name>`: one layer over every dirty texel.
+    fn declare_layers(&self, ctx: &Context, graph: &mut RenderGraph<Frame>, inputs: &GenerationInputs) -> Result<()> {
+        let layer_pipeline = Arc::new(ComputePipeline::new(ctx, shaders::TEXTURING_LAYER)?);
+        let (jobs, scratch, base_push) = (self.jobs, self.scratch, self.base_push);
+        let (layers, noise, maps) = (inputs.layers, inputs.noise, inputs.maps);
+        for (i, flat) in inputs.tree.layers.iter().enumerate() {
+            let name = format!(
+                "texturing.layer{i}.{}",
+                flat.layer.name.replace(char::is_whitespace, "_")
+            );
+            let pipeline = layer_pipeline.clone();
+            let mut pass = graph
+                .pass(&name)
+                .read(jobs, BufferAccess::StorageRead(Stage::Compute))
+                .read(layers, BufferAccess::StorageRead(Stage::Compute))
+                .read(noise, ImageAccess::Sampled(Stage::Compute));
+            for map in maps.present() {
+                pass = pass.read(map, ImageAccess::Sampled(Stage::Compute));
+            }
+            pass.write(scratch, BufferAccess::StorageReadWrite(Stage::Compute))
+                .record(move |pass, frame| {
+                    let tiles = frame.prepared::<TextureFrame>()?;
+                    let push = TileGenerationPush {
+                        handles: [
+                            pass.upload(jobs)?,
+                            pass.storage_buffer(scratch)?,
+                            pass.storage_buffer(layers)?,
+                            pass.sampled(noise)?,
+                        ],
+                        counts: [tiles.jobs, tiles.texels as u32, i as u32, 0],
+                        maps: maps.handles(),
+                        ..base_push
+                    };
+                    dispatch(pass.cmd(), &pipeline, &push)
+                });
+        }
+        Ok(())
     }
-    pass.record(move |pass, _| {
-        let (job_count, texels) = {
-            let s = locked(&shared)?;
-            (s.jobs, s.texels)
-        };
-        let push = TileGenerationPush {
-            handles: [pass.storage_buffer(jobs)?, pass.storage_buffer(scratch)?, 0, 0],
-            counts: [job_count, texels as u32, 0, 0],
-            ..base_push
-        };
-        dispatch(pass.cmd(), &pipeline, &push)
-    });
-    let readback = match streaming.readback {
-        true => Some(add_atlas_readback(ctx, graph, &colors, atlas_size)?),
-        false => None,
-    };
-    Ok(AtlasResources {
-        colors,
-        normals,
-        page_table,
-        atlas_size,
-        state,
-        readback,
-    })
+
+    /// `texturing.finish`: colour and normal into the atlas.
+    fn declare_finish(&self, ctx: &Context, graph: &mut RenderGraph<Frame>, images: &[ImageId]) -> Result<()> {
+        let pipeline = ComputePipeline::new(ctx, shaders::TEXTURING_FINISH)?;
+        let (jobs, scratch, base_push) = (self.jobs, self.scratch, self.base_push);
+        let mut pass = graph
+            .pass("texturing.finish")
+            .read(jobs, BufferAccess::StorageRead(Stage::Compute))
+            .read(scratch, BufferAccess::StorageRead(Stage::Compute));
+        for &image in images {
+            pass = pass.write(image, ImageAccess::StorageReadWrite(Stage::Compute));
+        }
+        pass.record(move |pass, frame| {
+            let tiles = frame.prepared::<TextureFrame>()?;
+            let push = TileGenerationPush {
+                handles: [pass.upload(jobs)?, pass.storage_buffer(scratch)?, 0, 0],
+                counts: [tiles.jobs, tiles.texels as u32, 0, 0],
+                ..base_push
+            };
+            dispatch(pass.cmd(), &pipeline, &push)
+        });
+        Ok(())
+    }
 }
 
 /// `texturing.readback`: every colour texture into host buffers.
 fn add_atlas_readback(
     ctx: &Context,
-    graph: &mut RenderGraph<FrameParams>,
-    colors: &[ResourceId],
+    graph: &mut RenderGraph<Frame>,
+    colors: &[(ImageId, u32)],
     atlas_size: u32,
 ) -> Result<Vec<Vec<Arc<Buffer>>>> {
     let mut copies = Vec::new();
     let mut buffers = Vec::new();
-    for (k, &image) in colors.iter().enumerate() {
+    for (k, &(image, _)) in colors.iter().enumerate() {
         let per_frame = Buffer::per_frame(
             ctx,
             BufferDesc {
@@ -445,7 +512,9 @@ fn add_atlas_readback(
     }
     let mut pass = graph.pass("texturing.readback").transfer();
     for &(image, buffer) in &copies {
-        pass = pass.read(image, Access::TransferSrc).write(buffer, Access::TransferDst);
+        pass = pass
+            .read(image, ImageAccess::TransferSrc)
+            .write(buffer, BufferAccess::TransferDst);
     }
     let recorded = copies.clone();
     pass.record(move |pass, _| {

@@ -91,4 +91,7 @@ pub struct TexturingFrame {
     pub color: [u32; 32],
     /// Sampled handles of the atlas normal textures.
     pub normal: [u32; 32],
+    /// terrain.draw: view ([`crate::terrain::geometry_image::TerrainView::code`]),
+    /// detail on (0/1), grid side N, 0.
+    pub draw: [u32; 4],
 }

@@ -8,15 +8,16 @@ use std::path::Path;
 use std::sync::Arc;
 
 use crate::error::{Error, Result};
-use crate::graph::{RenderGraph, ResourceId};
+use crate::graph::{ImageId, RenderGraph};
 use crate::io::heightmap::HeightField;
 use crate::texturing::layers::{LayerTree, INPUT_NAMES};
 use crate::vulkan::{Context, Format, Image, ImageDesc, ImageUsageFlags};
 
-/// The input maps as graph resources (`None`: absent).
+/// The input maps as graph resources with their sampled heap handles
+/// (`None`: absent).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct InputMaps {
-    pub maps: [Option<ResourceId>; 3],
+    pub maps: [Option<(ImageId, u32)>; 3],
 }
 
 impl InputMaps {
@@ -52,26 +53,29 @@ impl InputMaps {
                 },
                 bytemuck::cast_slice(&map.heights),
             )?;
-            out.maps[k] = Some(graph.import_image(Arc::new(image)));
+            let handle = image
+                .sampled_handle()
+                .ok_or_else(|| Error::Graph(format!("input map '{name}' has no sampled handle")))?;
+            out.maps[k] = Some((graph.import_image(Arc::new(image)), handle));
         }
         Ok(out)
     }
 
     /// The present maps.
-    pub fn present(&self) -> impl Iterator<Item = ResourceId> + '_ {
-        self.maps.iter().flatten().copied()
+    pub fn present(&self) -> impl Iterator<Item = ImageId> + '_ {
+        self.maps.iter().flatten().map(|(id, _)| *id)
     }
 
     /// `maps` of the shaders: sampled handles, and in w bit k when map k is
-    /// present; `sampled` gives a resource's handle.
-    pub fn handles(&self, sampled: impl Fn(ResourceId) -> Result<u32>) -> Result<[u32; 4]> {
+    /// present.
+    pub fn handles(&self) -> [u32; 4] {
         let mut handles = [0u32; 4];
         for (k, map) in self.maps.iter().enumerate() {
-            if let Some(id) = map {
-                handles[k] = sampled(*id)?;
+            if let Some((_, handle)) = map {
+                handles[k] = *handle;
                 handles[3] |= 1 << k;
             }
         }
-        Ok(handles)
+        handles
     }
 }

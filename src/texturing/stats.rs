@@ -184,6 +184,7 @@ mod tests {
             cpu_start_ms: 0.0,
         };
         FrameProfile {
+            prepare: Vec::new(),
             frame,
             passes: vec![pass("terrain.draw", 100.0), pass("texturing.layer0.rock", layer_ms)],
             gpu_ms: 100.0 + layer_ms,

@@ -368,6 +368,12 @@ impl Context {
         &self.shared.info
     }
 
+    /// Alignment of a storage-buffer range's offset
+    /// (`minStorageBufferOffsetAlignment`).
+    pub fn storage_buffer_alignment(&self) -> u64 {
+        self.shared.limits.min_storage_buffer_offset_alignment.max(1)
+    }
+
     /// The validation report of this instance (None without validation).
     pub fn validation_report(&self) -> Option<Arc<ValidationReport>> {
         self.shared.report.clone()

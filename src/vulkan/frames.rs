@@ -116,6 +116,15 @@ impl FrameRing {
         }))
     }
 
+    /// The number of the next frame and, once its slot's previous frame has
+    /// completed (this waits for it), leave to write that slot's host-visible
+    /// per-frame buffers: call before [`FrameRing::begin`] to prepare a frame.
+    pub fn wait_for_next(&mut self) -> Result<u64> {
+        let slot = (self.next_frame % FRAMES_IN_FLIGHT as u64) as usize;
+        self.ctx.wait(self.slots[slot].submitted)?;
+        Ok(self.next_frame)
+    }
+
     /// Waits for the next slot, returns the timestamps of the frame it held and
     /// starts recording a new frame with room for `queries` timestamps.
     pub fn begin(&mut self, queries: u32) -> Result<(RecordingFrame<'_>, Option<CompletedFrame>)> {

@@ -216,10 +216,23 @@ impl DescriptorHeap {
 
     /// Gives a storage buffer a handle in the storage-buffer array.
     pub fn register_buffer(&self, device: &ash::Device, buffer: vk::Buffer, size: u64) -> Result<u32> {
+        self.register_buffer_range(device, buffer, 0, size)
+    }
+
+    /// Gives the bytes `offset..offset + size` of a storage buffer a handle
+    /// in the storage-buffer array (`offset` aligned to
+    /// `minStorageBufferOffsetAlignment`).
+    pub fn register_buffer_range(
+        &self,
+        device: &ash::Device,
+        buffer: vk::Buffer,
+        offset: u64,
+        size: u64,
+    ) -> Result<u32> {
         let handle = self.allocate(HeapKind::StorageBuffer)?;
         let info = [vk::DescriptorBufferInfo {
             buffer,
-            offset: 0,
+            offset,
             range: size,
         }];
         let write = vk::WriteDescriptorSet::default()

@@ -126,6 +126,8 @@ pub struct Buffer {
     allocation: Option<Allocation>,
     desc: BufferDesc,
     storage_handle: Option<u32>,
+    /// Heap handles of sub-ranges ([`Buffer::range_handle`]), released with the buffer.
+    range_handles: Mutex<Vec<u32>>,
     pub(crate) state: Mutex<AccessState>,
 }
 
@@ -183,6 +185,7 @@ impl Buffer {
             allocation: Some(allocation),
             desc,
             storage_handle,
+            range_handles: Mutex::new(Vec::new()),
             state: Mutex::new(AccessState::UNUSED),
         })
     }
@@ -251,6 +254,35 @@ impl Buffer {
         self.storage_handle
     }
 
+    /// A descriptor-heap handle for the bytes `offset..offset + size` of this
+    /// storage buffer (shaders index the range from 0); `offset` must be a
+    /// multiple of the device's storage-buffer offset alignment
+    /// ([`Context::storage_buffer_alignment`]). Released with the buffer.
+    pub fn range_handle(&self, offset: u64, size: u64) -> Result<u32> {
+        let align = self.ctx.storage_buffer_alignment();
+        if self.storage_handle.is_none() || offset % align != 0 || size == 0 || offset + size > self.desc.size {
+            return Err(Error::invalid(
+                "buffer range",
+                format!(
+                    "{size} bytes at {offset} of '{}' ({} bytes, alignment {align}, storage: {})",
+                    self.desc.name,
+                    self.desc.size,
+                    self.storage_handle.is_some()
+                ),
+            ));
+        }
+        let handle = self
+            .ctx
+            .shared
+            .heap
+            .register_buffer_range(&self.ctx.shared.device, self.raw, offset, size)?;
+        self.range_handles
+            .lock()
+            .map_err(|_| Error::Device("buffer range lock poisoned".into()))?
+            .push(handle);
+        Ok(handle)
+    }
+
     /// Copies `data` into a host-visible buffer at `offset`.
     pub fn write(&self, offset: u64, data: &[u8]) -> Result<()> {
         let mapped = self.mapped()?;
@@ -301,7 +333,8 @@ impl Buffer {
 
 impl Drop for Buffer {
     fn drop(&mut self) {
-        if let Some(handle) = self.storage_handle {
+        let ranges = self.range_handles.get_mut().map(std::mem::take).unwrap_or_default();
+        for handle in self.storage_handle.into_iter().chain(ranges) {
             self.ctx
                 .shared
                 .heap

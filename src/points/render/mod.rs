@@ -4,10 +4,11 @@
 //!
 //! | pass | mode | what |
 //! |---|---|---|
-//! | `points.visibility` | ewa | CPU prefix per instance ([`selection`]), then depth only: ray–plane depth pushed back by ε |
+//! | (`prepare`) | both | CPU prefix per instance ([`selection`]) and instance records, before recording ([`PointRenderer`]) |
+//! | `points.visibility` | ewa | depth only: ray–plane depth pushed back by ε |
 //! | `points.accumulate` | ewa | depth test ≤ without writes, additive (w·colour, w), (w·normal, w·depth) into float targets |
 //! | `points.normalize` | ewa | full screen: divide by w, shade, write radiance, view depth and W |
-//! | `points.opaque` | opaque | CPU prefix, then opaque discs with ray–plane depth, shaded directly |
+//! | `points.opaque` | opaque | opaque discs with ray–plane depth, shaded directly |
 //!
 //! The graph derives every barrier between them. Shaders: `glsl/points/`.
 
@@ -15,12 +16,11 @@ pub mod gpu_layout;
 mod passes;
 pub mod selection;
 pub mod stats;
+mod technique;
 mod triangles;
 
-use std::sync::{Arc, Mutex};
-
-pub use passes::{add_point_passes, PointPasses, SplatTargets};
 pub use stats::PointFrameStats;
+pub use technique::{PointRenderer, PointViewFrame, PointsFrame};
 
 use crate::error::{Error, Result};
 
@@ -132,12 +132,12 @@ impl SplatSettings {
         }
         if let Some(e) = self.epsilon {
             if !(e.is_finite() && e > 0.0) {
-                return Err(Error::invalid("--epsilon", format!("{e} is not a positive number")));
+                return Err(Error::invalid(
+                    "points.epsilon",
+                    format!("{e} is not a positive number"),
+                ));
             }
         }
         Ok(())
     }
 }
-
-/// Statistics shared between the passes' recording and the renderer.
-pub(crate) type SharedStats = Arc<Mutex<stats::StatsLog>>;

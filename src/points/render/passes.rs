@@ -1,139 +1,218 @@
 //! The points passes as render-graph declarations (see the table in
-//! [`super`]): pipelines, buffers and the recording of the draws.
+//! [`super`]): pipelines and the recording of the draws of a view's
+//! prepared [`FramePlan`]. Each pass reads like a sentence; the plan comes
+//! from [`super::PointRenderer`]'s `prepare`.
 
-use std::sync::{Arc, Mutex};
-use std::time::Instant;
+use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 
-use super::gpu_layout::{frame_header, gaussian_table, pack_nodes, HEADER_BYTES, INSTANCE_BYTES};
-use super::selection::{plan_frame, FramePlan, ObjectLayout};
-use super::stats::{PointFrameStats, StatsLog};
-use super::triangles::{draw_triangles, TriangleBuffer};
-use super::{SharedStats, SplatMode, SplatPrimitive, SplatSettings};
+use super::selection::FramePlan;
+use super::triangles::draw_triangles;
+use super::{PointsFrame, SplatPrimitive};
 use crate::error::{Error, Result};
-use crate::graph::{Access, ImageInfo, PassContext, RenderGraph, ResourceId, Stage};
-use crate::points::build::clusters::{cluster_normals, CLUSTER_COUNT};
-use crate::points::scene::PointScene;
+use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, PassBuilder, RenderGraph, Stage, UploadRegion};
 use crate::shaders;
-use crate::view::FrameParams;
+use crate::view::{Frame, SceneTargets, ViewIndex};
 use crate::vulkan::{
-    Blend, Buffer, BufferDesc, BufferUsageFlags, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline,
-    GraphicsPipelineDesc, LoadOp, MemoryLocation, PrimitiveTopology, SpirV,
+    Blend, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp,
+    PrimitiveTopology, SpirV,
 };
 
+/// `SplatPush.pass`: which pass the shaders run in.
 const PASS_VISIBILITY: u32 = 0;
 const PASS_ACCUMULATE: u32 = 1;
 const PASS_OPAQUE: u32 = 2;
+/// `SplatPush.primitive`.
 const PRIMITIVE_QUAD: u32 = 0;
 const PRIMITIVE_INSTANCED: u32 = 1;
 const PRIMITIVE_POINT: u32 = 2;
+/// `SplatPush.size_class`: every splat, only those a point can cover, only larger ones.
 const SIZE_ANY: u32 = 0;
 const SIZE_POINT: u32 = 1;
 const SIZE_OVERSIZE: u32 = 2;
 const NO_HANDLE: u32 = u32::MAX;
 
-/// Push constants of the points passes (`Push` in glsl/include/splat.glsl).
+/// Push constants of the points passes (`Push` in glsl/include/splat.glsl:
+/// `handles`, then `mode`).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub(super) struct SplatPush {
-    /// Splats (or hybrid triangles), point frame, drawn counter, Gaussian table.
-    pub handles: [u32; 4],
-    /// Pass, primitive, size class, instance record.
-    pub mode: [u32; 4],
+    /// Splats (or hybrid triangles), storage.
+    pub splats: u32,
+    /// The view's point frame (header and instance records), storage.
+    pub frame: u32,
+    /// Drawn-splat counter, storage ([`NO_HANDLE`]: do not count).
+    pub counter: u32,
+    /// Gaussian table, storage.
+    pub table: u32,
+    /// `PASS_*`.
+    pub pass: u32,
+    /// `PRIMITIVE_*`.
+    pub primitive: u32,
+    /// `SIZE_*`.
+    pub size_class: u32,
+    /// Instance record of the draw.
+    pub record: u32,
 }
 
-/// The images the points passes draw into (declared by the renderer).
+/// Push constants of `points.normalize` (`glsl/points/normalize.frag`).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct NormalizePush {
+    /// Sampled (colour·w, w) target.
+    color_weight: u32,
+    /// The view's point frame, storage.
+    frame: u32,
+    /// Sampled (normal·w, depth·w) target.
+    normal_depth: u32,
+    _pad: [u32; 5],
+}
+
+/// The buffers every points pass reads, and the splat settings they use.
 #[derive(Clone, Copy, Debug)]
-pub struct SplatTargets {
-    /// Radiance (RGBA32F), loaded.
-    pub radiance: ResourceId,
-    /// View depth (R32F), loaded.
-    pub view_depth: ResourceId,
-    /// Depth buffer (D32F).
-    pub depth: ResourceId,
-    /// W: the accumulated EWA weight (R32F), written everywhere.
-    pub weight: ResourceId,
+pub(super) struct PointBuffers {
+    pub splats: BufferId,
+    pub table: BufferId,
+    /// GPU counters, per frame slot (None without vertexPipelineStoresAndAtomics).
+    pub counter: Option<BufferId>,
+    /// Hybrid triangles (§10.1.8), when the scene has any.
+    pub triangles: Option<BufferId>,
+    pub primitive: SplatPrimitive,
+}
+
+/// One view's points passes: its index, frame region and targets.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PointView {
+    pub index: ViewIndex,
+    pub frame: UploadRegion,
+    pub radiance: ImageId,
+    pub view_depth: ImageId,
+    pub depth: ImageId,
+    pub weight: ImageId,
     /// Clear the depth buffer first (no terrain drew into it).
     pub clear_depth: bool,
 }
 
-/// Resources the renderer keeps for the points passes.
-pub struct PointPasses {
-    pub(crate) stats: SharedStats,
-    _splats: Arc<Buffer>,
-    _triangles: Option<Arc<Buffer>>,
-}
+impl PointBuffers {
+    /// Declares the reads every splat pass makes (and the counter's write when `count`).
+    fn read_by<'g>(&self, builder: PassBuilder<'g, Frame>, frame: UploadRegion, count: bool) -> PassBuilder<'g, Frame> {
+        let mut builder = builder
+            .read(self.splats, BufferAccess::StorageRead(Stage::Vertex))
+            .read(frame, BufferAccess::StorageRead(Stage::Graphics))
+            .read(self.table, BufferAccess::StorageRead(Stage::Fragment));
+        if let (true, Some(c)) = (count, self.counter) {
+            builder = builder.write(c, BufferAccess::StorageReadWrite(Stage::Vertex));
+        }
+        if let Some(t) = self.triangles {
+            builder = builder.read(t, BufferAccess::StorageRead(Stage::Vertex));
+        }
+        builder
+    }
 
-impl PointPasses {
-    /// Statistics of every completed frame not yet taken (call after all frames completed).
-    pub fn take_stats(&self) -> Result<Vec<PointFrameStats>> {
-        locked(&self.stats)?.take_all_completed()
+    /// The push constants of `pass` (counting the drawn splats when `count`).
+    fn push(
+        &self,
+        ctx: &crate::graph::PassContext<'_>,
+        frame: UploadRegion,
+        pass: u32,
+        count: bool,
+    ) -> Result<SplatPush> {
+        Ok(SplatPush {
+            splats: ctx.storage_buffer(self.splats)?,
+            frame: ctx.upload(frame)?,
+            counter: match (count, self.counter) {
+                (true, Some(c)) => ctx.storage_buffer(c)?,
+                _ => NO_HANDLE,
+            },
+            table: ctx.storage_buffer(self.table)?,
+            pass,
+            primitive: PRIMITIVE_QUAD,
+            size_class: SIZE_ANY,
+            record: 0,
+        })
+    }
+
+    /// The triangle buffer's handle in a pass.
+    fn triangle_handle(&self, ctx: &crate::graph::PassContext<'_>) -> Result<Option<u32>> {
+        self.triangles.map(|t| ctx.storage_buffer(t)).transpose()
     }
 }
 
-/// The value behind `mutex` (shared between the passes' recording closures).
-fn locked<T>(mutex: &Mutex<T>) -> Result<std::sync::MutexGuard<'_, T>> {
-    mutex
-        .lock()
-        .map_err(|_| Error::Graph("points pass state lock poisoned".into()))
+/// The plan of view `index` in `frame`.
+fn plan_of(frame: &Frame, index: ViewIndex) -> Result<&FramePlan> {
+    Ok(&frame.prepared::<PointsFrame>()?.view(index)?.plan)
 }
 
-fn pipeline(
-    ctx: &Context,
+/// A splat or hybrid-triangle pipeline of one pass.
+struct PipelineSpec {
     name: &'static str,
-    (vertex, fragment): (SpirV, SpirV),
-    points: bool,
+    shaders: (SpirV, SpirV),
     color_formats: Vec<Format>,
     blend: Blend,
-    (depth_write, depth_compare): (bool, CompareOp),
-) -> Result<GraphicsPipeline> {
-    GraphicsPipeline::new(
-        ctx,
-        &GraphicsPipelineDesc {
-            name,
-            vertex,
-            fragment,
-            vertex_stride: 0,
-            vertex_attributes: Vec::new(),
-            topology: if points {
-                PrimitiveTopology::POINT_LIST
-            } else {
-                PrimitiveTopology::TRIANGLE_LIST
-            },
-            cull_back_faces: false,
-            wireframe: false,
-            color_formats,
-            blend,
-            depth_format: Some(Format::D32_SFLOAT),
-            depth_test: true,
-            depth_write,
-            depth_compare,
-        },
-    )
+    depth: (bool, CompareOp),
 }
 
-/// Triangle pipeline plus, for point primitives, the point pipeline.
-struct PassPipelines {
+impl PipelineSpec {
+    fn build(&self, ctx: &Context, depth_format: Format, points: bool) -> Result<GraphicsPipeline> {
+        GraphicsPipeline::new(
+            ctx,
+            &GraphicsPipelineDesc {
+                name: self.name,
+                vertex: self.shaders.0,
+                fragment: self.shaders.1,
+                vertex_stride: 0,
+                vertex_attributes: Vec::new(),
+                topology: if points {
+                    PrimitiveTopology::POINT_LIST
+                } else {
+                    PrimitiveTopology::TRIANGLE_LIST
+                },
+                cull_back_faces: false,
+                wireframe: false,
+                color_formats: self.color_formats.clone(),
+                blend: self.blend,
+                depth_format: Some(depth_format),
+                depth_test: true,
+                depth_write: self.depth.0,
+                depth_compare: self.depth.1,
+            },
+        )
+    }
+}
+
+/// A pass's pipelines: splats as triangles, as points (point primitive),
+/// and hybrid triangles (when the scene has any).
+pub(super) struct PassPipelines {
     triangles: GraphicsPipeline,
     points: Option<GraphicsPipeline>,
+    hybrid: Option<GraphicsPipeline>,
 }
 
 impl PassPipelines {
-    fn new(ctx: &Context, primitive: SplatPrimitive, build: impl Fn(bool) -> Result<GraphicsPipeline>) -> Result<Self> {
+    fn new(
+        ctx: &Context,
+        targets: &SceneTargets,
+        buffers: &PointBuffers,
+        splats: PipelineSpec,
+        hybrid: PipelineSpec,
+    ) -> Result<Self> {
+        let depth = targets.formats.depth;
+        let points = if buffers.primitive == SplatPrimitive::Point {
+            if !ctx.has_feature("largePoints") {
+                return Err(Error::invalid(
+                    "points.primitive",
+                    "point: the device lacks feature largePoints (use quad or instanced)",
+                ));
+            }
+            Some(splats.build(ctx, depth, true)?)
+        } else {
+            None
+        };
         Ok(PassPipelines {
-            triangles: build(false)?,
-            points: if primitive == SplatPrimitive::Point {
-                if !ctx.has_feature("largePoints") {
-                    return Err(Error::invalid(
-                        "--splat-primitive point",
-                        "the device lacks feature largePoints (use quad or instanced)",
-                    ));
-                }
-                Some(build(true)?)
-            } else {
-                None
-            },
+            triangles: splats.build(ctx, depth, false)?,
+            points,
+            hybrid: buffers.triangles.map(|_| hybrid.build(ctx, depth, false)).transpose()?,
         })
     }
 
@@ -149,432 +228,297 @@ impl PassPipelines {
             n.checked_mul(6)
                 .ok_or_else(|| Error::invalid("splat count", format!("{n} splats exceed one draw")))
         };
+        let each = |cmd: &mut CommandRecorder,
+                    push: &mut SplatPush,
+                    draw: &dyn Fn(&mut CommandRecorder, u32) -> Result<()>| {
+            for d in &plan.draws {
+                push.record = d.record;
+                cmd.push_constants(push)?;
+                draw(cmd, d.count)?;
+            }
+            Ok::<(), Error>(())
+        };
         match (primitive, &self.points) {
             (SplatPrimitive::Point, Some(points)) => {
                 cmd.bind_graphics(points);
-                push.mode[1] = PRIMITIVE_POINT;
-                push.mode[2] = SIZE_POINT;
-                for d in &plan.draws {
-                    push.mode[3] = d.record;
-                    cmd.push_constants(&push)?;
-                    cmd.draw(d.count, 1);
-                }
+                (push.primitive, push.size_class) = (PRIMITIVE_POINT, SIZE_POINT);
+                each(cmd, &mut push, &|cmd, n| Ok(cmd.draw(n, 1)))?;
                 // Fallback: splats larger than the largest point size as quads.
                 cmd.bind_graphics(&self.triangles);
-                push.mode[1] = PRIMITIVE_QUAD;
-                push.mode[2] = SIZE_OVERSIZE;
-                for d in &plan.draws {
-                    push.mode[3] = d.record;
-                    cmd.push_constants(&push)?;
-                    cmd.draw(six(d.count)?, 1);
-                }
+                (push.primitive, push.size_class) = (PRIMITIVE_QUAD, SIZE_OVERSIZE);
+                each(cmd, &mut push, &|cmd, n| Ok(cmd.draw(six(n)?, 1)))?;
+            }
+            (SplatPrimitive::Instanced, _) => {
+                cmd.bind_graphics(&self.triangles);
+                (push.primitive, push.size_class) = (PRIMITIVE_INSTANCED, SIZE_ANY);
+                each(cmd, &mut push, &|cmd, n| Ok(cmd.draw(6, n)))?;
             }
             _ => {
                 cmd.bind_graphics(&self.triangles);
-                let instanced = primitive == SplatPrimitive::Instanced;
-                push.mode[1] = if instanced { PRIMITIVE_INSTANCED } else { PRIMITIVE_QUAD };
-                push.mode[2] = SIZE_ANY;
-                for d in &plan.draws {
-                    push.mode[3] = d.record;
-                    cmd.push_constants(&push)?;
-                    if instanced {
-                        cmd.draw(6, d.count);
-                    } else {
-                        cmd.draw(six(d.count)?, 1);
-                    }
-                }
+                (push.primitive, push.size_class) = (PRIMITIVE_QUAD, SIZE_ANY);
+                each(cmd, &mut push, &|cmd, n| Ok(cmd.draw(six(n)?, 1)))?;
             }
         }
         Ok(())
     }
+
+    /// Records the hybrid triangles, if any (`triangles`: their buffer's handle).
+    fn draw_hybrid(
+        &self,
+        cmd: &mut CommandRecorder,
+        plan: &FramePlan,
+        push: SplatPush,
+        triangles: Option<u32>,
+    ) -> Result<()> {
+        match (&self.hybrid, triangles) {
+            (Some(pipeline), Some(handle)) => draw_triangles(cmd, pipeline, plan, push, handle),
+            _ => Ok(()),
+        }
+    }
 }
 
-/// One host-written storage buffer per frame slot.
-fn host_buffers(ctx: &Context, name: &str, size: u64) -> Result<Vec<Arc<Buffer>>> {
-    Buffer::per_frame(
-        ctx,
-        BufferDesc {
-            name: name.into(),
-            size,
-            usage: BufferUsageFlags::STORAGE_BUFFER,
-            location: MemoryLocation::CpuToGpu,
-        },
-    )
-}
-
-/// Uploads the splat lists of `scene` and declares the points passes of
-/// `settings.mode` into `graph`, after the terrain.
-pub fn add_point_passes(
+/// `points.opaque` (the `--splat opaque` baseline): shaded opaque discs
+/// with ray–plane depth, and the hybrid triangles.
+pub(super) fn declare_opaque(
     ctx: &Context,
-    graph: &mut RenderGraph<FrameParams>,
-    scene: &PointScene,
-    settings: SplatSettings,
-    targets: SplatTargets,
-    (width, height): (u32, u32),
-) -> Result<PointPasses> {
-    settings.validate()?;
-    scene.validate()?;
-    let mut scene = scene.clone();
-    if let Some(epsilon) = settings.epsilon {
-        for object in &mut scene.objects {
-            *object = object.with_epsilon(epsilon)?;
-        }
-    }
-    let triangle_buffer = TriangleBuffer::upload(ctx, &scene)?;
-    let mut splats = Vec::with_capacity(scene.total_splats());
-    let mut layouts = Vec::with_capacity(scene.objects.len());
-    for (o, object) in scene.objects.iter().enumerate() {
-        let first = u32::try_from(splats.len()).map_err(|_| Error::invalid("points", "too many splats"))?;
-        let clusters = settings
-            .normal_clusters
-            .then(|| Arc::new(cluster_normals(&object.tree)));
-        match &clusters {
-            Some(c) => splats.extend(pack_nodes(&c.nodes)),
-            None => splats.extend(pack_nodes(&object.tree.nodes)),
-        }
-        layouts.push(ObjectLayout {
-            first,
-            clusters,
-            first_triangle: triangle_buffer.as_ref().map_or(0, |t| t.firsts[o]),
-        });
-    }
-    if splats.len() > u32::MAX as usize / 6 {
-        return Err(Error::invalid(
-            "points",
-            format!("{} splats exceed the limit", splats.len()),
-        ));
-    }
-    let splat_buffer = Arc::new(Buffer::with_data(
+    graph: &mut RenderGraph<Frame>,
+    name: &str,
+    (buffers, view): (PointBuffers, PointView),
+    targets: &SceneTargets,
+) -> Result<()> {
+    let formats = vec![
+        targets.formats.radiance,
+        targets.formats.view_depth,
+        targets.formats.weight,
+    ];
+    let spec = |name, fragment| PipelineSpec {
+        name,
+        shaders: (shaders::SPLAT_VERT, fragment),
+        color_formats: formats.clone(),
+        blend: Blend::None,
+        depth: (true, CompareOp::LESS),
+    };
+    let pipelines = PassPipelines::new(
         ctx,
-        "splats",
-        BufferUsageFlags::STORAGE_BUFFER,
-        bytemuck::cast_slice(&splats),
-    )?);
-    let table = Arc::new(Buffer::with_data(
-        ctx,
-        "gaussian table",
-        BufferUsageFlags::STORAGE_BUFFER,
-        bytemuck::cast_slice(&gaussian_table(settings.cutoff)),
-    )?);
-    let draws_per_instance = if settings.normal_clusters { CLUSTER_COUNT } else { 1 };
-    let frame_bytes = HEADER_BYTES + INSTANCE_BYTES * (scene.instances.len() * draws_per_instance).max(1) as u64;
-    let frame_buffers = host_buffers(ctx, "point frame", frame_bytes)?;
-    let counting = ctx.has_feature("vertexPipelineStoresAndAtomics");
-    let counters = if counting {
-        Some(host_buffers(ctx, "splat counter", 16)?)
-    } else {
-        None
-    };
-    let stats: SharedStats = Arc::new(Mutex::new(StatsLog::new(counters.clone())));
-
-    let splats_id = graph.import_buffer(splat_buffer.clone());
-    let table_id = graph.import_buffer(table);
-    let frame_id = graph.import_buffers_per_frame(frame_buffers);
-    let counter_id = counters.map(|c| graph.import_buffers_per_frame(c));
-    let triangles_id = triangle_buffer.as_ref().map(|t| graph.import_buffer(t.buffer.clone()));
-    // The hybrid triangles' pipeline of a pass (§10.1.8), when the scene has any.
-    let triangle_pipeline = |name: &'static str, fragment: SpirV, formats: Vec<Format>, blend, depth| {
-        triangles_id
-            .map(|_| {
-                pipeline(
-                    ctx,
-                    name,
-                    (shaders::HYBRID_VERT, fragment),
-                    false,
-                    formats,
-                    blend,
-                    depth,
-                )
-            })
-            .transpose()
-    };
-    // The triangle buffer's handle in a pass.
-    let triangle_handle = move |pass: &PassContext<'_>| -> Result<Option<u32>> {
-        triangles_id.map(|t| pass.storage_buffer(t)).transpose()
-    };
-    let max_point_size = ctx.info().max_point_size;
-    let plan = Arc::new(Mutex::new(FramePlan::default()));
-
-    // The first pass plans the frame: prefixes, instance records, statistics.
-    let scene = Arc::new(scene);
-    let layouts = Arc::new(layouts);
-    let plan_frame_into = {
-        let (plan, stats, scene, layouts) = (plan.clone(), stats.clone(), scene.clone(), layouts.clone());
-        move |pass: &mut PassContext<'_>, params: &FrameParams| -> Result<()> {
-            let started = Instant::now();
-            let camera = &params.camera;
-            let (header, view) = frame_header(camera, (width, height), params.sun, &settings, max_point_size);
-            let view_proj = camera.view_proj_f64(params.aspect);
-            let new_plan = plan_frame(&scene, &layouts, camera.eye, view, view_proj);
-            let buffer = pass.buffer(frame_id)?;
-            buffer.write(0, bytemuck::bytes_of(&header))?;
-            buffer.write(HEADER_BYTES, bytemuck::cast_slice(&new_plan.records))?;
-            let frame_stats = PointFrameStats {
-                frame: pass.frame(),
-                instances: new_plan.instances,
-                instances_drawn: new_plan.instances_drawn,
-                list_splats: new_plan.list_splats,
-                prefix_splats: new_plan.prefix_splats,
-                prefix_triangles: new_plan.prefix_triangles,
-                triangles_drawn: None,
-                interval_passed: None,
-                drawn_splats: None,
-                cpu_ms: started.elapsed().as_secs_f64() * 1e3,
-            };
-            locked(&stats)?.begin_frame(frame_stats)?;
-            *locked(&plan)? = new_plan;
+        targets,
+        &buffers,
+        spec("points.opaque", shaders::SPLAT_OPAQUE_FRAG),
+        PipelineSpec {
+            shaders: (shaders::HYBRID_VERT, shaders::HYBRID_OPAQUE_FRAG),
+            ..spec("points.opaque.triangles", shaders::HYBRID_OPAQUE_FRAG)
+        },
+    )?;
+    let builder = buffers.read_by(graph.pass(name).graphics(), view.frame, true);
+    builder
+        .write(view.radiance, ImageAccess::ColorAttachmentReadWrite)
+        .write(view.view_depth, ImageAccess::ColorAttachmentReadWrite)
+        .write(view.weight, ImageAccess::ColorAttachmentWrite)
+        .write(view.depth, ImageAccess::DepthAttachmentWrite)
+        .record(move |pass, frame| {
+            let plan = plan_of(frame, view.index)?;
+            let push = buffers.push(pass, view.frame, PASS_OPAQUE, true)?;
+            let triangles = buffers.triangle_handle(pass)?;
+            let (radiance, view_depth) = (pass.image(view.radiance)?, pass.image(view.view_depth)?);
+            let (weight, depth) = (pass.image(view.weight)?, pass.image(view.depth)?);
+            let cmd = pass.cmd();
+            cmd.begin_rendering(
+                &[
+                    (radiance, LoadOp::Load),
+                    (view_depth, LoadOp::Load),
+                    (weight, LoadOp::Clear([0.0; 4])),
+                ],
+                Some((depth, view.clear_depth.then_some(1.0))),
+            );
+            pipelines.draw(cmd, plan, buffers.primitive, push)?;
+            pipelines.draw_hybrid(cmd, plan, push, triangles)?;
+            cmd.end_rendering();
             Ok(())
-        }
+        });
+    Ok(())
+}
+
+/// The two float targets of EWA accumulation (§10.2): (colour·w, w) and
+/// (normal·w, depth·w).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Accumulation {
+    pub color_weight: ImageId,
+    pub normal_depth: ImageId,
+}
+
+/// `points.visibility`, `points.accumulate` and `points.normalize`: the
+/// three passes of perspective-accurate EWA splatting (§10.2, Table 10.1).
+pub(super) fn declare_ewa(
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame>,
+    names: [&str; 3],
+    (buffers, view): (PointBuffers, PointView),
+    targets: &SceneTargets,
+) -> Result<()> {
+    let info = crate::graph::ImageInfo::new(targets.width, targets.height, targets.formats.accumulation);
+    let accumulation = Accumulation {
+        color_weight: graph.create_image("splat colour·w, w", info.clone()),
+        normal_depth: graph.create_image("splat normal·w, depth·w", info),
     };
-    let push_for = move |pass: &PassContext<'_>, kind: u32, count: bool| -> Result<SplatPush> {
-        Ok(SplatPush {
-            handles: [
-                pass.storage_buffer(splats_id)?,
-                pass.storage_buffer(frame_id)?,
-                match (count, counter_id) {
-                    (true, Some(c)) => pass.storage_buffer(c)?,
-                    _ => NO_HANDLE,
-                },
-                pass.storage_buffer(table_id)?,
-            ],
-            mode: [kind, PRIMITIVE_QUAD, SIZE_ANY, 0],
-        })
+    declare_visibility(ctx, graph, names[0], (buffers, view), targets)?;
+    declare_accumulate(ctx, graph, names[1], (buffers, view), targets, accumulation)?;
+    declare_normalize(ctx, graph, names[2], view, targets, accumulation)
+}
+
+/// `points.visibility`: ray–plane depth pushed back by ε (§10.2.3), hybrid
+/// triangles first.
+fn declare_visibility(
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame>,
+    name: &str,
+    (buffers, view): (PointBuffers, PointView),
+    targets: &SceneTargets,
+) -> Result<()> {
+    let spec = |name, shaders| PipelineSpec {
+        name,
+        shaders,
+        color_formats: Vec::new(),
+        blend: Blend::None,
+        depth: (true, CompareOp::LESS),
     };
-    let depth_load = if targets.clear_depth { Some(1.0) } else { None };
-    let primitive = settings.primitive;
-    if width > 0xffff || height > 0xffff {
-        return Err(Error::invalid(
-            "image size",
-            "points passes support at most 65535 pixels per side",
-        ));
-    }
+    let pipelines = PassPipelines::new(
+        ctx,
+        targets,
+        &buffers,
+        spec(
+            "points.visibility",
+            (shaders::SPLAT_VERT, shaders::SPLAT_VISIBILITY_FRAG),
+        ),
+        spec(
+            "points.visibility.triangles",
+            (shaders::HYBRID_VERT, shaders::HYBRID_VISIBILITY_FRAG),
+        ),
+    )?;
+    let builder = buffers.read_by(graph.pass(name).graphics(), view.frame, true);
+    builder
+        .write(view.depth, ImageAccess::DepthAttachmentWrite)
+        .record(move |pass, frame| {
+            let plan = plan_of(frame, view.index)?;
+            let push = buffers.push(pass, view.frame, PASS_VISIBILITY, true)?;
+            let triangles = buffers.triangle_handle(pass)?;
+            let depth = pass.image(view.depth)?;
+            let cmd = pass.cmd();
+            cmd.begin_rendering(&[], Some((depth, view.clear_depth.then_some(1.0))));
+            pipelines.draw_hybrid(cmd, plan, push, triangles)?;
+            pipelines.draw(cmd, plan, buffers.primitive, push)?;
+            cmd.end_rendering();
+            Ok(())
+        });
+    Ok(())
+}
 
-    match settings.mode {
-        SplatMode::Opaque => {
-            let pipes = PassPipelines::new(ctx, primitive, |points| {
-                pipeline(
-                    ctx,
-                    "points.opaque",
-                    (shaders::SPLAT_VERT, shaders::SPLAT_OPAQUE_FRAG),
-                    points,
-                    vec![Format::R32G32B32A32_SFLOAT, Format::R32_SFLOAT, Format::R32_SFLOAT],
-                    Blend::None,
-                    (true, CompareOp::LESS),
-                )
-            })?;
-            let opaque_triangles = triangle_pipeline(
-                "points.opaque.triangles",
-                shaders::HYBRID_OPAQUE_FRAG,
-                vec![Format::R32G32B32A32_SFLOAT, Format::R32_SFLOAT, Format::R32_SFLOAT],
-                Blend::None,
-                (true, CompareOp::LESS),
-            )?;
-            let mut builder = graph
-                .pass("points.opaque")
-                .graphics()
-                .read(splats_id, Access::StorageBufferRead(Stage::Vertex))
-                .read(frame_id, Access::StorageBufferRead(Stage::Graphics))
-                .read(table_id, Access::StorageBufferRead(Stage::Fragment))
-                .write(targets.radiance, Access::ColorAttachmentReadWrite)
-                .write(targets.view_depth, Access::ColorAttachmentReadWrite)
-                .write(targets.weight, Access::ColorAttachmentWrite)
-                .write(targets.depth, Access::DepthAttachmentWrite);
-            if let Some(c) = counter_id {
-                builder = builder.write(c, Access::StorageBufferReadWrite(Stage::Vertex));
-            }
-            if let Some(t) = triangles_id {
-                builder = builder.read(t, Access::StorageBufferRead(Stage::Vertex));
-            }
-            builder.record(move |pass, params| {
-                plan_frame_into(pass, params)?;
-                let push = push_for(pass, PASS_OPAQUE, true)?;
-                let triangles = triangle_handle(pass)?;
-                let (radiance, view_depth, weight, depth) = (
-                    pass.image(targets.radiance)?,
-                    pass.image(targets.view_depth)?,
-                    pass.image(targets.weight)?,
-                    pass.image(targets.depth)?,
-                );
-                let plan = locked(&plan)?;
-                let cmd = pass.cmd();
-                cmd.begin_rendering(
-                    &[
-                        (radiance, LoadOp::Load),
-                        (view_depth, LoadOp::Load),
-                        (weight, LoadOp::Clear([0.0; 4])),
-                    ],
-                    Some((depth, depth_load)),
-                );
-                pipes.draw(cmd, &plan, primitive, push)?;
-                if let (Some(pipeline), Some(handle)) = (&opaque_triangles, triangles) {
-                    draw_triangles(cmd, pipeline, &plan, push, handle)?;
-                }
-                cmd.end_rendering();
-                Ok(())
-            });
-        }
-        SplatMode::Ewa => {
-            let visibility = PassPipelines::new(ctx, primitive, |points| {
-                pipeline(
-                    ctx,
-                    "points.visibility",
-                    (shaders::SPLAT_VERT, shaders::SPLAT_VISIBILITY_FRAG),
-                    points,
-                    Vec::new(),
-                    Blend::None,
-                    (true, CompareOp::LESS),
-                )
-            })?;
-            let visibility_triangles = triangle_pipeline(
-                "points.visibility.triangles",
-                shaders::HYBRID_VISIBILITY_FRAG,
-                Vec::new(),
-                Blend::None,
-                (true, CompareOp::LESS),
-            )?;
-            let accumulate = PassPipelines::new(ctx, primitive, |points| {
-                pipeline(
-                    ctx,
-                    "points.accumulate",
-                    (shaders::SPLAT_VERT, shaders::SPLAT_ACCUMULATE_FRAG),
-                    points,
-                    vec![Format::R32G32B32A32_SFLOAT, Format::R32G32B32A32_SFLOAT],
-                    Blend::Additive,
-                    (false, CompareOp::LESS_OR_EQUAL),
-                )
-            })?;
-            let accumulate_triangles = triangle_pipeline(
-                "points.accumulate.triangles",
-                shaders::HYBRID_ACCUMULATE_FRAG,
-                vec![Format::R32G32B32A32_SFLOAT, Format::R32G32B32A32_SFLOAT],
-                Blend::Additive,
-                (false, CompareOp::LESS_OR_EQUAL),
-            )?;
-            let normalize = GraphicsPipeline::new(
-                ctx,
-                &GraphicsPipelineDesc::full_screen(
-                    "points.normalize",
-                    (shaders::FULL_SCREEN_VERT, shaders::SPLAT_NORMALIZE_FRAG),
-                    vec![Format::R32G32B32A32_SFLOAT, Format::R32_SFLOAT, Format::R32_SFLOAT],
-                ),
-            )?;
-            let color_weight = graph.create_image(
-                "splat colour·w, w",
-                ImageInfo::new(width, height, Format::R32G32B32A32_SFLOAT),
+/// `points.accumulate`: depth test ≤ without writes, additive (w·colour,
+/// w) and (w·normal, w·depth) into the float targets (§10.2).
+fn declare_accumulate(
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame>,
+    name: &str,
+    (buffers, view): (PointBuffers, PointView),
+    targets: &SceneTargets,
+    accumulation: Accumulation,
+) -> Result<()> {
+    let spec = |name, shaders| PipelineSpec {
+        name,
+        shaders,
+        color_formats: vec![targets.formats.accumulation; 2],
+        blend: Blend::Additive,
+        depth: (false, CompareOp::LESS_OR_EQUAL),
+    };
+    let pipelines = PassPipelines::new(
+        ctx,
+        targets,
+        &buffers,
+        spec(
+            "points.accumulate",
+            (shaders::SPLAT_VERT, shaders::SPLAT_ACCUMULATE_FRAG),
+        ),
+        spec(
+            "points.accumulate.triangles",
+            (shaders::HYBRID_VERT, shaders::HYBRID_ACCUMULATE_FRAG),
+        ),
+    )?;
+    let builder = buffers.read_by(graph.pass(name).graphics(), view.frame, false);
+    builder
+        .read(view.depth, ImageAccess::DepthAttachmentRead)
+        .write(accumulation.color_weight, ImageAccess::ColorAttachmentWrite)
+        .write(accumulation.normal_depth, ImageAccess::ColorAttachmentWrite)
+        .record(move |pass, frame| {
+            let plan = plan_of(frame, view.index)?;
+            let push = buffers.push(pass, view.frame, PASS_ACCUMULATE, false)?;
+            let triangles = buffers.triangle_handle(pass)?;
+            let (cw, nd) = (
+                pass.image(accumulation.color_weight)?,
+                pass.image(accumulation.normal_depth)?,
             );
-            let normal_depth = graph.create_image(
-                "splat normal·w, depth·w",
-                ImageInfo::new(width, height, Format::R32G32B32A32_SFLOAT),
+            let depth = pass.image(view.depth)?;
+            let cmd = pass.cmd();
+            cmd.begin_rendering(
+                &[(cw, LoadOp::Clear([0.0; 4])), (nd, LoadOp::Clear([0.0; 4]))],
+                Some((depth, None)),
             );
+            pipelines.draw(cmd, plan, buffers.primitive, push)?;
+            pipelines.draw_hybrid(cmd, plan, push, triangles)?;
+            cmd.end_rendering();
+            Ok(())
+        });
+    Ok(())
+}
 
-            let mut builder = graph
-                .pass("points.visibility")
-                .graphics()
-                .read(splats_id, Access::StorageBufferRead(Stage::Vertex))
-                .read(frame_id, Access::StorageBufferRead(Stage::Graphics))
-                .read(table_id, Access::StorageBufferRead(Stage::Fragment))
-                .write(targets.depth, Access::DepthAttachmentWrite);
-            if let Some(c) = counter_id {
-                builder = builder.write(c, Access::StorageBufferReadWrite(Stage::Vertex));
-            }
-            if let Some(t) = triangles_id {
-                builder = builder.read(t, Access::StorageBufferRead(Stage::Vertex));
-            }
-            let visibility_plan = plan.clone();
-            builder.record(move |pass, params| {
-                plan_frame_into(pass, params)?;
-                let push = push_for(pass, PASS_VISIBILITY, true)?;
-                let triangles = triangle_handle(pass)?;
-                let depth = pass.image(targets.depth)?;
-                let plan = locked(&visibility_plan)?;
-                let cmd = pass.cmd();
-                cmd.begin_rendering(&[], Some((depth, depth_load)));
-                if let (Some(pipeline), Some(handle)) = (&visibility_triangles, triangles) {
-                    draw_triangles(cmd, pipeline, &plan, push, handle)?;
-                }
-                visibility.draw(cmd, &plan, primitive, push)?;
-                cmd.end_rendering();
-                Ok(())
-            });
-
-            let mut builder = graph
-                .pass("points.accumulate")
-                .graphics()
-                .read(splats_id, Access::StorageBufferRead(Stage::Vertex))
-                .read(frame_id, Access::StorageBufferRead(Stage::Graphics))
-                .read(table_id, Access::StorageBufferRead(Stage::Fragment))
-                .read(targets.depth, Access::DepthAttachmentRead)
-                .write(color_weight, Access::ColorAttachmentWrite)
-                .write(normal_depth, Access::ColorAttachmentWrite);
-            if let Some(t) = triangles_id {
-                builder = builder.read(t, Access::StorageBufferRead(Stage::Vertex));
-            }
-            builder.record(move |pass, _| {
-                let push = push_for(pass, PASS_ACCUMULATE, false)?;
-                let triangles = triangle_handle(pass)?;
-                let (cw, nd, depth) = (
-                    pass.image(color_weight)?,
-                    pass.image(normal_depth)?,
-                    pass.image(targets.depth)?,
-                );
-                let plan = locked(&plan)?;
-                let cmd = pass.cmd();
-                cmd.begin_rendering(
-                    &[(cw, LoadOp::Clear([0.0; 4])), (nd, LoadOp::Clear([0.0; 4]))],
-                    Some((depth, None)),
-                );
-                accumulate.draw(cmd, &plan, primitive, push)?;
-                if let (Some(pipeline), Some(handle)) = (&accumulate_triangles, triangles) {
-                    draw_triangles(cmd, pipeline, &plan, push, handle)?;
-                }
-                cmd.end_rendering();
-                Ok(())
-            });
-
-            graph
-                .pass("points.normalize")
-                .graphics()
-                .read(color_weight, Access::SampledImage(Stage::Fragment))
-                .read(normal_depth, Access::SampledImage(Stage::Fragment))
-                .read(frame_id, Access::StorageBufferRead(Stage::Fragment))
-                .write(targets.radiance, Access::ColorAttachmentReadWrite)
-                .write(targets.view_depth, Access::ColorAttachmentReadWrite)
-                .write(targets.weight, Access::ColorAttachmentWrite)
-                .record(move |pass, _| {
-                    let push = SplatPush {
-                        handles: [
-                            pass.sampled(color_weight)?,
-                            pass.storage_buffer(frame_id)?,
-                            pass.sampled(normal_depth)?,
-                            0,
-                        ],
-                        mode: [0; 4],
-                    };
-                    let (radiance, view_depth, weight) = (
-                        pass.image(targets.radiance)?,
-                        pass.image(targets.view_depth)?,
-                        pass.image(targets.weight)?,
-                    );
-                    let cmd = pass.cmd();
-                    cmd.begin_rendering(
-                        &[
-                            (radiance, LoadOp::Load),
-                            (view_depth, LoadOp::Load),
-                            (weight, LoadOp::Clear([0.0; 4])),
-                        ],
-                        None,
-                    );
-                    cmd.bind_graphics(&normalize);
-                    cmd.push_constants(&push)?;
-                    cmd.draw(3, 1);
-                    cmd.end_rendering();
-                    Ok(())
-                });
-        }
-    }
-    Ok(PointPasses {
-        stats,
-        _splats: splat_buffer,
-        _triangles: triangle_buffer.map(|t| t.buffer),
-    })
+/// `points.normalize`: full screen, divide by w, shade (sun, sky, haze),
+/// write radiance, view depth and W.
+fn declare_normalize(
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame>,
+    name: &str,
+    view: PointView,
+    targets: &SceneTargets,
+    accumulation: Accumulation,
+) -> Result<()> {
+    let formats = &targets.formats;
+    let pipeline = Arc::new(GraphicsPipeline::new(
+        ctx,
+        &GraphicsPipelineDesc::full_screen(
+            "points.normalize",
+            (shaders::FULL_SCREEN_VERT, shaders::SPLAT_NORMALIZE_FRAG),
+            vec![formats.radiance, formats.view_depth, formats.weight],
+        ),
+    )?);
+    graph
+        .pass(name)
+        .graphics()
+        .read(accumulation.color_weight, ImageAccess::Sampled(Stage::Fragment))
+        .read(accumulation.normal_depth, ImageAccess::Sampled(Stage::Fragment))
+        .read(view.frame, BufferAccess::StorageRead(Stage::Fragment))
+        .write(view.radiance, ImageAccess::ColorAttachmentReadWrite)
+        .write(view.view_depth, ImageAccess::ColorAttachmentReadWrite)
+        .write(view.weight, ImageAccess::ColorAttachmentWrite)
+        .record(move |pass, _| {
+            let push = NormalizePush {
+                color_weight: pass.sampled(accumulation.color_weight)?,
+                frame: pass.upload(view.frame)?,
+                normal_depth: pass.sampled(accumulation.normal_depth)?,
+                _pad: [0; 5],
+            };
+            let (radiance, view_depth) = (pass.image(view.radiance)?, pass.image(view.view_depth)?);
+            let weight = pass.image(view.weight)?;
+            let cmd = pass.cmd();
+            cmd.begin_rendering(
+                &[
+                    (radiance, LoadOp::Load),
+                    (view_depth, LoadOp::Load),
+                    (weight, LoadOp::Clear([0.0; 4])),
+                ],
+                None,
+            );
+            cmd.bind_graphics(&pipeline);
+            cmd.push_constants(&push)?;
+            cmd.draw(3, 1);
+            cmd.end_rendering();
+            Ok(())
+        });
+    Ok(())
 }

@@ -69,9 +69,9 @@ pub(super) fn draw_triangles(
         return Ok(());
     }
     cmd.bind_graphics(pipeline);
-    push.handles[0] = triangles;
+    push.splats = triangles;
     for d in &plan.triangle_draws {
-        push.mode[3] = d.record;
+        push.record = d.record;
         cmd.push_constants(&push)?;
         cmd.draw(d.count * 3, 1);
     }

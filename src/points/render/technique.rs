@@ -1,0 +1,252 @@
+//! Point objects as a technique (dissertation §10.1.7, §10.2): the splat
+//! lists on the GPU, the points passes of each view, and per frame, in
+//! `prepare`, the CPU selection (frustum culling, prefix by binary search,
+//! object→camera in f64) whose plan the passes draw.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use super::gpu_layout::{frame_header, gaussian_table, pack_nodes, HEADER_BYTES, INSTANCE_BYTES};
+use super::passes::{declare_ewa, declare_opaque, PointBuffers, PointView};
+use super::selection::{plan_frame, FramePlan, ObjectLayout};
+use super::stats::{PointFrameStats, StatsLog};
+use super::triangles::TriangleBuffer;
+use super::{SplatMode, SplatSettings};
+use crate::error::{Error, Result};
+use crate::graph::RenderGraph;
+use crate::points::build::clusters::{cluster_normals, CLUSTER_COUNT};
+use crate::points::scene::PointScene;
+use crate::view::{pass_name, Frame, FrameContext, SceneTargets, Technique, View, ViewIndex};
+use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Context, MemoryLocation};
+
+/// What the points passes read this frame: each view's plan.
+pub struct PointsFrame {
+    pub views: Vec<PointViewFrame>,
+}
+
+/// One view's prepared selection.
+pub struct PointViewFrame {
+    pub view: ViewIndex,
+    pub plan: FramePlan,
+}
+
+impl PointsFrame {
+    /// The prepared plan of view `index`.
+    pub fn view(&self, index: ViewIndex) -> Result<&PointViewFrame> {
+        self.views
+            .iter()
+            .find(|v| v.view == index)
+            .ok_or_else(|| Error::Graph(format!("points: view {index} was not prepared")))
+    }
+}
+
+/// The point objects of a scene: splat lists uploaded once, the points
+/// passes of every view, and the per-frame selection in `prepare`.
+pub struct PointRenderer {
+    settings: SplatSettings,
+    scene: PointScene,
+    layouts: Vec<ObjectLayout>,
+    max_point_size: f32,
+    draws_per_instance: usize,
+    /// The splats, the Gaussian table, the counters and the triangles.
+    resources: (
+        Arc<Buffer>,
+        Arc<Buffer>,
+        Option<Vec<Arc<Buffer>>>,
+        Option<TriangleBuffer>,
+    ),
+    buffers: Option<PointBuffers>,
+    views: Vec<PointView>,
+    stats: StatsLog,
+}
+
+impl PointRenderer {
+    /// Uploads the splat lists of `scene` (re-derived for
+    /// `settings.epsilon`, clustered when asked for).
+    pub fn new(ctx: &Context, scene: &PointScene, settings: SplatSettings) -> Result<PointRenderer> {
+        settings.validate()?;
+        scene.validate()?;
+        let mut scene = scene.clone();
+        if let Some(epsilon) = settings.epsilon {
+            for object in &mut scene.objects {
+                *object = object.with_epsilon(epsilon)?;
+            }
+        }
+        let triangles = TriangleBuffer::upload(ctx, &scene)?;
+        let mut splats = Vec::with_capacity(scene.total_splats());
+        let mut layouts = Vec::with_capacity(scene.objects.len());
+        for (o, object) in scene.objects.iter().enumerate() {
+            let first = u32::try_from(splats.len()).map_err(|_| Error::invalid("points", "too many splats"))?;
+            let clusters = settings
+                .normal_clusters
+                .then(|| Arc::new(cluster_normals(&object.tree)));
+            match &clusters {
+                Some(c) => splats.extend(pack_nodes(&c.nodes)),
+                None => splats.extend(pack_nodes(&object.tree.nodes)),
+            }
+            layouts.push(ObjectLayout {
+                first,
+                clusters,
+                first_triangle: triangles.as_ref().map_or(0, |t| t.firsts[o]),
+            });
+        }
+        if splats.len() > u32::MAX as usize / 6 {
+            return Err(Error::invalid(
+                "points",
+                format!("{} splats exceed the limit", splats.len()),
+            ));
+        }
+        let storage = BufferUsageFlags::STORAGE_BUFFER;
+        let splat_buffer = Arc::new(Buffer::with_data(
+            ctx,
+            "splats",
+            storage,
+            bytemuck::cast_slice(&splats),
+        )?);
+        let table = gaussian_table(settings.cutoff);
+        let table = Arc::new(Buffer::with_data(
+            ctx,
+            "gaussian table",
+            storage,
+            bytemuck::cast_slice(&table),
+        )?);
+        let counters = match ctx.has_feature("vertexPipelineStoresAndAtomics") {
+            true => Some(Buffer::per_frame(
+                ctx,
+                BufferDesc {
+                    name: "splat counter".into(),
+                    size: 16,
+                    usage: storage,
+                    location: MemoryLocation::CpuToGpu,
+                },
+            )?),
+            false => None,
+        };
+        Ok(PointRenderer {
+            draws_per_instance: if settings.normal_clusters { CLUSTER_COUNT } else { 1 },
+            max_point_size: ctx.info().max_point_size,
+            stats: StatsLog::new(counters.clone()),
+            resources: (splat_buffer, table, counters, triangles),
+            buffers: None,
+            views: Vec::new(),
+            settings,
+            scene,
+            layouts,
+        })
+    }
+
+    /// Declares the points passes of view `index` into `targets` (W
+    /// required): `points.visibility`, `points.accumulate`,
+    /// `points.normalize` for EWA splats, or `points.opaque`.
+    /// `clear_depth`: no terrain drew into the depth buffer.
+    pub fn declare(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame>,
+        (index, view): (ViewIndex, &View),
+        targets: &SceneTargets,
+        clear_depth: bool,
+    ) -> Result<()> {
+        if targets.width > 0xffff || targets.height > 0xffff {
+            return Err(Error::invalid(
+                "image size",
+                "points passes support at most 65535 pixels per side",
+            ));
+        }
+        let weight = targets
+            .weight
+            .ok_or_else(|| Error::Graph("points: the view's targets have no splat weight".into()))?;
+        let buffers = *self.buffers.get_or_insert_with(|| {
+            let (splats, table, counters, triangles) = &self.resources;
+            PointBuffers {
+                splats: graph.import_buffer(splats.clone()),
+                table: graph.import_buffer(table.clone()),
+                counter: counters.as_ref().map(|c| graph.import_buffers_per_frame(c.clone())),
+                triangles: triangles.as_ref().map(|t| graph.import_buffer(t.buffer.clone())),
+                primitive: self.settings.primitive,
+            }
+        });
+        let records = (self.scene.instances.len() * self.draws_per_instance).max(1) as u64;
+        let point_view = PointView {
+            index,
+            frame: graph.upload_region(
+                &pass_name("point frame", &view.name),
+                HEADER_BYTES + INSTANCE_BYTES * records,
+            ),
+            radiance: targets.radiance,
+            view_depth: targets.view_depth,
+            depth: targets.depth,
+            weight,
+            clear_depth,
+        };
+        let name = |base| pass_name(base, &view.name);
+        match self.settings.mode {
+            SplatMode::Opaque => declare_opaque(ctx, graph, &name("points.opaque"), (buffers, point_view), targets)?,
+            SplatMode::Ewa => {
+                let names = [
+                    name("points.visibility"),
+                    name("points.accumulate"),
+                    name("points.normalize"),
+                ];
+                let names = [names[0].as_str(), names[1].as_str(), names[2].as_str()];
+                declare_ewa(ctx, graph, names, (buffers, point_view), targets)?
+            }
+        }
+        self.views.push(point_view);
+        Ok(())
+    }
+
+    /// Statistics of every completed frame not yet taken (call after all
+    /// frames completed).
+    pub fn take_stats(&mut self) -> Result<Vec<PointFrameStats>> {
+        self.stats.take_all_completed()
+    }
+}
+
+impl Technique for PointRenderer {
+    type Prepared = PointsFrame;
+
+    fn name(&self) -> &'static str {
+        "points"
+    }
+
+    /// Per view: the prefix of every visible instance and its record
+    /// (object→camera in f64), uploaded with the view's header; the frame's
+    /// statistics (the GPU counts of the slot's previous frame are read now).
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<PointsFrame> {
+        let started = Instant::now();
+        let mut views = Vec::with_capacity(self.views.len());
+        let mut stats = PointFrameStats {
+            frame: frame.index,
+            ..PointFrameStats::default()
+        };
+        for point_view in &self.views {
+            let view = frame
+                .views
+                .get(point_view.index)
+                .ok_or_else(|| Error::Graph(format!("points: the frame has no view {}", point_view.index)))?;
+            let camera = &view.camera;
+            let size = (view.width, view.height);
+            let (header, view_matrix) =
+                frame_header(camera, size, frame.lighting.sun, &self.settings, self.max_point_size);
+            let view_proj = camera.view_proj_f64(view.aspect());
+            let plan = plan_frame(&self.scene, &self.layouts, camera.eye, view_matrix, view_proj);
+            frame.uploads.write_pod(point_view.frame, &header)?;
+            frame
+                .uploads
+                .write_at(point_view.frame, HEADER_BYTES, bytemuck::cast_slice(&plan.records))?;
+            stats.instances = plan.instances;
+            stats.instances_drawn += plan.instances_drawn;
+            stats.list_splats += plan.list_splats;
+            stats.prefix_splats += plan.prefix_splats;
+            stats.prefix_triangles += plan.prefix_triangles;
+            views.push(PointViewFrame {
+                view: point_view.index,
+                plan,
+            });
+        }
+        stats.cpu_ms = started.elapsed().as_secs_f64() * 1e3;
+        self.stats.begin_frame(stats)?;
+        Ok(PointsFrame { views })
+    }
+}

@@ -1,0 +1,301 @@
+//! The terrain as a technique (dissertation §7.4): the height field's GPU
+//! resources, one geometry image per view, and the per-frame CPU stage —
+//! sketch map, importance map and warp of every view (§7.4.2,
+//! [`crate::terrain::lod`]) — run in `prepare`, before the frame is
+//! recorded; `terrain.warp` and `terrain.draw` then only read what it
+//! prepared.
+
+use std::sync::Arc;
+
+use bytemuck::Zeroable;
+
+use crate::error::{Error, Result};
+use crate::graph::{BufferId, ImageId, RenderGraph, UploadRegion};
+use crate::io::heightmap::HeightField;
+use crate::terrain::geometry_image::{declare_warp_pass, GeometryImage, TerrainSettings, WarpPass, WarpPush};
+use crate::terrain::lod::LodFrame;
+use crate::terrain::shading::{declare_draw_pass, DrawPass, TerrainDrawPush};
+use crate::texturing::generation::{AtlasBindings, GenerationInputs};
+use crate::texturing::gpu_layout::{pack_layers, TexturingFrame, TexturingMode};
+use crate::texturing::input_maps::InputMaps;
+use crate::texturing::layers::LayerTree;
+use crate::view::{pass_name, Frame, FrameContext, SceneTargets, Technique, View, ViewIndex};
+use crate::vulkan::{Buffer, BufferUsageFlags, Context, Image};
+
+/// How `terrain.draw` colours the surface (§7.4.3 or §8.2).
+pub struct TerrainTexturing<'a> {
+    pub mode: TexturingMode,
+    pub layers: &'a LayerTree,
+    /// Extra input maps of the layers ([`crate::texturing::input_maps`]).
+    pub input_maps: &'a [Option<HeightField>; 3],
+}
+
+/// One view's terrain resources.
+struct TerrainViewState {
+    index: ViewIndex,
+    lod: LodFrame,
+    /// The warped sketch map (per frame).
+    warp: UploadRegion,
+    /// The texturing constants `terrain.draw` reads (per frame).
+    constants: UploadRegion,
+    vertices: BufferId,
+    vertices_handle: u32,
+    atlas: Option<AtlasBindings>,
+}
+
+/// The terrain: persistent GPU state, `terrain.warp` and `terrain.draw` per
+/// view, and the CPU LOD of every view in `prepare`.
+pub struct Terrain {
+    geometry: GeometryImage,
+    mode: TexturingMode,
+    layer_count: u32,
+    atlas: ImageId,
+    noise: ImageId,
+    indices: BufferId,
+    layers: BufferId,
+    maps: InputMaps,
+    /// Heap handles: sketch atlas (sampled), noise tile (sampled), layers (storage).
+    handles: [u32; 3],
+    views: Vec<TerrainViewState>,
+}
+
+/// What the terrain passes read this frame.
+pub struct TerrainFrame {
+    pub views: Vec<TerrainViewFrame>,
+}
+
+/// One view's prepared push constants.
+#[derive(Clone, Copy, Debug)]
+pub struct TerrainViewFrame {
+    pub view: ViewIndex,
+    pub warp: WarpPush,
+    pub draw: TerrainDrawPush,
+}
+
+impl TerrainFrame {
+    /// The prepared data of view `index`.
+    pub fn view(&self, index: ViewIndex) -> Result<&TerrainViewFrame> {
+        self.views
+            .iter()
+            .find(|v| v.view == index)
+            .ok_or_else(|| Error::Graph(format!("terrain: view {index} was not prepared")))
+    }
+}
+
+fn heap_handle(image_or_buffer: Option<u32>, what: &str) -> Result<u32> {
+    image_or_buffer.ok_or_else(|| Error::Graph(format!("terrain: {what} has no heap handle")))
+}
+
+impl Terrain {
+    /// Uploads the height field, the noise tile, the surface layers and
+    /// their input maps, and imports them into `graph`.
+    pub fn new(
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame>,
+        field: Arc<HeightField>,
+        settings: TerrainSettings,
+        texturing: &TerrainTexturing,
+    ) -> Result<Terrain> {
+        let geometry = GeometryImage::new(ctx, field, settings)?;
+        let maps = InputMaps::import(ctx, graph, texturing.layers, texturing.input_maps)?;
+        let layer_count = texturing.layers.layers.len() as u32;
+        if layer_count == 0 {
+            return Err(Error::invalid("surface layers", "the tree has no layer"));
+        }
+        let layers = Arc::new(Buffer::with_data(
+            ctx,
+            "surface layers",
+            BufferUsageFlags::STORAGE_BUFFER,
+            bytemuck::cast_slice(&pack_layers(texturing.layers)),
+        )?);
+        let sampled = |image: &Image, what| heap_handle(image.sampled_handle(), what);
+        let handles = [
+            sampled(&geometry.atlas, "the sketch atlas")?,
+            sampled(&geometry.noise, "the noise tile")?,
+            heap_handle(layers.storage_handle(), "the layers buffer")?,
+        ];
+        Ok(Terrain {
+            atlas: graph.import_image(geometry.atlas.clone()),
+            noise: graph.import_image(geometry.noise.clone()),
+            indices: graph.import_buffer(geometry.indices.clone()),
+            layers: graph.import_buffer(layers),
+            geometry,
+            mode: texturing.mode,
+            layer_count,
+            maps,
+            handles,
+            views: Vec::new(),
+        })
+    }
+
+    /// What the texture atlas's generation passes read.
+    pub fn generation_inputs<'a>(&self, tree: &'a LayerTree) -> GenerationInputs<'a> {
+        GenerationInputs {
+            field: self.geometry.field.clone(),
+            heights: self.atlas,
+            noise: self.noise,
+            layers: self.layers,
+            maps: self.maps,
+            tree,
+        }
+    }
+
+    /// Declares `terrain.warp` of view `index`, with its geometry image.
+    pub fn declare_warp(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame>,
+        (index, view): (ViewIndex, &View),
+    ) -> Result<()> {
+        let vertex_buffer = self.geometry.vertex_buffer(ctx, &view.name)?;
+        let vertices_handle = heap_handle(vertex_buffer.storage_handle(), "the vertex buffer")?;
+        let vertices = graph.import_buffer(vertex_buffer);
+        let warp = graph.upload_region(
+            &pass_name("terrain warp", &view.name),
+            self.geometry.warp_upload_bytes(),
+        );
+        let constants = graph.upload_region(
+            &pass_name("terrain texturing", &view.name),
+            std::mem::size_of::<TexturingFrame>() as u64,
+        );
+        let pass = WarpPass {
+            view: index,
+            atlas: self.atlas,
+            noise: self.noise,
+            upload: warp,
+            vertices,
+            grid_side: self.geometry.settings.grid_side,
+        };
+        declare_warp_pass(ctx, graph, &pass_name("terrain.warp", &view.name), pass)?;
+        self.views.push(TerrainViewState {
+            index,
+            lod: LodFrame::default(),
+            warp,
+            constants,
+            vertices,
+            vertices_handle,
+            atlas: None,
+        });
+        Ok(())
+    }
+
+    /// Declares `terrain.draw` of view `index` into `targets`, textured from
+    /// `atlas` when given (after [`Terrain::declare_warp`] of that view).
+    pub fn declare_draw(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame>,
+        (index, view): (ViewIndex, &View),
+        targets: &SceneTargets,
+        atlas: Option<&AtlasBindings>,
+    ) -> Result<()> {
+        let state = (self.views.iter_mut().find(|v| v.index == index))
+            .ok_or_else(|| Error::Graph(format!("terrain.draw of view {index} before its terrain.warp")))?;
+        state.atlas = atlas.cloned();
+        let side = self.geometry.settings.grid_side;
+        let pass = DrawPass {
+            view: index,
+            vertices: state.vertices,
+            indices: self.indices,
+            index_count: (side - 1) * (side - 1) * 6,
+            noise: self.noise,
+            heights: self.atlas,
+            layers: self.layers,
+            maps: self.maps,
+            constants: state.constants,
+            atlas: state.atlas.clone(),
+        };
+        declare_draw_pass(ctx, graph, &pass_name("terrain.draw", &view.name), pass, targets)
+    }
+
+    /// The texturing constants of `terrain.draw` (`TerrainTexturing` in
+    /// glsl/include/texture_atlas.glsl); `page_table`: this frame's handle.
+    fn texturing_constants(&self, atlas: Option<(&AtlasBindings, u32)>) -> TexturingFrame {
+        let field = &self.geometry.field;
+        let (lo, hi) = field.min_max();
+        let extent = field.extent();
+        let [heights, noise, layers] = self.handles;
+        let mut frame = TexturingFrame {
+            handles: [layers, heights, noise, self.mode.code()],
+            grid: [field.columns, field.rows, self.layer_count, 0],
+            spacing_range: [field.spacing.x as f32, field.spacing.y as f32, lo, hi],
+            extent: [extent.x as f32, extent.y as f32, 0.0, 0.0],
+            maps: self.maps.handles(),
+            draw: self.geometry.settings.draw_constants(),
+            ..TexturingFrame::zeroed()
+        };
+        if let Some((a, page_table)) = atlas {
+            frame.atlas = [page_table, a.colors.len() as u32, a.atlas_size, 0];
+            for (k, (c, n)) in a.colors.iter().zip(&a.normals).enumerate() {
+                (frame.color[k], frame.normal[k]) = (c.1, n.1);
+            }
+        }
+        frame
+    }
+}
+
+impl Technique for Terrain {
+    type Prepared = TerrainFrame;
+
+    fn name(&self) -> &'static str {
+        "terrain"
+    }
+
+    /// Per view: sketch map, importance map and warp (§7.4.2) into the
+    /// warp upload, the texturing constants, and the passes' push constants.
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<TerrainFrame> {
+        let mut views = Vec::with_capacity(self.views.len());
+        let settings = self.geometry.settings;
+        for k in 0..self.views.len() {
+            let state = &self.views[k];
+            let view = frame
+                .views
+                .get(state.index)
+                .ok_or_else(|| Error::Graph(format!("terrain: the frame has no view {}", state.index)))?;
+            let camera = &view.camera;
+            let page_table = match &state.atlas {
+                Some(a) => Some((a, frame.uploads.handle(a.page_table)?)),
+                None => None,
+            };
+            let constants = self.texturing_constants(page_table);
+            let (warp_region, constants_region) = (state.warp, state.constants);
+            frame.uploads.write_pod(constants_region, &constants)?;
+            let [heights, noise, _] = self.handles;
+            let warp = WarpPush {
+                handles: [
+                    heights,
+                    frame.uploads.handle(warp_region)?,
+                    self.views[k].vertices_handle,
+                    noise,
+                ],
+                ..self.geometry.warp_push()
+            };
+            let state = &mut self.views[k];
+            let debug = settings.view.debug_scalar();
+            state
+                .lod
+                .plan(&self.geometry.field, camera, view.aspect(), &settings.lod, debug)?;
+            frame
+                .uploads
+                .write(warp_region, bytemuck::cast_slice(&state.lod.upload))?;
+            let pixel_footprint = 2.0 * (0.5 * camera.fov_y_deg.to_radians()).tan() / f64::from(view.height);
+            let lighting = frame.lighting;
+            let draw = TerrainDrawPush {
+                view_proj: camera.view_proj(view.aspect()).to_cols_array(),
+                eye: camera.eye.as_vec3().extend(self.geometry.atlas_spacing()).to_array(),
+                forward: camera.forward().as_vec3().extend(pixel_footprint as f32).to_array(),
+                sun: lighting.sun.extend(lighting.snow_line).to_array(),
+                detail_amplitude: settings.detail_amplitude,
+                detail_h: settings.detail_h,
+                noise_tile: noise,
+                texturing_frame: frame.uploads.handle(constants_region)?,
+            };
+            views.push(TerrainViewFrame {
+                view: state.index,
+                warp,
+                draw,
+            });
+        }
+        Ok(TerrainFrame { views })
+    }
+}
