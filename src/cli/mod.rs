@@ -3,6 +3,7 @@
 mod args;
 mod errors;
 mod fly;
+mod orbit;
 mod points;
 mod spt;
 mod terrain_spec;
