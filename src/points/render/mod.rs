@@ -132,7 +132,10 @@ impl SplatSettings {
         }
         if let Some(e) = self.epsilon {
             if !(e.is_finite() && e > 0.0) {
-                return Err(Error::invalid("--epsilon", format!("{e} is not a positive number")));
+                return Err(Error::invalid(
+                    "points.epsilon",
+                    format!("{e} is not a positive number"),
+                ));
             }
         }
         Ok(())
