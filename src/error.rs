@@ -5,7 +5,10 @@
 use std::path::PathBuf;
 
 /// Everything that can go wrong in alpenglow, as one-line messages.
+///
+/// Non-exhaustive: later versions may add variants.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// The Vulkan loader (libvulkan.so.1) could not be opened.
     #[error("cannot load the Vulkan loader: {0} (on Debian 12 run tools/install-vulkan-runtime.sh)")]
@@ -32,8 +35,17 @@ pub enum Error {
     #[error("cannot write {}: {message}", path.display())]
     Output { path: PathBuf, message: String },
     /// A parameter (camera, size, option) is out of range.
-    #[error("invalid {what}: {message}")]
-    InvalidArgument { what: String, message: String },
+    #[error("invalid {parameter}: {message}")]
+    InvalidArgument {
+        /// The library's name of the parameter: a field path of the
+        /// settings it belongs to where there is one, e.g. `width`,
+        /// `camera.fov_y_deg`, `terrain.grid_side`, `points.epsilon`;
+        /// otherwise a short description ("texture atlas", a file name).
+        /// Front ends map these names to their own (the CLI to its flags).
+        parameter: String,
+        /// What is wrong with it, one line.
+        message: String,
+    },
     /// The render graph was declared inconsistently.
     #[error("render graph: {0}")]
     Graph(String),
@@ -59,11 +71,37 @@ impl Error {
         }
     }
 
-    /// An invalid-argument error naming the parameter.
-    pub fn invalid(what: impl Into<String>, message: impl std::fmt::Display) -> Self {
+    /// An invalid-argument error naming the parameter (see
+    /// [`Error::InvalidArgument`] for how parameters are named).
+    pub fn invalid(parameter: impl Into<String>, message: impl std::fmt::Display) -> Self {
         Error::InvalidArgument {
-            what: what.into(),
+            parameter: parameter.into(),
             message: message.to_string(),
         }
+    }
+
+    /// The parameter an [`Error::InvalidArgument`] names; None for every
+    /// other error.
+    pub fn parameter(&self) -> Option<&str> {
+        match self {
+            Error::InvalidArgument { parameter, .. } => Some(parameter),
+            _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn invalid_names_its_parameter() {
+        let e = Error::invalid("camera.fov_y_deg", "0 degrees; must be in (0, 180)");
+        assert_eq!(e.parameter(), Some("camera.fov_y_deg"));
+        assert_eq!(
+            e.to_string(),
+            "invalid camera.fov_y_deg: 0 degrees; must be in (0, 180)"
+        );
+        assert_eq!(Error::input("a.png", "truncated").parameter(), None);
     }
 }

@@ -12,12 +12,8 @@ fn main() -> ExitCode {
     match cli::run() {
         Ok(code) => code,
         Err(e) => {
-            // One line: the error and its causes.
-            let mut line = format!("error: {e}");
-            for cause in e.chain().skip(1) {
-                line.push_str(&format!(": {cause}"));
-            }
-            eprintln!("{}", line.replace('\n', " "));
+            // One line: the error and its causes, parameters named by their flags.
+            eprintln!("error: {}", cli::error_line(&e));
             ExitCode::FAILURE
         }
     }

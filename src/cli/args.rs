@@ -5,8 +5,9 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
 
+use crate::cli::orbit::parse_orbit;
 use crate::cli::terrain_spec::TerrainSpec;
-use alpenglow::view::camera_path::{parse_orbit, Orbit};
+use alpenglow::view::camera_path::Orbit;
 
 /// alpenglow: a Vulkan renderer for large outdoor scenes.
 #[derive(Parser, Debug)]

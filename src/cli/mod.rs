@@ -1,7 +1,9 @@
 //! Subcommands of the `alpenglow` binary.
 
 mod args;
+mod errors;
 mod fly;
+mod orbit;
 mod points;
 mod spt;
 mod terrain_spec;
@@ -22,6 +24,8 @@ use alpenglow::terrain::lod::{ImportanceFactors, LodMode, LodSettings};
 use alpenglow::terrain::sketch_map::SketchAlignment;
 use alpenglow::texturing::stats::TextureSummary;
 use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector, ValidationReport};
+pub use errors::error_line;
+
 use args::{
     AlignArg, BenchArgs, Cli, Command, DeviceArgs, FactorArg, LodArg, RenderArgs, SceneArgs, Switch, TerrainArgs,
     ViewArg,

@@ -48,7 +48,7 @@ impl PointTransform {
     /// translation in world units, rotation in degrees about x, then y, then
     /// z (extrinsic), uniform scale.
     pub fn parse(text: &str) -> Result<PointTransform> {
-        let bad = |msg: String| Error::invalid("--points-transform", format!("'{text}': {msg}"));
+        let bad = |msg: String| Error::invalid("points.transform", format!("'{text}': {msg}"));
         let mut out = PointTransform::default();
         for part in text.split(';').map(str::trim).filter(|p| !p.is_empty()) {
             let (key, value) = part
@@ -318,7 +318,10 @@ mod tests {
         assert_eq!(PointTransform::parse("").unwrap(), PointTransform::default());
         for bad in ["t=1,2", "s=0", "s=-1", "q=1", "t=1,x,3", "r", "s=inf"] {
             let e = PointTransform::parse(bad).unwrap_err().to_string();
-            assert!(e.contains("--points-transform") && !e.contains('\n'), "{bad}: {e}");
+            assert!(
+                e.starts_with("invalid points.transform: ") && !e.contains('\n'),
+                "{bad}: {e}"
+            );
         }
     }
 }

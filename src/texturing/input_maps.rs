@@ -35,8 +35,8 @@ impl InputMaps {
             let Some(map) = map else {
                 if tree.uses_input(k) {
                     return Err(Error::invalid(
-                        "surface layers",
-                        format!("a layer constrains input map '{name}' but none was given (--input-map {name}=FILE)"),
+                        format!("input_maps.{name}"),
+                        format!("a layer constrains input map '{name}' but none was given"),
                     ));
                 }
                 continue;

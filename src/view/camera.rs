@@ -37,13 +37,13 @@ impl Camera {
         }
         if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
             return Err(Error::invalid(
-                "--fov-y",
+                "camera.fov_y_deg",
                 format!("{} degrees; must be in (0, 180)", self.fov_y_deg),
             ));
         }
         if !(self.near > 0.0 && self.near.is_finite() && self.far > self.near && self.far.is_finite()) {
             return Err(Error::invalid(
-                "--near/--far",
+                "camera.near/camera.far",
                 format!(
                     "near {} and far {}; need 0 < near < far, both finite",
                     self.near, self.far
@@ -128,10 +128,10 @@ mod tests {
         assert!(c.validate().is_err());
         let mut c = camera();
         c.fov_y_deg = 180.0;
-        assert!(c.validate().is_err());
+        assert_eq!(c.validate().unwrap_err().parameter(), Some("camera.fov_y_deg"));
         let mut c = camera();
         c.near = 0.0;
-        assert!(c.validate().is_err());
+        assert_eq!(c.validate().unwrap_err().parameter(), Some("camera.near/camera.far"));
         let mut c = camera();
         c.eye.x = f64::NAN;
         assert!(c.validate().is_err());

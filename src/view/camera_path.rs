@@ -48,8 +48,8 @@ pub struct Keyframe {
     pub target: DVec3,
 }
 
-/// The angle at which [`parse_orbit`] starts an orbit: −90°, i.e. south of
-/// the centre looking north, like [`crate::renderer::Scene::default_camera`].
+/// The usual start of an orbit (the CLI's): −90°, i.e. south of the centre
+/// looking north, like [`crate::renderer::Scene::default_camera`].
 pub const DEFAULT_START_ANGLE_DEG: f64 = -90.0;
 
 /// The eye circles `centre` at `radius` (in the xy plane) and at height
@@ -87,7 +87,7 @@ impl Orbit {
         }
         if self.radius <= 0.0 {
             return Err(Error::invalid(
-                "--orbit",
+                "orbit",
                 format!("radius {} must be positive", self.radius),
             ));
         }
@@ -325,34 +325,20 @@ pub fn load_keyframes(path: &Path) -> Result<CameraPath> {
     parse_keyframes(&text, path)
 }
 
-/// Parses the CLI value `CX,CY,CZ,RADIUS,HEIGHT[,TURNS]` (TURNS default 1)
-/// into an orbit starting at [`DEFAULT_START_ANGLE_DEG`].
-pub fn parse_orbit(s: &str) -> std::result::Result<Orbit, String> {
-    let usage = "CX,CY,CZ,RADIUS,HEIGHT[,TURNS]";
-    let numbers = s
-        .split(',')
-        .map(|p| p.trim().parse::<f64>())
-        .collect::<std::result::Result<Vec<_>, _>>()
-        .map_err(|_| format!("--orbit '{s}' is not {usage} (comma-separated numbers)"))?;
-    let (centre, radius, height, turns) = match numbers.as_slice() {
-        &[x, y, z, r, h] => (DVec3::new(x, y, z), r, h, 1.0),
-        &[x, y, z, r, h, n] => (DVec3::new(x, y, z), r, h, n),
-        other => return Err(format!("--orbit '{s}' has {} numbers; expected {usage}", other.len())),
-    };
-    let orbit = Orbit {
-        centre,
-        radius,
-        height,
-        turns,
-        start_angle_deg: DEFAULT_START_ANGLE_DEG,
-    };
-    orbit.validate().map_err(|e| format!("--orbit '{s}': {e}"))?;
-    Ok(orbit)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An orbit starting at [`DEFAULT_START_ANGLE_DEG`].
+    fn orbit_around(centre: DVec3, radius: f64, height: f64, turns: f64) -> Orbit {
+        Orbit {
+            centre,
+            radius,
+            height,
+            turns,
+            start_angle_deg: DEFAULT_START_ANGLE_DEG,
+        }
+    }
 
     fn base() -> Camera {
         Camera {
@@ -522,9 +508,7 @@ target = [5120.0, 5120.0, 0.0]
 
     #[test]
     fn orbit_circles_the_centre_and_returns() {
-        let orbit = parse_orbit("5120, 5120, 200, 3000, 900").unwrap();
-        assert_eq!(orbit.turns, 1.0);
-        assert_eq!(orbit.start_angle_deg, DEFAULT_START_ANGLE_DEG);
+        let orbit = orbit_around(DVec3::new(5120.0, 5120.0, 200.0), 3000.0, 900.0, 1.0);
         let path = CameraPath::Orbit(orbit);
         assert_eq!((path.start_time(), path.duration()), (0.0, 1.0));
         let start = path.camera_at(0.0, &base());
@@ -547,31 +531,30 @@ target = [5120.0, 5120.0, 0.0]
             quarter.eye.distance(DVec3::new(8120.0, 5120.0, 1100.0)) < 1e-9,
             "counter-clockwise"
         );
-        let half = CameraPath::Orbit(parse_orbit("0,0,0,10,5,0.5").unwrap());
+        let half = CameraPath::Orbit(orbit_around(DVec3::ZERO, 10.0, 5.0, 0.5));
         assert!(half.camera_at(1.0, &base()).eye.distance(DVec3::new(0.0, 10.0, 5.0)) < 1e-12);
     }
 
     #[test]
-    fn parse_orbit_rejects_bad_values() {
-        for s in [
-            "",
-            "1,2,3,4",
-            "1,2,3,4,5,6,7",
-            "1,2,x,4,5",
-            "1,2,3,0,5",
-            "1,2,3,-1,5",
-            "1,2,3,4,inf",
+    fn orbit_validation_names_the_orbit() {
+        for bad in [
+            orbit_around(DVec3::ZERO, 0.0, 1.0, 1.0),
+            orbit_around(DVec3::ZERO, -1.0, 1.0, 1.0),
+            orbit_around(DVec3::ZERO, 1.0, f64::INFINITY, 1.0),
+            orbit_around(DVec3::new(0.0, f64::NAN, 0.0), 1.0, 1.0, 1.0),
         ] {
-            let e = parse_orbit(s).unwrap_err();
-            assert!(e.starts_with(&format!("--orbit '{s}'")), "{e}");
+            let e = bad.validate().unwrap_err();
+            assert_eq!(e.parameter(), Some("orbit"), "{e}");
+            assert!(!e.to_string().contains("--"), "{e}");
         }
+        orbit_around(DVec3::ZERO, 1.0, 0.0, 0.0).validate().unwrap();
     }
 
     #[test]
     fn sample_counts_and_valid_cameras() {
         let paths = [
             parse(FILE).unwrap(),
-            CameraPath::Orbit(parse_orbit("0,0,0,1000,300,2.5").unwrap()),
+            CameraPath::Orbit(orbit_around(DVec3::ZERO, 1000.0, 300.0, 2.5)),
         ];
         for path in &paths {
             assert!(path.sample(0, &base()).is_empty());

@@ -1,0 +1,174 @@
+//! Library errors in the command line's words. The library names the
+//! parameter at fault by its own name (`width`, `camera.fov_y_deg`,
+//! `terrain.grid_side`, see [`alpenglow::Error::InvalidArgument`]); the
+//! command line reports the flag that sets it (`--width`, `--fov-y`,
+//! `--grid`).
+
+/// Library parameter → the flag that sets it. Parameters without an entry
+/// are reported under their library name.
+const FLAGS: &[(&str, &str)] = &[
+    ("width", "--width"),
+    ("height", "--height"),
+    ("camera.fov_y_deg", "--fov-y"),
+    ("camera.near", "--near"),
+    ("camera.far", "--far"),
+    ("orbit", "--orbit"),
+    ("terrain.grid_side", "--grid"),
+    ("terrain.lod.sketch_side", "--sketch"),
+    ("terrain.detail_amplitude", "--detail-amplitude"),
+    ("points.epsilon", "--epsilon"),
+    ("points.primitive", "--splat-primitive"),
+    ("points.transform", "--points-transform"),
+];
+
+/// The flag(s) that set library parameter `parameter`: a [`FLAGS`] entry;
+/// `a/b` (two parameters at fault together) as `flag(a)/flag(b)`;
+/// `input_maps.NAME` as `--input-map NAME=FILE`. None for parameters no
+/// flag sets.
+pub fn flag(parameter: &str) -> Option<String> {
+    if let Some((a, b)) = parameter.split_once('/') {
+        return Some(format!("{}/{}", flag(a)?, flag(b)?));
+    }
+    if let Some(name) = parameter.strip_prefix("input_maps.") {
+        return Some(format!("--input-map {name}=FILE"));
+    }
+    FLAGS
+        .iter()
+        .find(|(p, _)| *p == parameter)
+        .map(|(_, f)| (*f).to_owned())
+}
+
+/// A library error's message with the parameter named by its flag.
+pub fn describe(e: &alpenglow::Error) -> String {
+    match e {
+        alpenglow::Error::InvalidArgument { parameter, message } => match flag(parameter) {
+            Some(flag) => format!("invalid {flag}: {message}"),
+            None => e.to_string(),
+        },
+        _ => e.to_string(),
+    }
+}
+
+/// The one-line report of `e` and its causes (`a: b: c`), library errors
+/// among them in the command line's words ([`describe`]).
+pub fn error_line(e: &anyhow::Error) -> String {
+    let parts: Vec<String> = e
+        .chain()
+        .map(|cause| match cause.downcast_ref::<alpenglow::Error>() {
+            Some(e) => describe(e),
+            None => cause.to_string(),
+        })
+        .collect();
+    parts.join(": ").replace('\n', " ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alpenglow::points::render::SplatSettings;
+    use alpenglow::points::scene::PointTransform;
+    use alpenglow::renderer::Camera;
+    use alpenglow::view::camera_path::Orbit;
+    use anyhow::Context as _;
+    use glam::DVec3;
+
+    fn camera() -> Camera {
+        Camera {
+            eye: DVec3::ZERO,
+            target: DVec3::X,
+            up: DVec3::Z,
+            fov_y_deg: 50.0,
+            near: 0.1,
+            far: 100.0,
+        }
+    }
+
+    fn line(e: alpenglow::Error) -> String {
+        error_line(&anyhow::Error::from(e))
+    }
+
+    #[test]
+    fn table_and_composite_names() {
+        assert_eq!(flag("width").as_deref(), Some("--width"));
+        assert_eq!(flag("camera.near/camera.far").as_deref(), Some("--near/--far"));
+        assert_eq!(flag("camera.near/texture atlas"), None);
+        assert_eq!(
+            flag("input_maps.rainfall").as_deref(),
+            Some("--input-map rainfall=FILE")
+        );
+        assert_eq!(flag("texture atlas"), None);
+        let unmapped = alpenglow::Error::invalid("texture atlas", "full");
+        assert_eq!(describe(&unmapped), "invalid texture atlas: full");
+        let io = alpenglow::Error::input("a.png", "truncated");
+        assert_eq!(describe(&io), io.to_string());
+    }
+
+    /// The library's errors, reported by the CLI, name the flags.
+    #[test]
+    fn library_errors_name_the_flags() {
+        let cases: Vec<(alpenglow::Error, &str)> = vec![
+            (
+                Camera {
+                    fov_y_deg: 0.0,
+                    ..camera()
+                }
+                .validate()
+                .unwrap_err(),
+                "invalid --fov-y: ",
+            ),
+            (
+                Camera {
+                    near: 10.0,
+                    far: 5.0,
+                    ..camera()
+                }
+                .validate()
+                .unwrap_err(),
+                "invalid --near/--far: ",
+            ),
+            (
+                Orbit {
+                    centre: DVec3::ZERO,
+                    radius: 0.0,
+                    height: 1.0,
+                    turns: 1.0,
+                    start_angle_deg: 0.0,
+                }
+                .validate()
+                .unwrap_err(),
+                "invalid --orbit: ",
+            ),
+            (
+                PointTransform::parse("s=0").unwrap_err(),
+                "invalid --points-transform: ",
+            ),
+            (
+                SplatSettings {
+                    epsilon: Some(0.0),
+                    ..SplatSettings::default()
+                }
+                .validate()
+                .unwrap_err(),
+                "invalid --epsilon: ",
+            ),
+            (
+                alpenglow::renderer::validate_size(0, 32).unwrap_err(),
+                "invalid --width: ",
+            ),
+        ];
+        for (e, start) in cases {
+            let line = line(e);
+            assert!(line.starts_with(start), "{line}");
+        }
+    }
+
+    #[test]
+    fn causes_are_described_too() {
+        let e = Err::<(), _>(alpenglow::Error::invalid("camera.fov_y_deg", "0 degrees"))
+            .context("camera path frame 3")
+            .unwrap_err();
+        assert_eq!(error_line(&e), "camera path frame 3: invalid --fov-y: 0 degrees");
+        let e = anyhow::anyhow!("two\nlines");
+        assert_eq!(error_line(&e), "two lines");
+    }
+}
