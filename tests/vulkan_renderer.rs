@@ -264,3 +264,12 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
     drop(ctx);
     assert_validation_clean(&report);
 }
+
+/// A simulator hands the renderer to its render thread: `Renderer` is `Send`
+/// (a compile-time check; the test fails to build otherwise).
+#[test]
+fn renderer_is_send() {
+    fn assert_send<T: Send>() {}
+    assert_send::<Renderer>();
+    assert_send::<alpenglow::graph::BakedGraph<alpenglow::view::Frame>>();
+}

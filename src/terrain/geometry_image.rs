@@ -119,13 +119,13 @@ impl TerrainSettings {
         }
         if !(self.detail_amplitude.is_finite() && self.detail_amplitude >= 0.0 && self.detail_amplitude <= 10.0) {
             return Err(Error::invalid(
-                "detail amplitude",
+                "terrain.detail_amplitude",
                 format!("{} (must be in 0..=10)", self.detail_amplitude),
             ));
         }
         if !(self.detail_h.is_finite() && self.detail_h >= 0.0 && self.detail_h <= 2.0) {
             return Err(Error::invalid(
-                "detail H",
+                "terrain.detail_h",
                 format!("{} (must be in 0..=2)", self.detail_h),
             ));
         }
