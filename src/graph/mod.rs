@@ -248,6 +248,28 @@ impl<P: 'static> RenderGraph<P> {
         self.outputs.push((buffer.0, Some(Access::HostRead)));
     }
 
+    /// Declares `name`, a transfer pass copying each image into its buffer,
+    /// and reads the buffers back to the host after the frame.
+    pub fn read_back_images(&mut self, name: &str, copies: Vec<(ImageId, BufferId)>) {
+        let mut pass = self.pass(name).transfer();
+        for &(image, buffer) in &copies {
+            pass = pass
+                .read(image, ImageAccess::TransferSrc)
+                .write(buffer, BufferAccess::TransferDst);
+        }
+        let recorded = copies.clone();
+        pass.record(move |pass, _| {
+            for &(image, buffer) in &recorded {
+                let (image, buffer) = (pass.image(image)?, pass.buffer(buffer)?);
+                pass.cmd().copy_image_to_buffer(image, buffer);
+            }
+            Ok(())
+        });
+        for (_, buffer) in copies {
+            self.read_back(buffer);
+        }
+    }
+
     /// Starts declaring a compute pass.
     pub fn pass(&mut self, name: &str) -> PassBuilder<'_, P> {
         self.begin_pass(name, PassKind::Compute)

@@ -22,7 +22,7 @@ pub use crate::view::{validate_size, Camera, MAX_IMAGE_SIDE};
 pub use scene::Scene;
 
 use crate::error::{Error, Result};
-use crate::graph::{BakedGraph, BufferAccess, BufferId, FrameOutcome, ImageAccess, ImageId, RenderGraph};
+use crate::graph::{BakedGraph, BufferId, FrameOutcome, ImageId, RenderGraph};
 use crate::lighting::sky::Sky;
 use crate::points::render::{PointFrameStats, PointRenderer, SplatSettings};
 use crate::post::tonemap::Tonemap;
@@ -145,23 +145,7 @@ fn declare_readback(ctx: &Context, graph: &mut RenderGraph<Frame>, targets: &Sce
     if let (Some(image), Some(buffers)) = (targets.weight, &rb.weight) {
         copies.push((image, graph.import_buffers_per_frame(buffers.clone())));
     }
-    let mut pass = graph.pass("readback").transfer();
-    for &(image, buffer) in &copies {
-        pass = pass
-            .read(image, ImageAccess::TransferSrc)
-            .write(buffer, BufferAccess::TransferDst);
-    }
-    let recorded = copies.clone();
-    pass.record(move |pass, _| {
-        for &(image, buffer) in &recorded {
-            let (image, buffer) = (pass.image(image)?, pass.buffer(buffer)?);
-            pass.cmd().copy_image_to_buffer(image, buffer);
-        }
-        Ok(())
-    });
-    for &(_, buffer) in &copies {
-        graph.read_back(buffer);
-    }
+    graph.read_back_images("readback", copies);
     Ok(rb)
 }
 

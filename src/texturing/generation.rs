@@ -175,12 +175,15 @@ pub struct GenerationInputs<'a> {
     pub tree: &'a LayerTree,
 }
 
+/// An atlas texture and its graph resource.
+type AtlasTexture = (ImageId, Arc<Image>);
+
 /// The atlas textures, imported into `graph`: (colour, normal) per texture.
 fn atlas_textures(
     ctx: &Context,
     graph: &mut RenderGraph<Frame>,
     streaming: &TextureStreaming,
-) -> Result<Vec<[(ImageId, Arc<Image>); 2]>> {
+) -> Result<Vec<[AtlasTexture; 2]>> {
     let readback_usage = match streaming.readback {
         true => ImageUsageFlags::TRANSFER_SRC,
         false => ImageUsageFlags::empty(),
@@ -188,7 +191,7 @@ fn atlas_textures(
     let size = streaming.atlas.size;
     let mut textures = Vec::new();
     for (k, tile) in streaming.atlas.texture_tile_sizes().into_iter().enumerate() {
-        let mut image = |what: &str| -> Result<(ImageId, Arc<Image>)> {
+        let mut image = |what: &str| -> Result<AtlasTexture> {
             let image = Arc::new(Image::new(
                 ctx,
                 ImageDesc {
@@ -510,23 +513,7 @@ fn add_atlas_readback(
         copies.push((image, graph.import_buffers_per_frame(per_frame.clone())));
         buffers.push(per_frame);
     }
-    let mut pass = graph.pass("texturing.readback").transfer();
-    for &(image, buffer) in &copies {
-        pass = pass
-            .read(image, ImageAccess::TransferSrc)
-            .write(buffer, BufferAccess::TransferDst);
-    }
-    let recorded = copies.clone();
-    pass.record(move |pass, _| {
-        for &(image, buffer) in &recorded {
-            let (image, buffer) = (pass.image(image)?, pass.buffer(buffer)?);
-            pass.cmd().copy_image_to_buffer(image, buffer);
-        }
-        Ok(())
-    });
-    for &(_, buffer) in &copies {
-        graph.read_back(buffer);
-    }
+    graph.read_back_images("texturing.readback", copies);
     Ok(buffers)
 }
 

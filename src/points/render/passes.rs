@@ -228,13 +228,13 @@ impl PassPipelines {
             n.checked_mul(6)
                 .ok_or_else(|| Error::invalid("splat count", format!("{n} splats exceed one draw")))
         };
-        let each = |cmd: &mut CommandRecorder,
-                    push: &mut SplatPush,
-                    draw: &dyn Fn(&mut CommandRecorder, u32) -> Result<()>| {
+        // One draw per instance; `counts(n)`: vertices and instances for n splats.
+        let each = |cmd: &mut CommandRecorder, push: &mut SplatPush, counts: &dyn Fn(u32) -> Result<(u32, u32)>| {
             for d in &plan.draws {
                 push.record = d.record;
                 cmd.push_constants(push)?;
-                draw(cmd, d.count)?;
+                let (vertices, instances) = counts(d.count)?;
+                cmd.draw(vertices, instances);
             }
             Ok::<(), Error>(())
         };
@@ -242,21 +242,21 @@ impl PassPipelines {
             (SplatPrimitive::Point, Some(points)) => {
                 cmd.bind_graphics(points);
                 (push.primitive, push.size_class) = (PRIMITIVE_POINT, SIZE_POINT);
-                each(cmd, &mut push, &|cmd, n| Ok(cmd.draw(n, 1)))?;
+                each(cmd, &mut push, &|n| Ok((n, 1)))?;
                 // Fallback: splats larger than the largest point size as quads.
                 cmd.bind_graphics(&self.triangles);
                 (push.primitive, push.size_class) = (PRIMITIVE_QUAD, SIZE_OVERSIZE);
-                each(cmd, &mut push, &|cmd, n| Ok(cmd.draw(six(n)?, 1)))?;
+                each(cmd, &mut push, &|n| Ok((six(n)?, 1)))?;
             }
             (SplatPrimitive::Instanced, _) => {
                 cmd.bind_graphics(&self.triangles);
                 (push.primitive, push.size_class) = (PRIMITIVE_INSTANCED, SIZE_ANY);
-                each(cmd, &mut push, &|cmd, n| Ok(cmd.draw(6, n)))?;
+                each(cmd, &mut push, &|n| Ok((6, n)))?;
             }
             _ => {
                 cmd.bind_graphics(&self.triangles);
                 (push.primitive, push.size_class) = (PRIMITIVE_QUAD, SIZE_ANY);
-                each(cmd, &mut push, &|cmd, n| Ok(cmd.draw(six(n)?, 1)))?;
+                each(cmd, &mut push, &|n| Ok((six(n)?, 1)))?;
             }
         }
         Ok(())

@@ -40,6 +40,17 @@ impl PointsFrame {
     }
 }
 
+/// The GPU buffers of the point objects, uploaded once.
+struct PointResources {
+    splats: Arc<Buffer>,
+    /// The Gaussian lookup table.
+    table: Arc<Buffer>,
+    /// Drawn-splat counters per frame slot (None without vertexPipelineStoresAndAtomics).
+    counters: Option<Vec<Arc<Buffer>>>,
+    /// Hybrid triangles (§10.1.8), when the scene has any.
+    triangles: Option<TriangleBuffer>,
+}
+
 /// The point objects of a scene: splat lists uploaded once, the points
 /// passes of every view, and the per-frame selection in `prepare`.
 pub struct PointRenderer {
@@ -48,13 +59,7 @@ pub struct PointRenderer {
     layouts: Vec<ObjectLayout>,
     max_point_size: f32,
     draws_per_instance: usize,
-    /// The splats, the Gaussian table, the counters and the triangles.
-    resources: (
-        Arc<Buffer>,
-        Arc<Buffer>,
-        Option<Vec<Arc<Buffer>>>,
-        Option<TriangleBuffer>,
-    ),
+    resources: PointResources,
     buffers: Option<PointBuffers>,
     views: Vec<PointView>,
     stats: StatsLog,
@@ -126,7 +131,12 @@ impl PointRenderer {
             draws_per_instance: if settings.normal_clusters { CLUSTER_COUNT } else { 1 },
             max_point_size: ctx.info().max_point_size,
             stats: StatsLog::new(counters.clone()),
-            resources: (splat_buffer, table, counters, triangles),
+            resources: PointResources {
+                splats: splat_buffer,
+                table,
+                counters,
+                triangles,
+            },
             buffers: None,
             views: Vec::new(),
             settings,
@@ -157,7 +167,12 @@ impl PointRenderer {
             .weight
             .ok_or_else(|| Error::Graph("points: the view's targets have no splat weight".into()))?;
         let buffers = *self.buffers.get_or_insert_with(|| {
-            let (splats, table, counters, triangles) = &self.resources;
+            let PointResources {
+                splats,
+                table,
+                counters,
+                triangles,
+            } = &self.resources;
             PointBuffers {
                 splats: graph.import_buffer(splats.clone()),
                 table: graph.import_buffer(table.clone()),
