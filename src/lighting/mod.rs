@@ -1,4 +1,8 @@
-//! Outdoor lighting (§6.3, §9). For now: the analytic sky of the default
-//! scene; the Preetham sky, aerial perspective, shadows and PRT follow.
+//! Outdoor lighting (§6.3, §9; `ALGORITHMS.md` §6): the sun and sky models,
+//! aerial perspective, sun shadows and sky light on the terrain. The frame's
+//! [`crate::view::Lighting`] request becomes per-view GPU constants
+//! ([`constants::LightingFrame`], `glsl/include/lighting.glsl`) that every
+//! shading pass reads.
 
+pub mod constants;
 pub mod sky;

@@ -61,7 +61,7 @@ impl Sky {
                     right: right.extend(0.0).to_array(),
                     up: up.extend(0.0).to_array(),
                     forward: forward.extend(0.0).to_array(),
-                    sun: frame.lighting.sun.extend(0.0).to_array(),
+                    sun: frame.lighting.sun_direction().extend(0.0).to_array(),
                 };
                 let (radiance, view_depth) = (pass.image(radiance)?, pass.image(view_depth)?);
                 let cmd = pass.cmd();

@@ -201,9 +201,9 @@ impl Renderer {
             settings,
             readback,
             lighting: Lighting {
-                sun: scene.sun_direction,
-                exposure: 1.0,
+                sun: crate::view::SunPosition::Direction(scene.sun_direction),
                 snow_line: lo + (hi - lo) * 0.8,
+                ..Lighting::default()
             },
             frames_rendered: 0,
             techniques: Techniques { terrain, atlas, points },

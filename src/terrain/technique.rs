@@ -284,7 +284,7 @@ impl Technique for Terrain {
                 view_proj: camera.view_proj(view.aspect()).to_cols_array(),
                 eye: camera.eye.as_vec3().extend(self.geometry.atlas_spacing()).to_array(),
                 forward: camera.forward().as_vec3().extend(pixel_footprint as f32).to_array(),
-                sun: lighting.sun.extend(lighting.snow_line).to_array(),
+                sun: lighting.sun_direction().extend(lighting.snow_line).to_array(),
                 detail_amplitude: settings.detail_amplitude,
                 detail_h: settings.detail_h,
                 noise_tile: noise,

@@ -14,12 +14,12 @@
 pub mod camera;
 pub mod camera_path;
 mod frame;
+pub mod lighting;
 mod targets;
-
-use glam::Vec3;
 
 pub use camera::{frustum_planes, Camera};
 pub use frame::{Frame, FrameContext, Technique};
+pub use lighting::{Exposure, Lighting, ShadowMode, SkyLightMode, SkyModel, SunPosition};
 pub use targets::{SceneTargets, TargetFormats};
 
 use crate::error::{Error, Result};
@@ -81,15 +81,4 @@ pub fn validate_size(width: u32, height: u32) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// The lighting every pass of a frame shares.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Lighting {
-    /// Unit direction towards the sun.
-    pub sun: Vec3,
-    /// Multiplier applied to radiance before tone mapping.
-    pub exposure: f32,
-    /// Altitude (m) above which flat ground is snow-covered.
-    pub snow_line: f32,
 }
