@@ -5,6 +5,14 @@
 
 use bytemuck::{Pod, Zeroable};
 
+/// Angular radius of the sun's disc (rad).
+pub const SUN_ANGULAR_RADIUS: f32 = 0.004_654;
+/// Luminance of the sun's disc above the atmosphere (cd/m²), the absolute
+/// scale every sky model shares.
+pub const SUN_LUMINANCE_EXTRATERRESTRIAL: f32 = 1.96e9;
+/// Colour of the sun above the atmosphere in linear sRGB (luminance 1).
+pub const SUN_COLOUR_EXTRATERRESTRIAL: [f32; 3] = [1.0568, 0.9857, 0.9300];
+
 /// Shadow cascades, at most.
 pub const MAX_CASCADES: usize = 4;
 
@@ -73,6 +81,12 @@ pub struct LightingFrame {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn extraterrestrial_colour_has_unit_luminance() {
+        let [r, g, b] = SUN_COLOUR_EXTRATERRESTRIAL;
+        assert!((0.2126 * r + 0.7152 * g + 0.0722 * b - 1.0).abs() < 1e-3);
+    }
 
     #[test]
     fn layout_matches_std430() {
