@@ -11,7 +11,7 @@ pub const SUN_ANGULAR_RADIUS: f32 = 0.004_654;
 /// scale every sky model shares.
 pub const SUN_LUMINANCE_EXTRATERRESTRIAL: f32 = 1.96e9;
 /// Colour of the sun above the atmosphere in linear sRGB (luminance 1).
-pub const SUN_COLOUR_EXTRATERRESTRIAL: [f32; 3] = [1.0568, 0.9857, 0.9300];
+pub const SUN_COLOUR_EXTRATERRESTRIAL: [f32; 3] = [1.0602, 0.9889, 0.9330];
 
 /// Shadow cascades, at most.
 pub const MAX_CASCADES: usize = 4;
