@@ -22,6 +22,8 @@ struct FrameSlot {
     /// Timestamps the last submission wrote, and its frame number.
     written_queries: u32,
     frame: u64,
+    /// The previous frame's timestamps, read by `wait_for_next`.
+    completed: Option<CompletedFrame>,
 }
 
 /// GPU timestamps of a completed frame, in nanoseconds from the first query.
@@ -77,6 +79,7 @@ impl FrameRing {
                 submitted: 0,
                 written_queries: 0,
                 frame: 0,
+                completed: None,
             });
         }
         Ok(FrameRing {
@@ -119,9 +122,20 @@ impl FrameRing {
     /// The number of the next frame and, once its slot's previous frame has
     /// completed (this waits for it), leave to write that slot's host-visible
     /// per-frame buffers: call before [`FrameRing::begin`] to prepare a frame.
+    ///
+    /// It also reads the timestamps of the slot's previous frame, which may
+    /// block further (lavapipe reports the timeline value reached before the
+    /// queries are available): that wait belongs here, before the frame's
+    /// CPU work starts, not inside the frame's CPU time.
     pub fn wait_for_next(&mut self) -> Result<u64> {
         let slot = (self.next_frame % FRAMES_IN_FLIGHT as u64) as usize;
         self.ctx.wait(self.slots[slot].submitted)?;
+        if self.slots[slot].completed.is_none() {
+            let completed = self.read_timestamps(slot)?;
+            let s = &mut self.slots[slot];
+            s.completed = completed;
+            s.written_queries = 0;
+        }
         Ok(self.next_frame)
     }
 
@@ -130,7 +144,10 @@ impl FrameRing {
     pub fn begin(&mut self, queries: u32) -> Result<(RecordingFrame<'_>, Option<CompletedFrame>)> {
         let slot = (self.next_frame % FRAMES_IN_FLIGHT as u64) as usize;
         self.ctx.wait(self.slots[slot].submitted)?;
-        let completed = self.read_timestamps(slot)?;
+        let completed = match self.slots[slot].completed.take() {
+            Some(c) => Some(c),
+            None => self.read_timestamps(slot)?,
+        };
         let device = &self.ctx.shared.device;
         if queries > self.slots[slot].query_capacity {
             let capacity = queries.next_power_of_two().max(16);
@@ -175,6 +192,9 @@ impl FrameRing {
         self.ctx.wait_idle()?;
         let mut done = Vec::new();
         for slot in 0..self.slots.len() {
+            if let Some(c) = self.slots[slot].completed.take() {
+                done.push(c);
+            }
             if let Some(c) = self.read_timestamps(slot)? {
                 done.push(c);
             }
