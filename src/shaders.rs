@@ -26,6 +26,8 @@ pub const FULL_SCREEN_VERT: SpirV = spirv!("post/full_screen.vert");
 pub const SKY_FRAG: SpirV = spirv!("lighting/sky.frag");
 /// tonemap: HDR → sRGB8.
 pub const TONEMAP: SpirV = spirv!("post/tonemap.comp");
+/// exposure.meter: mean log luminance → the exposure multiplier.
+pub const EXPOSURE_METER: SpirV = spirv!("post/exposure.comp");
 /// points.*: vertex stage of every splat pass (interval test, EWA set-up).
 pub const SPLAT_VERT: SpirV = spirv!("points/splat.vert");
 /// points.visibility: ray–plane depth pushed back by ε.

@@ -6,7 +6,7 @@ layout(push_constant) uniform Push {
     mat4 view_proj;
     vec4 eye;      // xyz, w = d0 (sketch-atlas spacing, metres)
     vec4 forward;  // xyz: camera forward axis; w = pixel footprint per metre of depth
-    vec4 sun;      // xyz: direction towards the sun; w = snow line (m)
+    uvec4 lighting;  // x: storage handle of the view's LightingFrame (lighting.glsl)
     float detail_amplitude;
     float detail_h;
     uint noise_tile;       // sampled handle of the wavelet noise tile

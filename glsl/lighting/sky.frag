@@ -1,22 +1,26 @@
 #version 460
-// sky: analytic sky radiance along each pixel's view ray; depth +inf.
-#include "../include/heap.glsl"
-#include "../include/atmosphere.glsl"
+// sky (§6.3; ALGORITHMS.md §6): the frame's sky model along each pixel's
+// view ray plus the sun disc, in absolute units; view depth +inf; the
+// lighting AOVs of sky pixels are (1, 1).
+#include "../include/sky.glsl"
 
 layout(push_constant) uniform Push {
-    vec4 right;    // xyz: camera right · tan(fov_x/2)
-    vec4 up;       // xyz: camera up · tan(fov_y/2)
-    vec4 forward;  // xyz: camera forward
-    vec4 sun;      // xyz: towards the sun
+    vec4 right;       // xyz: camera right · tan(fov_x/2)
+    vec4 up;          // xyz: camera up · tan(fov_y/2)
+    vec4 forward;     // xyz: camera forward
+    uvec4 lighting;   // x: storage handle of the view's LightingFrame
 } pc;
 
 layout(location = 0) in vec2 in_ndc;
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_depth;
+layout(location = 2) out vec2 out_visibility;
 
 void main() {
     // Vulkan NDC y points down the image: row 0 is the top, so negate.
     vec3 dir = normalize(pc.forward.xyz + in_ndc.x * pc.right.xyz - in_ndc.y * pc.up.xyz);
-    out_color = vec4(sky_radiance(dir, normalize(pc.sun.xyz)), 1.0);
+    uint l = pc.lighting.x;
+    out_color = vec4(sky_radiance(l, dir) + sun_disc_radiance(l, dir), 1.0);
     out_depth = POSITIVE_INFINITY;
+    out_visibility = vec2(1.0);
 }

@@ -7,9 +7,10 @@
 layout(location = 0) out vec4 out_radiance;
 layout(location = 1) out float out_view_depth;
 layout(location = 2) out float out_weight;
+layout(location = 3) out vec2 out_visibility;
 
 void main() {
-    out_radiance = vec4(shade_splat(in_color, in_normal, in_position), 1.0);
+    out_radiance = vec4(shade_splat(in_color, in_normal, in_position, out_visibility), 1.0);
     out_view_depth = -in_position.z;
     out_weight = 1.0;
 }

@@ -10,6 +10,7 @@
 layout(location = 0) out vec4 out_radiance;
 layout(location = 1) out float out_view_depth;
 layout(location = 2) out float out_weight;
+layout(location = 3) out vec2 out_visibility;
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
@@ -22,7 +23,7 @@ void main() {
     float depth = nd.w / cw.a;
     vec3 ray = pixel_ray(gl_FragCoord.xy);
     vec3 position = ray * (depth / -ray.z);
-    out_radiance = vec4(shade_splat(albedo, nd.xyz, position), 1.0);
+    out_radiance = vec4(shade_splat(albedo, nd.xyz, position, out_visibility), 1.0);
     out_view_depth = depth;
     out_weight = cw.a;
 }

@@ -8,6 +8,7 @@
 layout(location = 0) out vec4 out_radiance;
 layout(location = 1) out float out_view_depth;
 layout(location = 2) out float out_weight;
+layout(location = 3) out vec2 out_visibility;
 
 void main() {
     SplatSample s;
@@ -15,7 +16,7 @@ void main() {
         discard;
     }
     gl_FragDepth = depth_of(s.position.z);
-    out_radiance = vec4(shade_splat(in_color.rgb, in_normal.xyz, s.position), 1.0);
+    out_radiance = vec4(shade_splat(in_color.rgb, in_normal.xyz, s.position, out_visibility), 1.0);
     out_view_depth = -s.position.z;
     out_weight = 1.0;
 }

@@ -3,15 +3,17 @@
 // "Colour"; ALGORITHMS.md §3 items 6 and 8): per-pixel bump mapping with the
 // detail octaves between the vertex's split octave and the pixel footprint,
 // surface type from altitude, slope and orientation with turbulence-perturbed
-// boundaries, sun and sky ambient, haze. Writes HDR radiance and view depth.
+// boundaries; lit by the frame's sun (with shadows) and sky light, seen
+// through aerial perspective (§9; glsl/include/surface_lighting.glsl).
+// Writes HDR radiance (absolute), view depth and the lighting AOVs.
 // The debug views colour the same surface by a diagnostic instead.
 #include "../include/heap.glsl"
-#include "../include/atmosphere.glsl"
 #include "../include/terrain_detail.glsl"
 #include "../include/terrain_draw.glsl"
 #include "../include/bspline_height.glsl"
 #include "../include/surface_layers.glsl"
 #include "../include/texture_atlas.glsl"
+#include "../include/surface_lighting.glsl"
 
 
 layout(location = 0) in vec3 in_world;
@@ -22,6 +24,7 @@ layout(location = 4) in vec2 in_grid;
 
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_depth;
+layout(location = 2) out vec2 out_visibility;
 
 // Blue → green → yellow → red for t in [0, 1].
 vec3 ramp(float t) {
@@ -31,7 +34,7 @@ vec3 ramp(float t) {
 
 // Surface type → albedo. Boundaries are perturbed by low-frequency
 // turbulence (the wavelet tile at coarse scales) before classification.
-vec3 albedo(vec3 n, vec3 p, uint tile) {
+vec3 albedo(vec3 n, vec3 p, uint tile, vec3 sun, float snow_line_base) {
     // Turbulence needs no smooth derivative: one bilinear fetch per octave.
     float turb = 0.0;
     float scale = 1.0 / 180.0;
@@ -45,14 +48,14 @@ vec3 albedo(vec3 n, vec3 p, uint tile) {
     float slope = 1.0 - n.z + 0.12 * (turb - 0.3);
     float altitude = p.z + 80.0 * (turb - 0.3);
     // Orientation: slopes facing the sun dry out, slopes facing away keep snow.
-    float facing = dot(normalize(n.xy + 1e-6), normalize(pc.sun.xy + 1e-6)) * (1.0 - n.z) * 4.0;
+    float facing = dot(normalize(n.xy + 1e-6), normalize(sun.xy + 1e-6)) * (1.0 - n.z) * 4.0;
     vec3 grass = vec3(0.16, 0.24, 0.08);
     vec3 dry_grass = vec3(0.34, 0.31, 0.15);
     vec3 rock = vec3(0.34, 0.31, 0.28);
     vec3 snow = vec3(0.90, 0.92, 0.95);
     vec3 c = mix(grass, dry_grass, smoothstep(0.1, 0.6, facing + 0.8 * (turb - 0.3)));
     c = mix(c, rock, smoothstep(0.22, 0.34, slope));
-    float snow_line = pc.sun.w - 60.0 * clamp(-facing, -1.0, 1.0);
+    float snow_line = snow_line_base - 60.0 * clamp(-facing, -1.0, 1.0);
     return mix(c, snow, smoothstep(snow_line, snow_line + 40.0, altitude) * (1.0 - smoothstep(0.38, 0.55, slope)));
 }
 
@@ -63,9 +66,9 @@ void main() {
     bool detail = draw.y != 0u;
     uint tile = pc.noise_tile;
     float d0 = pc.eye.w;
-    vec3 sun = normalize(pc.sun.xyz);
+    uint lighting = pc.lighting.x;
+    vec3 sun = g_lighting[lighting].f.sun.xyz;
     vec3 to_point = in_world - pc.eye.xyz;
-    float dist = length(to_point);
     float depth = dot(to_point, pc.forward.xyz);
     out_depth = depth;
 
@@ -101,12 +104,11 @@ void main() {
             // The layers' displacement bumps the normal on top of the mesh's.
             n = normalize(n + vec3(-extra, 0.0) * n.z);
         } else {
-            a = albedo(n, in_world, tile);
+            a = albedo(n, in_world, tile, sun, g_lighting[lighting].f.exposure.z);
         }
-        vec3 sky_ambient = mix(SKY_HORIZON, SKY_ZENITH, 0.5 + 0.5 * n.z) * (0.5 + 0.5 * n.z);
-        radiance = a * (SUN_RADIANCE * max(dot(n, sun), 0.0) + sky_ambient);
-        radiance = apply_haze(radiance, dist, to_point / max(dist, 1e-6), sun);
+        radiance = shade_diffuse(lighting, a, in_world, n, depth, pc.eye.xyz, out_visibility);
     } else {
+        out_visibility = vec2(1.0);
         vec3 c;
         if (view == VIEW_IMPORTANCE) {
             c = ramp(sqrt(in_debug));
@@ -118,14 +120,15 @@ void main() {
         } else {
             c = vec3(0.55);
         }
+        // Diagnostic colours at a daylight-like scale (the exposure is automatic).
         float light = 0.45 + 0.55 * max(dot(n, sun), 0.0);
-        radiance = c * light;
+        radiance = c * light * 3000.0;
         if (view == VIEW_WIREFRAME) {
             // Every fourth grid line, so the mesh stays legible at small image sizes.
             vec2 g = in_grid / 4.0;
             vec2 f = abs(fract(g + 0.5) - 0.5) / max(fwidth(g), vec2(1e-6));
             float line = 1.0 - clamp(min(f.x, f.y) - 0.5, 0.0, 1.0);
-            radiance = mix(radiance, vec3(0.02, 0.05, 0.12), line);
+            radiance = mix(radiance, vec3(0.02, 0.05, 0.12) * 3000.0, line);
         }
     }
     out_color = vec4(radiance, 1.0);

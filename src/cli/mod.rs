@@ -325,7 +325,9 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
         write_png_rgba8(p, &images.rgba8, images.width, images.height)
     })?;
     outputs.write(&args.exr, |p| {
-        let extra: Vec<(&str, &[f32])> = images.weight.iter().map(|w| ("W", w.as_slice())).collect();
+        let (sun, sky) = (images.visibility_channel(0), images.visibility_channel(1));
+        let mut extra: Vec<(&str, &[f32])> = vec![("sun_visibility", &sun), ("sky_visibility", &sky)];
+        extra.extend(images.weight.iter().map(|w| ("W", w.as_slice())));
         write_exr(p, images.width, images.height, &images.hdr, &images.depth, &extra)
     })?;
     outputs.write(&args.profile, |p| write_profile_json(p, &device, &profiles))?;

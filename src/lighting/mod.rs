@@ -6,3 +6,4 @@
 
 pub mod constants;
 pub mod sky;
+pub mod technique;

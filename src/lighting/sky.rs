@@ -1,11 +1,13 @@
-//! `sky`: a full-screen triangle shading every pixel with the analytic sky
-//! radiance along its view ray and clearing view-space depth to +inf. A
-//! placeholder for the Perez/Preetham sky of §9.1 (ALGORITHMS.md §6).
+//! `sky`: a full-screen triangle shading every pixel with the frame's sky
+//! model (the Perez/Preetham sky of §6.3 or the physical atmosphere;
+//! `glsl/include/sky.glsl`) along its view ray plus the sun disc, in
+//! absolute units, and clearing view-space depth to +inf and the lighting
+//! AOVs to (1, 1).
 
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
-use crate::graph::{ImageAccess, RenderGraph};
+use crate::graph::{ImageAccess, RenderGraph, Stage};
 use crate::shaders;
 use crate::view::{pass_name, Frame, SceneTargets, TargetFormats, View, ViewIndex};
 use crate::vulkan::{Context, GraphicsPipeline, GraphicsPipelineDesc, LoadOp};
@@ -20,8 +22,8 @@ struct SkyPush {
     /// Image up axis scaled by the half-height.
     up: [f32; 4],
     forward: [f32; 4],
-    /// Unit direction towards the sun.
-    sun: [f32; 4],
+    /// x: storage handle of the view's lighting constants.
+    lighting: [u32; 4],
 }
 
 /// The sky: a pipeline, and one `sky` pass per view.
@@ -37,7 +39,7 @@ impl Sky {
             &GraphicsPipelineDesc::full_screen(
                 "sky",
                 (shaders::FULL_SCREEN_VERT, shaders::SKY_FRAG),
-                vec![formats.radiance, formats.view_depth],
+                vec![formats.radiance, formats.view_depth, formats.visibility],
             ),
         )?;
         Ok(Sky {
@@ -48,12 +50,15 @@ impl Sky {
     /// Declares `sky` for view `index`: writes its radiance and view depth.
     pub fn declare(&self, graph: &mut RenderGraph<Frame>, (index, view): (ViewIndex, &View), targets: &SceneTargets) {
         let pipeline = self.pipeline.clone();
-        let (radiance, view_depth) = (targets.radiance, targets.view_depth);
-        graph
-            .pass(&pass_name("sky", &view.name))
-            .graphics()
+        let (radiance, view_depth, visibility) = (targets.radiance, targets.view_depth, targets.visibility);
+        let lighting = targets.lighting.constants;
+        let builder = graph.pass(&pass_name("sky", &view.name)).graphics();
+        targets
+            .lighting
+            .read_in(builder, Stage::Fragment)
             .write(radiance, ImageAccess::ColorAttachmentWrite)
             .write(view_depth, ImageAccess::ColorAttachmentWrite)
+            .write(visibility, ImageAccess::ColorAttachmentWrite)
             .record(move |pass, frame| {
                 let view = frame.view(index)?;
                 let (right, up, forward) = view.camera.ray_basis(view.aspect());
@@ -61,11 +66,19 @@ impl Sky {
                     right: right.extend(0.0).to_array(),
                     up: up.extend(0.0).to_array(),
                     forward: forward.extend(0.0).to_array(),
-                    sun: frame.lighting.sun_direction().extend(0.0).to_array(),
+                    lighting: [pass.upload(lighting)?, 0, 0, 0],
                 };
                 let (radiance, view_depth) = (pass.image(radiance)?, pass.image(view_depth)?);
+                let visibility = pass.image(visibility)?;
                 let cmd = pass.cmd();
-                cmd.begin_rendering(&[(radiance, LoadOp::DontCare), (view_depth, LoadOp::DontCare)], None);
+                cmd.begin_rendering(
+                    &[
+                        (radiance, LoadOp::DontCare),
+                        (view_depth, LoadOp::DontCare),
+                        (visibility, LoadOp::DontCare),
+                    ],
+                    None,
+                );
                 cmd.bind_graphics(&pipeline);
                 cmd.push_constants(&push)?;
                 cmd.draw(3, 1);

@@ -1,3 +1,4 @@
 //! Post-processing: what turns the frame's HDR radiance into its outputs.
 
+pub mod exposure;
 pub mod tonemap;

@@ -1,11 +1,12 @@
-//! `tonemap`: HDR radiance → 8-bit sRGB (exposure, ACES fit, sRGB curve).
+//! `tonemap`: absolute HDR radiance → 8-bit sRGB: the frame's exposure
+//! (`exposure.meter`), a filmic tone curve (Hill's ACES fit), the sRGB curve.
 
 use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
-use crate::graph::{ImageAccess, RenderGraph, Stage};
+use crate::graph::{BufferAccess, BufferId, ImageAccess, RenderGraph, Stage};
 use crate::shaders;
 use crate::view::{pass_name, Frame, SceneTargets, View};
 use crate::vulkan::{ComputePipeline, Context};
@@ -17,13 +18,12 @@ struct TonemapPush {
     /// Storage image handles: HDR radiance (read), sRGB (written).
     radiance: u32,
     display: u32,
-    _pad: [u32; 2],
+    /// Storage handle of the exposure buffer (`exposure.meter`).
+    exposure: u32,
+    _pad: u32,
     width: u32,
     height: u32,
     _pad2: [u32; 2],
-    /// Multiplier applied to radiance before the tone curve.
-    exposure: f32,
-    _pad3: [f32; 3],
 }
 
 /// Tone mapping: a pipeline, and one `tonemap` pass per view.
@@ -39,21 +39,23 @@ impl Tonemap {
         })
     }
 
-    /// Declares `tonemap` for `view`: its radiance into its display image.
-    pub fn declare(&self, graph: &mut RenderGraph<Frame>, view: &View, targets: &SceneTargets) {
+    /// Declares `tonemap` for `view`: its radiance, exposed by `exposure`,
+    /// into its display image.
+    pub fn declare(&self, graph: &mut RenderGraph<Frame>, view: &View, targets: &SceneTargets, exposure: BufferId) {
         let pipeline = self.pipeline.clone();
         let (radiance, display, width, height) = (targets.radiance, targets.display, targets.width, targets.height);
         graph
             .pass(&pass_name("tonemap", &view.name))
             .read(radiance, ImageAccess::StorageRead(Stage::Compute))
+            .read(exposure, BufferAccess::StorageRead(Stage::Compute))
             .write(display, ImageAccess::StorageWrite(Stage::Compute))
-            .record(move |pass, _frame| {
+            .record(move |pass, _| {
                 let push = TonemapPush {
                     radiance: pass.storage_image(radiance)?,
                     display: pass.storage_image(display)?,
+                    exposure: pass.storage_buffer(exposure)?,
                     width,
                     height,
-                    exposure: 1.0,
                     ..TonemapPush::zeroed()
                 };
                 let cmd = pass.cmd();

@@ -24,7 +24,9 @@ pub use scene::Scene;
 use crate::error::{Error, Result};
 use crate::graph::{BakedGraph, BufferId, FrameOutcome, ImageId, RenderGraph};
 use crate::lighting::sky::Sky;
+use crate::lighting::technique::{FieldInfo, SceneLighting};
 use crate::points::render::{PointFrameStats, PointRenderer, SplatSettings};
+use crate::post::exposure::ExposureMeter;
 use crate::post::tonemap::Tonemap;
 use crate::profile::FrameProfile;
 use crate::terrain::geometry_image::TerrainSettings;
@@ -81,6 +83,17 @@ pub struct FrameImages {
     /// W: the accumulated EWA splat weight before normalisation (opaque
     /// splats: 1), 0 where no splat reached; None for scenes without points.
     pub weight: Option<Vec<f32>>,
+    /// The lighting AOVs, 2 floats per pixel: sun visibility (0 = in
+    /// shadow, 1 = lit; the filtered shadow term) and sky visibility (the
+    /// ambient-occlusion term, 1 = open sky); (1, 1) for sky pixels.
+    pub visibility: Vec<f32>,
+}
+
+impl FrameImages {
+    /// One AOV channel of [`FrameImages::visibility`]: 0 sun, 1 sky.
+    pub fn visibility_channel(&self, k: usize) -> Vec<f32> {
+        self.visibility.iter().skip(k).step_by(2).copied().collect()
+    }
 }
 
 struct Readback {
@@ -88,11 +101,13 @@ struct Readback {
     depth: Vec<Arc<Buffer>>,
     ldr: Vec<Arc<Buffer>>,
     weight: Option<Vec<Arc<Buffer>>>,
+    visibility: Vec<Arc<Buffer>>,
 }
 
 /// The techniques of a scene, each with its persistent state.
 /// (The sky and tone mapping prepare nothing: their passes own their pipelines.)
 struct Techniques {
+    lighting: SceneLighting,
     terrain: Option<Terrain>,
     atlas: Option<TextureAtlas>,
     points: Option<PointRenderer>,
@@ -132,6 +147,7 @@ fn declare_readback(ctx: &Context, graph: &mut RenderGraph<Frame>, targets: &Sce
         hdr: host_buffers(ctx, "hdr", pixels * 16)?,
         depth: host_buffers(ctx, "depth", pixels * 4)?,
         ldr: host_buffers(ctx, "srgb", pixels * 4)?,
+        visibility: host_buffers(ctx, "lighting visibility", pixels * 8)?,
         weight: match targets.weight {
             Some(_) => Some(host_buffers(ctx, "splat weight", pixels * 4)?),
             None => None,
@@ -141,6 +157,10 @@ fn declare_readback(ctx: &Context, graph: &mut RenderGraph<Frame>, targets: &Sce
         (targets.radiance, graph.import_buffers_per_frame(rb.hdr.clone())),
         (targets.view_depth, graph.import_buffers_per_frame(rb.depth.clone())),
         (targets.display, graph.import_buffers_per_frame(rb.ldr.clone())),
+        (
+            targets.visibility,
+            graph.import_buffers_per_frame(rb.visibility.clone()),
+        ),
     ];
     if let (Some(image), Some(buffers)) = (targets.weight, &rb.weight) {
         copies.push((image, graph.import_buffers_per_frame(buffers.clone())));
@@ -166,6 +186,7 @@ impl Renderer {
         // The view the graph is declared for; every frame brings its camera.
         let view = View::new(scene.default_camera(), w, h);
         let targets = SceneTargets::declare(&mut graph, &view, !scene.points.is_empty());
+        let lighting = scene_lighting(scene, &targets);
         let sky = Sky::new(ctx, &targets.formats)?;
         sky.declare(&mut graph, (0, &view), &targets);
         let (terrain, atlas) = match scene.draw_terrain {
@@ -183,8 +204,8 @@ impl Renderer {
                 Some(points)
             }
         };
-        let tonemap = Tonemap::new(ctx)?;
-        tonemap.declare(&mut graph, &view, &targets);
+        let exposure = ExposureMeter::new(ctx)?.declare(&mut graph, &view, &targets);
+        Tonemap::new(ctx)?.declare(&mut graph, &view, &targets, exposure);
         let readback = match settings.readback {
             true => Some(declare_readback(ctx, &mut graph, &targets)?),
             false => {
@@ -206,8 +227,28 @@ impl Renderer {
                 ..Lighting::default()
             },
             frames_rendered: 0,
-            techniques: Techniques { terrain, atlas, points },
+            techniques: Techniques {
+                lighting,
+                terrain,
+                atlas,
+                points,
+            },
         })
+    }
+
+    /// The lighting of the next frames.
+    pub fn lighting(&self) -> &Lighting {
+        &self.lighting
+    }
+
+    /// Sets the lighting of the next frames (sun, sky model, exposure,
+    /// shadows, sky light): checked here, so a bad value fails before any
+    /// frame is recorded. The renderer must have been built with the parts
+    /// the lighting uses (see [`RenderSettings::lighting`]).
+    pub fn set_lighting(&mut self, lighting: Lighting) -> Result<()> {
+        lighting.validate()?;
+        self.lighting = lighting;
+        Ok(())
     }
 
     /// The context the renderer draws with.
@@ -230,6 +271,7 @@ impl Renderer {
         let mut stages = Vec::new();
         let mut uploads = self.graph.uploads(index);
         let t = &mut self.techniques;
+        frame.prepare(&mut t.lighting, &mut uploads, &mut stages)?;
         if let Some(terrain) = &mut t.terrain {
             frame.prepare(terrain, &mut uploads, &mut stages)?;
         }
@@ -291,6 +333,7 @@ impl Renderer {
                 Some(w) => Some(floats(&w[slot])?),
                 None => None,
             },
+            visibility: floats(&rb.visibility[slot])?,
         })
     }
 
@@ -343,6 +386,24 @@ impl Renderer {
             None => Ok(Vec::new()),
         }
     }
+}
+
+/// The scene's lighting technique, writing the view's lighting constants.
+fn scene_lighting(scene: &Scene, targets: &SceneTargets) -> SceneLighting {
+    let field = &scene.heights;
+    let extent = field.extent();
+    let (lo, _) = scene.height_range();
+    SceneLighting::new(
+        vec![targets.lighting.constants],
+        FieldInfo {
+            extent: [extent.x as f32, extent.y as f32],
+            texels: [
+                field.columns.saturating_sub(1) as f32,
+                field.rows.saturating_sub(1) as f32,
+            ],
+            ground: lo,
+        },
+    )
 }
 
 /// The terrain of `scene` and, when texturing from the atlas, the texture

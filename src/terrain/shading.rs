@@ -29,8 +29,8 @@ pub struct TerrainDrawPush {
     pub eye: [f32; 4],
     /// xyz, w = pixel footprint per metre of depth.
     pub forward: [f32; 4],
-    /// xyz, w = snow line.
-    pub sun: [f32; 4],
+    /// x: storage handle of the view's lighting constants.
+    pub lighting: [u32; 4],
     pub detail_amplitude: f32,
     pub detail_h: f32,
     /// Sampled handle of the wavelet noise tile.
@@ -75,7 +75,11 @@ fn pipeline(ctx: &Context, targets: &SceneTargets) -> Result<GraphicsPipeline> {
             topology: PrimitiveTopology::TRIANGLE_LIST,
             cull_back_faces: false,
             wireframe: false,
-            color_formats: vec![targets.formats.radiance, targets.formats.view_depth],
+            color_formats: vec![
+                targets.formats.radiance,
+                targets.formats.view_depth,
+                targets.formats.visibility,
+            ],
             blend: Blend::None,
             depth_format: Some(targets.formats.depth),
             depth_test: true,
@@ -115,17 +119,25 @@ pub fn declare_draw_pass(
         }
     }
     let (radiance, view_depth, depth) = (targets.radiance, targets.view_depth, targets.depth);
+    let visibility = targets.visibility;
+    builder = targets.lighting.read_in(builder, Stage::Fragment);
     builder
         .write(radiance, ImageAccess::ColorAttachmentReadWrite)
+        .write(visibility, ImageAccess::ColorAttachmentReadWrite)
         .write(view_depth, ImageAccess::ColorAttachmentReadWrite)
         .write(depth, ImageAccess::DepthAttachmentWrite)
         .record(move |ctx, frame| {
             let push = frame.prepared::<crate::terrain::TerrainFrame>()?.view(pass.view)?.draw;
             let (radiance, view_depth, depth) = (ctx.image(radiance)?, ctx.image(view_depth)?, ctx.image(depth)?);
             let (vertices, indices) = (ctx.buffer(pass.vertices)?, ctx.buffer(pass.indices)?);
+            let visibility = ctx.image(visibility)?;
             let cmd = ctx.cmd();
             cmd.begin_rendering(
-                &[(radiance, LoadOp::Load), (view_depth, LoadOp::Load)],
+                &[
+                    (radiance, LoadOp::Load),
+                    (view_depth, LoadOp::Load),
+                    (visibility, LoadOp::Load),
+                ],
                 Some((depth, Some(1.0))),
             );
             cmd.bind_graphics(&pipeline);

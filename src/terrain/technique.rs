@@ -41,6 +41,8 @@ struct TerrainViewState {
     vertices: BufferId,
     vertices_handle: u32,
     atlas: Option<AtlasBindings>,
+    /// The view's lighting constants (set by `declare_draw`).
+    lighting: Option<UploadRegion>,
 }
 
 /// The terrain: persistent GPU state, `terrain.warp` and `terrain.draw` per
@@ -175,6 +177,7 @@ impl Terrain {
             vertices,
             vertices_handle,
             atlas: None,
+            lighting: None,
         });
         Ok(())
     }
@@ -192,6 +195,7 @@ impl Terrain {
         let state = (self.views.iter_mut().find(|v| v.index == index))
             .ok_or_else(|| Error::Graph(format!("terrain.draw of view {index} before its terrain.warp")))?;
         state.atlas = atlas.cloned();
+        state.lighting = Some(targets.lighting.constants);
         let side = self.geometry.settings.grid_side;
         let pass = DrawPass {
             view: index,
@@ -279,12 +283,15 @@ impl Technique for Terrain {
                 .uploads
                 .write(warp_region, bytemuck::cast_slice(&state.lod.upload))?;
             let pixel_footprint = 2.0 * (0.5 * camera.fov_y_deg.to_radians()).tan() / f64::from(view.height);
-            let lighting = frame.lighting;
+            let lighting = match state.lighting {
+                Some(region) => frame.uploads.handle(region)?,
+                None => return Err(Error::Graph(format!("terrain.draw of view {k} was not declared"))),
+            };
             let draw = TerrainDrawPush {
                 view_proj: camera.view_proj(view.aspect()).to_cols_array(),
                 eye: camera.eye.as_vec3().extend(self.geometry.atlas_spacing()).to_array(),
                 forward: camera.forward().as_vec3().extend(pixel_footprint as f32).to_array(),
-                sun: lighting.sun_direction().extend(lighting.snow_line).to_array(),
+                lighting: [lighting, 0, 0, 0],
                 detail_amplitude: settings.detail_amplitude,
                 detail_h: settings.detail_h,
                 noise_tile: noise,

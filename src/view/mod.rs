@@ -20,7 +20,7 @@ mod targets;
 pub use camera::{frustum_planes, Camera};
 pub use frame::{Frame, FrameContext, Technique};
 pub use lighting::{Exposure, Lighting, ShadowMode, SkyLightMode, SkyModel, SunPosition};
-pub use targets::{SceneTargets, TargetFormats};
+pub use targets::{LightingInputs, SceneTargets, TargetFormats, LIGHTING_CONSTANTS_BYTES};
 
 use crate::error::{Error, Result};
 

@@ -3,8 +3,13 @@
 //! literal of their own.
 
 use super::View;
-use crate::graph::{ImageId, ImageInfo, RenderGraph};
+use crate::graph::{
+    BufferAccess, BufferId, ImageAccess, ImageId, ImageInfo, PassBuilder, RenderGraph, Stage, UploadRegion,
+};
 use crate::vulkan::Format;
+
+/// Bytes of one view's lighting constants (`crate::lighting::constants::LightingFrame`).
+pub const LIGHTING_CONSTANTS_BYTES: u64 = 592;
 
 /// Formats of the scene targets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -21,6 +26,8 @@ pub struct TargetFormats {
     pub display: Format,
     /// The points passes' float accumulation targets (colour·w, w; normal·w, depth·w).
     pub accumulation: Format,
+    /// The lighting AOVs: sun visibility, sky visibility.
+    pub visibility: Format,
 }
 
 impl Default for TargetFormats {
@@ -32,12 +39,40 @@ impl Default for TargetFormats {
             weight: Format::R32_SFLOAT,
             display: Format::R8G8B8A8_UNORM,
             accumulation: Format::R32G32B32A32_SFLOAT,
+            visibility: Format::R32G32_SFLOAT,
         }
     }
 }
 
+/// What every shading pass of a view reads for its lighting (§9): the
+/// view's lighting constants (an upload region the lighting technique writes
+/// in its prepare step) and the images and buffers the lighting passes
+/// write (lookup tables, shadow atlas, sky-light maps), which the pass must
+/// declare as reads so the graph orders it after them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightingInputs {
+    pub constants: UploadRegion,
+    pub images: Vec<ImageId>,
+    pub buffers: Vec<BufferId>,
+}
+
+impl LightingInputs {
+    /// Declares the reads of a pass whose shaders (at `stage`) shade with
+    /// the lighting.
+    pub fn read_in<'g, P: 'static>(&self, mut builder: PassBuilder<'g, P>, stage: Stage) -> PassBuilder<'g, P> {
+        builder = builder.read(self.constants, BufferAccess::StorageRead(stage));
+        for &image in &self.images {
+            builder = builder.read(image, ImageAccess::Sampled(stage));
+        }
+        for &buffer in &self.buffers {
+            builder = builder.read(buffer, BufferAccess::StorageRead(stage));
+        }
+        builder
+    }
+}
+
 /// One view's render targets (transient images of the frame graph).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SceneTargets {
     pub width: u32,
     pub height: u32,
@@ -52,6 +87,11 @@ pub struct SceneTargets {
     pub weight: Option<ImageId>,
     /// Tone-mapped sRGB (`formats.display`).
     pub display: ImageId,
+    /// The lighting AOVs (`formats.visibility`): sun visibility (0 = in
+    /// shadow, 1 = lit) and sky visibility (1 = open sky); 1, 1 for sky.
+    pub visibility: ImageId,
+    /// The view's lighting.
+    pub lighting: LightingInputs,
 }
 
 impl SceneTargets {
@@ -60,6 +100,7 @@ impl SceneTargets {
         let formats = TargetFormats::default();
         let (w, h) = (view.width, view.height);
         let name = |what: &str| super::pass_name(what, &view.name);
+        let constants = graph.upload_region(&name("lighting"), LIGHTING_CONSTANTS_BYTES);
         let mut image = |what: &str, format| graph.create_image(&name(what), ImageInfo::new(w, h, format));
         SceneTargets {
             width: w,
@@ -70,6 +111,12 @@ impl SceneTargets {
             depth: image("depth buffer", formats.depth),
             display: image("srgb", formats.display),
             weight: weight.then(|| image("splat weight", formats.weight)),
+            visibility: image("lighting visibility", formats.visibility),
+            lighting: LightingInputs {
+                constants,
+                images: Vec::new(),
+                buffers: Vec::new(),
+            },
         }
     }
 }

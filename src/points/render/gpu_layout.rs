@@ -3,7 +3,7 @@
 //! the instances to draw.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{DMat3, DMat4, DVec3, Vec3};
+use glam::{DMat3, DMat4, DVec3};
 
 use super::SplatSettings;
 use crate::points::build::hybrid::HybridMesh;
@@ -81,8 +81,9 @@ pub struct FrameHeader {
     pub depth: [f32; 4],
     /// Width, height, largest point size, near plane.
     pub viewport: [f32; 4],
-    /// Sun direction in camera space; w = 1 shaded, 0 unlit (albedo).
-    pub sun_camera: [f32; 4],
+    /// x: storage handle of the view's lighting constants; y: 1 shaded, 0
+    /// unlit (albedo).
+    pub lighting: [u32; 4],
     /// Rows of the camera → world rotation.
     pub camera_to_world: [[f32; 4]; 3],
     /// World eye position; w = 1 two-sided splats, 0 back-facing splats culled.
@@ -137,7 +138,7 @@ pub fn view_and_intrinsics(camera: &Camera, width: u32, height: u32) -> (DMat4, 
 pub fn frame_header(
     camera: &Camera,
     (width, height): (u32, u32),
-    sun_world: Vec3,
+    lighting: u32,
     settings: &SplatSettings,
     max_point_size: f32,
 ) -> (FrameHeader, DMat4) {
@@ -152,13 +153,12 @@ pub fn frame_header(
     // glam's perspective_rh: depth = (far/(near−far)·z + near·far/(near−far)) / −z.
     let p22 = far / (near - far);
     let p32 = near * far / (near - far);
-    let sun = (view3 * sun_world.as_dvec3()).normalize_or_zero();
     let header = FrameHeader {
         k: rows(k),
         k_inv: rows(k_inv),
         depth: [p22 as f32, p32 as f32, settings.visibility_offset, settings.cutoff],
         viewport: [width as f32, height as f32, max_point_size, near as f32],
-        sun_camera: sun.as_vec3().extend(if settings.shaded { 1.0 } else { 0.0 }).to_array(),
+        lighting: [lighting, settings.shaded as u32, 0, 0],
         camera_to_world: rows(view3.transpose()),
         eye: camera
             .eye

@@ -90,6 +90,10 @@ pub(super) struct PointView {
     pub view_depth: ImageId,
     pub depth: ImageId,
     pub weight: ImageId,
+    /// The lighting AOVs.
+    pub visibility: ImageId,
+    /// The view's lighting constants.
+    pub lighting: UploadRegion,
     /// Clear the depth buffer first (no terrain drew into it).
     pub clear_depth: bool,
 }
@@ -290,6 +294,7 @@ pub(super) fn declare_opaque(
         targets.formats.radiance,
         targets.formats.view_depth,
         targets.formats.weight,
+        targets.formats.visibility,
     ];
     let spec = |name, fragment| PipelineSpec {
         name,
@@ -309,10 +314,13 @@ pub(super) fn declare_opaque(
         },
     )?;
     let builder = buffers.read_by(graph.pass(name).graphics(), view.frame, true);
-    builder
+    targets
+        .lighting
+        .read_in(builder, Stage::Fragment)
         .write(view.radiance, ImageAccess::ColorAttachmentReadWrite)
         .write(view.view_depth, ImageAccess::ColorAttachmentReadWrite)
         .write(view.weight, ImageAccess::ColorAttachmentWrite)
+        .write(view.visibility, ImageAccess::ColorAttachmentReadWrite)
         .write(view.depth, ImageAccess::DepthAttachmentWrite)
         .record(move |pass, frame| {
             let plan = plan_of(frame, view.index)?;
@@ -320,12 +328,14 @@ pub(super) fn declare_opaque(
             let triangles = buffers.triangle_handle(pass)?;
             let (radiance, view_depth) = (pass.image(view.radiance)?, pass.image(view.view_depth)?);
             let (weight, depth) = (pass.image(view.weight)?, pass.image(view.depth)?);
+            let visibility = pass.image(view.visibility)?;
             let cmd = pass.cmd();
             cmd.begin_rendering(
                 &[
                     (radiance, LoadOp::Load),
                     (view_depth, LoadOp::Load),
                     (weight, LoadOp::Clear([0.0; 4])),
+                    (visibility, LoadOp::Load),
                 ],
                 Some((depth, view.clear_depth.then_some(1.0))),
             );
@@ -484,18 +494,20 @@ fn declare_normalize(
         &GraphicsPipelineDesc::full_screen(
             "points.normalize",
             (shaders::FULL_SCREEN_VERT, shaders::SPLAT_NORMALIZE_FRAG),
-            vec![formats.radiance, formats.view_depth, formats.weight],
+            vec![formats.radiance, formats.view_depth, formats.weight, formats.visibility],
         ),
     )?);
-    graph
-        .pass(name)
-        .graphics()
+    let builder = graph.pass(name).graphics();
+    targets
+        .lighting
+        .read_in(builder, Stage::Fragment)
         .read(accumulation.color_weight, ImageAccess::Sampled(Stage::Fragment))
         .read(accumulation.normal_depth, ImageAccess::Sampled(Stage::Fragment))
         .read(view.frame, BufferAccess::StorageRead(Stage::Fragment))
         .write(view.radiance, ImageAccess::ColorAttachmentReadWrite)
         .write(view.view_depth, ImageAccess::ColorAttachmentReadWrite)
         .write(view.weight, ImageAccess::ColorAttachmentWrite)
+        .write(view.visibility, ImageAccess::ColorAttachmentReadWrite)
         .record(move |pass, _| {
             let push = NormalizePush {
                 color_weight: pass.sampled(accumulation.color_weight)?,
@@ -504,13 +516,14 @@ fn declare_normalize(
                 _pad: [0; 5],
             };
             let (radiance, view_depth) = (pass.image(view.radiance)?, pass.image(view.view_depth)?);
-            let weight = pass.image(view.weight)?;
+            let (weight, visibility) = (pass.image(view.weight)?, pass.image(view.visibility)?);
             let cmd = pass.cmd();
             cmd.begin_rendering(
                 &[
                     (radiance, LoadOp::Load),
                     (view_depth, LoadOp::Load),
                     (weight, LoadOp::Clear([0.0; 4])),
+                    (visibility, LoadOp::Load),
                 ],
                 None,
             );

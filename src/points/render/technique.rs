@@ -192,6 +192,8 @@ impl PointRenderer {
             view_depth: targets.view_depth,
             depth: targets.depth,
             weight,
+            visibility: targets.visibility,
+            lighting: targets.lighting.constants,
             clear_depth,
         };
         let name = |base| pass_name(base, &view.name);
@@ -245,7 +247,7 @@ impl Technique for PointRenderer {
             let (header, view_matrix) = frame_header(
                 camera,
                 size,
-                frame.lighting.sun_direction(),
+                frame.uploads.handle(point_view.lighting)?,
                 &self.settings,
                 self.max_point_size,
             );

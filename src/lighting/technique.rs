@@ -1,0 +1,125 @@
+//! The lighting technique (§6.3, §9): its prepare step turns the frame's
+//! [`Lighting`] request into each view's [`LightingFrame`] constants (sun,
+//! sky model coefficients, aerial perspective, cascades, map handles) in the
+//! view's upload region ([`crate::view::LightingInputs::constants`]), which
+//! every shading pass reads; the lighting passes (lookup tables, shadow
+//! casters, sky light) are declared by its parts.
+
+use glam::Vec3;
+
+use super::constants::*;
+use crate::error::Result;
+use crate::graph::UploadRegion;
+use crate::view::{FrameContext, Lighting, ShadowMode, SkyLightMode, SkyModel, Technique};
+
+/// What the height field contributes to the constants.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FieldInfo {
+    /// Extent (m) of the field: texel centres run from 0 to it.
+    pub extent: [f32; 2],
+    /// Columns − 1, rows − 1.
+    pub texels: [f32; 2],
+    /// Lowest height (m): the ground of the atmosphere.
+    pub ground: f32,
+}
+
+/// The frame's lighting constants, per view, as written.
+pub struct PreparedLighting {
+    pub views: Vec<LightingFrame>,
+}
+
+/// The lighting of a scene: per-view constant regions and the parts'
+/// persistent state.
+pub struct SceneLighting {
+    /// The constants region of each view.
+    regions: Vec<UploadRegion>,
+    field: FieldInfo,
+}
+
+impl SceneLighting {
+    /// Lighting for views whose constants go to `regions`.
+    pub fn new(regions: Vec<UploadRegion>, field: FieldInfo) -> SceneLighting {
+        SceneLighting { regions, field }
+    }
+
+    /// The constants of one view (without view-dependent parts).
+    fn constants(&self, lighting: &Lighting) -> LightingFrame {
+        let mut f = LightingFrame::zeroed_frame();
+        let sun = lighting.sun_direction();
+        f.sun = sun.extend(SUN_ANGULAR_RADIUS).to_array();
+        let radiance = sun_radiance_placeholder(sun);
+        let solid_angle = std::f32::consts::PI * SUN_ANGULAR_RADIUS * SUN_ANGULAR_RADIUS;
+        f.sun_radiance = radiance.extend(0.0).to_array();
+        f.sun_irradiance = (radiance * solid_angle).extend(0.0).to_array();
+        f.zenith = [8000.0, 0.3, 0.3, lighting.turbidity];
+        f.models = [
+            match lighting.sky {
+                SkyModel::Preetham => SKY_PREETHAM,
+                SkyModel::Physical => SKY_PHYSICAL,
+            },
+            match lighting.shadows {
+                ShadowMode::Off => SHADOWS_OFF,
+                ShadowMode::Cascaded => SHADOWS_CASCADED,
+                ShadowMode::Horizon => SHADOWS_HORIZON,
+            },
+            match lighting.sky_light {
+                SkyLightMode::Off => SKY_LIGHT_OFF,
+                SkyLightMode::Reference => SKY_LIGHT_REFERENCE,
+                SkyLightMode::Sh => SKY_LIGHT_SH,
+                SkyLightMode::Ao => SKY_LIGHT_AO,
+                SkyLightMode::Patches => SKY_LIGHT_PATCHES,
+            },
+            match lighting.albedo_override {
+                Some(_) => LIGHTING_ALBEDO_OVERRIDE,
+                None => 0,
+            },
+        ];
+        f.exposure = [0.0, 0.0, lighting.snow_line, lighting.albedo_override.unwrap_or(0.0)];
+        f.field = [
+            self.field.extent[0],
+            self.field.extent[1],
+            self.field.texels[0],
+            self.field.texels[1],
+        ];
+        f
+    }
+}
+
+/// The transmitted sun until the sky model lands: the extraterrestrial sun
+/// through a Rayleigh-only air mass.
+fn sun_radiance_placeholder(sun: Vec3) -> Vec3 {
+    let colour = Vec3::from(SUN_COLOUR_EXTRATERRESTRIAL) * SUN_LUMINANCE_EXTRATERRESTRIAL;
+    let mass = 1.0 / sun.z.max(0.02);
+    let tau = Vec3::new(0.05, 0.11, 0.27);
+    colour * Vec3::new((-tau.x * mass).exp(), (-tau.y * mass).exp(), (-tau.z * mass).exp()) * (sun.z > 0.0) as u8 as f32
+}
+
+impl LightingFrame {
+    /// All zeros.
+    pub fn zeroed_frame() -> LightingFrame {
+        bytemuck::Zeroable::zeroed()
+    }
+}
+
+impl Technique for SceneLighting {
+    type Prepared = PreparedLighting;
+
+    fn name(&self) -> &'static str {
+        "lighting"
+    }
+
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<PreparedLighting> {
+        frame.lighting.validate()?;
+        let mut views = Vec::with_capacity(frame.views.len());
+        for (k, _view) in frame.views.iter().enumerate() {
+            let constants = self.constants(frame.lighting);
+            let region = *self
+                .regions
+                .get(k)
+                .ok_or_else(|| crate::error::Error::Graph(format!("view {k} has no lighting constants region")))?;
+            frame.uploads.write_pod(region, &constants)?;
+            views.push(constants);
+        }
+        Ok(PreparedLighting { views })
+    }
+}
