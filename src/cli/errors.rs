@@ -19,6 +19,19 @@ const FLAGS: &[(&str, &str)] = &[
     ("points.epsilon", "--epsilon"),
     ("points.primitive", "--splat-primitive"),
     ("points.transform", "--points-transform"),
+    ("lighting.sun_elevation", "--sun-elevation"),
+    ("lighting.sun_azimuth", "--sun-azimuth"),
+    ("lighting.turbidity", "--turbidity"),
+    ("lighting.exposure", "--exposure"),
+    ("lighting.sh_bands", "--sh-bands"),
+    ("lighting.bounces", "--bounces"),
+    ("lighting.sky_patches", "--sky-patches"),
+    ("lighting.albedo_override", "--albedo-override"),
+    ("lighting.sky_preset", "--sky-preset"),
+    ("lighting.date", "--date"),
+    ("lighting.time", "--time"),
+    ("lighting.latitude", "--latitude"),
+    ("lighting.longitude", "--longitude"),
 ];
 
 /// The flag(s) that set library parameter `parameter`: a [`FLAGS`] entry;

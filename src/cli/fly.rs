@@ -107,7 +107,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     let mut wall_ms = Vec::with_capacity(cameras.len());
     let texture_stats;
     let profiles = {
-        let settings = render_settings(&args.scene, staging.is_some())?;
+        let settings = render_settings(&args.scene, &scene, staging.is_some())?;
         let mut renderer = Renderer::new(&ctx, &scene, settings)?;
         let bar = ProgressBar::new(cameras.len() as u64);
         bar.set_style(

@@ -3,6 +3,7 @@
 mod args;
 mod errors;
 mod fly;
+mod lighting;
 mod orbit;
 mod points;
 mod spt;
@@ -166,7 +167,9 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
 }
 
 /// Render settings of the scene arguments.
-fn render_settings(args: &SceneArgs, readback: bool) -> Result<RenderSettings> {
+fn render_settings(args: &SceneArgs, scene: &Scene, readback: bool) -> Result<RenderSettings> {
+    let lighting = lighting::lighting(&args.lighting, scene.default_lighting())?;
+    lighting.validate()?;
     Ok(RenderSettings {
         width: args.width,
         height: args.height,
@@ -179,6 +182,7 @@ fn render_settings(args: &SceneArgs, readback: bool) -> Result<RenderSettings> {
             args::TexturingArg::Atlas => alpenglow::texturing::gpu_layout::TexturingMode::Atlas,
         },
         texture_streaming: texture_streaming(args),
+        lighting: Some(lighting),
     })
 }
 
@@ -298,7 +302,7 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
     let report = ctx.validation_report();
     let device = ctx.info().name.clone();
     let (images, profiles) = {
-        let settings = render_settings(&args.scene, true)?;
+        let settings = render_settings(&args.scene, &scene, true)?;
         let mut renderer = Renderer::new(&ctx, &scene, settings)?;
         let frame = renderer.render_settled(&camera, MAX_SETTLE_FRAMES)?;
         let images = renderer.read(&frame)?;
@@ -355,7 +359,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     let texture_stats;
     let settle_frames;
     let profiles = {
-        let settings = render_settings(&args.scene, false)?;
+        let settings = render_settings(&args.scene, &scene, false)?;
         let mut renderer = Renderer::new(&ctx, &scene, settings)?;
         // A still view: first every texture tile (untimed), then warm-up and timed frames.
         settle_frames = renderer.render_settled(&camera, MAX_SETTLE_FRAMES)?.frame + 1;

@@ -52,6 +52,9 @@ pub struct RenderSettings {
     pub texturing: TexturingMode,
     /// Tile streaming of [`TexturingMode::Atlas`].
     pub texture_streaming: TextureStreaming,
+    /// The lighting of the first frames (None: [`Scene::default_lighting`]);
+    /// change it between frames with [`Renderer::set_lighting`].
+    pub lighting: Option<Lighting>,
 }
 
 impl RenderSettings {
@@ -65,6 +68,7 @@ impl RenderSettings {
             points: SplatSettings::default(),
             texturing: TexturingMode::default(),
             texture_streaming: TextureStreaming::for_image(width, height),
+            lighting: None,
         }
     }
 }
@@ -186,7 +190,7 @@ impl Renderer {
         // The view the graph is declared for; every frame brings its camera.
         let view = View::new(scene.default_camera(), w, h);
         let targets = SceneTargets::declare(&mut graph, &view, !scene.points.is_empty());
-        let lighting = scene_lighting(scene, &targets);
+        let scene_lighting = scene_lighting(scene, &targets);
         let sky = Sky::new(ctx, &targets.formats)?;
         sky.declare(&mut graph, (0, &view), &targets);
         let (terrain, atlas) = match scene.draw_terrain {
@@ -214,21 +218,18 @@ impl Renderer {
             }
         };
         let graph = graph.bake(ctx)?;
-        let (lo, hi) = scene.height_range();
+        let lighting = settings.lighting.unwrap_or_else(|| scene.default_lighting());
+        lighting.validate()?;
         Ok(Renderer {
             ctx: ctx.clone(),
             frames: FrameRing::new(ctx)?,
             graph,
             settings,
             readback,
-            lighting: Lighting {
-                sun: crate::view::SunPosition::Direction(scene.sun_direction),
-                snow_line: lo + (hi - lo) * 0.8,
-                ..Lighting::default()
-            },
+            lighting,
             frames_rendered: 0,
             techniques: Techniques {
-                lighting,
+                lighting: scene_lighting,
                 terrain,
                 atlas,
                 points,

@@ -10,6 +10,7 @@ use crate::points::build::spt::{epsilon_from_pixels, SptOptions};
 use crate::points::scene::{scatter_rocks, PointScene};
 use crate::terrain::procedural::ProceduralTerrain;
 use crate::view::camera::Camera;
+use crate::view::{Lighting, SunPosition};
 
 /// Rocks of the default scene: distinct shapes, surfels per shape, instances.
 pub const DEFAULT_ROCKS: (usize, usize, usize) = (4, 4000, 300);
@@ -61,6 +62,17 @@ impl Scene {
         let rocks = scatter_rocks(&self.heights, shapes, samples, count, (3.0, 16.0), 0xA1BE, &spt)?;
         self.points.append(rocks);
         Ok(())
+    }
+
+    /// The default lighting of the scene: its sun, a snow line at 80 % of
+    /// its height range, the rest [`Lighting::default`].
+    pub fn default_lighting(&self) -> Lighting {
+        let (lo, hi) = self.height_range();
+        Lighting {
+            sun: SunPosition::Direction(self.sun_direction),
+            snow_line: lo + (hi - lo) * 0.8,
+            ..Lighting::default()
+        }
     }
 
     /// A scene of `heights` with the default sun and no point objects.

@@ -1,0 +1,157 @@
+//! The lighting flags (§6.3, §9): sun position by angles, by date and place
+//! or by a preset, sky model, turbidity, exposure, shadows, sky light.
+
+use clap::{Args, ValueEnum};
+
+use alpenglow::view::{Exposure, Lighting, ShadowMode, SkyLightMode, SkyModel, SunPosition};
+
+#[derive(Args, Debug, Clone, Default)]
+pub struct LightingArgs {
+    /// Sun elevation above the horizon, degrees (-90..90).
+    #[arg(long = "sun-elevation", allow_hyphen_values = true)]
+    pub sun_elevation: Option<f32>,
+    /// Sun azimuth, degrees clockwise from +Y (north of the height field).
+    #[arg(long = "sun-azimuth", allow_hyphen_values = true)]
+    pub sun_azimuth: Option<f32>,
+    /// Date YYYY-MM-DD for the solar position (with --time, --latitude, --longitude).
+    #[arg(long)]
+    pub date: Option<String>,
+    /// Local mean solar time HH:MM (with --date).
+    #[arg(long)]
+    pub time: Option<String>,
+    /// Latitude, degrees north (with --date).
+    #[arg(long, allow_hyphen_values = true)]
+    pub latitude: Option<f64>,
+    /// Longitude, degrees east (with --date).
+    #[arg(long, allow_hyphen_values = true)]
+    pub longitude: Option<f64>,
+    /// The text's environments of Fig. 9.3: morning (day 298 07:30) or noon (day 180 12:00), 49.6° N, T = 2.1.
+    #[arg(long = "sky-preset")]
+    pub sky_preset: Option<String>,
+    /// Atmospheric turbidity T (1.7..10; default 3, or the preset's).
+    #[arg(long)]
+    pub turbidity: Option<f32>,
+    /// Sky model.
+    #[arg(long, value_enum, default_value_t = SkyArg::Physical)]
+    pub sky: SkyArg,
+    /// Exposure: EV100, or "auto" (metered from the frame).
+    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
+    pub exposure: String,
+    /// Sun shadows.
+    #[arg(long, value_enum, default_value_t = ShadowArg::Cascaded)]
+    pub shadows: ShadowArg,
+    /// Sky light on the terrain (§9.3–9.5).
+    #[arg(long, value_enum, default_value_t = LightingArg::Sh)]
+    pub lighting: LightingArg,
+    /// Spherical-harmonic bands of --lighting sh: 3 or 5.
+    #[arg(long = "sh-bands", default_value_t = 5)]
+    pub sh_bands: u32,
+    /// Interreflection bounces of the sky-light transfer: 0, 1 or 2.
+    #[arg(long, default_value_t = 1)]
+    pub bounces: u32,
+    /// Sky patches per side of --lighting patches: 4 (16 patches) or 8 (64).
+    #[arg(long = "sky-patches", default_value_t = 8)]
+    pub sky_patches: u32,
+    /// Render every surface with this albedo (1: white diffuse).
+    #[arg(long = "albedo-override")]
+    pub albedo_override: Option<f32>,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SkyArg {
+    /// Preetham/Perez analytic sky (§6.3).
+    Preetham,
+    /// Rayleigh + Mie + ozone lookup tables (Hillaire 2020).
+    #[default]
+    Physical,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ShadowArg {
+    /// Cascaded shadow maps (terrain and points).
+    #[default]
+    Cascaded,
+    /// Horizon maps of the height field.
+    Horizon,
+    Off,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum LightingArg {
+    /// Monte Carlo ray tracing of the height field (slow; still frames).
+    Reference,
+    /// Precomputed radiance transfer in spherical harmonics.
+    #[default]
+    Sh,
+    /// Ambient occlusion with bent normals.
+    Ao,
+    /// Sky as constant patches with per-patch visibility.
+    Patches,
+    /// Unoccluded sky light.
+    Off,
+}
+
+/// A one-line error naming `flag`.
+fn bad(flag: &str, message: impl std::fmt::Display) -> anyhow::Error {
+    anyhow::anyhow!("invalid {flag}: {message}")
+}
+
+/// The lighting of the arguments, on top of `base` (the scene's sun and
+/// snow line).
+pub fn lighting(args: &LightingArgs, base: Lighting) -> anyhow::Result<Lighting> {
+    let mut l = Lighting {
+        sky: match args.sky {
+            SkyArg::Preetham => SkyModel::Preetham,
+            SkyArg::Physical => SkyModel::Physical,
+        },
+        shadows: match args.shadows {
+            ShadowArg::Cascaded => ShadowMode::Cascaded,
+            ShadowArg::Horizon => ShadowMode::Horizon,
+            ShadowArg::Off => ShadowMode::Off,
+        },
+        sky_light: match args.lighting {
+            LightingArg::Reference => SkyLightMode::Reference,
+            LightingArg::Sh => SkyLightMode::Sh,
+            LightingArg::Ao => SkyLightMode::Ao,
+            LightingArg::Patches => SkyLightMode::Patches,
+            LightingArg::Off => SkyLightMode::Off,
+        },
+        sh_bands: args.sh_bands,
+        bounces: args.bounces,
+        sky_patches: args.sky_patches,
+        albedo_override: args.albedo_override,
+        ..base
+    };
+    l.exposure = match args.exposure.as_str() {
+        "auto" => Exposure::Auto,
+        ev => Exposure::Ev100(
+            ev.parse::<f32>()
+                .map_err(|_| bad("--exposure", format!("{ev:?}: expected an EV100 number or \"auto\"")))?,
+        ),
+    };
+    sun_position(args, &mut l)?;
+    if let Some(t) = args.turbidity {
+        l.turbidity = t;
+    }
+    Ok(l)
+}
+
+/// The sun (and a preset's turbidity) of the arguments.
+fn sun_position(args: &LightingArgs, l: &mut Lighting) -> anyhow::Result<()> {
+    let angles = args.sun_elevation.is_some() || args.sun_azimuth.is_some();
+    let place = args.date.is_some() || args.time.is_some() || args.latitude.is_some() || args.longitude.is_some();
+    let preset = args.sky_preset.is_some();
+    if (angles as u8 + place as u8 + preset as u8) > 1 {
+        return Err(bad(
+            "--sun-elevation/--date/--sky-preset",
+            "give the sun by angles, by date and place, or by a preset, not several",
+        ));
+    }
+    if angles {
+        l.sun = SunPosition::Angles {
+            elevation_deg: args.sun_elevation.unwrap_or(30.0),
+            azimuth_deg: args.sun_azimuth.unwrap_or(180.0),
+        };
+    }
+    Ok(())
+}
