@@ -26,6 +26,7 @@ const uint SKY_LIGHT_PATCHES = 4u;
 const uint LIGHTING_SUN_IN_ENVIRONMENT = 1u;  // the sun is part of the sky-light environment (figures)
 const uint LIGHTING_ALBEDO_OVERRIDE = 2u;     // every surface has albedo exposure.w
 const uint LIGHTING_NO_SUN_DIRECT = 4u;       // no direct sun term (sky light only)
+const uint LIGHTING_NO_AERIAL_PERSPECTIVE = 8u;
 
 struct LightingFrame {
     vec4 sun;              // xyz: unit vector towards the sun (+Z up); w: angular radius of the disc (rad)

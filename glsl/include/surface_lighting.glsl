@@ -35,6 +35,9 @@ vec3 shade_diffuse(uint lighting, vec3 albedo, vec3 world, vec3 normal, float vi
         radiance += a / PI * g_lighting[lighting].f.sun_irradiance.rgb * max(dot(normal, sun), 0.0) * sun_vis;
     }
     visibility = vec2(sun_vis, sky.a);
+    if ((flags & LIGHTING_NO_AERIAL_PERSPECTIVE) != 0u) {
+        return radiance;
+    }
     return aerial_perspective(lighting, radiance, eye, world);
 }
 

@@ -33,6 +33,7 @@ pub const SKY_LIGHT_PATCHES: u32 = 4;
 pub const LIGHTING_SUN_IN_ENVIRONMENT: u32 = 1;
 pub const LIGHTING_ALBEDO_OVERRIDE: u32 = 2;
 pub const LIGHTING_NO_SUN_DIRECT: u32 = 4;
+pub const LIGHTING_NO_AERIAL_PERSPECTIVE: u32 = 8;
 
 /// One view's lighting constants (std430, field for field as in GLSL).
 #[repr(C)]

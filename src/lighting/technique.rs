@@ -72,6 +72,9 @@ impl SceneLighting {
             match lighting.albedo_override {
                 Some(_) => LIGHTING_ALBEDO_OVERRIDE,
                 None => 0,
+            } | match lighting.aerial_perspective {
+                true => 0,
+                false => LIGHTING_NO_AERIAL_PERSPECTIVE,
             },
         ];
         f.exposure = [0.0, 0.0, lighting.snow_line, lighting.albedo_override.unwrap_or(0.0)];

@@ -85,6 +85,9 @@ pub struct Lighting {
     pub sky_patches: u32,
     /// Every surface this albedo (white diffuse: 1) instead of its texture.
     pub albedo_override: Option<f32>,
+    /// Aerial perspective on everything drawn (false: surfaces as if seen
+    /// from up close; checks and figures).
+    pub aerial_perspective: bool,
     /// Altitude (m) above which flat ground is snow-covered (classic texturing).
     pub snow_line: f32,
 }
@@ -105,6 +108,7 @@ impl Default for Lighting {
             bounces: 1,
             sky_patches: 8,
             albedo_override: None,
+            aerial_perspective: true,
             snow_line: f32::INFINITY,
         }
     }
