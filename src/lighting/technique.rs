@@ -75,6 +75,9 @@ impl SceneLighting {
             } | match lighting.aerial_perspective {
                 true => 0,
                 false => LIGHTING_NO_AERIAL_PERSPECTIVE,
+            } | match lighting.sun_in_sky_light {
+                true => LIGHTING_SUN_IN_ENVIRONMENT | LIGHTING_NO_SUN_DIRECT,
+                false => 0,
             },
         ];
         f.exposure = [0.0, 0.0, lighting.snow_line, lighting.albedo_override.unwrap_or(0.0)];

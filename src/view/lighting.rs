@@ -85,6 +85,10 @@ pub struct Lighting {
     pub sky_patches: u32,
     /// Every surface this albedo (white diffuse: 1) instead of its texture.
     pub albedo_override: Option<f32>,
+    /// The sun is part of the sky-light environment (projected into SH,
+    /// patches, sampled by the reference) instead of a separate direct term
+    /// with shadows: the text's "sun + sky" comparisons (Fig. 9.4).
+    pub sun_in_sky_light: bool,
     /// Aerial perspective on everything drawn (false: surfaces as if seen
     /// from up close; checks and figures).
     pub aerial_perspective: bool,
@@ -108,6 +112,7 @@ impl Default for Lighting {
             bounces: 1,
             sky_patches: 8,
             albedo_override: None,
+            sun_in_sky_light: false,
             aerial_perspective: true,
             snow_line: f32::INFINITY,
         }
