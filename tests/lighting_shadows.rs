@@ -278,7 +278,6 @@ fn run(
             })
             .collect();
         uploads.write(probe_region, bytemuck::cast_slice(&packed)).unwrap();
-        drop(uploads);
         baked.execute(&mut frames, &frame, &[]).expect("frame");
         baked.finish(&mut frames).expect("finish");
         let bytes = out.mapped().expect("mapped");
