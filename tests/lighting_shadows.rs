@@ -12,6 +12,9 @@ use std::sync::Arc;
 use alpenglow::graph::{BufferAccess, ImageAccess, RenderGraph, Stage};
 use alpenglow::lighting::constants::{LightingFrame, SHADOWS_CASCADED, SUN_ANGULAR_RADIUS};
 use alpenglow::lighting::shadows::{record_cascades, SceneBounds, ShadowFrame, ShadowMaps, ShadowSettings};
+use alpenglow::points::render::shadow::PointShadows;
+use alpenglow::points::render::{PointRenderer, SplatSettings};
+use alpenglow::points::scene::{PointScene, PointTransform};
 use alpenglow::shaders;
 use alpenglow::terrain::shadow::shadow_pipeline;
 use alpenglow::view::lighting::sun_direction;
@@ -149,7 +152,7 @@ fn probes(cam: &Camera, aspect: f64, distance: f64, with_box: bool) -> Vec<(DVec
 /// probe for each sun; returns per sun the probes' visibility and the plan.
 fn run(
     ctx: &Context,
-    with_box: bool,
+    (with_box, points): (bool, Option<&PointScene>),
     suns: &[(f32, f32)],
     probes: &[(DVec3, DVec3)],
 ) -> Vec<(Vec<f32>, alpenglow::lighting::shadows::CascadePlan)> {
@@ -160,14 +163,22 @@ fn run(
         lambda: 0.75,
         pcf_radius: 2,
     };
-    let bounds = SceneBounds {
+    let mut bounds = SceneBounds {
         min: DVec3::new(-PLANE, -PLANE, 0.0),
         max: DVec3::new(PLANE, PLANE, BOX_MAX.z),
     };
+    let renderer = points.map(|scene| PointRenderer::new(ctx, scene, SplatSettings::default()).expect("points"));
+    if let Some(b) = renderer.as_ref().and_then(PointShadows::bounds) {
+        bounds = bounds.union(b);
+    }
     let view = View::new(camera(), 320, 200);
     let mut shadows = ShadowMaps::new(settings, bounds).expect("shadow maps");
     let mut graph = RenderGraph::<Frame>::new();
     let target = shadows.declare_view(ctx, &mut graph, (0, &view)).expect("atlas");
+    let mut point_shadows = renderer.as_ref().map(|r| PointShadows::new(r, &shadows));
+    if let Some(p) = point_shadows.as_mut() {
+        p.declare(ctx, &mut graph, (0, &view), target).expect("points.shadow");
+    }
     let (vertices, indices) = mesh(with_box);
     let index_count = indices.len() as u32;
     let vertex_buffer = Buffer::with_data(
@@ -262,6 +273,9 @@ fn run(
         frame
             .prepare(&mut shadows, &mut uploads, &mut Vec::new())
             .expect("prepare");
+        if let Some(p) = point_shadows.as_mut() {
+            frame.prepare(p, &mut uploads, &mut Vec::new()).expect("prepare points");
+        }
         let plan = frame.prepared::<ShadowFrame>().unwrap().view(0).unwrap().clone();
         let mut constants = LightingFrame::zeroed();
         constants.sun = sun_direction(elevation_deg, azimuth_deg)
@@ -297,7 +311,7 @@ fn sun_visibility_agrees_with_a_ray_cast() {
         let probes = probes(&cam, 1.6, 500.0, true);
         assert!(probes.len() > 500, "{} probes", probes.len());
         let suns = [(30.0f32, 180.0f32), (15.0, 230.0), (20.0, 160.0)];
-        for ((vis, plan), &(elevation, azimuth)) in run(&ctx, true, &suns, &probes).iter().zip(&suns) {
+        for ((vis, plan), &(elevation, azimuth)) in run(&ctx, (true, None), &suns, &probes).iter().zip(&suns) {
             let sun = sun_direction(elevation, azimuth).as_dvec3();
             let (mut checked, mut shadowed, mut wrong) = (0, 0, Vec::new());
             for (&(p, _), &v) in probes.iter().zip(vis) {
@@ -348,13 +362,47 @@ fn a_lit_plane_has_no_acne() {
             .enumerate()
             .map(|(k, &e)| (e, 37.0 + 61.0 * k as f32))
             .collect();
-        for ((vis, _), (elevation, azimuth)) in run(&ctx, false, &suns, &probes).iter().zip(&suns) {
+        for ((vis, _), (elevation, azimuth)) in run(&ctx, (false, None), &suns, &probes).iter().zip(&suns) {
             let min = vis.iter().copied().fold(f32::INFINITY, f32::min);
             assert!(
                 min >= 0.999,
                 "sun {elevation}°/{azimuth}°: visibility {min} on a lit plane"
             );
         }
+    }
+    drop(ctx);
+    assert_validation_clean(&report);
+}
+
+#[test]
+fn point_objects_cast_shadows() {
+    let (ctx, report) = validated_context();
+    {
+        let mut scene = PointScene::default();
+        // The bunny, stood up and scaled to about 90 m, on the plane at the origin.
+        let transform = PointTransform::parse("r=90,0,0;s=600").expect("transform");
+        scene.add(common::points::bunny_object(false), transform);
+        let instance = &scene.instances[0];
+        let tree = &scene.objects[0].tree;
+        let centre = instance
+            .transform
+            .matrix()
+            .transform_point3(tree.bounds_centre.as_dvec3());
+        let (elevation, azimuth) = (50.0f32, 200.0f32);
+        let sun = sun_direction(elevation, azimuth).as_dvec3();
+        let under = centre - sun * (centre.z / sun.z);
+        let cam = camera();
+        let probes = vec![(under, DVec3::Z), (DVec3::new(-150.0, 0.0, 0.0), DVec3::Z)];
+        let depth = (under - cam.eye).dot(cam.forward());
+        assert!(depth > 0.0 && depth < 500.0);
+        let results = run(&ctx, (false, Some(&scene)), &[(elevation, azimuth)], &probes);
+        let vis = &results[0].0;
+        assert!(
+            vis[0] < 0.05,
+            "the ground under the bunny towards the sun is lit: {}",
+            vis[0]
+        );
+        assert!(vis[1] > 0.99, "open ground is shadowed: {}", vis[1]);
     }
     drop(ctx);
     assert_validation_clean(&report);
