@@ -52,3 +52,13 @@ pub const TEXTURING_UPSAMPLE: SpirV = spirv!("texturing/upsample.comp");
 pub const TEXTURING_LAYER: SpirV = spirv!("texturing/layer.comp");
 /// texturing.finish: colour and displacement normal into the atlas (§8.2).
 pub const TEXTURING_FINISH: SpirV = spirv!("texturing/finish.comp");
+/// terrain.shadow: the warped geometry image into a cascade of the shadow atlas (§9.5).
+pub const SHADOW_TERRAIN_VERT: SpirV = spirv!("lighting/shadow_terrain.vert");
+/// terrain.shadow: depth only (no colour output).
+pub const SHADOW_DEPTH_FRAG: SpirV = spirv!("lighting/shadow_depth.frag");
+/// points.shadow: splats as depth discs in a cascade of the shadow atlas (§9.5).
+pub const SHADOW_POINTS_VERT: SpirV = spirv!("lighting/shadow_points.vert");
+/// points.shadow: discards outside the splat's disc.
+pub const SHADOW_POINTS_FRAG: SpirV = spirv!("lighting/shadow_points.frag");
+/// shadow probe: `sun_visibility` at a list of points (tests and AOV checks of §9.5).
+pub const SHADOW_PROBE: SpirV = spirv!("lighting/shadow_probe.comp");

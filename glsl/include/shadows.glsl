@@ -1,14 +1,99 @@
-// Sun visibility (§9.5): cascaded shadow maps (PCF) or horizon maps, by
-// models.y. PLACEHOLDER until the shadow work lands: always lit.
+// Sun visibility (§9.5): cascaded shadow maps with percentage-closer
+// filtering, or the horizon maps of the height field, by models.y.
+// The atlas, cascade matrices and texel sizes come from LightingFrame
+// (src/lighting/shadows/cascades.rs fills them): cascade i owns quadrant
+// (i % 2, i / 2) of one D32 image; depth 0 is nearest the sun.
 #ifndef ALPENGLOW_SHADOWS_GLSL
 #define ALPENGLOW_SHADOWS_GLSL
 
 #include "lighting.glsl"
+#include "horizon.glsl"
+
+// Fraction of the cascade's depth range over which it blends into the next.
+const float SHADOW_BLEND_BAND = 0.1;
+
+// Filtered visibility of world point `p` in cascade `i`: a separable tent of
+// half-width R + 1 texels (R = PCF radius) over the (2R + 2)² texels around
+// p's position, weights depending continuously on the sub-texel position
+// (bilinear for R = 0, 5×5-like tent for R = 2); deterministic.
+float shadow_cascade_pcf(uint lighting, uint i, vec3 p) {
+    uvec4 sh = g_lighting[lighting].f.shadows;
+    vec4 clip = g_lighting[lighting].f.cascade_view_proj[i] * vec4(p, 1.0);
+    float size = float(sh.z);
+    int radius = int(sh.w);
+    float extent = float(radius) + 1.0;
+    vec2 tc = (clip.xy * 0.5 + 0.5) * size - 0.5;
+    vec2 base = floor(tc);
+    vec2 f = tc - base;
+    int quadrant = int(sh.z / 2u);
+    ivec2 q0 = ivec2(int(i % 2u), int(i / 2u)) * quadrant;
+    ivec2 q1 = q0 + ivec2(quadrant - 1);
+    float reference = clip.z;
+    float lit = 0.0;
+    float total = 0.0;
+    for (int y = -radius; y <= radius + 1; ++y) {
+        float wy = max(extent - abs(float(y) - f.y), 0.0);
+        for (int x = -radius; x <= radius + 1; ++x) {
+            float w = wy * max(extent - abs(float(x) - f.x), 0.0);
+            ivec2 texel = clamp(ivec2(base) + ivec2(x, y), q0, q1);
+            float depth = texelFetch(sampler2D(g_textures[nonuniformEXT(sh.x)], g_samplers[SAMPLER_NEAREST_CLAMP]),
+                                     texel, 0).r;
+            lit += reference <= depth ? w : 0.0;
+            total += w;
+        }
+    }
+    return total > 0.0 ? lit / total : 1.0;
+}
+
+// Visibility in cascade `i` of the surface point `world` with unit normal
+// `normal`: the lookup point is offset along the normal (normal-offset bias,
+// growing with the slope towards the sun so the whole PCF footprint stays
+// above the caster's plane) and towards the sun by one texel.
+float shadow_cascade(uint lighting, uint i, vec3 world, vec3 normal, vec3 sun) {
+    float texel = g_lighting[lighting].f.cascade_texel[i];
+    float radius = float(g_lighting[lighting].f.shadows.w);
+    float cos_theta = clamp(dot(normal, sun), -1.0, 1.0);
+    float sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
+    float offset = texel * (0.5 + 1.5 * (radius + 1.0) * sin_theta);
+    return shadow_cascade_pcf(lighting, i, world + normal * offset + sun * texel);
+}
 
 // 0 = in shadow, 1 = lit, filtered, at world point `world` with geometric
 // normal `normal`, `view_depth` metres from the camera along its axis.
+// Shadows off: 1. A sun below the horizon: 0 (softened over its disc).
+// Beyond the last cascade: lit (by the terrain; the horizon is still applied).
 float sun_visibility(uint lighting, vec3 world, vec3 normal, float view_depth) {
-    return 1.0;
+    uint mode = g_lighting[lighting].f.models.y;
+    if (mode == SHADOWS_OFF) {
+        return 1.0;
+    }
+    vec4 sun = g_lighting[lighting].f.sun;
+    float above = smoothstep(-sun.w, sun.w, sun.z);
+    if (above <= 0.0) {
+        return 0.0;
+    }
+    if (mode == SHADOWS_HORIZON) {
+        return min(above, horizon_sun_visibility(lighting, world));
+    }
+    uint count = min(g_lighting[lighting].f.shadows.y, uint(MAX_CASCADES));
+    vec4 far = g_lighting[lighting].f.cascade_far;
+    uint i = 0u;
+    while (i < count && view_depth > far[i]) {
+        ++i;
+    }
+    if (i >= count) {
+        return above;
+    }
+    vec3 n = normalize(normal);
+    float v = shadow_cascade(lighting, i, world, n, sun.xyz);
+    float start = i == 0u ? 0.0 : far[i - 1u];
+    float band = SHADOW_BLEND_BAND * (far[i] - start);
+    float t = band > 0.0 ? (view_depth - (far[i] - band)) / band : 0.0;
+    if (t > 0.0) {
+        float next = i + 1u < count ? shadow_cascade(lighting, i + 1u, world, n, sun.xyz) : 1.0;
+        v = mix(v, next, clamp(t, 0.0, 1.0));
+    }
+    return v * above;
 }
 
 #endif

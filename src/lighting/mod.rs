@@ -5,5 +5,6 @@
 //! shading pass reads.
 
 pub mod constants;
+pub mod shadows;
 pub mod sky;
 pub mod technique;

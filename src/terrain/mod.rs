@@ -11,6 +11,7 @@ pub mod lod;
 pub mod procedural;
 pub mod raycast;
 pub mod shading;
+pub mod shadow;
 pub mod sketch_map;
 pub mod technique;
 pub mod warp;

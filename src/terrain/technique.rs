@@ -212,6 +212,20 @@ impl Terrain {
         declare_draw_pass(ctx, graph, &pass_name("terrain.draw", &view.name), pass, targets)
     }
 
+    /// View `index`'s geometry image (vertex buffer), the grid's index
+    /// buffer and its index count, and the height field's box (x, y over
+    /// the extent, z over the height range): what `terrain.shadow` draws.
+    pub fn shadow_geometry(&self, index: ViewIndex) -> Result<(BufferId, BufferId, u32, [f64; 6])> {
+        let state = (self.views.iter().find(|v| v.index == index))
+            .ok_or_else(|| Error::Graph(format!("terrain.shadow of view {index} before its terrain.warp")))?;
+        let side = self.geometry.settings.grid_side;
+        let field = &self.geometry.field;
+        let (lo, hi) = field.min_max();
+        let extent = field.extent();
+        let bounds = [0.0, 0.0, f64::from(lo), extent.x, extent.y, f64::from(hi)];
+        Ok((state.vertices, self.indices, (side - 1) * (side - 1) * 6, bounds))
+    }
+
     /// The texturing constants of `terrain.draw` (`TerrainTexturing` in
     /// glsl/include/texture_atlas.glsl); `page_table`: this frame's handle.
     fn texturing_constants(&self, atlas: Option<(&AtlasBindings, u32)>) -> TexturingFrame {

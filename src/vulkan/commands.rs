@@ -248,6 +248,20 @@ impl CommandRecorder {
         }
     }
 
+    /// Restricts drawing to the `width`×`height` rectangle at (`x`, `y`) of
+    /// the attachments (e.g. one cascade's quadrant of a shadow atlas).
+    pub fn set_scissor(&mut self, x: u32, y: u32, width: u32, height: u32) {
+        let rect = vk::Rect2D {
+            offset: vk::Offset2D {
+                x: x.min(i32::MAX as u32) as i32,
+                y: y.min(i32::MAX as u32) as i32,
+            },
+            extent: vk::Extent2D { width, height },
+        };
+        // SAFETY: every graphics pipeline has a dynamic scissor; non-negative offsets.
+        unsafe { self.device().cmd_set_scissor(self.cmd, 0, &[rect]) };
+    }
+
     /// Ends dynamic rendering.
     pub fn end_rendering(&mut self) {
         // SAFETY: paired with `begin_rendering`.

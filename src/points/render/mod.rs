@@ -15,6 +15,7 @@
 pub mod gpu_layout;
 mod passes;
 pub mod selection;
+pub mod shadow;
 pub mod stats;
 mod technique;
 mod triangles;

@@ -213,6 +213,12 @@ impl PointRenderer {
         Ok(())
     }
 
+    /// The scene, where each object's list is, and the splat buffer: what
+    /// `points.shadow` draws (`super::shadow`).
+    pub(super) fn shadow_sources(&self) -> (&PointScene, &[ObjectLayout], &Arc<Buffer>) {
+        (&self.scene, &self.layouts, &self.resources.splats)
+    }
+
     /// Statistics of every completed frame not yet taken (call after all
     /// frames completed).
     pub fn take_stats(&mut self) -> Result<Vec<PointFrameStats>> {

@@ -1,0 +1,260 @@
+//! Cascaded sun shadow maps (dissertation §9.5, which compares shadow maps
+//! with the horizon maps of the height field; `ALGORITHMS.md` §6).
+//!
+//! [`ShadowMaps`] owns one shadow atlas per view: a single `D32_SFLOAT` 2-D
+//! image, 2×2 quadrants, one per cascade, imported into the graph so its
+//! sampled heap handle never changes. Per frame its `prepare`
+//! ([`Technique`]) plans each view's cascades ([`cascades::plan_cascades`])
+//! into a [`ShadowFrame`]; the lead copies a view's [`CascadePlan`] into its
+//! `LightingFrame` with [`CascadePlan::fill`].
+//!
+//! Passes, in this order, each writing the atlas as a depth attachment:
+//!
+//! | pass | declared by | what |
+//! |---|---|---|
+//! | `shadow.clear` | [`ShadowMaps::declare_view`] | clears the atlas to 1 |
+//! | `terrain.shadow` | `Terrain::declare_shadow` (`src/terrain/shadow.rs`) | the view's warped geometry image, per cascade |
+//! | `points.shadow` | `PointShadows::declare` (`src/points/render/shadow.rs`) | splats as depth discs, per cascade |
+//!
+//! The caster passes read the cascade matrices from the frame's prepared
+//! [`ShadowFrame`] and push them (no upload region): each cascade is one
+//! draw with the scissor on its quadrant. Consumers sample the atlas
+//! through `glsl/include/shadows.glsl` after declaring
+//! `ImageAccess::Sampled(Stage::Fragment)` (or `Compute`) of
+//! [`ShadowTarget::atlas`].
+
+pub mod cascades;
+
+use std::sync::Arc;
+
+use bytemuck::{Pod, Zeroable};
+
+pub use cascades::{plan_cascades, Cascade, CascadePlan, SceneBounds, ShadowSettings};
+
+use crate::error::{Error, Result};
+use crate::graph::{ImageAccess, ImageId, RenderGraph};
+use crate::view::{pass_name, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
+use crate::vulkan::{CommandRecorder, Context, Format, Image, ImageDesc, ImageUsageFlags};
+
+/// The depth format of shadow atlases.
+pub const SHADOW_FORMAT: Format = Format::D32_SFLOAT;
+
+/// Push constants of the shadow caster passes
+/// (`glsl/lighting/shadow_terrain.vert`, `glsl/lighting/shadow_points.vert`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct ShadowCasterPush {
+    /// World → atlas clip space of the cascade drawn.
+    pub view_proj: [f32; 16],
+    /// xyz: unit vector towards the sun; w: world size (m) of one texel of the cascade.
+    pub sun_texel: [f32; 4],
+    /// Pass-specific heap handles and indices.
+    pub handles: [u32; 4],
+}
+
+/// One view's shadow atlas in the graph.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShadowTarget {
+    pub view: ViewIndex,
+    /// The atlas (declare `ImageAccess::Sampled(..)` to read it).
+    pub atlas: ImageId,
+    /// Its sampled heap handle (fixed for the atlas's lifetime).
+    pub handle: u32,
+    /// Side in texels.
+    pub size: u32,
+}
+
+struct ShadowView {
+    target: ShadowTarget,
+    /// Kept alive with the graph that imported it.
+    _image: Arc<Image>,
+}
+
+/// What the shadow passes read this frame: each view's cascades.
+#[derive(Clone, Debug, Default)]
+pub struct ShadowFrame {
+    pub views: Vec<(ViewIndex, CascadePlan)>,
+}
+
+impl ShadowFrame {
+    /// The cascades of view `index`.
+    pub fn view(&self, index: ViewIndex) -> Result<&CascadePlan> {
+        self.views
+            .iter()
+            .find(|(v, _)| *v == index)
+            .map(|(_, p)| p)
+            .ok_or_else(|| Error::Graph(format!("shadows: view {index} was not prepared")))
+    }
+}
+
+/// The shadow atlases of every view and the per-frame cascade planning.
+pub struct ShadowMaps {
+    settings: ShadowSettings,
+    bounds: SceneBounds,
+    views: Vec<ShadowView>,
+}
+
+impl ShadowMaps {
+    /// Shadow maps for casters inside `bounds` (see
+    /// `Terrain::shadow_bounds`, `PointShadows::bounds`).
+    pub fn new(settings: ShadowSettings, bounds: SceneBounds) -> Result<ShadowMaps> {
+        settings.validate()?;
+        if !(bounds.min.is_finite() && bounds.max.is_finite()) || bounds.min.cmpgt(bounds.max).any() {
+            return Err(Error::invalid(
+                "shadows.bounds",
+                format!("{:?}..{:?}; must be finite, min ≤ max", bounds.min, bounds.max),
+            ));
+        }
+        Ok(ShadowMaps {
+            settings,
+            bounds,
+            views: Vec::new(),
+        })
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &ShadowSettings {
+        &self.settings
+    }
+
+    /// The box holding every caster.
+    pub fn bounds(&self) -> SceneBounds {
+        self.bounds
+    }
+
+    /// Replaces the casters' bounds (e.g. after objects were added).
+    pub fn set_bounds(&mut self, bounds: SceneBounds) {
+        self.bounds = bounds;
+    }
+
+    /// Creates view `index`'s atlas, imports it and declares `shadow.clear`
+    /// (clears it to depth 1 each frame). Declare before the caster passes.
+    pub fn declare_view(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame>,
+        (index, view): (ViewIndex, &View),
+    ) -> Result<ShadowTarget> {
+        if self.views.iter().any(|v| v.target.view == index) {
+            return Err(Error::Graph(format!("shadows: view {index} declared twice")));
+        }
+        let size = self.settings.atlas_size;
+        let image = Arc::new(Image::new(
+            ctx,
+            ImageDesc {
+                name: pass_name("shadow atlas", &view.name),
+                width: size,
+                height: size,
+                format: SHADOW_FORMAT,
+                usage: ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | ImageUsageFlags::SAMPLED,
+            },
+        )?);
+        let handle = image
+            .sampled_handle()
+            .ok_or_else(|| Error::Graph("shadows: the atlas has no sampled handle".into()))?;
+        let atlas = graph.import_image(image.clone());
+        graph
+            .pass(&pass_name("shadow.clear", &view.name))
+            .graphics()
+            .write(atlas, ImageAccess::DepthAttachmentWrite)
+            .record(move |ctx, _| {
+                let image = ctx.image(atlas)?;
+                let cmd = ctx.cmd();
+                cmd.begin_rendering(&[], Some((image, Some(1.0))));
+                cmd.end_rendering();
+                Ok(())
+            });
+        let target = ShadowTarget {
+            view: index,
+            atlas,
+            handle,
+            size,
+        };
+        self.views.push(ShadowView { target, _image: image });
+        Ok(target)
+    }
+
+    /// The atlas of view `index`.
+    pub fn target(&self, index: ViewIndex) -> Result<ShadowTarget> {
+        self.views
+            .iter()
+            .find(|v| v.target.view == index)
+            .map(|v| v.target)
+            .ok_or_else(|| Error::Graph(format!("shadows: view {index} has no atlas")))
+    }
+
+    /// The cascades of view `index` (`view`) for `sun` (unit vector towards
+    /// it). With `mode` other than [`ShadowMode::Cascaded`] the plan has no
+    /// cascade and the passes only clear.
+    pub fn plan(&self, index: ViewIndex, view: &View, sun: glam::Vec3, mode: ShadowMode) -> Result<CascadePlan> {
+        let target = self.target(index)?;
+        let mut plan = plan_cascades(
+            &view.camera,
+            view.aspect(),
+            sun,
+            self.bounds,
+            &self.settings,
+            target.handle,
+        )?;
+        if mode != ShadowMode::Cascaded {
+            plan.cascades.clear();
+        }
+        Ok(plan)
+    }
+}
+
+impl Technique for ShadowMaps {
+    type Prepared = ShadowFrame;
+
+    fn name(&self) -> &'static str {
+        "shadows"
+    }
+
+    /// Plans every declared view's cascades for the frame's sun.
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<ShadowFrame> {
+        let sun = frame.lighting.sun_direction();
+        let mut views = Vec::with_capacity(self.views.len());
+        for v in &self.views {
+            let index = v.target.view;
+            let view = frame
+                .views
+                .get(index)
+                .ok_or_else(|| Error::Graph(format!("shadows: the frame has no view {index}")))?;
+            views.push((index, self.plan(index, view, sun, frame.lighting.shadows)?));
+        }
+        Ok(ShadowFrame { views })
+    }
+}
+
+/// Records a caster pass: renders into `atlas` (loaded), and per cascade of
+/// `plan` sets the scissor on its quadrant and calls `draw` with the
+/// cascade's push constants (`handles` left to `draw`).
+pub fn record_cascades(
+    cmd: &mut CommandRecorder,
+    atlas: &Image,
+    plan: &CascadePlan,
+    mut draw: impl FnMut(&mut CommandRecorder, ShadowCasterPush) -> Result<()>,
+) -> Result<()> {
+    let count = plan.count() as usize;
+    if count == 0 {
+        return Ok(());
+    }
+    let quadrant = atlas.desc().width / 2;
+    cmd.begin_rendering(&[], Some((atlas, None)));
+    let mut result = Ok(());
+    for (i, c) in plan.cascades.iter().take(count).enumerate() {
+        let (x, y) = ((i as u32 % 2) * quadrant, (i as u32 / 2) * quadrant);
+        cmd.set_scissor(x, y, quadrant, quadrant);
+        let push = ShadowCasterPush {
+            view_proj: c.view_proj.as_mat4().to_cols_array(),
+            sun_texel: plan.sun.as_vec3().extend(c.texel as f32).to_array(),
+            handles: [0; 4],
+        };
+        result = draw(cmd, push);
+        if result.is_err() {
+            break;
+        }
+    }
+    cmd.end_rendering();
+    result
+}

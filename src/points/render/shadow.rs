@@ -1,0 +1,284 @@
+//! `points.shadow`: the point objects (rocks, scans) as casters in the
+//! view's cascaded shadow maps (§9.5; [`crate::lighting::shadows`]).
+//!
+//! Each splat of an instance's prefix (§10.1.7: r_lo from the view's eye,
+//! so the shadow uses the level of detail the view draws) that passes the
+//! interval test r_min ≤ r < r_max in the vertex stage becomes a depth-only
+//! disc of its radius in its tangent plane: a quad of six pulled vertices
+//! whose fragment stage discards outside the disc
+//! (`glsl/lighting/shadow_points.vert`, `.frag`). Simplifications: the
+//! splats' clip lines (sharp edges) are ignored, so edges cast slightly
+//! rounder shadows; both faces cast; the triangles of hybrid objects
+//! (§10.1.8) do not cast, their splats do. Instances whose bounding sphere
+//! cannot reach any cascade's box are skipped ([`CascadePlan::may_cast`]).
+//!
+//! Instance records (object → world, in f32 world coordinates like the
+//! terrain's vertices) go into one upload region per view, written in
+//! `prepare`.
+
+use std::sync::Arc;
+
+use bytemuck::{Pod, Zeroable};
+use glam::DVec3;
+
+use super::selection::ObjectLayout;
+use super::PointRenderer;
+use crate::error::{Error, Result};
+use crate::graph::{BufferAccess, BufferId, ImageAccess, RenderGraph, Stage, UploadRegion};
+use crate::lighting::shadows::{
+    plan_cascades, record_cascades, CascadePlan, SceneBounds, ShadowFrame, ShadowMaps, ShadowSettings, ShadowTarget,
+    SHADOW_FORMAT,
+};
+use crate::points::scene::PointScene;
+use crate::shaders;
+use crate::view::{pass_name, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
+use crate::vulkan::{Blend, Buffer, CompareOp, Context, GraphicsPipeline, GraphicsPipelineDesc, PrimitiveTopology};
+
+/// Header of a view's shadow records (`ShadowPoints` in shadow_points.vert).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct ShadowHeader {
+    /// World eye position of the view.
+    eye: [f32; 4],
+}
+
+/// One caster record (`ShadowInstance` in shadow_points.vert).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct ShadowInstance {
+    /// Object → world, column-major.
+    model: [f32; 16],
+    /// Scale, first splat (u32 bits), prefix length (u32 bits), 0.
+    params: [f32; 4],
+}
+
+const HEADER_BYTES: u64 = std::mem::size_of::<ShadowHeader>() as u64;
+const RECORD_BYTES: u64 = std::mem::size_of::<ShadowInstance>() as u64;
+
+/// One draw of `points.shadow`: record index and splats of its prefix.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShadowDraw {
+    pub record: u32,
+    pub count: u32,
+}
+
+/// What `points.shadow` draws this frame, per view.
+#[derive(Clone, Debug, Default)]
+pub struct PointShadowFrame {
+    pub views: Vec<(ViewIndex, Vec<ShadowDraw>)>,
+}
+
+impl PointShadowFrame {
+    fn view(&self, index: ViewIndex) -> Result<&[ShadowDraw]> {
+        self.views
+            .iter()
+            .find(|(v, _)| *v == index)
+            .map(|(_, d)| d.as_slice())
+            .ok_or_else(|| Error::Graph(format!("points.shadow: view {index} was not prepared")))
+    }
+}
+
+struct ShadowView {
+    index: ViewIndex,
+    region: UploadRegion,
+}
+
+/// The point objects as shadow casters: `points.shadow` per view and the
+/// per-frame caster records in `prepare`.
+pub struct PointShadows {
+    scene: PointScene,
+    layouts: Vec<ObjectLayout>,
+    splats: Arc<Buffer>,
+    splats_id: Option<BufferId>,
+    settings: ShadowSettings,
+    bounds: SceneBounds,
+    views: Vec<ShadowView>,
+}
+
+/// The box around every instance's bounding sphere, or None without instances.
+pub fn scene_bounds(scene: &PointScene) -> Option<SceneBounds> {
+    scene
+        .instances
+        .iter()
+        .map(|inst| {
+            let tree = &scene.objects[inst.object].tree;
+            let centre = inst.transform.matrix().transform_point3(tree.bounds_centre.as_dvec3());
+            let r = DVec3::splat(f64::from(tree.bounds_radius) * inst.transform.scale);
+            SceneBounds {
+                min: centre - r,
+                max: centre + r,
+            }
+        })
+        .reduce(SceneBounds::union)
+}
+
+impl PointShadows {
+    /// Casters of `renderer`'s objects into the atlases of `shadows` (same
+    /// settings and bounds, so the culling matches its cascades).
+    pub fn new(renderer: &PointRenderer, shadows: &ShadowMaps) -> PointShadows {
+        let (scene, layouts, splats) = renderer.shadow_sources();
+        PointShadows {
+            scene: scene.clone(),
+            layouts: layouts.to_vec(),
+            splats: splats.clone(),
+            splats_id: None,
+            settings: *shadows.settings(),
+            bounds: shadows.bounds(),
+            views: Vec::new(),
+        }
+    }
+
+    /// The box around the instances (for [`ShadowMaps::new`]).
+    pub fn bounds(renderer: &PointRenderer) -> Option<SceneBounds> {
+        scene_bounds(renderer.shadow_sources().0)
+    }
+
+    fn records_per_instance(&self) -> usize {
+        self.layouts
+            .iter()
+            .map(|l| l.clusters.as_ref().map_or(1, |c| c.clusters.len()))
+            .max()
+            .unwrap_or(1)
+    }
+
+    /// Declares `points.shadow` of view `index` into `target` (after
+    /// `shadow.clear`; the cascades come from the frame's [`ShadowFrame`]).
+    pub fn declare(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame>,
+        (index, view): (ViewIndex, &View),
+        target: ShadowTarget,
+    ) -> Result<()> {
+        let splats = *self
+            .splats_id
+            .get_or_insert_with(|| graph.import_buffer(self.splats.clone()));
+        let records = (self.scene.instances.len() * self.records_per_instance()).max(1) as u64;
+        let region = graph.upload_region(
+            &pass_name("point shadow casters", &view.name),
+            HEADER_BYTES + RECORD_BYTES * records,
+        );
+        let pipeline = GraphicsPipeline::new(
+            ctx,
+            &GraphicsPipelineDesc {
+                name: "points.shadow",
+                vertex: shaders::SHADOW_POINTS_VERT,
+                fragment: shaders::SHADOW_POINTS_FRAG,
+                vertex_stride: 0,
+                vertex_attributes: Vec::new(),
+                topology: PrimitiveTopology::TRIANGLE_LIST,
+                cull_back_faces: false,
+                wireframe: false,
+                color_formats: Vec::new(),
+                blend: Blend::None,
+                depth_format: Some(SHADOW_FORMAT),
+                depth_test: true,
+                depth_write: true,
+                depth_compare: CompareOp::LESS_OR_EQUAL,
+            },
+        )?;
+        let atlas = target.atlas;
+        graph
+            .pass(&pass_name("points.shadow", &view.name))
+            .graphics()
+            .read(splats, BufferAccess::StorageRead(Stage::Vertex))
+            .read(region, BufferAccess::StorageRead(Stage::Vertex))
+            .write(atlas, ImageAccess::DepthAttachmentWrite)
+            .record(move |ctx, frame| {
+                let plan = frame.prepared::<ShadowFrame>()?.view(index)?;
+                let draws = frame.prepared::<PointShadowFrame>()?.view(index)?;
+                if draws.is_empty() {
+                    return Ok(());
+                }
+                let handles = [ctx.storage_buffer(splats)?, ctx.upload(region)?];
+                let image = ctx.image(atlas)?;
+                record_cascades(ctx.cmd(), image, plan, |cmd, mut push| {
+                    cmd.bind_graphics(&pipeline);
+                    for d in draws {
+                        push.handles = [handles[0], handles[1], d.record, 0];
+                        cmd.push_constants(&push)?;
+                        cmd.draw(d.count * 6, 1);
+                    }
+                    Ok(())
+                })
+            });
+        self.views.push(ShadowView { index, region });
+        Ok(())
+    }
+
+    /// The caster records of one view for `plan`, and its draws.
+    fn plan_view(&self, eye: DVec3, plan: &CascadePlan) -> (Vec<ShadowInstance>, Vec<ShadowDraw>) {
+        let (mut records, mut draws) = (Vec::new(), Vec::new());
+        if plan.count() == 0 {
+            return (records, draws);
+        }
+        for inst in &self.scene.instances {
+            let tree = &self.scene.objects[inst.object].tree;
+            let layout = &self.layouts[inst.object];
+            let model = inst.transform.matrix();
+            let scale = inst.transform.scale;
+            let centre = model.transform_point3(tree.bounds_centre.as_dvec3());
+            let radius = f64::from(tree.bounds_radius) * scale;
+            if !plan.may_cast(centre, radius) {
+                continue;
+            }
+            let r_lo = ((((eye - centre).length() - radius) / scale).max(0.0)) as f32;
+            let ranges: Vec<(u32, usize)> = match &layout.clusters {
+                None => vec![(layout.first, tree.prefix_len(r_lo))],
+                Some(c) => (c.clusters.iter().enumerate())
+                    .map(|(k, cl)| (layout.first + cl.first, c.cluster_prefix_len(k, r_lo)))
+                    .collect(),
+            };
+            let model = model.as_mat4().to_cols_array();
+            for (first, count) in ranges.into_iter().filter(|&(_, n)| n > 0) {
+                draws.push(ShadowDraw {
+                    record: records.len() as u32,
+                    count: count as u32,
+                });
+                records.push(ShadowInstance {
+                    model,
+                    params: [scale as f32, f32::from_bits(first), f32::from_bits(count as u32), 0.0],
+                });
+            }
+        }
+        (records, draws)
+    }
+}
+
+impl Technique for PointShadows {
+    type Prepared = PointShadowFrame;
+
+    fn name(&self) -> &'static str {
+        "points.shadow"
+    }
+
+    /// Per view: the cascades (as [`ShadowMaps`] plans them), the instances
+    /// that can cast into them and their prefixes, uploaded as records.
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<PointShadowFrame> {
+        let mut views = Vec::with_capacity(self.views.len());
+        for v in &self.views {
+            let view = frame
+                .views
+                .get(v.index)
+                .ok_or_else(|| Error::Graph(format!("points.shadow: the frame has no view {}", v.index)))?;
+            let sun = frame.lighting.sun_direction();
+            let (records, draws) = if frame.lighting.shadows == ShadowMode::Cascaded {
+                let plan = plan_cascades(&view.camera, view.aspect(), sun, self.bounds, &self.settings, 0)?;
+                self.plan_view(view.camera.eye, &plan)
+            } else {
+                (Vec::new(), Vec::new())
+            };
+            let header = ShadowHeader {
+                eye: view.camera.eye.as_vec3().extend(0.0).to_array(),
+            };
+            frame.uploads.write_pod(v.region, &header)?;
+            if !records.is_empty() {
+                frame
+                    .uploads
+                    .write_at(v.region, HEADER_BYTES, bytemuck::cast_slice(&records))?;
+            }
+            views.push((v.index, draws));
+        }
+        Ok(PointShadowFrame { views })
+    }
+}
