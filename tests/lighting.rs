@@ -42,7 +42,9 @@ fn preetham_zenith(turbidity: f64, sun_zenith: f64) -> (f64, f64, f64) {
     let th = [sun_zenith.powi(3), sun_zenith.powi(2), sun_zenith, 1.0];
     let poly = |m: [[f64; 4]; 3]| -> f64 {
         let tt = [t * t, t, 1.0];
-        (0..3).map(|i| tt[i] * (0..4).map(|j| m[i][j] * th[j]).sum::<f64>()).sum()
+        (0..3)
+            .map(|i| tt[i] * (0..4).map(|j| m[i][j] * th[j]).sum::<f64>())
+            .sum()
     };
     let x = poly([
         [0.00166, -0.00375, 0.00209, 0.0],

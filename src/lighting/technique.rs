@@ -8,6 +8,7 @@
 use glam::Vec3;
 
 use super::constants::*;
+use super::shadows::ShadowFrame;
 use crate::error::Result;
 use crate::graph::UploadRegion;
 use crate::view::{FrameContext, Lighting, ShadowMode, SkyLightMode, SkyModel, Technique};
@@ -118,7 +119,10 @@ impl Technique for SceneLighting {
         frame.lighting.validate()?;
         let mut views = Vec::with_capacity(frame.views.len());
         for (k, _view) in frame.views.iter().enumerate() {
-            let constants = self.constants(frame.lighting);
+            let mut constants = self.constants(frame.lighting);
+            if let Ok(shadows) = frame.prepared::<ShadowFrame>() {
+                shadows.view(k)?.fill(&mut constants);
+            }
             let region = *self
                 .regions
                 .get(k)

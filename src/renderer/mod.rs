@@ -14,6 +14,7 @@
 //! for EWA splats, or `points.opaque`; see [`crate::points::render`]) →
 //! `tonemap` (compute) → `readback` (transfer).
 
+mod lighting;
 pub mod scene;
 
 use std::sync::Arc;
@@ -23,8 +24,9 @@ pub use scene::Scene;
 
 use crate::error::{Error, Result};
 use crate::graph::{BakedGraph, BufferId, FrameOutcome, ImageId, RenderGraph};
+use crate::lighting::shadows::ShadowSettings;
 use crate::lighting::sky::Sky;
-use crate::lighting::technique::{FieldInfo, SceneLighting};
+use crate::lighting::technique::SceneLighting;
 use crate::points::render::{PointFrameStats, PointRenderer, SplatSettings};
 use crate::post::exposure::ExposureMeter;
 use crate::post::tonemap::Tonemap;
@@ -52,6 +54,8 @@ pub struct RenderSettings {
     pub texturing: TexturingMode,
     /// Tile streaming of [`TexturingMode::Atlas`].
     pub texture_streaming: TextureStreaming,
+    /// The sun's cascaded shadow maps.
+    pub shadows: ShadowSettings,
     /// The lighting of the first frames (None: [`Scene::default_lighting`]);
     /// change it between frames with [`Renderer::set_lighting`].
     pub lighting: Option<Lighting>,
@@ -68,6 +72,10 @@ impl RenderSettings {
             points: SplatSettings::default(),
             texturing: TexturingMode::default(),
             texture_streaming: TextureStreaming::for_image(width, height),
+            shadows: ShadowSettings {
+                atlas_size: 2048,
+                ..ShadowSettings::default()
+            },
             lighting: None,
         }
     }
@@ -112,6 +120,7 @@ struct Readback {
 /// (The sky and tone mapping prepare nothing: their passes own their pipelines.)
 struct Techniques {
     lighting: SceneLighting,
+    shadows: Option<lighting::SunShadows>,
     terrain: Option<Terrain>,
     atlas: Option<TextureAtlas>,
     points: Option<PointRenderer>,
@@ -189,25 +198,50 @@ impl Renderer {
         let mut graph = RenderGraph::new();
         // The view the graph is declared for; every frame brings its camera.
         let view = View::new(scene.default_camera(), w, h);
-        let targets = SceneTargets::declare(&mut graph, &view, !scene.points.is_empty());
-        let scene_lighting = scene_lighting(scene, &targets);
+        let mut targets = SceneTargets::declare(&mut graph, &view, !scene.points.is_empty());
+        let scene_lighting = lighting::scene_lighting(scene, &targets);
         let sky = Sky::new(ctx, &targets.formats)?;
         sky.declare(&mut graph, (0, &view), &targets);
-        let (terrain, atlas) = match scene.draw_terrain {
-            true => {
-                let (terrain, atlas) = declare_terrain(ctx, &mut graph, scene, &settings, (&view, &targets))?;
-                (Some(terrain), atlas)
-            }
-            false => (None, None),
+        let mut terrain = match scene.draw_terrain {
+            true => Some(warped_terrain(ctx, &mut graph, scene, &settings, &view)?),
+            false => None,
         };
-        let points = match scene.points.is_empty() {
+        let mut points = match scene.points.is_empty() {
             true => None,
-            false => {
-                let mut points = PointRenderer::new(ctx, &scene.points, settings.points)?;
-                points.declare(ctx, &mut graph, (0, &view), &targets, !scene.draw_terrain)?;
-                Some(points)
-            }
+            false => Some(PointRenderer::new(ctx, &scene.points, settings.points)?),
         };
+        // The atlas's generation passes before the shadow casters: validation
+        // layers before 1.3.268 count their dispatches as writing every buffer
+        // of the heap, the geometry image included, so the casters' barrier
+        // must come after them.
+        let atlas = match (&terrain, settings.texturing) {
+            (Some(terrain), TexturingMode::Atlas) => Some(TextureAtlas::declare(
+                ctx,
+                &mut graph,
+                terrain.generation_inputs(&scene.layers),
+                settings.texture_streaming,
+            )?),
+            _ => None,
+        };
+        let shadows = lighting::declare_shadows(
+            ctx,
+            &mut graph,
+            (&view, &mut targets),
+            (terrain.as_ref(), points.as_ref()),
+            settings.shadows,
+        )?;
+        if let Some(terrain) = &mut terrain {
+            terrain.declare_draw(
+                ctx,
+                &mut graph,
+                (0, &view),
+                &targets,
+                atlas.as_ref().map(|a| a.bindings()),
+            )?;
+        }
+        if let Some(points) = &mut points {
+            points.declare(ctx, &mut graph, (0, &view), &targets, !scene.draw_terrain)?;
+        }
         let exposure = ExposureMeter::new(ctx)?.declare(&mut graph, &view, &targets);
         Tonemap::new(ctx)?.declare(&mut graph, &view, &targets, exposure);
         let readback = match settings.readback {
@@ -230,6 +264,7 @@ impl Renderer {
             frames_rendered: 0,
             techniques: Techniques {
                 lighting: scene_lighting,
+                shadows,
                 terrain,
                 atlas,
                 points,
@@ -272,6 +307,13 @@ impl Renderer {
         let mut stages = Vec::new();
         let mut uploads = self.graph.uploads(index);
         let t = &mut self.techniques;
+        if let Some(shadows) = &mut t.shadows {
+            frame.prepare(&mut shadows.maps, &mut uploads, &mut stages)?;
+            if let Some(points) = &mut shadows.points {
+                frame.prepare(points, &mut uploads, &mut stages)?;
+            }
+        }
+        // After the shadows: the constants carry their cascades.
         frame.prepare(&mut t.lighting, &mut uploads, &mut stages)?;
         if let Some(terrain) = &mut t.terrain {
             frame.prepare(terrain, &mut uploads, &mut stages)?;
@@ -389,33 +431,14 @@ impl Renderer {
     }
 }
 
-/// The scene's lighting technique, writing the view's lighting constants.
-fn scene_lighting(scene: &Scene, targets: &SceneTargets) -> SceneLighting {
-    let field = &scene.heights;
-    let extent = field.extent();
-    let (lo, _) = scene.height_range();
-    SceneLighting::new(
-        vec![targets.lighting.constants],
-        FieldInfo {
-            extent: [extent.x as f32, extent.y as f32],
-            texels: [
-                field.columns.saturating_sub(1) as f32,
-                field.rows.saturating_sub(1) as f32,
-            ],
-            ground: lo,
-        },
-    )
-}
-
-/// The terrain of `scene` and, when texturing from the atlas, the texture
-/// atlas: `terrain.warp`, the generation passes, then `terrain.draw`.
-fn declare_terrain(
+/// The terrain of `scene` with its `terrain.warp` declared.
+fn warped_terrain(
     ctx: &Context,
     graph: &mut RenderGraph<Frame>,
     scene: &Scene,
     settings: &RenderSettings,
-    (view, targets): (&View, &SceneTargets),
-) -> Result<(Terrain, Option<TextureAtlas>)> {
+    view: &View,
+) -> Result<Terrain> {
     let texturing = TerrainTexturing {
         mode: settings.texturing,
         layers: &scene.layers,
@@ -424,15 +447,5 @@ fn declare_terrain(
     let field = Arc::new(scene.heights.clone());
     let mut terrain = Terrain::new(ctx, graph, field, settings.terrain, &texturing)?;
     terrain.declare_warp(ctx, graph, (0, view))?;
-    let atlas = match settings.texturing {
-        TexturingMode::Atlas => Some(TextureAtlas::declare(
-            ctx,
-            graph,
-            terrain.generation_inputs(&scene.layers),
-            settings.texture_streaming,
-        )?),
-        _ => None,
-    };
-    terrain.declare_draw(ctx, graph, (0, view), targets, atlas.as_ref().map(|a| a.bindings()))?;
-    Ok((terrain, atlas))
+    Ok(terrain)
 }

@@ -48,11 +48,7 @@ impl Frame {
 
     /// The prepared data of type `T`.
     pub fn prepared<T: Any>(&self) -> Result<&T> {
-        self.prepared
-            .iter()
-            .find(|(t, _)| *t == TypeId::of::<T>())
-            .and_then(|(_, v)| v.downcast_ref::<T>())
-            .ok_or_else(|| Error::Graph(format!("{} was not prepared for this frame", type_name::<T>())))
+        find_prepared(&self.prepared)
     }
 
     /// Runs `technique`'s prepare step as the profile stage
@@ -70,6 +66,7 @@ impl Frame {
                 views: &self.views,
                 lighting: &self.lighting,
                 uploads,
+                earlier: &self.prepared,
             };
             technique.prepare(&mut ctx)
         })?;
@@ -86,6 +83,24 @@ pub struct FrameContext<'a, 'u> {
     pub views: &'a [View],
     pub lighting: &'a Lighting,
     pub uploads: &'a mut UploadWriter<'u>,
+    /// What the techniques prepared before this one.
+    earlier: &'a [(TypeId, Box<dyn Any + Send + Sync>)],
+}
+
+impl FrameContext<'_, '_> {
+    /// The prepared data of type `T` of a technique prepared earlier this
+    /// frame (the lighting reads the shadow cascades' plan).
+    pub fn prepared<T: Any>(&self) -> Result<&T> {
+        find_prepared(self.earlier)
+    }
+}
+
+fn find_prepared<T: Any>(prepared: &[(TypeId, Box<dyn Any + Send + Sync>)]) -> Result<&T> {
+    prepared
+        .iter()
+        .find(|(t, _)| *t == TypeId::of::<T>())
+        .and_then(|(_, v)| v.downcast_ref::<T>())
+        .ok_or_else(|| Error::Graph(format!("{} was not prepared for this frame", type_name::<T>())))
 }
 
 /// A technique: persistent GPU state, passes declared once into the frame
