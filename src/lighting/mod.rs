@@ -4,5 +4,8 @@
 //! ([`constants::LightingFrame`], `glsl/include/lighting.glsl`) that every
 //! shading pass reads.
 
+pub mod aerial;
 pub mod constants;
+pub mod preetham;
 pub mod sky;
+pub mod solar;
