@@ -1,6 +1,14 @@
-//! Where the sun is (§9.5, Fig. 9.3: the lighting environments are given as
-//! day of year, time of day and turbidity): solar elevation and azimuth from
-//! the date, the time, the latitude and the longitude.
+//! The sun (§6.3, §9.5): where it is and what reaches the ground.
+//!
+//! Position (Fig. 9.3 gives its lighting environments as day of year, time
+//! of day and turbidity): solar elevation and azimuth from the date, the
+//! time, the latitude and the longitude.
+//!
+//! Colour ([`transmitted_sun`]): the extraterrestrial disc
+//! ([`SUN_LUMINANCE_EXTRATERRESTRIAL`] is its mean luminance: × the disc's
+//! solid angle it gives the solar illuminance constant, ≈ 133 klx) times the
+//! spectral transmittances of Preetham, Shirley and Smits 1999, appendix
+//! A.1, averaged over a few wavelengths per channel.
 //!
 //! Algorithm: NOAA's solar calculator spreadsheet (Global Monitoring
 //! Laboratory), after Meeus, "Astronomical Algorithms" ch. 25: the sun's
@@ -23,6 +31,7 @@
 
 use glam::Vec3;
 
+use super::constants::{SUN_ANGULAR_RADIUS, SUN_COLOUR_EXTRATERRESTRIAL, SUN_LUMINANCE_EXTRATERRESTRIAL};
 use crate::error::{Error, Result};
 use crate::view::lighting::{sun_direction, SunPosition};
 
@@ -297,6 +306,148 @@ impl SkyPreset {
             Clock::MeanSolar,
         )
     }
+}
+
+/// Precipitable water (cm) for the water-vapour transmittance.
+pub const WATER_VAPOUR_CM: f32 = 2.0;
+/// Total ozone column (cm) of Preetham's appendix A.1.
+pub const OZONE_CM: f32 = 0.35;
+/// Relative optical air mass at sun zenith angle `zenith_deg` (clamped to
+/// 0..=90°): Kasten and Young 1989, `1 / (cos z + 0.50572·(96.07995° −
+/// z)^−1.6364)`; ≈ 38 at the horizon.
+pub fn relative_air_mass(zenith_deg: f32) -> f32 {
+    let z = zenith_deg.clamp(0.0, 90.0);
+    1.0 / (z.to_radians().cos() + 0.50572 * (96.07995 - z).powf(-1.6364))
+}
+
+/// Linear interpolation in a table of (wavelength nm, value), clamped.
+fn table(t: &[(f32, f32)], lambda: f32) -> f32 {
+    let i = t.partition_point(|&(l, _)| l < lambda);
+    if i == 0 {
+        return t[0].1;
+    }
+    if i == t.len() {
+        return t[t.len() - 1].1;
+    }
+    let ((l0, v0), (l1, v1)) = (t[i - 1], t[i]);
+    v0 + (v1 - v0) * (lambda - l0) / (l1 - l0)
+}
+
+/// Ozone absorption k_o (1/cm), appendix A.1 (from Iqbal 1983), 355–790 nm.
+const K_OZONE: [(f32, f32); 44] = [
+    (355.0, 0.0),
+    (445.0, 0.003),
+    (450.0, 0.003),
+    (455.0, 0.004),
+    (460.0, 0.006),
+    (465.0, 0.008),
+    (470.0, 0.009),
+    (475.0, 0.012),
+    (480.0, 0.014),
+    (485.0, 0.017),
+    (490.0, 0.021),
+    (495.0, 0.025),
+    (500.0, 0.03),
+    (505.0, 0.035),
+    (510.0, 0.04),
+    (515.0, 0.045),
+    (520.0, 0.048),
+    (525.0, 0.057),
+    (530.0, 0.063),
+    (535.0, 0.07),
+    (540.0, 0.075),
+    (545.0, 0.08),
+    (550.0, 0.085),
+    (555.0, 0.095),
+    (560.0, 0.103),
+    (565.0, 0.11),
+    (570.0, 0.12),
+    (575.0, 0.122),
+    (580.0, 0.12),
+    (585.0, 0.118),
+    (590.0, 0.115),
+    (595.0, 0.12),
+    (600.0, 0.125),
+    (605.0, 0.13),
+    (610.0, 0.12),
+    (620.0, 0.105),
+    (630.0, 0.09),
+    (640.0, 0.079),
+    (650.0, 0.067),
+    (660.0, 0.057),
+    (670.0, 0.048),
+    (680.0, 0.036),
+    (690.0, 0.028),
+    (700.0, 0.023),
+];
+/// Mixed-gas (O₂) absorption k_g (1/km), appendix A.1.
+const K_GAS: [(f32, f32); 4] = [(759.0, 0.0), (760.0, 3.0), (770.0, 0.21), (771.0, 0.0)];
+/// Water-vapour absorption k_wa (1/cm), appendix A.1.
+const K_WATER: [(f32, f32); 5] = [
+    (689.0, 0.0),
+    (690.0, 0.016),
+    (700.0, 0.024),
+    (710.0, 0.0125),
+    (720.0, 1.0),
+];
+
+/// Spectral transmittance of the atmosphere along relative air mass `m` at
+/// `lambda_nm` and turbidity `t` (Preetham 1999, appendix A.1): Rayleigh
+/// `e^(−0.008735 λ^−4.08 m)`, aerosols (Ångström) `e^(−β λ^−α m)` with
+/// `β = 0.04608T − 0.04586`, `α = 1.3`, ozone `e^(−k_o l m)` with l = 0.35
+/// cm, mixed gases `e^(−1.41 k_g m / (1 + 118.93 k_g m)^0.45)` and water
+/// vapour `e^(−0.2385 k_wa w m / (1 + 20.07 k_wa w m)^0.45)`, w = 2 cm
+/// (λ in µm). The last two absorb only above 689 nm, beyond the sampled
+/// channels; the water table stops at 720 nm.
+pub fn spectral_transmittance(lambda_nm: f32, m: f32, t: f32) -> f32 {
+    let l = lambda_nm / 1000.0;
+    let rayleigh = -0.008735 * l.powf(-4.08) * m;
+    let aerosol = -(0.04608 * t - 0.04586).max(0.0) * l.powf(-1.3) * m;
+    let ozone = -table(&K_OZONE, lambda_nm) * OZONE_CM * m;
+    let kg = table(&K_GAS, lambda_nm) * m;
+    let gas = -1.41 * kg / (1.0 + 118.93 * kg).powf(0.45);
+    let kw = if lambda_nm <= 720.0 {
+        table(&K_WATER, lambda_nm)
+    } else {
+        0.0
+    } * WATER_VAPOUR_CM
+        * m;
+    let water = -0.2385 * kw / (1.0 + 20.07 * kw).powf(0.45);
+    (rayleigh + aerosol + ozone + gas + water).exp()
+}
+
+/// Wavelengths (nm) averaged for each of R, G, B: equal-weight samples
+/// across the band where each sRGB channel is most sensitive (a coarse
+/// stand-in for integrating with colour-matching functions).
+pub const CHANNEL_SAMPLES_NM: [[f32; 4]; 3] = [
+    [600.0, 620.0, 640.0, 660.0],
+    [520.0, 540.0, 560.0, 580.0],
+    [440.0, 455.0, 470.0, 485.0],
+];
+
+/// Atmospheric transmittance of R, G, B for a sun at `zenith_deg`.
+pub fn sun_transmittance(zenith_deg: f32, t: f32) -> Vec3 {
+    let m = relative_air_mass(zenith_deg);
+    Vec3::from_array(
+        CHANNEL_SAMPLES_NM
+            .map(|band| band.iter().map(|&l| spectral_transmittance(l, m, t)).sum::<f32>() / band.len() as f32),
+    )
+}
+
+/// Mean radiance of the sun's disc at the ground towards unit `sun`:
+/// extraterrestrial luminance × colour × [`sun_transmittance`], times the
+/// fraction of the disc above the horizon (linear in elevation across the
+/// disc), so it reaches 0 when the disc has set.
+pub fn transmitted_sun(sun: Vec3, t: f32) -> Vec3 {
+    let elevation = sun.z.clamp(-1.0, 1.0).asin();
+    let visible = ((elevation + SUN_ANGULAR_RADIUS) / (2.0 * SUN_ANGULAR_RADIUS)).clamp(0.0, 1.0);
+    if visible <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let zenith_deg = 90.0 - elevation.to_degrees();
+    Vec3::from_array(SUN_COLOUR_EXTRATERRESTRIAL)
+        * (SUN_LUMINANCE_EXTRATERRESTRIAL * visible)
+        * sun_transmittance(zenith_deg, t)
 }
 
 #[cfg(test)]
