@@ -4,7 +4,10 @@
 //! ([`constants::LightingFrame`], `glsl/include/lighting.glsl`) that every
 //! shading pass reads.
 
+pub mod aerial;
 pub mod constants;
+pub mod preetham;
 pub mod shadows;
 pub mod sky;
+pub mod solar;
 pub mod technique;
