@@ -3,6 +3,7 @@
 
 use clap::{Args, ValueEnum};
 
+use alpenglow::lighting::solar::{parse_date, parse_time, solar_position, Clock, SkyPreset};
 use alpenglow::view::{Exposure, Lighting, ShadowMode, SkyLightMode, SkyModel, SunPosition};
 
 #[derive(Args, Debug, Clone, Default)]
@@ -21,10 +22,10 @@ pub struct LightingArgs {
     pub time: Option<String>,
     /// Latitude, degrees north (with --date).
     #[arg(long, allow_hyphen_values = true)]
-    pub latitude: Option<f64>,
+    pub latitude: Option<f32>,
     /// Longitude, degrees east (with --date).
     #[arg(long, allow_hyphen_values = true)]
-    pub longitude: Option<f64>,
+    pub longitude: Option<f32>,
     /// The text's environments of Fig. 9.3: morning (day 298 07:30) or noon (day 180 12:00), 49.6° N, T = 2.1.
     #[arg(long = "sky-preset")]
     pub sky_preset: Option<String>,
@@ -152,6 +153,32 @@ fn sun_position(args: &LightingArgs, l: &mut Lighting) -> anyhow::Result<()> {
             elevation_deg: args.sun_elevation.unwrap_or(30.0),
             azimuth_deg: args.sun_azimuth.unwrap_or(180.0),
         };
+    }
+    if let Some(name) = &args.sky_preset {
+        let preset = SkyPreset::parse(name)?;
+        l.sun = preset.sun()?.position();
+        l.turbidity = preset.turbidity();
+    }
+    if place {
+        let (Some(date), Some(time), Some(latitude), Some(longitude)) =
+            (&args.date, &args.time, args.latitude, args.longitude)
+        else {
+            return Err(bad(
+                "--date/--time/--latitude/--longitude",
+                "the sun by date and place needs all four",
+            ));
+        };
+        let date = parse_date(date)?;
+        let minutes = parse_time(time)?;
+        let sun = solar_position(
+            date.year,
+            date.day_of_year(),
+            minutes,
+            latitude,
+            longitude,
+            Clock::MeanSolar,
+        )?;
+        l.sun = sun.position();
     }
     Ok(())
 }

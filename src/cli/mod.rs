@@ -183,6 +183,7 @@ fn render_settings(args: &SceneArgs, scene: &Scene, readback: bool) -> Result<Re
         },
         texture_streaming: texture_streaming(args),
         lighting: Some(lighting),
+        ..RenderSettings::new(args.width, args.height)
     })
 }
 

@@ -5,9 +5,9 @@
 //! every shading pass reads; the lighting passes (lookup tables, shadow
 //! casters, sky light) are declared by its parts.
 
-use glam::Vec3;
-
+use super::aerial::AerialCoefficients;
 use super::constants::*;
+use super::preetham::PreethamSky;
 use super::shadows::ShadowFrame;
 use crate::error::Result;
 use crate::graph::UploadRegion;
@@ -43,16 +43,15 @@ impl SceneLighting {
         SceneLighting { regions, field }
     }
 
-    /// The constants of one view (without view-dependent parts).
-    fn constants(&self, lighting: &Lighting) -> LightingFrame {
+    /// The constants of one view (without view-dependent parts): the
+    /// Preetham sky's coefficients and the transmitted sun (§6.3), the
+    /// aerial perspective's scattering coefficients (§9.1), the modes.
+    fn constants(&self, lighting: &Lighting) -> Result<LightingFrame> {
         let mut f = LightingFrame::zeroed_frame();
         let sun = lighting.sun_direction();
-        f.sun = sun.extend(SUN_ANGULAR_RADIUS).to_array();
-        let radiance = sun_radiance_placeholder(sun);
-        let solid_angle = std::f32::consts::PI * SUN_ANGULAR_RADIUS * SUN_ANGULAR_RADIUS;
-        f.sun_radiance = radiance.extend(0.0).to_array();
-        f.sun_irradiance = (radiance * solid_angle).extend(0.0).to_array();
-        f.zenith = [8000.0, 0.3, 0.3, lighting.turbidity];
+        PreethamSky::new(sun, lighting.turbidity)?.fill(&mut f);
+        AerialCoefficients::for_turbidity(lighting.turbidity)?.fill(&mut f);
+        f.mie[3] = self.field.ground;
         f.models = [
             match lighting.sky {
                 SkyModel::Preetham => SKY_PREETHAM,
@@ -88,17 +87,8 @@ impl SceneLighting {
             self.field.texels[0],
             self.field.texels[1],
         ];
-        f
+        Ok(f)
     }
-}
-
-/// The transmitted sun until the sky model lands: the extraterrestrial sun
-/// through a Rayleigh-only air mass.
-fn sun_radiance_placeholder(sun: Vec3) -> Vec3 {
-    let colour = Vec3::from(SUN_COLOUR_EXTRATERRESTRIAL) * SUN_LUMINANCE_EXTRATERRESTRIAL;
-    let mass = 1.0 / sun.z.max(0.02);
-    let tau = Vec3::new(0.05, 0.11, 0.27);
-    colour * Vec3::new((-tau.x * mass).exp(), (-tau.y * mass).exp(), (-tau.z * mass).exp()) * (sun.z > 0.0) as u8 as f32
 }
 
 impl LightingFrame {
@@ -119,7 +109,7 @@ impl Technique for SceneLighting {
         frame.lighting.validate()?;
         let mut views = Vec::with_capacity(frame.views.len());
         for (k, _view) in frame.views.iter().enumerate() {
-            let mut constants = self.constants(frame.lighting);
+            let mut constants = self.constants(frame.lighting)?;
             if let Ok(shadows) = frame.prepared::<ShadowFrame>() {
                 shadows.view(k)?.fill(&mut constants);
             }
