@@ -50,3 +50,13 @@ pub const TEXTURING_UPSAMPLE: SpirV = spirv!("texturing/upsample.comp");
 pub const TEXTURING_LAYER: SpirV = spirv!("texturing/layer.comp");
 /// texturing.finish: colour and displacement normal into the atlas (§8.2).
 pub const TEXTURING_FINISH: SpirV = spirv!("texturing/finish.comp");
+/// sky_light.horizon: horizon tracing of the height field and the sun horizon map (§9.5).
+pub const SKY_LIGHT_HORIZON: SpirV = spirv!("lighting/horizon.comp");
+/// sky_light.transfer: direct SH and patch transfer, sky visibility, bent normals (§9.3, §9.5).
+pub const SKY_LIGHT_TRANSFER: SpirV = spirv!("lighting/sky_light_transfer.comp");
+/// sky_light.bounce: one interreflection bounce of the transfer (§9.4).
+pub const SKY_LIGHT_BOUNCE: SpirV = spirv!("lighting/sky_light_bounce.comp");
+/// lighting.environment: the sky projected into SH and sky patches (§9.3, §9.5).
+pub const LIGHTING_ENVIRONMENT: SpirV = spirv!("lighting/environment.comp");
+/// lighting.sky_light: the per-texel sky-light map by mode (§9.3–9.5).
+pub const SKY_LIGHT_EVALUATE: SpirV = spirv!("lighting/sky_light_evaluate.comp");

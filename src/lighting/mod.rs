@@ -6,3 +6,5 @@
 
 pub mod constants;
 pub mod sky;
+pub mod sh;
+pub mod sky_light;
