@@ -2,8 +2,9 @@
 // lighting.environment (§9.3, §9.5; ALGORITHMS.md §6): the frame's sky
 // radiance projected onto 25 RGB SH coefficients and averaged over the sky
 // patches (8×8 and 4×4: azimuth sector × z bin of the upper hemisphere).
-// Quadrature: the midpoint rule on an equal-area grid of 128 azimuths × 64
-// z rows over the sphere; with LIGHTING_SUN_IN_ENVIRONMENT the sun adds a
+// Quadrature: 128 equally spaced azimuths × 64 z rows, the rows a 4-point
+// Gauss–Legendre rule in each of 16 z bins of width 1/8 (the patch bins of
+// the upper hemisphere), exact for the zonal SH up to band 4; with LIGHTING_SUN_IN_ENVIRONMENT the sun adds a
 // delta of its disc's irradiance. One workgroup; every sum is taken in a
 // fixed order (deterministic).
 #include "../include/heap.glsl"
@@ -37,13 +38,17 @@ void main() {
     for (int a = 0; a < SECTORS; ++a) {
         sectors[a] = vec3(0.0);
     }
+    const float nodes[4] = float[4](-0.861136311594053, -0.339981043584856, 0.339981043584856, 0.861136311594053);
+    const float weights[4] = float[4](0.347854845137454, 0.652145154862546, 0.652145154862546, 0.347854845137454);
     for (int row = 2 * t; row < 2 * t + 2; ++row) {
-        float z = -1.0 + 2.0 * (float(row) + 0.5) / float(ROWS);
+        int bin = row / 4;
+        float z = -1.0 + (float(bin) + 0.5 + 0.5 * nodes[row % 4]) / 8.0;
+        float wz = weights[row % 4] / 16.0;
         float r = sqrt(max(1.0 - z * z, 0.0));
         for (int i = 0; i < AZIMUTHS; ++i) {
             float phi = 2.0 * SH_PI * (float(i) + 0.5) / float(AZIMUTHS);
             vec3 dir = vec3(r * cos(phi), r * sin(phi), z);
-            vec3 radiance = sky_radiance(lighting, dir);
+            vec3 radiance = sky_radiance(lighting, dir) * wz;
             float y[25];
             sh_basis(dir, y);
             for (int c = 0; c < 25; ++c) {
@@ -63,7 +68,7 @@ void main() {
     vec4 sun = g_lighting[lighting].f.sun;
     vec3 sun_e = g_lighting[lighting].f.sun_irradiance.rgb;
     bool sun_in = (g_lighting[lighting].f.models.w & LIGHTING_SUN_IN_ENVIRONMENT) != 0u;
-    float cell = 4.0 * SH_PI / float(AZIMUTHS * ROWS);
+    float cell = 2.0 * SH_PI / float(AZIMUTHS);
     uint out_ = pc.handles.y;
     if (t < 25) {
         vec3 sum = vec3(0.0);
@@ -92,7 +97,7 @@ void main() {
         int b = k / 8;
         int a = k % 8;
         vec3 sum = s_sectors[16 + 2 * b][a] + s_sectors[17 + 2 * b][a];
-        vec3 mean = sum / float(4 * AZIMUTHS / SECTORS);
+        vec3 mean = sum * cell / patch_solid_angle;
         if (k == sun_patch) {
             mean += sun_e / patch_solid_angle;
         }
