@@ -36,7 +36,16 @@ fn constant_sky(sun: DVec3, sun_in_environment: bool) -> LightingFrame {
     f.sun_irradiance = [5000.0, 4000.0, 3000.0, 0.0];
     f.zenith = [SKY, 0.3127, 0.3290, 3.0];
     f.perez_norm = [1.0, 1.0, 1.0, 0.0];
-    f.models = [SKY_PREETHAM, 0, 0, if sun_in_environment { LIGHTING_SUN_IN_ENVIRONMENT } else { 0 }];
+    f.models = [
+        SKY_PREETHAM,
+        0,
+        0,
+        if sun_in_environment {
+            LIGHTING_SUN_IN_ENVIRONMENT
+        } else {
+            0
+        },
+    ];
     f
 }
 
@@ -97,7 +106,9 @@ fn run_frames(ctx: &Context, sky: &SkyLight, frames_in: &[(LightingFrame, Lighti
         let mut constants = *constants;
         sky.fill(&mut constants);
         baked.uploads(next).write_pod(region, &constants).unwrap();
-        baked.execute(&mut frames, &Frame::new(next, Vec::new(), *lighting), &[]).unwrap();
+        baked
+            .execute(&mut frames, &Frame::new(next, Vec::new(), *lighting), &[])
+            .unwrap();
         baked.finish(&mut frames).unwrap();
         let vec4s = |b: &Buffer| bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(b.mapped().unwrap());
         out.push((vec4s(&env), vec4s(&map)));
@@ -116,15 +127,26 @@ fn the_gpu_basis_is_the_cpu_basis() {
         let field = HeightField::from_fn(9, 9, DVec2::ONE, |_, _| 0.0);
         let sky = SkyLight::new(&ctx, bake(&ctx, &field, BakeSettings::default())).unwrap();
         let l = lighting(SkyLightMode::Sh, 5, 8);
-        for sun in [DVec3::new(0.3, -0.5, 0.8), DVec3::new(-0.7, 0.2, 0.2), DVec3::new(0.1, 0.9, -0.3)] {
+        for sun in [
+            DVec3::new(0.3, -0.5, 0.8),
+            DVec3::new(-0.7, 0.2, 0.2),
+            DVec3::new(0.1, 0.9, -0.3),
+        ] {
             let sun = sun.normalize();
-            let out = run_frames(&ctx, &sky, &[(constant_sky(sun, true), l), (constant_sky(sun, false), l)]);
+            let out = run_frames(
+                &ctx,
+                &sky,
+                &[(constant_sky(sun, true), l), (constant_sky(sun, false), l)],
+            );
             let y = sh::basis_all(sun);
-            for i in 0..25 {
+            for (i, y) in y.iter().enumerate() {
                 for ch in 0..3 {
                     let delta = f64::from(out[0].0[i][ch] - out[1].0[i][ch]);
-                    let want = f64::from(constant_sky(sun, true).sun_irradiance[ch]) * y[i];
-                    assert!((delta - want).abs() < 1e-3 * 5000.0, "coefficient {i} channel {ch}: {delta} vs {want}");
+                    let want = f64::from(constant_sky(sun, true).sun_irradiance[ch]) * y;
+                    assert!(
+                        (delta - want).abs() < 0.05,
+                        "coefficient {i} channel {ch}: {delta} vs {want}"
+                    );
                 }
             }
         }
@@ -178,8 +200,22 @@ fn a_valley_sees_less_sky_than_a_crest() {
         let field = HeightField::from_fn(65, 33, DVec2::new(10.0, 10.0), |c, _| {
             60.0 * (2.0 * std::f32::consts::PI * c as f32 / 32.0).cos()
         });
-        let direct = bake(&ctx, &field, BakeSettings { bounces: 0, ..BakeSettings::default() });
-        let bounced = bake(&ctx, &field, BakeSettings { bounces: 2, ..BakeSettings::default() });
+        let direct = bake(
+            &ctx,
+            &field,
+            BakeSettings {
+                bounces: 0,
+                ..BakeSettings::default()
+            },
+        );
+        let bounced = bake(
+            &ctx,
+            &field,
+            BakeSettings {
+                bounces: 2,
+                ..BakeSettings::default()
+            },
+        );
         let data = direct.read_back(&ctx).unwrap();
         let sun = DVec3::new(0.0, 0.6, 0.8);
         let frame = [(constant_sky(sun, false), lighting(SkyLightMode::Sh, 5, 8))];
@@ -188,8 +224,18 @@ fn a_valley_sees_less_sky_than_a_crest() {
         let (d, b) = (lit(direct), lit(bounced));
         assert!((d[crest][3] - 1.0).abs() < 1e-3, "crest visibility {}", d[crest][3]);
         assert!(d[valley][3] < 0.9, "valley visibility {}", d[valley][3]);
-        assert!(d[valley][1] < 0.9 * d[crest][1], "valley {} vs crest {}", d[valley][1], d[crest][1]);
-        assert!(b[valley][1] > d[valley][1] * 1.01, "a bounce adds light: {} vs {}", b[valley][1], d[valley][1]);
+        assert!(
+            d[valley][1] < 0.9 * d[crest][1],
+            "valley {} vs crest {}",
+            d[valley][1],
+            d[crest][1]
+        );
+        assert!(
+            b[valley][1] > d[valley][1] * 1.01,
+            "a bounce adds light: {} vs {}",
+            b[valley][1],
+            d[valley][1]
+        );
         assert!(b[valley][1] < d[crest][1]);
         // The horizon map towards +X (tile 0, red) at the valley: the
         // steepest rise max_d 60 (1 − cos(π d / 16)) / (10 d) is at d ≈ 11.9.

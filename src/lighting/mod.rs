@@ -5,6 +5,6 @@
 //! shading pass reads.
 
 pub mod constants;
-pub mod sky;
 pub mod sh;
+pub mod sky;
 pub mod sky_light;

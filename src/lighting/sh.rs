@@ -82,14 +82,13 @@ pub fn basis(dir: DVec3, bands: usize, out: &mut [f64]) {
         power[m] = (re * dir.x - im * dir.y, re * dir.y + im * dir.x);
     }
     for l in 0..bands {
-        for m in 0..=l {
+        for (m, &(re, im)) in power.iter().enumerate().take(l + 1) {
             let p = normalisation(l, m) * legendre_reduced(l, m, dir.z);
             if m == 0 {
                 if let Some(o) = out.get_mut(index(l, 0)) {
                     *o = p;
                 }
             } else {
-                let (re, im) = power[m];
                 let s = std::f64::consts::SQRT_2 * p;
                 if let Some(o) = out.get_mut(index(l, m as i32)) {
                     *o = s * re;
@@ -222,9 +221,9 @@ mod tests {
         // Gram matrix by numerical integration.
         let n = 8;
         let mut gram = [[0.0; MAX_COEFFICIENTS]; MAX_COEFFICIENTS];
-        for i in 0..MAX_COEFFICIENTS {
+        for (i, row) in gram.iter_mut().enumerate() {
             let c = project(|d| basis_all(d)[i], MAX_BANDS, n);
-            gram[i][..].copy_from_slice(&c);
+            row.copy_from_slice(&c);
         }
         for (i, row) in gram.iter().enumerate() {
             for (j, g) in row.iter().enumerate() {

@@ -257,7 +257,11 @@ impl SkyLightBake {
         let transfer_bytes = texels * u64::from(stride) * 4;
         let mut transfers = vec![storage(ctx, "sky-light transfer (direct)", transfer_bytes)?];
         for b in 1..=settings.bounces {
-            transfers.push(storage(ctx, &format!("sky-light transfer (bounce {b})"), transfer_bytes)?);
+            transfers.push(storage(
+                ctx,
+                &format!("sky-light transfer (bounce {b})"),
+                transfer_bytes,
+            )?);
         }
         let horizon_map = Arc::new(Image::new(ctx, horizon_map_desc(columns, rows))?);
 
@@ -338,7 +342,9 @@ impl SkyLightBake {
             run_chunks(ctx, &mut frames, graph, rows, chunk_rows, progress, (&mut done, total))?;
         }
         frames.finish()?;
-        let transfer = transfers.pop().ok_or_else(|| Error::Graph("sky light: no transfer".into()))?;
+        let transfer = transfers
+            .pop()
+            .ok_or_else(|| Error::Graph("sky light: no transfer".into()))?;
         Ok(SkyLightBake {
             settings: *settings,
             columns,
@@ -353,10 +359,18 @@ impl SkyLightBake {
     }
 
     /// A bake from cached data (checked against `field` and `settings`).
-    pub fn upload(ctx: &Context, field: &HeightField, settings: &BakeSettings, data: &BakeData) -> Result<SkyLightBake> {
+    pub fn upload(
+        ctx: &Context,
+        field: &HeightField,
+        settings: &BakeSettings,
+        data: &BakeData,
+    ) -> Result<SkyLightBake> {
         let key = BakeKey::new(field, settings);
         if data.key != key {
-            return Err(Error::invalid("sky light", "the cached bake is of another field or settings"));
+            return Err(Error::invalid(
+                "sky light",
+                "the cached bake is of another field or settings",
+            ));
         }
         let usage = BufferUsageFlags::STORAGE_BUFFER | BufferUsageFlags::TRANSFER_SRC;
         Ok(SkyLightBake {
@@ -366,7 +380,11 @@ impl SkyLightBake {
             spacing: field.spacing,
             surface: Arc::new(Buffer::with_data(ctx, "sky-light surface", usage, &data.surface)?),
             transfer: Arc::new(Buffer::with_data(ctx, "sky-light transfer", usage, &data.transfer)?),
-            horizon_map: Arc::new(Image::with_data(ctx, horizon_map_desc(field.columns, field.rows), &data.horizon)?),
+            horizon_map: Arc::new(Image::with_data(
+                ctx,
+                horizon_map_desc(field.columns, field.rows),
+                &data.horizon,
+            )?),
             from_cache: true,
             key,
         })

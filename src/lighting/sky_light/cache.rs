@@ -229,7 +229,11 @@ pub fn store(path: &Path, data: &BakeData) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(|e| {
             Error::output(
                 path,
-                format!("cannot create the cache directory {}: {}", dir.display(), crate::io::one_line(e)),
+                format!(
+                    "cannot create the cache directory {}: {}",
+                    dir.display(),
+                    crate::io::one_line(e)
+                ),
             )
         })?;
     }

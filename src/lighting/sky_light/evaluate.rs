@@ -147,7 +147,12 @@ impl SkyLight {
     /// constants in `lighting` and the sampled images in `sky_inputs`, e.g.
     /// the atmosphere's lookup tables) and `lighting.sky_light`; imports
     /// the persistent resources. Once per graph.
-    pub fn declare(&self, graph: &mut RenderGraph<Frame>, lighting: UploadRegion, sky_inputs: &[ImageId]) -> SkyLightIds {
+    pub fn declare(
+        &self,
+        graph: &mut RenderGraph<Frame>,
+        lighting: UploadRegion,
+        sky_inputs: &[ImageId],
+    ) -> SkyLightIds {
         let ids = SkyLightIds {
             map: graph.import_image(self.map.clone()),
             horizon: graph.import_image(self.bake.horizon_map.clone()),

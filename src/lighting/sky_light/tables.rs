@@ -103,7 +103,10 @@ mod tests {
                 let v = n.z * f64::from(table[j * ROW + 2 * p]) + n_t * f64::from(table[j * ROW + 2 * p + 1]);
                 let want_cos = direct[index(l, m as i32)];
                 let got_cos = v * if m > 0 { (m as f64 * phi).cos() } else { 1.0 };
-                assert!((got_cos - want_cos).abs() < 1e-5, "l {l} m {m}: {got_cos} vs {want_cos}");
+                assert!(
+                    (got_cos - want_cos).abs() < 1e-5,
+                    "l {l} m {m}: {got_cos} vs {want_cos}"
+                );
                 if m > 0 {
                     let got_sin = v * (m as f64 * phi).sin();
                     let want_sin = direct[index(l, -(m as i32))];
