@@ -62,3 +62,13 @@ pub const SHADOW_POINTS_VERT: SpirV = spirv!("lighting/shadow_points.vert");
 pub const SHADOW_POINTS_FRAG: SpirV = spirv!("lighting/shadow_points.frag");
 /// shadow probe: `sun_visibility` at a list of points (tests and AOV checks of §9.5).
 pub const SHADOW_PROBE: SpirV = spirv!("lighting/shadow_probe.comp");
+/// sky_light.horizon: horizon tracing of the height field and the sun horizon map (§9.5).
+pub const SKY_LIGHT_HORIZON: SpirV = spirv!("lighting/horizon.comp");
+/// sky_light.transfer: direct SH and patch transfer, sky visibility, bent normals (§9.3, §9.5).
+pub const SKY_LIGHT_TRANSFER: SpirV = spirv!("lighting/sky_light_transfer.comp");
+/// sky_light.bounce: one interreflection bounce of the transfer (§9.4).
+pub const SKY_LIGHT_BOUNCE: SpirV = spirv!("lighting/sky_light_bounce.comp");
+/// lighting.environment: the sky projected into SH and sky patches (§9.3, §9.5).
+pub const LIGHTING_ENVIRONMENT: SpirV = spirv!("lighting/environment.comp");
+/// lighting.sky_light: the per-texel sky-light map by mode (§9.3–9.5).
+pub const SKY_LIGHT_EVALUATE: SpirV = spirv!("lighting/sky_light_evaluate.comp");

@@ -7,7 +7,10 @@
 pub mod aerial;
 pub mod constants;
 pub mod preetham;
+pub mod reference;
+pub mod sh;
 pub mod shadows;
 pub mod sky;
+pub mod sky_light;
 pub mod solar;
 pub mod technique;
