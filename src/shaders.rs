@@ -50,3 +50,5 @@ pub const TEXTURING_UPSAMPLE: SpirV = spirv!("texturing/upsample.comp");
 pub const TEXTURING_LAYER: SpirV = spirv!("texturing/layer.comp");
 /// texturing.finish: colour and displacement normal into the atlas (§8.2).
 pub const TEXTURING_FINISH: SpirV = spirv!("texturing/finish.comp");
+/// lighting.reference: Monte Carlo ray tracing of sky light on the height field (§9.2).
+pub const LIGHTING_REFERENCE: SpirV = spirv!("lighting/reference.comp");

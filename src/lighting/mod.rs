@@ -5,4 +5,5 @@
 //! shading pass reads.
 
 pub mod constants;
+pub mod reference;
 pub mod sky;
