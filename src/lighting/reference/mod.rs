@@ -75,6 +75,9 @@ mod pyramid;
 pub mod sampling;
 mod trace;
 
+#[cfg(test)]
+mod tests;
+
 pub use cpu::{CpuReference, SunInput, TexelEstimate};
 pub use gpu::{MonteCarloReference, ReferenceImages, ReferenceProgress};
 pub use pyramid::field_buffer_words;
