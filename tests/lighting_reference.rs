@@ -42,7 +42,11 @@ fn lighting(sun_in_environment: bool, radius: f32) -> LightingFrame {
     let s = sun_direction(35.0, 120.0);
     l.sun = [s.x, s.y, s.z, radius];
     l.sun_irradiance = [3.0, 2.5, 2.0, 0.0];
-    l.models[3] = if sun_in_environment { LIGHTING_SUN_IN_ENVIRONMENT } else { 0 };
+    l.models[3] = if sun_in_environment {
+        LIGHTING_SUN_IN_ENVIRONMENT
+    } else {
+        0
+    };
     l
 }
 
@@ -83,8 +87,14 @@ fn run_gpu(
     let mut graph: RenderGraph<()> = RenderGraph::new();
     let region = graph.upload_region("lighting", std::mem::size_of::<LightingFrame>() as u64);
     let images = reference.declare(&mut graph, region, &[]);
-    let (sky_id, sun_id) = (graph.import_buffer(sky_buffer.clone()), graph.import_buffer(sun_buffer.clone()));
-    graph.read_back_images("readback", vec![(images.sky_light, sky_id), (images.sun_visibility, sun_id)]);
+    let (sky_id, sun_id) = (
+        graph.import_buffer(sky_buffer.clone()),
+        graph.import_buffer(sun_buffer.clone()),
+    );
+    graph.read_back_images(
+        "readback",
+        vec![(images.sky_light, sky_id), (images.sun_visibility, sun_id)],
+    );
     let mut baked = graph.bake(ctx).expect("bake");
     let mut ring = FrameRing::new(ctx).unwrap();
     let mut progress = Vec::new();
@@ -132,7 +142,10 @@ fn compare(field: &HeightField, settings: ReferenceSettings, frame: &LightingFra
             mean_dev += (deviation / e.sky_light.abs().max(Vec3::splat(1e-3))).max_element();
             for (g, p) in [(maps.sky[i][3], e.sky_visibility), (maps.sun[i], e.sun_visibility)] {
                 let sigma = (p * (1.0 - p) / n).sqrt();
-                assert!((g - p).abs() <= 3.0 * sigma + 2.0 / n, "texel ({c}, {r}): visibility {g} vs {p}");
+                assert!(
+                    (g - p).abs() <= 3.0 * sigma + 2.0 / n,
+                    "texel ({c}, {r}): visibility {g} vs {p}"
+                );
             }
         }
     }
@@ -159,7 +172,10 @@ fn gpu_matches_the_cpu_twin_with_bounces() {
         assert!(progress[0].restarted && progress[0].complete());
         assert!(!progress[1].restarted, "unchanged lighting must not recompute");
         compare(&field, settings, &frame, &maps);
-        assert!(maps.sun.iter().any(|&v| v > 0.0 && v < 1.0), "no partial sun visibility");
+        assert!(
+            maps.sun.iter().any(|&v| v > 0.0 && v < 1.0),
+            "no partial sun visibility"
+        );
         assert!(maps.sky.iter().any(|t| t[3] < 0.9), "no occluded sky");
 
         // The sun in the environment, one bounce, progressive over frames.
@@ -204,6 +220,7 @@ fn flat_field_on_the_gpu_sees_the_constant_sky() {
 #[ignore = "timing measurement"]
 fn timings() {
     let (ctx, report) = validated_context();
+    eprintln!("device: {} ({})", ctx.info().name, ctx.info().driver_name);
     for size in [129u32, 513] {
         let field = HeightField::from_fn(size, size, DVec2::new(30.0, 30.0), |c, r| {
             let (x, y) = (f64::from(c) * 0.05, f64::from(r) * 0.05);
@@ -217,7 +234,10 @@ fn timings() {
             };
             let frame = lighting(false, 0.004_654);
             let (_, _, elapsed) = run_gpu(&ctx, &field, settings, &[frame], None);
-            eprintln!("{size}² field, {samples} samples, 1 bounce: {:.2} s", elapsed.as_secs_f64());
+            eprintln!(
+                "{size}² field, {samples} samples, 1 bounce: {:.2} s",
+                elapsed.as_secs_f64()
+            );
         }
     }
     drop(ctx);

@@ -32,7 +32,11 @@ impl SunInput {
         let sun = SunInput {
             direction: Vec3::new(frame.sun[0], frame.sun[1], frame.sun[2]),
             angular_radius: frame.sun[3],
-            irradiance: Vec3::new(frame.sun_irradiance[0], frame.sun_irradiance[1], frame.sun_irradiance[2]),
+            irradiance: Vec3::new(
+                frame.sun_irradiance[0],
+                frame.sun_irradiance[1],
+                frame.sun_irradiance[2],
+            ),
             in_environment: flags & LIGHTING_SUN_IN_ENVIRONMENT != 0,
         };
         let albedo = if flags & LIGHTING_ALBEDO_OVERRIDE != 0 {

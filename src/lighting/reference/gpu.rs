@@ -119,7 +119,16 @@ fn chunk_barrier() -> Barrier {
 /// The parts of the lighting constants the maps depend on.
 fn lighting_key(l: &LightingFrame) -> Vec<u32> {
     let mut key: Vec<u32> = Vec::with_capacity(64);
-    for v in [l.sun, l.sun_radiance, l.sun_irradiance, l.zenith, l.perez_norm, l.rayleigh, l.mie, l.planet] {
+    for v in [
+        l.sun,
+        l.sun_radiance,
+        l.sun_irradiance,
+        l.zenith,
+        l.perez_norm,
+        l.rayleigh,
+        l.mie,
+        l.planet,
+    ] {
         key.extend(v.map(f32::to_bits));
     }
     for v in l.perez {
@@ -234,7 +243,7 @@ impl MonteCarloReference {
     }
 
     /// Imports the maps and the field into `graph` and declares
-    /// `lighting.reference`: it reads the lighting constants in `lighting`
+    /// `lighting.reference` (once per graph, not per view): it reads the lighting constants in `lighting`
     /// (any view's: the maps do not depend on the view) and samples
     /// `environment` (the sky model's lookup tables, whatever
     /// `sky_radiance` reads), and writes the maps.
@@ -259,15 +268,16 @@ impl MonteCarloReference {
         let (pipeline, schedule, settings) = (self.pipeline.clone(), self.schedule.clone(), self.settings);
         let (columns, spacing, offset) = (self.columns, self.spacing, self.offset);
         pass.record(move |pass, _| {
+            // Taken: a frame without `prepare` records nothing.
             let ((first, count), test_sky) = {
-                let s = lock(&schedule)?;
-                (s.pending, s.test_sky)
+                let mut s = lock(&schedule)?;
+                (std::mem::take(&mut s.pending), s.test_sky)
             };
             if count == 0 {
                 return Ok(());
             }
-            let flags = u32::from(test_sky.is_some()) * FLAG_TEST_SKY
-                + u32::from(settings.sun_bounces) * FLAG_SUN_BOUNCES;
+            let flags =
+                u32::from(test_sky.is_some()) * FLAG_TEST_SKY + u32::from(settings.sun_bounces) * FLAG_SUN_BOUNCES;
             let (a, b) = test_sky.unwrap_or_default();
             let mut push = ReferencePush {
                 handles: [

@@ -166,7 +166,10 @@ pub(crate) fn validate_field(field: &HeightField) -> Result<()> {
     let what = "lighting.reference.height_field";
     let (w, h) = (field.columns, field.rows);
     if w < 2 || h < 2 {
-        return Err(Error::invalid(what, format!("{w}×{h} samples; at least 2×2 are needed")));
+        return Err(Error::invalid(
+            what,
+            format!("{w}×{h} samples; at least 2×2 are needed"),
+        ));
     }
     if (w as usize).checked_mul(h as usize) != Some(field.heights.len()) {
         return Err(Error::invalid(
@@ -176,7 +179,10 @@ pub(crate) fn validate_field(field: &HeightField) -> Result<()> {
     }
     let s = field.spacing;
     if !(s.is_finite() && s.x > 0.0 && s.y > 0.0) {
-        return Err(Error::invalid(what, format!("spacing ({}, {}) must be finite and positive", s.x, s.y)));
+        return Err(Error::invalid(
+            what,
+            format!("spacing ({}, {}) must be finite and positive", s.x, s.y),
+        ));
     }
     if field.heights.iter().any(|v| !v.is_finite()) {
         return Err(Error::invalid(what, "a height is not finite"));

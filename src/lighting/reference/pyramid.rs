@@ -34,10 +34,7 @@ pub fn field_buffer_words(field: &HeightField) -> Result<Vec<u32>> {
         }
     }
     levels.push((w - 1, h - 1, level0));
-    loop {
-        let Some((lw, lh, prev)) = levels.last() else {
-            break;
-        };
+    while let Some((lw, lh, prev)) = levels.last() {
         let (lw, lh) = (*lw, *lh);
         if lw == 1 && lh == 1 {
             break;

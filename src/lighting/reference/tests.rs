@@ -40,7 +40,10 @@ fn flat_plane_sees_the_whole_sky() {
         let reference = CpuReference::new(&field, settings(64, bounces)).unwrap();
         for (c, r) in [(0, 0), (5, 4), (11, 8)] {
             let e = reference.texel(c, r, &sun(30.0, 40.0, false), 0.3, &sky).unwrap();
-            assert!((e.sky_light - Vec3::new(1.0, 2.0, 3.0)).abs().max_element() < 1e-5, "{e:?}");
+            assert!(
+                (e.sky_light - Vec3::new(1.0, 2.0, 3.0)).abs().max_element() < 1e-5,
+                "{e:?}"
+            );
             assert_eq!(e.sky_visibility, 1.0);
             assert_eq!(e.sun_visibility, 1.0);
             assert!(e.standard_error.max_element() < 1e-5);
@@ -66,7 +69,10 @@ fn v_valley_bottom_sees_cos_alpha_of_the_sky() {
         let reference = CpuReference::new(&field, settings(4096, 0)).unwrap();
         let e = reference.texel(16, 20, &sun(80.0, 0.0, false), 0.3, &sky).unwrap();
         let expected = slope.to_radians().cos() as f32;
-        assert!((e.sky_visibility - expected).abs() < 0.01, "{slope}°: {e:?} vs {expected}");
+        assert!(
+            (e.sky_visibility - expected).abs() < 0.01,
+            "{slope}°: {e:?} vs {expected}"
+        );
         // No bounces: the sky light is the visible sky.
         assert!((e.sky_light.x - 2.0 * e.sky_visibility).abs() < 1e-4);
     }
@@ -78,10 +84,28 @@ fn v_valley_walls_shadow_a_low_sun_and_bounce_light() {
     let sky = |d: Vec3| Vec3::splat(1.0 + d.z);
     let reference = CpuReference::new(&field, settings(256, 0)).unwrap();
     // Across the valley: below the 45° wall shadowed, above it lit.
-    assert_eq!(reference.texel(16, 20, &sun(30.0, 90.0, false), 0.3, &sky).unwrap().sun_visibility, 0.0);
-    assert_eq!(reference.texel(16, 20, &sun(60.0, 90.0, false), 0.3, &sky).unwrap().sun_visibility, 1.0);
+    assert_eq!(
+        reference
+            .texel(16, 20, &sun(30.0, 90.0, false), 0.3, &sky)
+            .unwrap()
+            .sun_visibility,
+        0.0
+    );
+    assert_eq!(
+        reference
+            .texel(16, 20, &sun(60.0, 90.0, false), 0.3, &sky)
+            .unwrap()
+            .sun_visibility,
+        1.0
+    );
     // Along the valley the sun is always visible.
-    assert_eq!(reference.texel(16, 20, &sun(5.0, 0.0, false), 0.3, &sky).unwrap().sun_visibility, 1.0);
+    assert_eq!(
+        reference
+            .texel(16, 20, &sun(5.0, 0.0, false), 0.3, &sky)
+            .unwrap()
+            .sun_visibility,
+        1.0
+    );
     // Bounces add light, more with a higher albedo; bounced sun adds more.
     let at = |bounces: u32, albedo: f32, sun_bounces: bool| {
         let s = ReferenceSettings {
@@ -89,7 +113,11 @@ fn v_valley_walls_shadow_a_low_sun_and_bounce_light() {
             ..settings(256, bounces)
         };
         let reference = CpuReference::new(&field, s).unwrap();
-        reference.texel(16, 20, &sun(60.0, 90.0, false), albedo, &sky).unwrap().sky_light.x
+        reference
+            .texel(16, 20, &sun(60.0, 90.0, false), albedo, &sky)
+            .unwrap()
+            .sky_light
+            .x
     };
     let (none, one, two) = (at(0, 0.3, false), at(1, 0.3, false), at(2, 0.3, false));
     assert!(none < one && one < two, "{none} {one} {two}");

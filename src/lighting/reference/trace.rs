@@ -190,7 +190,7 @@ impl<'a> HeightFieldTracer<'a> {
                 return None;
             }
         }
-        if !(t0 < t1) || !t1.is_finite() {
+        if t0 >= t1 || t0.is_nan() || !t1.is_finite() {
             return None;
         }
         // Amanatides–Woo over the cells from the one at t0.
@@ -258,7 +258,9 @@ mod tests {
 
     #[test]
     fn bilinear_saddle_is_hit_on_the_surface() {
-        let f = field(9, 9, |c, r| ((c - 4.0) * (r - 4.0)).abs().sqrt() * 3.0 + (c * 1.3).sin());
+        let f = field(9, 9, |c, r| {
+            ((c - 4.0) * (r - 4.0)).abs().sqrt() * 3.0 + (c * 1.3).sin()
+        });
         let tracer = HeightFieldTracer::new(&f).unwrap();
         for k in 0..200 {
             let a = f64::from(k) * 0.37;
