@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 
 use alpenglow::graph::RenderGraph;
 use alpenglow::io::heightmap::HeightField;
-use alpenglow::lighting::constants::{LightingFrame, LIGHTING_SUN_IN_ENVIRONMENT};
+use alpenglow::lighting::constants::{LightingFrame, LIGHTING_ALBEDO_OVERRIDE, LIGHTING_SUN_IN_ENVIRONMENT};
 use alpenglow::lighting::reference::{
     CpuReference, MonteCarloReference, ReferenceProgress, ReferenceSettings, SunInput,
 };
@@ -185,7 +185,9 @@ fn gpu_matches_the_cpu_twin_with_bounces() {
             rows_per_frame: Some(4),
             ..ReferenceSettings::default()
         };
-        let frame = lighting(true, 0.004_654);
+        let mut frame = lighting(true, 0.004_654);
+        frame.models[3] |= LIGHTING_ALBEDO_OVERRIDE;
+        frame.exposure[3] = 0.7;
         let (maps, progress, _) = run_gpu(&ctx, &field, settings, &[frame; 4], Some(SKY));
         assert_eq!(progress.iter().map(|p| p.rows_done).collect::<Vec<_>>(), [4, 8, 12, 13]);
         compare(&field, settings, &frame, &maps);
@@ -195,7 +197,7 @@ fn gpu_matches_the_cpu_twin_with_bounces() {
 }
 
 #[test]
-fn flat_field_on_the_gpu_sees_the_constant_sky() {
+fn flat_field_and_v_valley_on_the_gpu_match_the_analytic_values() {
     let (ctx, report) = validated_context();
     {
         let field = HeightField::from_fn(20, 9, DVec2::new(5.0, 5.0), |_, _| 1200.0);
@@ -210,6 +212,21 @@ fn flat_field_on_the_gpu_sees_the_constant_sky() {
             assert!((Vec3::from_slice(&t[..3]) - sky.0).abs().max_element() < 1e-5, "{t:?}");
             assert_eq!((t[3], *s), (1.0, 1.0));
         }
+        // The bottom of a V valley with 45° walls sees cos 45° of the sky
+        // (see the CPU twin's analytic test).
+        let tan = 1.0f64;
+        let valley = HeightField::from_fn(33, 41, DVec2::new(2.0, 2.0), |c, _| {
+            ((f64::from(c) - 16.0).abs() * 2.0 * tan + 100.0) as f32
+        });
+        let settings = ReferenceSettings {
+            samples: 1024,
+            bounces: 0,
+            ..ReferenceSettings::default()
+        };
+        let (maps, _, _) = run_gpu(&ctx, &valley, settings, &[lighting(false, 0.004_654)], Some(sky));
+        let bottom = maps.sky[20 * 33 + 16];
+        assert!((bottom[3] - std::f32::consts::FRAC_1_SQRT_2).abs() < 0.01, "{bottom:?}");
+        assert!((bottom[0] - bottom[3]).abs() < 1e-4, "{bottom:?}");
     }
     drop(ctx);
     assert_validation_clean(&report);
