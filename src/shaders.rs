@@ -72,3 +72,5 @@ pub const SKY_LIGHT_BOUNCE: SpirV = spirv!("lighting/sky_light_bounce.comp");
 pub const LIGHTING_ENVIRONMENT: SpirV = spirv!("lighting/environment.comp");
 /// lighting.sky_light: the per-texel sky-light map by mode (§9.3–9.5).
 pub const SKY_LIGHT_EVALUATE: SpirV = spirv!("lighting/sky_light_evaluate.comp");
+/// lighting.reference: Monte Carlo ray tracing of sky light on the height field (§9.2).
+pub const LIGHTING_REFERENCE: SpirV = spirv!("lighting/reference.comp");
