@@ -8,8 +8,10 @@
 use super::aerial::AerialCoefficients;
 use super::constants::*;
 use super::preetham::PreethamSky;
+use super::reference::MonteCarloReference;
 use super::shadows::ShadowFrame;
-use crate::error::Result;
+use super::sky_light::SkyLight;
+use crate::error::{Error, Result};
 use crate::graph::UploadRegion;
 use crate::view::{FrameContext, Lighting, ShadowMode, SkyLightMode, SkyModel, Technique};
 
@@ -35,12 +37,21 @@ pub struct SceneLighting {
     /// The constants region of each view.
     regions: Vec<UploadRegion>,
     field: FieldInfo,
+    /// Sky light on the terrain by SH, AO or patches (§9.3–9.5).
+    pub sky_light: Option<SkyLight>,
+    /// The Monte Carlo reference (§9.2), when the renderer was built for it.
+    pub reference: Option<MonteCarloReference>,
 }
 
 impl SceneLighting {
     /// Lighting for views whose constants go to `regions`.
     pub fn new(regions: Vec<UploadRegion>, field: FieldInfo) -> SceneLighting {
-        SceneLighting { regions, field }
+        SceneLighting {
+            regions,
+            field,
+            sky_light: None,
+            reference: None,
+        }
     }
 
     /// The constants of one view (without view-dependent parts): the
@@ -112,6 +123,19 @@ impl Technique for SceneLighting {
             let mut constants = self.constants(frame.lighting)?;
             if let Ok(shadows) = frame.prepared::<ShadowFrame>() {
                 shadows.view(k)?.fill(&mut constants);
+            }
+            if let Some(sky_light) = &self.sky_light {
+                sky_light.fill(&mut constants);
+            }
+            if frame.lighting.sky_light == SkyLightMode::Reference {
+                let reference = self.reference.as_ref().ok_or_else(|| {
+                    Error::invalid(
+                        "lighting.sky_light",
+                        "reference: the renderer was built without the Monte Carlo reference (start with it)",
+                    )
+                })?;
+                reference.prepare(&constants)?;
+                reference.fill(&mut constants)?;
             }
             let region = *self
                 .regions

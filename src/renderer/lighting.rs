@@ -3,14 +3,19 @@
 //! with their caster passes (terrain and points). Declared before any
 //! shading pass, so every shading pass reads what they write.
 
+use std::path::Path;
+
 use crate::error::Result;
 use crate::graph::RenderGraph;
+use crate::lighting::reference::{MonteCarloReference, ReferenceSettings};
 use crate::lighting::shadows::{ShadowMaps, ShadowSettings};
+use crate::lighting::sky_light::{BakeSettings, SkyLight, SkyLightBake};
 use crate::lighting::technique::{FieldInfo, SceneLighting};
 use crate::points::render::shadow::PointShadows;
 use crate::points::render::PointRenderer;
 use crate::terrain::Terrain;
 use crate::view::{Frame, SceneTargets, View};
+use crate::view::{Lighting, SkyLightMode};
 use crate::vulkan::Context;
 
 use super::Scene;
@@ -72,4 +77,47 @@ pub(super) fn declare_shadows(
     };
     targets.lighting.images.push(target.atlas);
     Ok(Some(SunShadows { maps, points }))
+}
+
+/// Bakes the height field's sky-light transfer (or loads it from `cache`),
+/// declares `lighting.environment` and `lighting.sky_light`, and, when the
+/// first frames use it, the Monte Carlo reference's `lighting.reference`;
+/// adds their maps to what the view's shading passes read.
+pub(super) fn declare_sky_light(
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame>,
+    (scene, lighting): (&Scene, &Lighting),
+    (targets, scene_lighting): (&mut SceneTargets, &mut SceneLighting),
+    cache: Option<&Path>,
+    progress: &mut dyn FnMut(f32),
+) -> Result<()> {
+    let region = targets.lighting.constants;
+    let sky_inputs = targets.lighting.images.clone();
+    let bake = SkyLightBake::bake(
+        ctx,
+        &scene.heights,
+        &BakeSettings::from_lighting(lighting),
+        cache,
+        progress,
+    )?;
+    let sky_light = SkyLight::new(ctx, bake)?;
+    let ids = sky_light.declare(graph, region, &sky_inputs);
+    targets.lighting.images.extend([ids.map, ids.horizon]);
+    targets.lighting.buffers.push(ids.environment);
+    scene_lighting.sky_light = Some(sky_light);
+    if lighting.sky_light == SkyLightMode::Reference {
+        let settings = ReferenceSettings {
+            bounces: lighting.bounces,
+            bounce_albedo: lighting.albedo_override.unwrap_or(0.3),
+            ..ReferenceSettings::default()
+        };
+        let reference = MonteCarloReference::new(ctx, &scene.heights, settings)?;
+        let images = reference.declare(graph, region, &sky_inputs);
+        targets
+            .lighting
+            .images
+            .extend([images.sky_light, images.sun_visibility]);
+        scene_lighting.reference = Some(reference);
+    }
+    Ok(())
 }

@@ -41,7 +41,7 @@ use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Context, FrameRing, Me
 
 /// Output size, whether frames are read back to the host, and the
 /// terrain's LOD and detail settings.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct RenderSettings {
     pub width: u32,
     pub height: u32,
@@ -56,6 +56,8 @@ pub struct RenderSettings {
     pub texture_streaming: TextureStreaming,
     /// The sun's cascaded shadow maps.
     pub shadows: ShadowSettings,
+    /// Where the sky-light bake is cached (None: baked every time).
+    pub cache_dir: Option<std::path::PathBuf>,
     /// The lighting of the first frames (None: [`Scene::default_lighting`]);
     /// change it between frames with [`Renderer::set_lighting`].
     pub lighting: Option<Lighting>,
@@ -76,6 +78,7 @@ impl RenderSettings {
                 atlas_size: 2048,
                 ..ShadowSettings::default()
             },
+            cache_dir: None,
             lighting: None,
         }
     }
@@ -186,6 +189,16 @@ impl Renderer {
     /// Uploads the scene, declares every technique's passes for the view
     /// and bakes the frame graph.
     pub fn new(ctx: &Context, scene: &Scene, settings: RenderSettings) -> Result<Renderer> {
+        Renderer::with_progress(ctx, scene, settings, &mut |_| {})
+    }
+
+    /// [`Renderer::new`], reporting the sky-light bake's progress (0..1).
+    pub fn with_progress(
+        ctx: &Context,
+        scene: &Scene,
+        settings: RenderSettings,
+        progress: &mut dyn FnMut(f32),
+    ) -> Result<Renderer> {
         validate_size(settings.width, settings.height)?;
         let (w, h) = (settings.width, settings.height);
         let max = ctx.max_image_dimension();
@@ -198,8 +211,20 @@ impl Renderer {
         let mut graph = RenderGraph::new();
         // The view the graph is declared for; every frame brings its camera.
         let view = View::new(scene.default_camera(), w, h);
+        let lighting = settings.lighting.unwrap_or_else(|| scene.default_lighting());
+        lighting.validate()?;
         let mut targets = SceneTargets::declare(&mut graph, &view, !scene.points.is_empty());
-        let scene_lighting = lighting::scene_lighting(scene, &targets);
+        let mut scene_lighting = lighting::scene_lighting(scene, &targets);
+        if scene.draw_terrain {
+            lighting::declare_sky_light(
+                ctx,
+                &mut graph,
+                (scene, &lighting),
+                (&mut targets, &mut scene_lighting),
+                settings.cache_dir.as_deref(),
+                progress,
+            )?;
+        }
         let sky = Sky::new(ctx, &targets.formats)?;
         sky.declare(&mut graph, (0, &view), &targets);
         let mut terrain = match scene.draw_terrain {
@@ -252,8 +277,6 @@ impl Renderer {
             }
         };
         let graph = graph.bake(ctx)?;
-        let lighting = settings.lighting.unwrap_or_else(|| scene.default_lighting());
-        lighting.validate()?;
         Ok(Renderer {
             ctx: ctx.clone(),
             frames: FrameRing::new(ctx)?,
