@@ -50,3 +50,9 @@ pub const TEXTURING_UPSAMPLE: SpirV = spirv!("texturing/upsample.comp");
 pub const TEXTURING_LAYER: SpirV = spirv!("texturing/layer.comp");
 /// texturing.finish: colour and displacement normal into the atlas (§8.2).
 pub const TEXTURING_FINISH: SpirV = spirv!("texturing/finish.comp");
+/// lighting.transmittance: the physical atmosphere's transmittance table (compute).
+pub const ATMOSPHERE_TRANSMITTANCE: SpirV = spirv!("lighting/atmosphere_transmittance.comp");
+/// lighting.multiscattering: the physical atmosphere's multiple-scattering table (compute).
+pub const ATMOSPHERE_MULTISCATTERING: SpirV = spirv!("lighting/atmosphere_multiscattering.comp");
+/// lighting.sky_view: the physical atmosphere's sky-view table of a view (compute).
+pub const ATMOSPHERE_SKY_VIEW: SpirV = spirv!("lighting/atmosphere_sky_view.comp");

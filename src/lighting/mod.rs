@@ -4,5 +4,6 @@
 //! ([`constants::LightingFrame`], `glsl/include/lighting.glsl`) that every
 //! shading pass reads.
 
+pub mod atmosphere;
 pub mod constants;
 pub mod sky;
