@@ -106,6 +106,44 @@ pub fn transmittance_lut_unit(p: &AtmosphereParameters, r: f64, mu: f64) -> (f64
     (x_mu.clamp(0.0, 1.0), (rho / h).clamp(0.0, 1.0))
 }
 
+/// Azimuth from the sun's φ and zenith angle θ (rad) of the sky-view
+/// table at unit coordinates `(x, y)` for a camera at radius `r` (m), as
+/// `atmosphere_sky_view_angles` in the GLSL: φ = π x², and the horizon
+/// mapping of Hillaire 2020 §5.3, θ = θ_h (1 − (1 − 2y)²) above the horizon
+/// (y < 1/2), θ_h + β (2y − 1)² below it, cos β = √(r² − R²) / r,
+/// θ_h = π − β.
+pub fn sky_view_angles(p: &AtmosphereParameters, r: f64, x: f64, y: f64) -> (f64, f64) {
+    let beta = sky_view_beta(p, r);
+    let horizon = std::f64::consts::PI - beta;
+    let theta = if y < 0.5 {
+        let c = 1.0 - 2.0 * y;
+        horizon * (1.0 - c * c)
+    } else {
+        let c = 2.0 * y - 1.0;
+        horizon + beta * c * c
+    };
+    (std::f64::consts::PI * x * x, theta)
+}
+
+/// Inverse of [`sky_view_angles`] (`atmosphere_sky_view_unit` in the GLSL).
+pub fn sky_view_unit(p: &AtmosphereParameters, r: f64, phi: f64, theta: f64) -> (f64, f64) {
+    let beta = sky_view_beta(p, r);
+    let horizon = std::f64::consts::PI - beta;
+    let y = if theta < horizon {
+        0.5 * (1.0 - (1.0 - theta / horizon).max(0.0).sqrt())
+    } else {
+        0.5 + 0.5 * ((theta - horizon) / beta.max(1e-6)).clamp(0.0, 1.0).sqrt()
+    };
+    let x = (phi / std::f64::consts::PI).clamp(0.0, 1.0).sqrt();
+    (x.clamp(0.0, 1.0), y.clamp(0.0, 1.0))
+}
+
+/// β: the angle between the nadir and the horizon seen from radius `r`.
+fn sky_view_beta(p: &AtmosphereParameters, r: f64) -> f64 {
+    let bottom = f64::from(p.bottom_radius);
+    ((r * r - bottom * bottom).max(0.0).sqrt() / r).clamp(-1.0, 1.0).acos()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -171,5 +209,29 @@ mod tests {
         let hazy = AtmosphereParameters::for_turbidity(6.0).unwrap();
         let dir = Vec3::new(0.8, 0.0, 0.6);
         assert!(sun_transmittance(&hazy, 0.0, dir).y < sun_transmittance(&clear, 0.0, dir).y);
+    }
+
+    #[test]
+    fn sky_view_mapping_puts_the_horizon_in_the_middle() {
+        let p = earth();
+        let r = f64::from(p.bottom_radius) + 500.0;
+        let (_, zenith) = sky_view_angles(&p, r, 0.3, 0.0);
+        assert_eq!(zenith, 0.0);
+        let (_, nadir) = sky_view_angles(&p, r, 0.3, 1.0);
+        assert!((nadir - std::f64::consts::PI).abs() < 1e-9);
+        // The geometric horizon, a little below the horizontal (0.72° at 500 m).
+        let (_, horizon) = sky_view_angles(&p, r, 0.0, 0.5);
+        let dip = horizon - std::f64::consts::FRAC_PI_2;
+        assert!(
+            (dip - (2.0 * 500.0 / f64::from(p.bottom_radius)).sqrt()).abs() < 1e-4,
+            "{dip}"
+        );
+        let (sun_side, _) = sky_view_angles(&p, r, 0.0, 0.2);
+        assert_eq!(sun_side, 0.0);
+        for &(x, y) in &[(0.1, 0.1), (0.5, 0.49), (0.9, 0.51), (1.0, 0.8)] {
+            let (phi, theta) = sky_view_angles(&p, r, x, y);
+            let (u, v) = sky_view_unit(&p, r, phi, theta);
+            assert!((u - x).abs() < 1e-9 && (v - y).abs() < 1e-9, "({x}, {y}) → ({u}, {v})");
+        }
     }
 }
