@@ -16,6 +16,22 @@
 //! - [`sun_transmittance`]: the CPU twin of the transmittance table, for the
 //!   sun's radiance at the ground.
 //!
+//! Per frame, for each view: fill its `LightingFrame` (ground altitude in
+//! `mie[3]` first), then the atmosphere's part, and upload it; a consumer
+//! declares sampled reads of the view's tables:
+//!
+//! ```text
+//! let atmosphere = PhysicalAtmosphere::new(&ctx, &AtmosphereParameters::default(), LutSizes::default(), views)?;
+//! let luts = atmosphere.declare(&mut graph, &[(view.name.as_str(), lighting_region)])?;
+//! let mut pass = graph.pass("sky").graphics();
+//! for id in luts.reads(view_index)? {
+//!     pass = pass.read(id, ImageAccess::Sampled(Stage::Fragment));
+//! }
+//! // prepare: AtmosphereParameters::for_turbidity(lighting.turbidity)?.fill(&mut frame);
+//! //          atmosphere.fill_handles(view_index, camera.eye.z, &mut frame)?;
+//! //          frame.sun_radiance from sun_transmittance(&params, eye altitude, sun) × disc radiance
+//! ```
+//!
 //! Radiance is absolute: linear sRGB with luminance in cd/m², the solar
 //! irradiance at the top of the atmosphere being the extraterrestrial sun
 //! luminance × colour × the disc's solid angle ([`solar_irradiance`]), the
