@@ -74,3 +74,9 @@ pub const LIGHTING_ENVIRONMENT: SpirV = spirv!("lighting/environment.comp");
 pub const SKY_LIGHT_EVALUATE: SpirV = spirv!("lighting/sky_light_evaluate.comp");
 /// lighting.reference: Monte Carlo ray tracing of sky light on the height field (§9.2).
 pub const LIGHTING_REFERENCE: SpirV = spirv!("lighting/reference.comp");
+/// lighting.transmittance: the physical atmosphere's transmittance table (compute).
+pub const ATMOSPHERE_TRANSMITTANCE: SpirV = spirv!("lighting/atmosphere_transmittance.comp");
+/// lighting.multiscattering: the physical atmosphere's multiple-scattering table (compute).
+pub const ATMOSPHERE_MULTISCATTERING: SpirV = spirv!("lighting/atmosphere_multiscattering.comp");
+/// lighting.sky_view: the physical atmosphere's sky-view table of a view (compute).
+pub const ATMOSPHERE_SKY_VIEW: SpirV = spirv!("lighting/atmosphere_sky_view.comp");

@@ -5,6 +5,7 @@
 //! shading pass reads.
 
 pub mod aerial;
+pub mod atmosphere;
 pub mod constants;
 pub mod preetham;
 pub mod reference;
