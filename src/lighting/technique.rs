@@ -5,7 +5,10 @@
 //! every shading pass reads; the lighting passes (lookup tables, shadow
 //! casters, sky light) are declared by its parts.
 
+use glam::Vec3;
+
 use super::aerial::AerialCoefficients;
+use super::atmosphere::{sun_transmittance, AtmosphereParameters, PhysicalAtmosphere};
 use super::constants::*;
 use super::preetham::PreethamSky;
 use super::reference::MonteCarloReference;
@@ -41,6 +44,8 @@ pub struct SceneLighting {
     pub sky_light: Option<SkyLight>,
     /// The Monte Carlo reference (§9.2), when the renderer was built for it.
     pub reference: Option<MonteCarloReference>,
+    /// The physical atmosphere's lookup tables (Hillaire 2020).
+    pub atmosphere: Option<PhysicalAtmosphere>,
 }
 
 impl SceneLighting {
@@ -51,6 +56,7 @@ impl SceneLighting {
             field,
             sky_light: None,
             reference: None,
+            atmosphere: None,
         }
     }
 
@@ -61,8 +67,23 @@ impl SceneLighting {
         let mut f = LightingFrame::zeroed_frame();
         let sun = lighting.sun_direction();
         PreethamSky::new(sun, lighting.turbidity)?.fill(&mut f);
-        AerialCoefficients::for_turbidity(lighting.turbidity)?.fill(&mut f);
         f.mie[3] = self.field.ground;
+        match lighting.sky {
+            SkyModel::Preetham => AerialCoefficients::for_turbidity(lighting.turbidity)?.fill(&mut f),
+            SkyModel::Physical => {
+                // The same atmosphere scatters the sky, dims the sun and
+                // hazes the distance.
+                let params = AtmosphereParameters::for_turbidity(lighting.turbidity)?;
+                params.fill(&mut f);
+                let transmittance = sun_transmittance(&params, 0.0, sun);
+                let outside = Vec3::from(SUN_COLOUR_EXTRATERRESTRIAL) * SUN_LUMINANCE_EXTRATERRESTRIAL;
+                let centre = outside * transmittance;
+                let u = f.sun_radiance[3];
+                let solid_angle = std::f32::consts::PI * SUN_ANGULAR_RADIUS * SUN_ANGULAR_RADIUS;
+                f.sun_radiance = centre.extend(u).to_array();
+                f.sun_irradiance = (centre * (1.0 - u / 3.0) * solid_angle).extend(0.0).to_array();
+            }
+        }
         f.models = [
             match lighting.sky {
                 SkyModel::Preetham => SKY_PREETHAM,
@@ -119,8 +140,11 @@ impl Technique for SceneLighting {
     fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<PreparedLighting> {
         frame.lighting.validate()?;
         let mut views = Vec::with_capacity(frame.views.len());
-        for (k, _view) in frame.views.iter().enumerate() {
+        for (k, view) in frame.views.iter().enumerate() {
             let mut constants = self.constants(frame.lighting)?;
+            if let Some(atmosphere) = &self.atmosphere {
+                atmosphere.fill_handles(k, view.camera.eye.z, &mut constants)?;
+            }
             if let Ok(shadows) = frame.prepared::<ShadowFrame>() {
                 shadows.view(k)?.fill(&mut constants);
             }

@@ -7,6 +7,7 @@ use std::path::Path;
 
 use crate::error::Result;
 use crate::graph::RenderGraph;
+use crate::lighting::atmosphere::{AtmosphereParameters, LutSizes, PhysicalAtmosphere};
 use crate::lighting::reference::{MonteCarloReference, ReferenceSettings};
 use crate::lighting::shadows::{ShadowMaps, ShadowSettings};
 use crate::lighting::sky_light::{BakeSettings, SkyLight, SkyLightBake};
@@ -119,5 +120,22 @@ pub(super) fn declare_sky_light(
             .extend([images.sky_light, images.sun_visibility]);
         scene_lighting.reference = Some(reference);
     }
+    Ok(())
+}
+
+/// The physical atmosphere's lookup tables: `lighting.transmittance`,
+/// `lighting.multiscattering` and the view's `lighting.sky_view`, declared
+/// first, read by every pass that evaluates the sky.
+pub(super) fn declare_atmosphere(
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame>,
+    (view, lighting): (&View, &Lighting),
+    (targets, scene_lighting): (&mut SceneTargets, &mut SceneLighting),
+) -> Result<()> {
+    let params = AtmosphereParameters::for_turbidity(lighting.turbidity)?;
+    let atmosphere = PhysicalAtmosphere::new(ctx, &params, LutSizes::default(), 1)?;
+    let luts = atmosphere.declare(graph, &[(view.name.as_str(), targets.lighting.constants)])?;
+    targets.lighting.images.extend(luts.reads(0)?);
+    scene_lighting.atmosphere = Some(atmosphere);
     Ok(())
 }

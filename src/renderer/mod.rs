@@ -215,6 +215,7 @@ impl Renderer {
         lighting.validate()?;
         let mut targets = SceneTargets::declare(&mut graph, &view, !scene.points.is_empty());
         let mut scene_lighting = lighting::scene_lighting(scene, &targets);
+        lighting::declare_atmosphere(ctx, &mut graph, (&view, &lighting), (&mut targets, &mut scene_lighting))?;
         if scene.draw_terrain {
             lighting::declare_sky_light(
                 ctx,
