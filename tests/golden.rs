@@ -60,7 +60,7 @@ fn check_golden_with(name: &str, scene: &Scene, camera: &Camera, points: SplatSe
             terrain: Default::default(),
             points,
             texturing,
-            texture_streaming: Default::default(),
+            ..RenderSettings::new(WIDTH, HEIGHT)
         };
         let mut renderer = Renderer::new(&ctx, scene, settings).expect("renderer");
         let frame = (renderer.render_settled(camera, SETTLE_FRAMES))

@@ -104,3 +104,161 @@ fn preetham_zenith_matches_the_published_formulas() {
     }
     assert_validation_clean(&report);
 }
+
+/// The world point of pixel (x, y) at view depth `depth`, and its view ray.
+fn pixel_world(camera: &Camera, (w, h): (u32, u32), (x, y): (u32, u32), depth: f32) -> (DVec3, DVec3) {
+    let (right, up, forward) = camera.ray_basis(f64::from(w) / f64::from(h));
+    let ndc_x = (f64::from(x) + 0.5) / f64::from(w) * 2.0 - 1.0;
+    let ndc_y = (f64::from(y) + 0.5) / f64::from(h) * 2.0 - 1.0;
+    let dir = (forward.as_dvec3() + right.as_dvec3() * ndc_x - up.as_dvec3() * ndc_y).normalize();
+    let t = f64::from(depth) / dir.dot(forward.as_dvec3());
+    (camera.eye + dir * t, dir)
+}
+
+#[test]
+fn sun_visibility_agrees_with_a_cpu_ray_cast_on_the_real_dem() {
+    use alpenglow::terrain::bspline::sample_bspline_gradient;
+    use alpenglow::terrain::raycast::Raycaster;
+    use alpenglow::view::{ShadowMode, SkyLightMode};
+
+    let (ctx, report) = validated_context();
+    {
+        let scene = Scene::new(common::jacksboro_field());
+        let camera = common::jacksboro_valley_camera();
+        let caster = Raycaster::new(&scene.heights).expect("ray caster");
+        let size = (160, 100);
+        for (elevation, azimuth) in [(12.0f32, 300.0f32), (50.0, 200.0)] {
+            let lighting = Lighting {
+                sun: SunPosition::Angles {
+                    elevation_deg: elevation,
+                    azimuth_deg: azimuth,
+                },
+                shadows: ShadowMode::Cascaded,
+                sky_light: SkyLightMode::Off,
+                ..scene.default_lighting()
+            };
+            let mut settings = RenderSettings {
+                texturing: TexturingMode::Classic,
+                lighting: Some(lighting),
+                ..RenderSettings::new(size.0, size.1)
+            };
+            settings.terrain.detail = false;
+            let mut renderer = Renderer::new(&ctx, &scene, settings).expect("renderer");
+            let frame = renderer.render(&camera).expect("frame");
+            let images = renderer.read(&frame).expect("readback");
+            renderer.finish().expect("finish");
+            let sun_gpu = images.visibility_channel(0);
+            let sun = lighting.sun_direction().as_dvec3();
+            let lit = |x: i64, y: i64| sun_gpu[(y * i64::from(size.0) + x) as usize] > 0.5;
+            let (mut compared, mut agreed, mut shadowed) = (0u32, 0u32, 0u32);
+            for y in 2..i64::from(size.1) - 2 {
+                for x in 2..i64::from(size.0) - 2 {
+                    let depth = images.depth[(y * i64::from(size.0) + x) as usize];
+                    if !depth.is_finite() {
+                        continue;
+                    }
+                    // Away from shadow edges: a 5×5 neighbourhood of one verdict.
+                    let centre = lit(x, y);
+                    if (-2..=2).any(|dy| (-2..=2).any(|dx| lit(x + dx, y + dy) != centre)) {
+                        continue;
+                    }
+                    let (world, _) = pixel_world(&camera, size, (x as u32, y as u32), depth);
+                    let g = sample_bspline_gradient(&scene.heights, world.x, world.y);
+                    let normal = DVec3::new(-g.x, -g.y, 1.0).normalize();
+                    // Surfaces facing away shadow themselves; the AOV is the cast-shadow term.
+                    if normal.dot(sun) < 0.15 {
+                        continue;
+                    }
+                    let origin = world + DVec3::Z * 4.0 + sun * 8.0;
+                    let cpu_lit = caster.raycast(origin, sun, f64::INFINITY).is_none();
+                    compared += 1;
+                    agreed += u32::from(cpu_lit == centre);
+                    shadowed += u32::from(!centre);
+                }
+            }
+            let share = f64::from(agreed) / f64::from(compared.max(1));
+            println!("sun {elevation}°: {agreed}/{compared} agree ({share:.3}), {shadowed} in shadow");
+            assert!(compared > 2000, "too few terrain pixels compared: {compared}");
+            assert!(
+                share >= 0.95,
+                "sun {elevation}°: only {share:.3} of pixels agree with the ray cast"
+            );
+            if elevation < 20.0 {
+                assert!(
+                    shadowed > 100,
+                    "a low sun over the DEM must cast shadows ({shadowed} shadowed pixels)"
+                );
+            }
+        }
+    }
+    assert_validation_clean(&report);
+}
+
+#[test]
+fn aerial_perspective_matches_its_cpu_twin() {
+    use alpenglow::lighting::aerial::{aerial_perspective, distant_radiance, AerialCoefficients};
+    use alpenglow::lighting::preetham::PreethamSky;
+    use alpenglow::view::{Exposure, ShadowMode, SkyLightMode};
+
+    let (ctx, report) = validated_context();
+    {
+        let scene = Scene::new(common::jacksboro_field());
+        let camera = common::jacksboro_valley_camera();
+        let size = (96, 60);
+        let lighting = Lighting {
+            sun: SunPosition::Angles {
+                elevation_deg: 35.0,
+                azimuth_deg: 160.0,
+            },
+            sky: SkyModel::Preetham,
+            turbidity: 3.0,
+            exposure: Exposure::Ev100(14.0),
+            shadows: ShadowMode::Off,
+            sky_light: SkyLightMode::Off,
+            ..scene.default_lighting()
+        };
+        let without = Lighting {
+            aerial_perspective: false,
+            ..lighting
+        };
+        let on = render(&ctx, &scene, &camera, lighting, size);
+        let off = render(&ctx, &scene, &camera, without, size);
+        let sun = lighting.sun_direction();
+        let sky = PreethamSky::new(sun, lighting.turbidity).expect("sky");
+        let coefficients = AerialCoefficients::for_turbidity(lighting.turbidity).expect("coefficients");
+        let (mut compared, mut far) = (0u32, 0u32);
+        for y in 0..size.1 {
+            for x in 0..size.0 {
+                let i = (y * size.0 + x) as usize;
+                let depth = on.depth[i];
+                if !depth.is_finite() {
+                    continue;
+                }
+                let (world, dir) = pixel_world(&camera, size, (x, y), depth);
+                let distance = (world - camera.eye).length() as f32;
+                let l0 = glam::Vec3::from_slice(&off.hdr[i * 4..i * 4 + 3]);
+                let l_inf = distant_radiance(
+                    |d| sky.radiance(d),
+                    &coefficients,
+                    dir.as_vec3(),
+                    sun,
+                    sky.sun_irradiance(),
+                );
+                let expected = aerial_perspective(l0, distance, l_inf, coefficients.extinction());
+                let got = glam::Vec3::from_slice(&on.hdr[i * 4..i * 4 + 3]);
+                let error = ((got - expected).abs() / expected.max(glam::Vec3::splat(1.0))).max_element();
+                assert!(
+                    error < 0.02,
+                    "pixel ({x}, {y}) at {distance:.0} m: got {got}, expected {expected} (L0 {l0}, L∞ {l_inf})"
+                );
+                compared += 1;
+                far += u32::from(distance > 10_000.0);
+            }
+        }
+        assert!(
+            compared > 1000 && far > 50,
+            "{compared} pixels compared, {far} beyond 10 km"
+        );
+    }
+    assert_validation_clean(&report);
+}

@@ -35,13 +35,38 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
             points: Default::default(),
             texturing: Default::default(),
             texture_streaming: Default::default(),
+            shadows: Default::default(),
+            cache_dir: None,
+            lighting: None,
         };
         let mut renderer = Renderer::new(&ctx, &scene, settings).expect("renderer");
         let layers = scene.layers.layers.iter().enumerate();
         let layer_passes = layers.map(|(i, l)| format!("texturing.layer{i}.{}", l.layer.name.replace(' ', "_")));
-        let mut expected: Vec<String> = ["sky", "terrain.warp", "texturing.upsample"].map(String::from).to_vec();
+        let mut expected: Vec<String> = [
+            "lighting.transmittance",
+            "lighting.multiscattering",
+            "lighting.sky_view",
+            "lighting.environment",
+            "lighting.sky_light",
+            "sky",
+            "terrain.warp",
+            "texturing.upsample",
+        ]
+        .map(String::from)
+        .to_vec();
         expected.extend(layer_passes);
-        expected.extend(["texturing.finish", "terrain.draw", "tonemap", "readback"].map(String::from));
+        expected.extend(
+            [
+                "texturing.finish",
+                "shadow.clear",
+                "terrain.shadow",
+                "terrain.draw",
+                "exposure.meter",
+                "tonemap",
+                "readback",
+            ]
+            .map(String::from),
+        );
         assert_eq!(renderer.pass_names(), expected);
         let camera = scene.default_camera();
         // Several frames, two in flight: exercises cross-frame barrier state.
@@ -92,9 +117,12 @@ fn renders_are_deterministic() {
             points: Default::default(),
             texturing: Default::default(),
             texture_streaming: Default::default(),
+            shadows: Default::default(),
+            cache_dir: None,
+            lighting: None,
         };
         let camera = scene.default_camera();
-        let mut first = Renderer::new(&ctx, &scene, settings).expect("renderer");
+        let mut first = Renderer::new(&ctx, &scene, settings.clone()).expect("renderer");
         let a = first.render(&camera).and_then(|f| first.read(&f)).expect("frame a");
         let mut second = Renderer::new(&ctx, &scene, settings).expect("renderer");
         let b = second.render(&camera).and_then(|f| second.read(&f)).expect("frame b");
@@ -233,6 +261,9 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
                 points: Default::default(),
                 texturing: Default::default(),
                 texture_streaming: Default::default(),
+                shadows: Default::default(),
+                cache_dir: None,
+                lighting: None,
             },
         )
         .unwrap();
@@ -257,6 +288,9 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
                 points: Default::default(),
                 texturing: Default::default(),
                 texture_streaming: Default::default(),
+                shadows: Default::default(),
+                cache_dir: None,
+                lighting: None,
             }
         )
         .is_err());

@@ -194,7 +194,7 @@ mod tests {
             let got = (x.x / x.z, x.y / x.z);
             assert!((got.0 - expected.0).abs() < 1e-3 && (got.1 - expected.1).abs() < 1e-3);
             let z = view.transform_point3(p).z;
-            let (header, _) = frame_header(&camera, (w, h), Vec3::Z, &SplatSettings::default(), 64.0);
+            let (header, _) = frame_header(&camera, (w, h), 0, &SplatSettings::default(), 64.0);
             let depth = (f64::from(header.depth[0]) * z + f64::from(header.depth[1])) / -z;
             assert!((depth - ndc.z).abs() < 1e-5, "{depth} vs {}", ndc.z);
         }
