@@ -10,11 +10,12 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context as _, Result};
+use super::lighting;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use alpenglow::io::image_out::write_png_rgba8;
 use alpenglow::profile::{median, summarize, write_chrome_trace};
-use alpenglow::renderer::{FrameImages, Renderer, Scene};
+use alpenglow::renderer::{FrameImages, Scene};
 use alpenglow::view::camera_path::{load_keyframes, CameraPath, Orbit, DEFAULT_START_ANGLE_DEG};
 
 use super::args::FlyArgs;
@@ -108,7 +109,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     let texture_stats;
     let profiles = {
         let settings = render_settings(&args.scene, &scene, staging.is_some())?;
-        let mut renderer = Renderer::new(&ctx, &scene, settings)?;
+        let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
         let bar = ProgressBar::new(cameras.len() as u64);
         bar.set_style(
             ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} frames {msg}")

@@ -1,6 +1,8 @@
 //! The lighting flags (§6.3, §9): sun position by angles, by date and place
 //! or by a preset, sky model, turbidity, exposure, shadows, sky light.
 
+use std::path::PathBuf;
+
 use clap::{Args, ValueEnum};
 
 use alpenglow::lighting::solar::{parse_date, parse_time, solar_position, Clock, SkyPreset};
@@ -56,6 +58,40 @@ pub struct LightingArgs {
     /// Render every surface with this albedo (1: white diffuse).
     #[arg(long = "albedo-override")]
     pub albedo_override: Option<f32>,
+    /// Where the sky-light bake is cached (default: $XDG_CACHE_HOME/alpenglow
+    /// or ~/.cache/alpenglow; "none": bake every time).
+    #[arg(long = "cache-dir")]
+    pub cache_dir: Option<PathBuf>,
+}
+
+/// The sky-light bake's cache folder of the arguments.
+pub fn cache_dir(args: &LightingArgs) -> Option<PathBuf> {
+    match &args.cache_dir {
+        Some(p) if p.as_os_str() == "none" => None,
+        Some(p) => Some(p.clone()),
+        None => std::env::var_os("XDG_CACHE_HOME")
+            .map(PathBuf::from)
+            .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
+            .map(|d| d.join("alpenglow")),
+    }
+}
+
+/// A renderer, with a progress bar while the sky-light transfer bakes.
+pub fn renderer(
+    ctx: &alpenglow::vulkan::Context,
+    scene: &alpenglow::renderer::Scene,
+    settings: alpenglow::renderer::RenderSettings,
+) -> alpenglow::Result<alpenglow::renderer::Renderer> {
+    let bar = indicatif::ProgressBar::new(1000);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("sky-light bake {bar:40} {percent:>3}% {elapsed}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let renderer = alpenglow::renderer::Renderer::with_progress(ctx, scene, settings, &mut |f| {
+        bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64)
+    });
+    bar.finish_and_clear();
+    renderer
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]

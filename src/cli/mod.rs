@@ -19,7 +19,7 @@ use glam::DVec2;
 use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
 use alpenglow::io::image_out::{write_exr, write_png_rgba8};
 use alpenglow::profile::{summarize, write_chrome_trace, write_profile_json, FrameProfile};
-use alpenglow::renderer::{validate_size, Camera, RenderSettings, Renderer, Scene};
+use alpenglow::renderer::{validate_size, Camera, RenderSettings, Scene};
 use alpenglow::terrain::geometry_image::{TerrainSettings, TerrainView};
 use alpenglow::terrain::lod::{ImportanceFactors, LodMode, LodSettings};
 use alpenglow::terrain::sketch_map::SketchAlignment;
@@ -183,6 +183,7 @@ fn render_settings(args: &SceneArgs, scene: &Scene, readback: bool) -> Result<Re
         },
         texture_streaming: texture_streaming(args),
         lighting: Some(lighting),
+        cache_dir: lighting::cache_dir(&args.lighting),
         ..RenderSettings::new(args.width, args.height)
     })
 }
@@ -304,7 +305,7 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
     let device = ctx.info().name.clone();
     let (images, profiles) = {
         let settings = render_settings(&args.scene, &scene, true)?;
-        let mut renderer = Renderer::new(&ctx, &scene, settings)?;
+        let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
         let frame = renderer.render_settled(&camera, MAX_SETTLE_FRAMES)?;
         let images = renderer.read(&frame)?;
         let profiles = renderer.finish()?;
@@ -361,7 +362,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     let settle_frames;
     let profiles = {
         let settings = render_settings(&args.scene, &scene, false)?;
-        let mut renderer = Renderer::new(&ctx, &scene, settings)?;
+        let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
         // A still view: first every texture tile (untimed), then warm-up and timed frames.
         settle_frames = renderer.render_settled(&camera, MAX_SETTLE_FRAMES)?.frame + 1;
         let mut last = std::time::Instant::now();
