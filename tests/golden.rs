@@ -163,7 +163,10 @@ fn bunny_scene() -> Scene {
     let mut points = PointScene::default();
     // The model is y-up; stand it up in the z-up world.
     points.add(bunny, PointTransform::parse("r=90,0,0").expect("transform"));
-    Scene::points_only(points)
+    let mut scene = Scene::points_only(points);
+    // Sun from behind the camera's left shoulder: the seen side is lit.
+    scene.sun_direction = alpenglow::view::lighting::sun_direction(40.0, 200.0);
+    scene
 }
 
 fn bunny_camera() -> Camera {

@@ -10,9 +10,18 @@
 #include "sky_physical.glsl"
 
 // Sky radiance along unit direction `dir` (+Z up), without the sun disc.
+// Below the horizon, where no terrain was drawn, both models show the same
+// stand-in for the ground: the horizon's radiance darkened smoothly
+// (preetham_ground_factor), so a scene without terrain is not lit by, or
+// exposed for, a black lower hemisphere.
 vec3 sky_radiance(uint lighting, vec3 dir) {
     if (g_lighting[lighting].f.models.x == SKY_PHYSICAL) {
-        return physical_sky(lighting, dir);
+        if (dir.z >= 0.0) {
+            return physical_sky(lighting, dir);
+        }
+        vec2 h = length(dir.xy) > 1e-6 ? normalize(dir.xy) : vec2(0.0, 1.0);
+        vec3 horizon = physical_sky(lighting, vec3(h * 0.99995, 0.01));
+        return horizon * preetham_ground_factor(dir.z);
     }
     return preetham_sky(lighting, dir);
 }

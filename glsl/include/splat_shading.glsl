@@ -6,6 +6,7 @@
 #define ALPENGLOW_SPLAT_SHADING_GLSL
 
 #include "splat.glsl"
+#define ALPENGLOW_POINTS
 #include "surface_lighting.glsl"
 
 vec3 camera_to_world(vec3 v) {
