@@ -293,7 +293,7 @@ fn render_bounces(
     shots
 }
 
-fn find<'a>(shots: &'a [Shot], setup: Setup, method: Method) -> &'a Shot {
+fn find(shots: &[Shot], setup: Setup, method: Method) -> &Shot {
     shots
         .iter()
         .find(|s| s.setup == setup && s.method == method)
@@ -329,6 +329,7 @@ fn error_table(shots: &[Shot]) -> String {
 }
 
 /// A diverging map of `(L_test − L_ref) / mean L_ref` over terrain pixels,
+/// (mean over the reference's terrain)
 /// ±`range` full scale: blue darker than the reference, red brighter,
 /// white equal; sky grey.
 fn difference_image(reference: &FrameImages, test: &FrameImages, range: f64) -> Vec<u8> {
@@ -387,7 +388,7 @@ fn write_figures(dir: &Path, shots: &[Shot]) {
             &format!("{}-{}-diff", s.name(), m.name()),
             (s, Method::Reference),
             (s, m),
-            0.5,
+            0.25,
         );
     }
     // Fig. 9.5: interreflection, 0/1/2 bounces (SH 5 bands and reference),
@@ -400,13 +401,13 @@ fn write_figures(dir: &Path, shots: &[Shot]) {
         "morning-sunsky-bounces-sh5-diff",
         (morning(0, true), Method::Sh(5)),
         (morning(2, true), Method::Sh(5)),
-        0.5,
+        0.25,
     );
     diff(
         "morning-sunsky-bounces-reference-diff",
         (morning(0, true), Method::Reference),
         (morning(2, true), Method::Reference),
-        0.5,
+        0.25,
     );
     // Fig. 9.6: 16 vs 64 patches with the sun in the sky light (the sun
     // falls into one patch).
@@ -417,7 +418,7 @@ fn write_figures(dir: &Path, shots: &[Shot]) {
             &format!("{}-{}-diff", s.name(), m.name()),
             (s, Method::Reference),
             (s, m),
-            0.5,
+            0.25,
         );
     }
     // Fig. 9.6 and 9.7: sky light with a separate, shadowed sun, morning
@@ -431,15 +432,35 @@ fn write_figures(dir: &Path, shots: &[Shot]) {
                 &format!("{}-{}-diff", s.name(), m.name()),
                 (s, Method::Reference),
                 (s, m),
-                0.5,
+                0.25,
             );
         }
     }
+    // Consistency of the two ways of lighting by the sun (0 bounces, same
+    // sky light): the reference's ray-traced sun in its map (field normals)
+    // against the separate direct sun with cascaded shadows (shading normals).
+    let (a, b) = (
+        find(shots, morning(0, false), Method::Reference),
+        find(shots, morning(0, true), Method::Reference),
+    );
+    png(
+        "morning-b0-reference-sunsky-vs-sky-diff",
+        &difference_image(&a.images, &b.images, 0.25),
+        a,
+    );
+    let sun_terms = format!(
+        "\nThe reference with the sun in its map against the reference with the separate, shadowed sun (morning, 0 bounces): mean FLIP {:.4}, relative RMSE {:.4}, mean L ratio {:.3}.\n",
+        mean_flip(&a.images.rgba8, &b.images.rgba8, a.images.width, a.images.height).0,
+        relative_rmse(&a.images, &b.images),
+        mean_ratio(&a.images, &b.images)
+    );
+    eprintln!("{sun_terms}");
     let mut md = String::from(
         "Errors against the Monte Carlo reference of the same environment and bounces \
          (written by `tests/lighting_figures.rs`).\n\n",
     );
     md.push_str(&error_table(shots));
+    md.push_str(&sun_terms);
     std::fs::write(dir.join("errors.md"), md).expect("errors.md");
 }
 
