@@ -173,16 +173,17 @@ fn a_flat_plane_under_a_constant_sky_gets_the_sky_radiance() {
         let frames: Vec<_> = modes.iter().map(|l| (constant_sky(sun, false), *l)).collect();
         for (out, l) in run_frames(&ctx, &sky, &frames).iter().zip(&modes) {
             let (env, map) = out;
-            // The sky is constant: only the constant SH term.
-            let radiance: Vec<f64> = (0..3).map(|ch| f64::from(env[0][ch]) / (2.0 * PI.sqrt())).collect();
-            assert!(radiance[0] > 1.0);
-            for c in env.iter().take(25).skip(1) {
-                assert!(c.iter().take(3).all(|v| v.abs() < 1e-3 * SKY), "not constant: {c:?}");
-            }
+            // The sky is constant (white, luminance SKY) above the horizon;
+            // below it the model darkens the horizon towards the ground
+            // (sky.glsl), which the flat plane does not see.
+            let radiance = [f64::from(SKY); 3];
+            assert!(env[0][0] > 1.0 && (f64::from(env[0][0]) / (2.0 * PI.sqrt())) < radiance[0]);
             for texel in map {
                 for ch in 0..3 {
                     let rel = (f64::from(texel[ch]) - radiance[ch]).abs() / radiance[ch];
-                    assert!(rel < 0.01, "{:?}: {} vs {}", l.sky_light, texel[ch], radiance[ch]);
+                    // SH: the band-limited transfer rings a little into the darker lower hemisphere.
+                    let tolerance = if l.sky_light == SkyLightMode::Sh { 0.03 } else { 0.01 };
+                    assert!(rel < tolerance, "{:?}: {} vs {}", l.sky_light, texel[ch], radiance[ch]);
                 }
                 assert!((texel[3] - 1.0).abs() < 1e-3, "visibility {}", texel[3]);
             }

@@ -39,6 +39,11 @@ fn settings(texturing: TexturingMode, streaming: TextureStreaming) -> RenderSett
     RenderSettings {
         texturing,
         texture_streaming: streaming,
+        // The textures under test, not the haze between them and the camera.
+        lighting: Some(alpenglow::view::Lighting {
+            aerial_perspective: false,
+            ..Default::default()
+        }),
         ..RenderSettings::new(WIDTH, HEIGHT)
     }
 }
