@@ -22,10 +22,15 @@ pub fn fresh_dir(test: &str) -> PathBuf {
 }
 
 /// Runs the binary with `args` (the device choice comes from the
-/// environment, `ALPENGLOW_DEVICE`, as for every user).
+/// environment, `ALPENGLOW_DEVICE`, as for every user). The sky-light bake
+/// is cached under the target folder, not the user's cache.
 pub fn run<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
     Command::new(bin())
         .args(args)
+        .env(
+            "XDG_CACHE_HOME",
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-cache"),
+        )
         .output()
         .unwrap_or_else(|e| panic!("cannot run {}: {e}", bin()))
 }
