@@ -441,3 +441,55 @@ fn bench_writes_json_summary() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn bad_lighting_flags_are_one_line_errors() {
+    let cases: &[(&str, &[&str], &[&str])] = &[
+        ("sun-elevation", &["--sun-elevation", "95"], &["--sun-elevation", "95"]),
+        ("turbidity-low", &["--turbidity", "1.5"], &["--turbidity", "1.7"]),
+        ("turbidity-high", &["--turbidity", "11"], &["--turbidity", "10"]),
+        ("sky-preset", &["--sky-preset", "dusk"], &["--sky-preset", "dusk"]),
+        (
+            "date",
+            &[
+                "--date",
+                "2026-02-30",
+                "--time",
+                "10:00",
+                "--latitude",
+                "45",
+                "--longitude",
+                "7",
+            ],
+            &["--date", "2026-02-30"],
+        ),
+        (
+            "time",
+            &[
+                "--date",
+                "2026-06-01",
+                "--time",
+                "25:00",
+                "--latitude",
+                "45",
+                "--longitude",
+                "7",
+            ],
+            &["--time", "25:00"],
+        ),
+        ("date-alone", &["--date", "2026-06-01"], &["--date", "all four"]),
+        ("exposure", &["--exposure", "bright"], &["--exposure", "bright"]),
+        ("sh-bands", &["--sh-bands", "4"], &["--sh-bands", "3 or 5"]),
+        ("bounces", &["--bounces", "3"], &["--bounces"]),
+        ("sky-patches", &["--sky-patches", "5"], &["--sky-patches"]),
+        ("albedo", &["--albedo-override", "1.5"], &["--albedo-override"]),
+        (
+            "sun-twice",
+            &["--sun-elevation", "10", "--sky-preset", "noon"],
+            &["--sun-elevation", "not several"],
+        ),
+    ];
+    for (name, args, needles) in cases {
+        expect_render_error(&format!("lighting-{name}"), args, needles);
+    }
+}
