@@ -107,11 +107,11 @@ fn preetham_zenith_matches_the_published_formulas() {
 
 /// The world point of pixel (x, y) at view depth `depth`, and its view ray.
 fn pixel_world(camera: &Camera, (w, h): (u32, u32), (x, y): (u32, u32), depth: f32) -> (DVec3, DVec3) {
-    let (right, up, forward) = camera.ray_basis(f64::from(w) / f64::from(h));
+    let (right, up, forward) = alpenglow::view::View::new(*camera, w, h).ray_basis();
     let ndc_x = (f64::from(x) + 0.5) / f64::from(w) * 2.0 - 1.0;
     let ndc_y = (f64::from(y) + 0.5) / f64::from(h) * 2.0 - 1.0;
     let dir = (forward.as_dvec3() + right.as_dvec3() * ndc_x - up.as_dvec3() * ndc_y).normalize();
-    let t = f64::from(depth) / dir.dot(forward.as_dvec3());
+    let t = f64::from(depth) / dir.dot(camera.forward());
     (camera.eye + dir * t, dir)
 }
 

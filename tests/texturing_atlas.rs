@@ -66,8 +66,7 @@ fn render(scene: &Scene, camera: &Camera, mode: TexturingMode) -> (FrameImages, 
 
 /// World xy of every terrain pixel (None for sky), from the view depth.
 fn world_xy(frame: &FrameImages, camera: &Camera) -> Vec<Option<DVec2>> {
-    let aspect = f64::from(frame.width) / f64::from(frame.height);
-    let (right, up, forward) = camera.ray_basis(aspect);
+    let (right, up, forward) = alpenglow::view::View::new(*camera, frame.width, frame.height).ray_basis();
     let (right, up, forward) = (right.as_dvec3(), up.as_dvec3(), forward.as_dvec3());
     (0..frame.height)
         .flat_map(|y| (0..frame.width).map(move |x| (x, y)))

@@ -30,6 +30,7 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
         let settings = RenderSettings {
             width: 96,
             height: 64,
+            views: Vec::new(),
             readback: true,
             terrain: Default::default(),
             points: Default::default(),
@@ -112,6 +113,7 @@ fn renders_are_deterministic() {
         let settings = RenderSettings {
             width: 80,
             height: 48,
+            views: Vec::new(),
             readback: true,
             terrain: Default::default(),
             points: Default::default(),
@@ -256,6 +258,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
             RenderSettings {
                 width: 16,
                 height: 16,
+                views: Vec::new(),
                 readback: true,
                 terrain: Default::default(),
                 points: Default::default(),
@@ -283,6 +286,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
             RenderSettings {
                 width: 0,
                 height: 16,
+                views: Vec::new(),
                 readback: false,
                 terrain: Default::default(),
                 points: Default::default(),

@@ -61,7 +61,7 @@ impl Sky {
             .write(visibility, ImageAccess::ColorAttachmentWrite)
             .record(move |pass, frame| {
                 let view = frame.view(index)?;
-                let (right, up, forward) = view.camera.ray_basis(view.aspect());
+                let (right, up, forward) = view.ray_basis();
                 let push = SkyPush {
                     right: right.extend(0.0).to_array(),
                     up: up.extend(0.0).to_array(),

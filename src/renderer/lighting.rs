@@ -27,13 +27,13 @@ pub(super) struct SunShadows {
     pub points: Option<PointShadows>,
 }
 
-/// The scene's lighting technique, writing the view's lighting constants.
-pub(super) fn scene_lighting(scene: &Scene, targets: &SceneTargets) -> SceneLighting {
+/// The scene's lighting technique, writing every view's lighting constants.
+pub(super) fn scene_lighting(scene: &Scene, targets: &[SceneTargets]) -> SceneLighting {
     let field = &scene.heights;
     let extent = field.extent();
     let (lo, _) = scene.height_range();
     SceneLighting::new(
-        vec![targets.lighting.constants],
+        targets.iter().map(|t| t.lighting.constants).collect(),
         FieldInfo {
             extent: [extent.x as f32, extent.y as f32],
             texels: [
@@ -45,14 +45,14 @@ pub(super) fn scene_lighting(scene: &Scene, targets: &SceneTargets) -> SceneLigh
     )
 }
 
-/// Declares the view's shadow atlas (`shadow.clear`) and its casters
+/// Declares each view's shadow atlas (`shadow.clear`) and its casters
 /// (`terrain.shadow` after the view's `terrain.warp`, `points.shadow`), and
 /// adds the atlas to what the view's shading passes read. None without
 /// casters.
 pub(super) fn declare_shadows(
     ctx: &Context,
     graph: &mut RenderGraph<Frame>,
-    (view, targets): (&View, &mut SceneTargets),
+    (views, targets): (&[View], &mut [SceneTargets]),
     (terrain, points): (Option<&Terrain>, Option<&PointRenderer>),
     settings: ShadowSettings,
 ) -> Result<Option<SunShadows>> {
@@ -64,20 +64,18 @@ pub(super) fn declare_shadows(
         (None, None) => return Ok(None),
     };
     let mut maps = ShadowMaps::new(settings, bounds)?;
-    let target = maps.declare_view(ctx, graph, (0, view))?;
-    if let Some(terrain) = terrain {
-        terrain.declare_shadow(ctx, graph, (0, view), target)?;
-    }
-    let points = match points {
-        Some(p) => {
-            let mut casters = PointShadows::new(p, &maps);
-            casters.declare(ctx, graph, (0, view), target)?;
-            Some(casters)
+    let mut casters = points.map(|p| PointShadows::new(p, &maps));
+    for (k, (view, targets)) in views.iter().zip(targets).enumerate() {
+        let target = maps.declare_view(ctx, graph, (k, view))?;
+        if let Some(terrain) = terrain {
+            terrain.declare_shadow(ctx, graph, (k, view), target)?;
         }
-        None => None,
-    };
-    targets.lighting.images.push(target.atlas);
-    Ok(Some(SunShadows { maps, points }))
+        if let Some(casters) = &mut casters {
+            casters.declare(ctx, graph, (k, view), target)?;
+        }
+        targets.lighting.images.push(target.atlas);
+    }
+    Ok(Some(SunShadows { maps, points: casters }))
 }
 
 /// Bakes the height field's sky-light transfer (or loads it from `cache`),
@@ -88,12 +86,12 @@ pub(super) fn declare_sky_light(
     ctx: &Context,
     graph: &mut RenderGraph<Frame>,
     (scene, lighting): (&Scene, &Lighting),
-    (targets, scene_lighting): (&mut SceneTargets, &mut SceneLighting),
+    (targets, scene_lighting): (&mut [SceneTargets], &mut SceneLighting),
     cache: Option<&Path>,
     progress: &mut dyn FnMut(f32),
 ) -> Result<()> {
-    let region = targets.lighting.constants;
-    let sky_inputs = targets.lighting.images.clone();
+    let region = targets[0].lighting.constants;
+    let sky_inputs = targets[0].lighting.images.clone();
     let bake = SkyLightBake::bake(
         ctx,
         &scene.heights,
@@ -103,10 +101,18 @@ pub(super) fn declare_sky_light(
     )?;
     let sky_light = SkyLight::new(ctx, bake)?;
     let ids = sky_light.declare(graph, region, &sky_inputs);
-    targets.lighting.images.extend([ids.map, ids.horizon]);
-    targets.lighting.buffers.push(ids.environment);
+    for t in targets.iter_mut() {
+        t.lighting.images.extend([ids.map, ids.horizon]);
+        t.lighting.buffers.push(ids.environment);
+    }
     scene_lighting.sky_light = Some(sky_light);
     if lighting.sky_light == SkyLightMode::Reference {
+        let [targets] = targets else {
+            return Err(crate::error::Error::invalid(
+                "lighting.sky_light",
+                "the Monte Carlo reference renders one view, not a rig",
+            ));
+        };
         let settings = ReferenceSettings {
             bounces: lighting.bounces,
             bounce_albedo: lighting.albedo_override.unwrap_or(0.3),
@@ -129,13 +135,18 @@ pub(super) fn declare_sky_light(
 pub(super) fn declare_atmosphere(
     ctx: &Context,
     graph: &mut RenderGraph<Frame>,
-    (view, lighting): (&View, &Lighting),
-    (targets, scene_lighting): (&mut SceneTargets, &mut SceneLighting),
+    (views, lighting): (&[View], &Lighting),
+    (targets, scene_lighting): (&mut [SceneTargets], &mut SceneLighting),
 ) -> Result<()> {
     let params = AtmosphereParameters::for_turbidity(lighting.turbidity)?;
-    let atmosphere = PhysicalAtmosphere::new(ctx, &params, LutSizes::default(), 1)?;
-    let luts = atmosphere.declare(graph, &[(view.name.as_str(), targets.lighting.constants)])?;
-    targets.lighting.images.extend(luts.reads(0)?);
+    let atmosphere = PhysicalAtmosphere::new(ctx, &params, LutSizes::default(), views.len())?;
+    let regions: Vec<(&str, _)> = (views.iter().zip(targets.iter()))
+        .map(|(v, t)| (v.name.as_str(), t.lighting.constants))
+        .collect();
+    let luts = atmosphere.declare(graph, &regions)?;
+    for (k, t) in targets.iter_mut().enumerate() {
+        t.lighting.images.extend(luts.reads(k)?);
+    }
     scene_lighting.atmosphere = Some(atmosphere);
     Ok(())
 }

@@ -1,7 +1,11 @@
 //! The renderer: composition only. It builds the frame graph of a scene
 //! once from the techniques (each declares its passes per view), then
-//! renders views of it, headless, into HDR radiance, view-space depth and
-//! tone-mapped sRGB. A frame is *prepare, then record*: every technique's
+//! renders frames of it, headless, into HDR radiance, view-space depth and
+//! tone-mapped sRGB. A frame renders 1 to 16 views ([`ViewSpec`], a
+//! multi-view rig, §3.3) in one submission: they share the scene's
+//! persistent state (texture atlas, sky-light bake, point trees); each has
+//! its own targets, geometry image, point selection and shadow cascades, and
+//! its passes are named `pass@view`. A frame is *prepare, then record*: every technique's
 //! `prepare` does its CPU work for the frame's views (profile stages
 //! `prepare.terrain`, `prepare.texturing`, `prepare.points`), then the baked
 //! graph records the passes, which only read what was prepared.
@@ -15,15 +19,20 @@
 //! `tonemap` (compute) → `readback` (transfer).
 
 mod lighting;
+mod readback;
 pub mod scene;
 
 use std::sync::Arc;
 
+pub use crate::view::rig::{Rig, ViewSpec, MAX_VIEWS};
 pub use crate::view::{validate_size, Camera, MAX_IMAGE_SIDE};
+pub use readback::FrameImages;
 pub use scene::Scene;
 
+use readback::Readback;
+
 use crate::error::{Error, Result};
-use crate::graph::{BakedGraph, BufferId, FrameOutcome, ImageId, RenderGraph};
+use crate::graph::{BakedGraph, FrameOutcome, RenderGraph};
 use crate::lighting::shadows::ShadowSettings;
 use crate::lighting::sky::Sky;
 use crate::lighting::technique::SceneLighting;
@@ -36,15 +45,20 @@ use crate::terrain::{Terrain, TerrainTexturing};
 use crate::texturing::generation::{TextureAtlas, TextureFrameStats, TextureStreaming};
 use crate::texturing::gpu_layout::TexturingMode;
 use crate::texturing::page_table::PageTable;
+use crate::view::rig::validate_views;
 use crate::view::{Frame, Lighting, SceneTargets, View};
-use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Context, FrameRing, MemoryLocation, FRAMES_IN_FLIGHT};
+use crate::vulkan::{Context, FrameRing, FRAMES_IN_FLIGHT};
 
-/// Output size, whether frames are read back to the host, and the
-/// terrain's LOD and detail settings.
+/// Output size (or the views of a rig), whether frames are read back to
+/// the host, and every technique's settings.
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
+    /// The image size of a single view (ignored when `views` is set).
     pub width: u32,
     pub height: u32,
+    /// The views every frame renders (1 to [`MAX_VIEWS`]); empty: one
+    /// unnamed `width`×`height` view.
+    pub views: Vec<ViewSpec>,
     /// Copy HDR, depth and sRGB images to host memory every frame.
     pub readback: bool,
     pub terrain: TerrainSettings,
@@ -69,6 +83,7 @@ impl RenderSettings {
         RenderSettings {
             width,
             height,
+            views: Vec::new(),
             readback: true,
             terrain: TerrainSettings::default(),
             points: SplatSettings::default(),
@@ -82,41 +97,25 @@ impl RenderSettings {
             lighting: None,
         }
     }
-}
 
-/// A rendered frame in host memory. Row 0 is the top of the image.
-#[derive(Clone, Debug)]
-pub struct FrameImages {
-    pub width: u32,
-    pub height: u32,
-    /// Tone-mapped sRGB, 4 bytes per pixel.
-    pub rgba8: Vec<u8>,
-    /// Linear HDR radiance, 4 floats per pixel (alpha 1 everywhere).
-    pub hdr: Vec<f32>,
-    /// View-space depth along the camera's forward axis, metres; +inf for sky.
-    pub depth: Vec<f32>,
-    /// W: the accumulated EWA splat weight before normalisation (opaque
-    /// splats: 1), 0 where no splat reached; None for scenes without points.
-    pub weight: Option<Vec<f32>>,
-    /// The lighting AOVs, 2 floats per pixel: sun visibility (0 = in
-    /// shadow, 1 = lit; the filtered shadow term) and sky visibility (the
-    /// ambient-occlusion term, 1 = open sky); (1, 1) for sky pixels.
-    pub visibility: Vec<f32>,
-}
-
-impl FrameImages {
-    /// One AOV channel of [`FrameImages::visibility`]: 0 sun, 1 sky.
-    pub fn visibility_channel(&self, k: usize) -> Vec<f32> {
-        self.visibility.iter().skip(k).step_by(2).copied().collect()
+    /// Settings for the views `views` (their atlas sized for all of them).
+    pub fn for_views(views: Vec<ViewSpec>) -> RenderSettings {
+        let sizes: Vec<(u32, u32)> = views.iter().map(|v| (v.width, v.height)).collect();
+        let (w, h) = sizes.first().copied().unwrap_or((1, 1));
+        RenderSettings {
+            texture_streaming: TextureStreaming::for_views(&sizes),
+            views,
+            ..RenderSettings::new(w, h)
+        }
     }
-}
 
-struct Readback {
-    hdr: Vec<Arc<Buffer>>,
-    depth: Vec<Arc<Buffer>>,
-    ldr: Vec<Arc<Buffer>>,
-    weight: Option<Vec<Arc<Buffer>>>,
-    visibility: Vec<Arc<Buffer>>,
+    /// The views a frame renders.
+    pub fn view_specs(&self) -> Vec<ViewSpec> {
+        match self.views.is_empty() {
+            true => vec![ViewSpec::new(self.width, self.height)],
+            false => self.views.clone(),
+        }
+    }
 }
 
 /// The techniques of a scene, each with its persistent state.
@@ -135,54 +134,13 @@ pub struct Renderer {
     ctx: Context,
     frames: FrameRing,
     graph: BakedGraph<Frame>,
-    settings: RenderSettings,
-    readback: Option<Readback>,
+    views: Vec<ViewSpec>,
+    /// Per view, when reading back.
+    readback: Option<Vec<Readback>>,
     lighting: Lighting,
     /// Frames rendered so far.
     frames_rendered: u64,
     techniques: Techniques,
-}
-
-/// One readback buffer per frame slot.
-fn host_buffers(ctx: &Context, name: &str, size: u64) -> Result<Vec<Arc<Buffer>>> {
-    Buffer::per_frame(
-        ctx,
-        BufferDesc {
-            name: format!("{name} readback"),
-            size,
-            usage: BufferUsageFlags::TRANSFER_DST,
-            location: MemoryLocation::GpuToCpu,
-        },
-    )
-}
-
-/// Declares `readback`: the view's images into per-frame host buffers.
-fn declare_readback(ctx: &Context, graph: &mut RenderGraph<Frame>, targets: &SceneTargets) -> Result<Readback> {
-    let pixels = u64::from(targets.width) * u64::from(targets.height);
-    let rb = Readback {
-        hdr: host_buffers(ctx, "hdr", pixels * 16)?,
-        depth: host_buffers(ctx, "depth", pixels * 4)?,
-        ldr: host_buffers(ctx, "srgb", pixels * 4)?,
-        visibility: host_buffers(ctx, "lighting visibility", pixels * 8)?,
-        weight: match targets.weight {
-            Some(_) => Some(host_buffers(ctx, "splat weight", pixels * 4)?),
-            None => None,
-        },
-    };
-    let mut copies: Vec<(ImageId, BufferId)> = vec![
-        (targets.radiance, graph.import_buffers_per_frame(rb.hdr.clone())),
-        (targets.view_depth, graph.import_buffers_per_frame(rb.depth.clone())),
-        (targets.display, graph.import_buffers_per_frame(rb.ldr.clone())),
-        (
-            targets.visibility,
-            graph.import_buffers_per_frame(rb.visibility.clone()),
-        ),
-    ];
-    if let (Some(image), Some(buffers)) = (targets.weight, &rb.weight) {
-        copies.push((image, graph.import_buffers_per_frame(buffers.clone())));
-    }
-    graph.read_back_images("readback", copies);
-    Ok(rb)
 }
 
 impl Renderer {
@@ -199,23 +157,31 @@ impl Renderer {
         settings: RenderSettings,
         progress: &mut dyn FnMut(f32),
     ) -> Result<Renderer> {
-        validate_size(settings.width, settings.height)?;
-        let (w, h) = (settings.width, settings.height);
+        let specs = settings.view_specs();
+        validate_views(&specs)?;
         let max = ctx.max_image_dimension();
-        if w > max || h > max {
+        if let Some(v) = specs.iter().find(|v| v.width > max || v.height > max) {
             return Err(Error::invalid(
                 "image size",
-                format!("{w}×{h} exceeds the device limit of {max} per side"),
+                format!("{}×{} exceeds the device limit of {max} per side", v.width, v.height),
             ));
         }
         let mut graph = RenderGraph::new();
-        // The view the graph is declared for; every frame brings its camera.
-        let view = View::new(scene.default_camera(), w, h);
+        // The views the graph is declared for; every frame brings their cameras.
+        let views: Vec<View> = specs.iter().map(|s| s.view(scene.default_camera())).collect();
         let lighting = settings.lighting.unwrap_or_else(|| scene.default_lighting());
         lighting.validate()?;
-        let mut targets = SceneTargets::declare(&mut graph, &view, !scene.points.is_empty());
+        let points_present = !scene.points.is_empty();
+        let mut targets: Vec<SceneTargets> = (views.iter())
+            .map(|v| SceneTargets::declare(&mut graph, v, points_present))
+            .collect();
         let mut scene_lighting = lighting::scene_lighting(scene, &targets);
-        lighting::declare_atmosphere(ctx, &mut graph, (&view, &lighting), (&mut targets, &mut scene_lighting))?;
+        lighting::declare_atmosphere(
+            ctx,
+            &mut graph,
+            (&views, &lighting),
+            (&mut targets, &mut scene_lighting),
+        )?;
         if scene.draw_terrain {
             lighting::declare_sky_light(
                 ctx,
@@ -226,15 +192,17 @@ impl Renderer {
                 progress,
             )?;
         }
-        let sky = Sky::new(ctx, &targets.formats)?;
-        sky.declare(&mut graph, (0, &view), &targets);
+        let sky = Sky::new(ctx, &targets[0].formats)?;
+        for (k, view) in views.iter().enumerate() {
+            sky.declare(&mut graph, (k, view), &targets[k]);
+        }
         let mut terrain = match scene.draw_terrain {
-            true => Some(warped_terrain(ctx, &mut graph, scene, &settings, &view)?),
+            true => Some(warped_terrain(ctx, &mut graph, scene, &settings, &views)?),
             false => None,
         };
-        let mut points = match scene.points.is_empty() {
-            true => None,
-            false => Some(PointRenderer::new(ctx, &scene.points, settings.points)?),
+        let mut points = match points_present {
+            true => Some(PointRenderer::new(ctx, &scene.points, settings.points)?),
+            false => None,
         };
         // The atlas's generation passes before the shadow casters: validation
         // layers before 1.3.268 count their dispatches as writing every buffer
@@ -252,38 +220,42 @@ impl Renderer {
         let shadows = lighting::declare_shadows(
             ctx,
             &mut graph,
-            (&view, &mut targets),
+            (&views, &mut targets),
             (terrain.as_ref(), points.as_ref()),
             settings.shadows,
         )?;
-        if let Some(terrain) = &mut terrain {
-            terrain.declare_draw(
-                ctx,
-                &mut graph,
-                (0, &view),
-                &targets,
-                atlas.as_ref().map(|a| a.bindings()),
-            )?;
-        }
-        if let Some(points) = &mut points {
-            points.declare(ctx, &mut graph, (0, &view), &targets, !scene.draw_terrain)?;
-        }
-        let exposure = ExposureMeter::new(ctx)?.declare(&mut graph, &view, &targets);
-        Tonemap::new(ctx)?.declare(&mut graph, &view, &targets, exposure);
-        let readback = match settings.readback {
-            true => Some(declare_readback(ctx, &mut graph, &targets)?),
-            false => {
-                graph.keep(targets.display);
-                None
+        // Every view's draws before any view's post-processing dispatches:
+        // validation layers before 1.3.268 count a dispatch as writing every
+        // buffer of the heap, the other views' geometry images included.
+        for (k, (view, targets)) in views.iter().zip(&targets).enumerate() {
+            if let Some(terrain) = &mut terrain {
+                let atlas = atlas.as_ref().map(|a| a.bindings());
+                terrain.declare_draw(ctx, &mut graph, (k, view), targets, atlas)?;
             }
-        };
+        }
+        for (k, (view, targets)) in views.iter().zip(&targets).enumerate() {
+            if let Some(points) = &mut points {
+                points.declare(ctx, &mut graph, (k, view), targets, !scene.draw_terrain)?;
+            }
+        }
+        let exposure = ExposureMeter::new(ctx)?;
+        let tonemap = Tonemap::new(ctx)?;
+        let mut readback = Vec::new();
+        for (view, targets) in views.iter().zip(&targets) {
+            let exposure = exposure.declare(&mut graph, view, targets);
+            tonemap.declare(&mut graph, view, targets, exposure);
+            match settings.readback {
+                true => readback.push(Readback::declare(ctx, &mut graph, view, targets)?),
+                false => graph.keep(targets.display),
+            }
+        }
         let graph = graph.bake(ctx)?;
         Ok(Renderer {
             ctx: ctx.clone(),
             frames: FrameRing::new(ctx)?,
             graph,
-            settings,
-            readback,
+            readback: settings.readback.then_some(readback),
+            views: specs,
             lighting,
             frames_rendered: 0,
             techniques: Techniques {
@@ -321,13 +293,36 @@ impl Renderer {
         self.graph.pass_names()
     }
 
-    /// Prepares, records and submits a frame of `camera`.
+    /// The views every frame renders.
+    pub fn views(&self) -> &[ViewSpec] {
+        &self.views
+    }
+
+    /// Prepares, records and submits a frame of `camera` (a renderer of
+    /// one view).
     pub fn render(&mut self, camera: &Camera) -> Result<FrameOutcome> {
-        camera.validate()?;
-        let view = View::new(*camera, self.settings.width, self.settings.height);
+        self.render_views(std::slice::from_ref(camera))
+    }
+
+    /// Prepares, records and submits a frame of every view, view `k`
+    /// through `cameras[k]`, in one submission.
+    pub fn render_views(&mut self, cameras: &[Camera]) -> Result<FrameOutcome> {
+        if cameras.len() != self.views.len() {
+            return Err(Error::invalid(
+                "cameras",
+                format!("{} cameras for {} views", cameras.len(), self.views.len()),
+            ));
+        }
+        let views: Vec<View> = (self.views.iter().zip(cameras))
+            .map(|(spec, camera)| {
+                let view = spec.view(*camera);
+                view.validate()?;
+                Ok(view)
+            })
+            .collect::<Result<_>>()?;
         // The slot's previous frame must be done before prepare writes its uploads.
         let index = self.frames.wait_for_next()?;
-        let mut frame = Frame::new(index, vec![view], self.lighting);
+        let mut frame = Frame::new(index, views, self.lighting);
         let mut stages = Vec::new();
         let mut uploads = self.graph.uploads(index);
         let t = &mut self.techniques;
@@ -358,8 +353,13 @@ impl Renderer {
     /// frame; at most `max_frames` frames, then errors. Same as
     /// [`Renderer::render`] without the atlas.
     pub fn render_settled(&mut self, camera: &Camera, max_frames: u32) -> Result<FrameOutcome> {
+        self.render_views_settled(std::slice::from_ref(camera), max_frames)
+    }
+
+    /// [`Renderer::render_settled`] of every view.
+    pub fn render_views_settled(&mut self, cameras: &[Camera], max_frames: u32) -> Result<FrameOutcome> {
         for _ in 0..max_frames.max(1) {
-            let outcome = self.render(camera)?;
+            let outcome = self.render_views(cameras)?;
             match &self.techniques.atlas {
                 Some(atlas) if atlas.last_deferred() > 0 => continue,
                 _ => return Ok(outcome),
@@ -371,13 +371,21 @@ impl Renderer {
         ))
     }
 
-    /// Waits for `frame` and copies its images out of the readback buffers.
-    /// Call before rendering [`FRAMES_IN_FLIGHT`] more frames.
+    /// Waits for `frame` and copies the first view's images out of the
+    /// readback buffers. Call before rendering [`FRAMES_IN_FLIGHT`] more frames.
     pub fn read(&mut self, frame: &FrameOutcome) -> Result<FrameImages> {
+        self.read_view(frame, 0)
+    }
+
+    /// [`Renderer::read`] of view `view`.
+    pub fn read_view(&mut self, frame: &FrameOutcome, view: usize) -> Result<FrameImages> {
         let rb = self
             .readback
             .as_ref()
             .ok_or_else(|| Error::invalid("readback", "the renderer was created without readback"))?;
+        let rb = rb
+            .get(view)
+            .ok_or_else(|| Error::invalid("view", format!("{view}; the renderer has {} views", self.views.len())))?;
         if self.frames_rendered > frame.frame + FRAMES_IN_FLIGHT as u64 {
             return Err(Error::invalid(
                 "readback",
@@ -388,20 +396,12 @@ impl Renderer {
             ));
         }
         self.ctx.wait(frame.timeline)?;
-        let slot = frame.frame as usize % FRAMES_IN_FLIGHT;
-        let floats = |b: &Buffer| -> Result<Vec<f32>> { Ok(bytemuck::pod_collect_to_vec(b.mapped()?)) };
-        Ok(FrameImages {
-            width: self.settings.width,
-            height: self.settings.height,
-            rgba8: rb.ldr[slot].mapped()?.to_vec(),
-            hdr: floats(&rb.hdr[slot])?,
-            depth: floats(&rb.depth[slot])?,
-            weight: match &rb.weight {
-                Some(w) => Some(floats(&w[slot])?),
-                None => None,
-            },
-            visibility: floats(&rb.visibility[slot])?,
-        })
+        rb.read(frame.frame as usize % FRAMES_IN_FLIGHT)
+    }
+
+    /// [`Renderer::read`] of every view, in order.
+    pub fn read_views(&mut self, frame: &FrameOutcome) -> Result<Vec<FrameImages>> {
+        (0..self.views.len()).map(|k| self.read_view(frame, k)).collect()
     }
 
     /// Waits for `frame` and copies the colour atlas textures (sRGB-encoded
@@ -455,13 +455,13 @@ impl Renderer {
     }
 }
 
-/// The terrain of `scene` with its `terrain.warp` declared.
+/// The terrain of `scene` with every view's `terrain.warp` declared.
 fn warped_terrain(
     ctx: &Context,
     graph: &mut RenderGraph<Frame>,
     scene: &Scene,
     settings: &RenderSettings,
-    view: &View,
+    views: &[View],
 ) -> Result<Terrain> {
     let texturing = TerrainTexturing {
         mode: settings.texturing,
@@ -470,6 +470,8 @@ fn warped_terrain(
     };
     let field = Arc::new(scene.heights.clone());
     let mut terrain = Terrain::new(ctx, graph, field, settings.terrain, &texturing)?;
-    terrain.declare_warp(ctx, graph, (0, view))?;
+    for (k, view) in views.iter().enumerate() {
+        terrain.declare_warp(ctx, graph, (k, view))?;
+    }
     Ok(terrain)
 }

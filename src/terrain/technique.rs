@@ -290,19 +290,24 @@ impl Technique for Terrain {
             };
             let state = &mut self.views[k];
             let debug = settings.view.debug_scalar();
-            state
-                .lod
-                .plan(&self.geometry.field, camera, view.aspect(), &settings.lod, debug)?;
+            let culling = view.culling_camera();
+            state.lod.plan(
+                &self.geometry.field,
+                &culling,
+                view.culling_aspect(),
+                &settings.lod,
+                debug,
+            )?;
             frame
                 .uploads
                 .write(warp_region, bytemuck::cast_slice(&state.lod.upload))?;
-            let pixel_footprint = 2.0 * (0.5 * camera.fov_y_deg.to_radians()).tan() / f64::from(view.height);
+            let pixel_footprint = view.pixel_angle();
             let lighting = match state.lighting {
                 Some(region) => frame.uploads.handle(region)?,
                 None => return Err(Error::Graph(format!("terrain.draw of view {k} was not declared"))),
             };
             let draw = TerrainDrawPush {
-                view_proj: camera.view_proj(view.aspect()).to_cols_array(),
+                view_proj: view.view_proj().to_cols_array(),
                 eye: camera.eye.as_vec3().extend(self.geometry.atlas_spacing()).to_array(),
                 forward: camera.forward().as_vec3().extend(pixel_footprint as f32).to_array(),
                 lighting: [lighting, 0, 0, 0],

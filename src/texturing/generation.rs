@@ -347,8 +347,8 @@ impl Technique for TextureAtlas {
         let camera = &view.camera;
         let quadtree_view = View {
             eye: camera.eye,
-            pixel_footprint: View::pixel_footprint_for(camera.fov_y_deg.to_radians(), view.height),
-            frustum: Some(frustum_planes(camera.view_proj_f64(view.aspect()))),
+            pixel_footprint: view.pixel_angle(),
+            frustum: Some(frustum_planes(view.view_proj_f64())),
         };
         let planned = self
             .plan(frame.index, &quadtree_view)

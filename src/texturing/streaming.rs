@@ -82,6 +82,13 @@ impl TextureStreaming {
         }
     }
 
+    /// Streaming for views of the sizes `sizes` rendered together: the
+    /// atlas holds the tiles of all of them (one image of their total pixels).
+    pub fn for_views(sizes: &[(u32, u32)]) -> TextureStreaming {
+        let pixels: u64 = sizes.iter().map(|&(w, h)| u64::from(w) * u64::from(h)).sum();
+        TextureStreaming::for_image(pixels.min(u64::from(u32::MAX)) as u32, 1)
+    }
+
     /// Bytes of the atlas textures (colour and normal, RGBA8).
     pub fn atlas_bytes(&self) -> u64 {
         let textures = self.atlas.texture_tile_sizes().len() as u64;

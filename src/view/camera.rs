@@ -1,7 +1,7 @@
 //! The pinhole camera of the CLI contract: world right-handed, +Z up,
 //! vertical field of view, image row 0 at the top.
 
-use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
+use glam::{DMat4, DQuat, DVec3, DVec4, Mat4};
 
 use crate::error::{Error, Result};
 
@@ -82,15 +82,57 @@ impl Camera {
         proj * view
     }
 
-    /// Right and up axes scaled by the half-extents of the image plane at
-    /// distance 1 (for reconstructing view rays).
-    pub fn ray_basis(&self, aspect: f64) -> (Vec3, Vec3, Vec3) {
-        let tan_y = (self.fov_y_deg.to_radians() * 0.5).tan();
-        (
-            (self.right() * tan_y * aspect).as_vec3(),
-            (self.image_up() * tan_y).as_vec3(),
-            self.forward().as_vec3(),
-        )
+    /// A camera at `pose` (camera → world, in the OpenGL/glTF camera
+    /// convention: x right, y up, looking down −z; scale is ignored).
+    pub fn from_pose(pose: DMat4, fov_y_deg: f64, near: f64, far: f64) -> Result<Camera> {
+        if !pose.is_finite() {
+            return Err(Error::invalid("camera.pose", "the matrix has a non-finite entry"));
+        }
+        let eye = pose.w_axis.truncate();
+        let forward = -pose.z_axis.truncate();
+        let up = pose.y_axis.truncate();
+        if forward.length() < 1e-12 || up.length() < 1e-12 || forward.normalize().cross(up.normalize()).length() < 1e-6
+        {
+            return Err(Error::invalid(
+                "camera.pose",
+                "its y and z axes are zero or parallel; not a rotation",
+            ));
+        }
+        let camera = Camera {
+            eye,
+            target: eye + forward.normalize(),
+            up: up.normalize(),
+            fov_y_deg,
+            near,
+            far,
+        };
+        camera.validate()?;
+        Ok(camera)
+    }
+
+    /// A camera at `position` turned by `rotation` (camera → world, the
+    /// [`Camera::from_pose`] convention: the identity looks down −z).
+    pub fn from_position_rotation(
+        position: DVec3,
+        rotation: DQuat,
+        fov_y_deg: f64,
+        near: f64,
+        far: f64,
+    ) -> Result<Camera> {
+        if !rotation.is_finite() || rotation.length() < 1e-9 {
+            return Err(Error::invalid(
+                "camera.rotation",
+                "the quaternion is zero or not finite",
+            ));
+        }
+        let pose = DMat4::from_rotation_translation(rotation.normalize(), position);
+        Camera::from_pose(pose, fov_y_deg, near, far)
+    }
+
+    /// The camera → world pose ([`Camera::from_pose`] convention).
+    pub fn pose(&self) -> DMat4 {
+        let (r, u, f) = (self.right(), self.image_up(), self.forward());
+        DMat4::from_cols(r.extend(0.0), u.extend(0.0), (-f).extend(0.0), self.eye.extend(1.0))
     }
 }
 
@@ -135,6 +177,29 @@ mod tests {
         let mut c = camera();
         c.eye.x = f64::NAN;
         assert!(c.validate().is_err());
+    }
+
+    #[test]
+    fn a_pose_round_trips() {
+        let c = Camera {
+            up: DVec3::new(0.1, 0.0, 1.0),
+            ..camera()
+        };
+        let back = Camera::from_pose(c.pose(), c.fov_y_deg, c.near, c.far).unwrap();
+        assert!(back.eye.abs_diff_eq(c.eye, 1e-12));
+        assert!(back.forward().abs_diff_eq(c.forward(), 1e-12));
+        assert!(back.image_up().abs_diff_eq(c.image_up(), 1e-12));
+        // The identity rotation looks down −z with +y up in the image.
+        let q = Camera::from_position_rotation(DVec3::ZERO, DQuat::IDENTITY, 60.0, 0.1, 10.0).unwrap();
+        assert!(q.forward().abs_diff_eq(-DVec3::Z, 1e-12) && q.image_up().abs_diff_eq(DVec3::Y, 1e-12));
+        // Rotating by 90° about +x looks along +y with +z up.
+        let q = DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2);
+        let c = Camera::from_position_rotation(DVec3::ONE, q, 60.0, 0.1, 10.0).unwrap();
+        assert!(c.forward().abs_diff_eq(DVec3::Y, 1e-12) && c.image_up().abs_diff_eq(DVec3::Z, 1e-12));
+        assert_eq!(
+            Camera::from_pose(DMat4::ZERO, 60.0, 0.1, 10.0).unwrap_err().parameter(),
+            Some("camera.pose")
+        );
     }
 
     #[test]

@@ -14,13 +14,18 @@
 pub mod camera;
 pub mod camera_path;
 mod frame;
+pub mod lens;
 pub mod lighting;
+pub mod rig;
 mod targets;
 
 pub use camera::{frustum_planes, Camera};
 pub use frame::{Frame, FrameContext, Technique};
+pub use lens::Intrinsics;
 pub use lighting::{Exposure, Lighting, ShadowMode, SkyLightMode, SkyModel, SunPosition};
 pub use targets::{LightingInputs, SceneTargets, TargetFormats, LIGHTING_CONSTANTS_BYTES};
+
+use glam::{DMat4, Mat4, Vec3};
 
 use crate::error::{Error, Result};
 
@@ -37,6 +42,9 @@ pub struct View {
     /// Image size in pixels.
     pub width: u32,
     pub height: u32,
+    /// Pinhole intrinsics in pixels; None: the camera's vertical field of
+    /// view, centred, square pixels.
+    pub intrinsics: Option<Intrinsics>,
 }
 
 /// Index of a view in [`Frame::views`].
@@ -50,6 +58,7 @@ impl View {
             camera,
             width,
             height,
+            intrinsics: None,
         }
     }
 
@@ -58,10 +67,80 @@ impl View {
         f64::from(self.width) / f64::from(self.height)
     }
 
-    /// Checks the camera and the image size.
+    /// The view's intrinsics: explicit ones, or those of the camera's
+    /// vertical field of view.
+    pub fn intrinsics(&self) -> Intrinsics {
+        self.intrinsics
+            .unwrap_or_else(|| Intrinsics::from_fov_y(self.camera.fov_y_deg, self.width, self.height))
+    }
+
+    /// The camera whose symmetric frustum (with [`View::culling_aspect`])
+    /// encloses the view's: CPU LOD, culling and shadow cascades plan with
+    /// it; the GPU projects with [`View::view_proj`]. The camera itself
+    /// without explicit intrinsics.
+    pub fn culling_camera(&self) -> Camera {
+        match self.intrinsics {
+            None => self.camera,
+            Some(k) => Camera {
+                fov_y_deg: k.enclosing_fov(self.width, self.height).0,
+                ..self.camera
+            },
+        }
+    }
+
+    /// Aspect ratio (tan of the half field of view across over down) of
+    /// [`View::culling_camera`].
+    pub fn culling_aspect(&self) -> f64 {
+        match self.intrinsics {
+            None => self.aspect(),
+            Some(k) => k.enclosing_fov(self.width, self.height).1,
+        }
+    }
+
+    /// World → Vulkan clip space (depth 0..1, row 0 at the top), in f64.
+    pub fn view_proj_f64(&self) -> DMat4 {
+        match self.intrinsics {
+            None => self.camera.view_proj_f64(self.aspect()),
+            Some(k) => {
+                let c = &self.camera;
+                k.projection(self.width, self.height, c.near, c.far) * DMat4::look_at_rh(c.eye, c.target, c.up)
+            }
+        }
+    }
+
+    /// [`View::view_proj_f64`] rounded to f32.
+    pub fn view_proj(&self) -> Mat4 {
+        self.view_proj_f64().as_mat4()
+    }
+
+    /// `(right, up, forward)` such that the view ray through NDC (x, y)
+    /// (y down) is `forward + x·right − y·up` (not normalised): the camera
+    /// axes scaled by the image plane's half-extents at depth 1 and the
+    /// forward axis shifted by the principal point.
+    pub fn ray_basis(&self) -> (Vec3, Vec3, Vec3) {
+        let k = self.intrinsics();
+        let c = &self.camera;
+        let (w, h) = (f64::from(self.width), f64::from(self.height));
+        let right = c.right() * (0.5 * w / k.fx);
+        let up = c.image_up() * (0.5 * h / k.fy);
+        let (ox, oy) = (2.0 * k.cx / w - 1.0, 2.0 * k.cy / h - 1.0);
+        let forward = c.forward() - ox * right + oy * up;
+        (right.as_vec3(), up.as_vec3(), forward.as_vec3())
+    }
+
+    /// The angle one pixel spans at the optical axis (radians, vertical).
+    pub fn pixel_angle(&self) -> f64 {
+        1.0 / self.intrinsics().fy
+    }
+
+    /// Checks the camera, the image size and the intrinsics.
     pub fn validate(&self) -> Result<()> {
         validate_size(self.width, self.height)?;
-        self.camera.validate()
+        self.camera.validate()?;
+        match &self.intrinsics {
+            Some(k) => k.validate(self.width, self.height),
+            None => Ok(()),
+        }
     }
 }
 

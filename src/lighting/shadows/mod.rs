@@ -189,8 +189,8 @@ impl ShadowMaps {
     pub fn plan(&self, index: ViewIndex, view: &View, sun: glam::Vec3, mode: ShadowMode) -> Result<CascadePlan> {
         let target = self.target(index)?;
         let mut plan = plan_cascades(
-            &view.camera,
-            view.aspect(),
+            &view.culling_camera(),
+            view.culling_aspect(),
             sun,
             self.bounds,
             &self.settings,

@@ -8,7 +8,7 @@ use glam::{DMat3, DMat4, DVec3};
 use super::SplatSettings;
 use crate::points::build::hybrid::HybridMesh;
 use crate::points::build::spt::SptNode;
-use crate::view::camera::Camera;
+use crate::view::View;
 
 /// One splat: an SPT node (§10.1.3) as the vertex stage reads it.
 #[repr(C)]
@@ -117,32 +117,25 @@ pub fn gaussian_table(cutoff: f32) -> Vec<f32> {
         .collect()
 }
 
-/// The camera's view matrix (world → camera, right-handed, looking down −z)
-/// and the pinhole intrinsics K of a `width`×`height` image, both in f64.
-pub fn view_and_intrinsics(camera: &Camera, width: u32, height: u32) -> (DMat4, DMat3) {
-    let view = DMat4::look_at_rh(camera.eye, camera.target, camera.up);
-    let (w, h) = (f64::from(width), f64::from(height));
-    let fy = 0.5 * h / (0.5 * camera.fov_y_deg.to_radians()).tan();
-    // Square pixels (the projection's aspect is width / height):
-    // pixel x = w/2 + fy·X/(−Z), y = h/2 − fy·Y/(−Z) (row 0 at the top).
-    let fx = fy;
+/// The view's view matrix (world → camera, right-handed, looking down −z)
+/// and its pinhole intrinsics K, both in f64.
+pub fn view_and_intrinsics(view: &View) -> (DMat4, DMat3) {
+    let camera = &view.camera;
+    let matrix = DMat4::look_at_rh(camera.eye, camera.target, camera.up);
+    let k = view.intrinsics();
+    // pixel x = cx + fx·X/(−Z), y = cy − fy·Y/(−Z) (row 0 at the top).
     let k = DMat3::from_cols(
-        DVec3::new(fx, 0.0, 0.0),
-        DVec3::new(0.0, -fy, 0.0),
-        DVec3::new(-0.5 * w, -0.5 * h, -1.0),
+        DVec3::new(k.fx, 0.0, 0.0),
+        DVec3::new(0.0, -k.fy, 0.0),
+        DVec3::new(-k.cx, -k.cy, -1.0),
     );
-    (view, k)
+    (matrix, k)
 }
 
 /// The header of a frame, and the world → camera matrix it was built from.
-pub fn frame_header(
-    camera: &Camera,
-    (width, height): (u32, u32),
-    lighting: u32,
-    settings: &SplatSettings,
-    max_point_size: f32,
-) -> (FrameHeader, DMat4) {
-    let (view, k) = view_and_intrinsics(camera, width, height);
+pub fn frame_header(view: &View, lighting: u32, settings: &SplatSettings, max_point_size: f32) -> (FrameHeader, DMat4) {
+    let (camera, width, height) = (&view.camera, view.width, view.height);
+    let (view, k) = view_and_intrinsics(view);
     let k_inv = k.inverse();
     let rows = |m: DMat3| {
         let t = m.transpose();
@@ -172,6 +165,7 @@ pub fn frame_header(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::view::Camera;
 
     #[test]
     fn intrinsics_agree_with_the_view_projection() {
@@ -184,8 +178,9 @@ mod tests {
             far: 5000.0,
         };
         let (w, h) = (640, 360);
-        let (view, k) = view_and_intrinsics(&camera, w, h);
-        let clip_of = camera.view_proj(w as f64 / h as f64).as_dmat4();
+        let v = View::new(camera, w, h);
+        let (view, k) = view_and_intrinsics(&v);
+        let clip_of = v.view_proj_f64();
         for p in [DVec3::new(120.0, 40.0, 5.0), DVec3::new(90.0, 80.0, 10.0)] {
             let c = clip_of * p.extend(1.0);
             let ndc = c.truncate() / c.w;
@@ -194,7 +189,7 @@ mod tests {
             let got = (x.x / x.z, x.y / x.z);
             assert!((got.0 - expected.0).abs() < 1e-3 && (got.1 - expected.1).abs() < 1e-3);
             let z = view.transform_point3(p).z;
-            let (header, _) = frame_header(&camera, (w, h), 0, &SplatSettings::default(), 64.0);
+            let (header, _) = frame_header(&v, 0, &SplatSettings::default(), 64.0);
             let depth = (f64::from(header.depth[0]) * z + f64::from(header.depth[1])) / -z;
             assert!((depth - ndc.z).abs() < 1e-5, "{depth} vs {}", ndc.z);
         }

@@ -263,7 +263,14 @@ impl Technique for PointShadows {
                 .ok_or_else(|| Error::Graph(format!("points.shadow: the frame has no view {}", v.index)))?;
             let sun = frame.lighting.sun_direction();
             let (records, draws) = if frame.lighting.shadows == ShadowMode::Cascaded {
-                let plan = plan_cascades(&view.camera, view.aspect(), sun, self.bounds, &self.settings, 0)?;
+                let plan = plan_cascades(
+                    &view.culling_camera(),
+                    view.culling_aspect(),
+                    sun,
+                    self.bounds,
+                    &self.settings,
+                    0,
+                )?;
                 self.plan_view(view.camera.eye, &plan)
             } else {
                 (Vec::new(), Vec::new())

@@ -249,15 +249,13 @@ impl Technique for PointRenderer {
                 .get(point_view.index)
                 .ok_or_else(|| Error::Graph(format!("points: the frame has no view {}", point_view.index)))?;
             let camera = &view.camera;
-            let size = (view.width, view.height);
             let (header, view_matrix) = frame_header(
-                camera,
-                size,
+                view,
                 frame.uploads.handle(point_view.lighting)?,
                 &self.settings,
                 self.max_point_size,
             );
-            let view_proj = camera.view_proj_f64(view.aspect());
+            let view_proj = view.view_proj_f64();
             let plan = plan_frame(&self.scene, &self.layouts, camera.eye, view_matrix, view_proj);
             frame.uploads.write_pod(point_view.frame, &header)?;
             frame
