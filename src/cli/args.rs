@@ -86,6 +86,8 @@ pub struct SceneArgs {
     #[command(flatten)]
     pub points: PointArgs,
     #[command(flatten)]
+    pub camera: super::rig::CameraArgs,
+    #[command(flatten)]
     pub lighting: super::lighting::LightingArgs,
     #[command(flatten)]
     pub device: DeviceArgs,

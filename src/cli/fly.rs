@@ -20,7 +20,8 @@ use alpenglow::view::camera_path::{load_keyframes, CameraPath, Orbit, DEFAULT_ST
 
 use super::args::FlyArgs;
 use super::{
-    camera, check_output_path, check_validation, context, load_scene, render_settings, report_textures, OutputSet,
+    camera, check_output_path, check_validation, context, load_scene, render_settings, report_textures, rig, views,
+    OutputSet,
 };
 
 /// The default path: one turn around the terrain's centre at 60 % of its
@@ -58,8 +59,9 @@ impl Drop for StagingGuard {
     }
 }
 
-fn frame_path(dir: &Path, index: usize) -> PathBuf {
-    dir.join(format!("frame_{index:05}.png"))
+/// Frame `index` of the view `view` (a rig's views each get a folder).
+fn frame_path(dir: &Path, view: &str, index: usize) -> PathBuf {
+    dir.join(view).join(format!("frame_{index:05}.png"))
 }
 
 fn stats(values: &[f64]) -> (f64, f64, f64) {
@@ -82,6 +84,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
             check_output_path(&Some(dir.clone()), "frame directory")?;
         }
     }
+    let (rig, specs) = views(&args.scene)?;
     let scene = load_scene(&args.scene)?;
     let base = camera(&args.scene, &scene)?;
     let path = match (&args.path, args.orbit) {
@@ -91,8 +94,10 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     };
     path.validate()?;
     let cameras = path.sample(args.frames, &base);
+    let mut frames = Vec::with_capacity(cameras.len());
     for (i, c) in cameras.iter().enumerate() {
         c.validate().with_context(|| format!("camera path frame {i}"))?;
+        frames.push(rig::frame_cameras(rig.as_ref(), c).with_context(|| format!("camera path frame {i}"))?);
     }
 
     let staging = args.out_dir.as_ref().map(|d| staging_dir(d));
@@ -100,6 +105,9 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     if let Some(dir) = &staging {
         std::fs::create_dir(dir).with_context(|| format!("cannot create {}", dir.display()))?;
         guard.0 = Some(dir.clone());
+        for view in specs.iter().filter(|v| !v.name.is_empty()) {
+            std::fs::create_dir(dir.join(&view.name)).with_context(|| format!("cannot create {}", dir.display()))?;
+        }
     }
 
     let ctx = context(&args.scene.device)?;
@@ -108,25 +116,28 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     let mut wall_ms = Vec::with_capacity(cameras.len());
     let texture_stats;
     let profiles = {
-        let settings = render_settings(&args.scene, &scene, staging.is_some())?;
+        let settings = render_settings(&args.scene, &scene, &specs, staging.is_some())?;
         let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
         let bar = ProgressBar::new(cameras.len() as u64);
         bar.set_style(
             ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} frames {msg}")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
-        let write = |images: &FrameImages, index: usize| -> Result<()> {
+        let write = |views: &[FrameImages], index: usize| -> Result<()> {
             if let Some(dir) = &staging {
-                write_png_rgba8(&frame_path(dir, index), &images.rgba8, images.width, images.height)?;
+                for images in views {
+                    let path = frame_path(dir, &images.name, index);
+                    write_png_rgba8(&path, &images.rgba8, images.width, images.height)?;
+                }
             }
             Ok(())
         };
         let mut pending = None;
         let mut last = std::time::Instant::now();
-        for (i, cam) in cameras.iter().enumerate() {
-            let outcome = renderer.render(cam)?;
+        for (i, cams) in frames.iter().enumerate() {
+            let outcome = renderer.render_views(cams)?;
             if let Some((index, frame)) = pending.take() {
-                let images = renderer.read(&frame)?;
+                let images = renderer.read_views(&frame)?;
                 write(&images, index)?;
             }
             if staging.is_some() {
@@ -137,7 +148,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
             bar.inc(1);
         }
         if let Some((index, frame)) = pending.take() {
-            let images = renderer.read(&frame)?;
+            let images = renderer.read_views(&frame)?;
             write(&images, index)?;
         }
         bar.finish_and_clear();
@@ -151,7 +162,12 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     let gpu: Vec<f64> = profiles.iter().map(|p| p.gpu_ms).collect();
     let cpu_warp: Vec<f64> = profiles
         .iter()
-        .filter_map(|p| p.passes.iter().find(|q| q.name == "terrain.warp").map(|q| q.cpu_ms))
+        .filter_map(|p| {
+            p.passes
+                .iter()
+                .find(|q| q.name.starts_with("terrain.warp"))
+                .map(|q| q.cpu_ms)
+        })
         .collect();
     let (gmin, gmed, gmax) = stats(&gpu);
     let (wmin, wmed, wmax) = stats(&wall_ms);

@@ -6,6 +6,7 @@ mod fly;
 mod lighting;
 mod orbit;
 mod points;
+mod rig;
 mod spt;
 mod terrain_spec;
 
@@ -19,7 +20,7 @@ use glam::DVec2;
 use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
 use alpenglow::io::image_out::{write_exr, write_png_rgba8};
 use alpenglow::profile::{summarize, write_chrome_trace, write_profile_json, FrameProfile};
-use alpenglow::renderer::{validate_size, Camera, RenderSettings, Scene};
+use alpenglow::renderer::{validate_size, Camera, FrameImages, RenderSettings, Scene, ViewSpec};
 use alpenglow::terrain::geometry_image::{TerrainSettings, TerrainView};
 use alpenglow::terrain::lod::{ImportanceFactors, LodMode, LodSettings};
 use alpenglow::terrain::sketch_map::SketchAlignment;
@@ -44,11 +45,18 @@ pub fn run() -> Result<ExitCode> {
             }
             // clap's message is multi-line; keep its first line.
             let text = e.to_string();
-            let first = text
-                .lines()
+            let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
+            let mut first = lines
                 .next()
                 .unwrap_or("invalid arguments")
-                .trim_start_matches("error: ");
+                .trim_start_matches("error: ")
+                .to_string();
+            // "the following required arguments were not provided:" names them on the next line.
+            if first.ends_with(':') {
+                if let Some(next) = lines.next() {
+                    first = format!("{first} {next}");
+                }
+            }
             bail!("{first} (see alpenglow --help)");
         }
     };
@@ -166,13 +174,21 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
     Ok(scene)
 }
 
-/// Render settings of the scene arguments.
-fn render_settings(args: &SceneArgs, scene: &Scene, readback: bool) -> Result<RenderSettings> {
+/// The rig of the scene arguments and the views a frame renders.
+pub(crate) fn views(args: &SceneArgs) -> Result<(Option<alpenglow::renderer::Rig>, Vec<ViewSpec>)> {
+    let rig = args.camera.rig(args.width)?;
+    let specs = args.camera.view_specs(rig.as_ref(), (args.width, args.height))?;
+    Ok((rig, specs))
+}
+
+/// Render settings of the scene arguments for the views `views`.
+fn render_settings(args: &SceneArgs, scene: &Scene, views: &[ViewSpec], readback: bool) -> Result<RenderSettings> {
     let lighting = lighting::lighting(&args.lighting, scene.default_lighting())?;
     lighting.validate()?;
     Ok(RenderSettings {
         width: args.width,
         height: args.height,
+        views: views.to_vec(),
         readback,
         terrain: terrain_settings(&args.terrain)?,
         points: points::splat_settings(&args.points, args.fov_y, args.height)?,
@@ -181,16 +197,17 @@ fn render_settings(args: &SceneArgs, scene: &Scene, readback: bool) -> Result<Re
             args::TexturingArg::Direct => alpenglow::texturing::gpu_layout::TexturingMode::Direct,
             args::TexturingArg::Atlas => alpenglow::texturing::gpu_layout::TexturingMode::Atlas,
         },
-        texture_streaming: texture_streaming(args),
+        texture_streaming: texture_streaming(args, views),
         lighting: Some(lighting),
         cache_dir: lighting::cache_dir(&args.lighting),
         ..RenderSettings::new(args.width, args.height)
     })
 }
 
-/// Atlas streaming with the tile budget of the arguments.
-fn texture_streaming(args: &SceneArgs) -> alpenglow::texturing::generation::TextureStreaming {
-    let mut streaming = alpenglow::texturing::generation::TextureStreaming::for_image(args.width, args.height);
+/// Atlas streaming for `views` with the tile budget of the arguments.
+fn texture_streaming(args: &SceneArgs, views: &[ViewSpec]) -> alpenglow::texturing::generation::TextureStreaming {
+    let sizes: Vec<(u32, u32)> = views.iter().map(|v| (v.width, v.height)).collect();
+    let mut streaming = alpenglow::texturing::generation::TextureStreaming::for_views(&sizes);
     let tiles = args.terrain.tile_budget as usize;
     let aim = u64::from(streaming.quadtree.aim_texels);
     streaming.budget = alpenglow::texturing::atlas::GenerationBudget {
@@ -273,7 +290,7 @@ fn camera(args: &SceneArgs, scene: &Scene) -> Result<Camera> {
         camera.far = far;
     }
     camera.validate()?;
-    Ok(camera)
+    args.camera.place(camera)
 }
 
 fn print_profile(device: &str, frame: &FrameProfile) {
@@ -294,20 +311,24 @@ fn print_profile(device: &str, frame: &FrameProfile) {
 const MAX_SETTLE_FRAMES: u32 = 64;
 
 fn render(args: RenderArgs) -> Result<ExitCode> {
-    check_output_path(&args.out, "PNG")?;
-    check_output_path(&args.exr, "EXR")?;
+    let (rig, specs) = views(&args.scene)?;
+    rig::check_pattern(&args.out, "--out", &specs)?;
+    rig::check_pattern(&args.exr, "--exr", &specs)?;
+    for path in [rig::view_paths(&args.out, &specs), rig::view_paths(&args.exr, &specs)].concat() {
+        check_output_path(&path, "output")?;
+    }
     check_output_path(&args.profile, "profile")?;
     check_output_path(&args.trace, "trace")?;
     let scene = load_scene(&args.scene)?;
-    let camera = camera(&args.scene, &scene)?;
+    let cameras = rig::frame_cameras(rig.as_ref(), &camera(&args.scene, &scene)?)?;
     let ctx = context(&args.scene.device)?;
     let report = ctx.validation_report();
     let device = ctx.info().name.clone();
-    let (images, profiles) = {
-        let settings = render_settings(&args.scene, &scene, true)?;
+    let (views, profiles) = {
+        let settings = render_settings(&args.scene, &scene, &specs, true)?;
         let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
-        let frame = renderer.render_settled(&camera, MAX_SETTLE_FRAMES)?;
-        let images = renderer.read(&frame)?;
+        let frame = renderer.render_views_settled(&cameras, MAX_SETTLE_FRAMES)?;
+        let views = renderer.read_views(&frame)?;
         let profiles = renderer.finish()?;
         if let Some(stats) = renderer.take_point_stats()?.last() {
             println!("{}", stats.summary());
@@ -322,20 +343,18 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
                 last.tiles.resident
             );
         }
-        (images, profiles)
+        (views, profiles)
     };
     drop(ctx);
     check_validation(report)?;
     let mut outputs = OutputSet::default();
-    outputs.write(&args.out, |p| {
-        write_png_rgba8(p, &images.rgba8, images.width, images.height)
-    })?;
-    outputs.write(&args.exr, |p| {
-        let (sun, sky) = (images.visibility_channel(0), images.visibility_channel(1));
-        let mut extra: Vec<(&str, &[f32])> = vec![("sun_visibility", &sun), ("sky_visibility", &sky)];
-        extra.extend(images.weight.iter().map(|w| ("W", w.as_slice())));
-        write_exr(p, images.width, images.height, &images.hdr, &images.depth, &extra)
-    })?;
+    for images in &views {
+        let path = |p: &Option<PathBuf>| p.as_ref().map(|p| rig::view_path(p, &images.name));
+        outputs.write(&path(&args.out), |p| {
+            write_png_rgba8(p, &images.rgba8, images.width, images.height)
+        })?;
+        outputs.write(&path(&args.exr), |p| write_view_exr(p, images))?;
+    }
     outputs.write(&args.profile, |p| write_profile_json(p, &device, &profiles))?;
     outputs.write(&args.trace, |p| write_chrome_trace(p, &device, &profiles))?;
     outputs.commit();
@@ -345,14 +364,23 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// A view's EXR: R, G, B, A, Z and its AOVs.
+fn write_view_exr(path: &Path, images: &FrameImages) -> alpenglow::Result<()> {
+    let (sun, sky) = (images.visibility_channel(0), images.visibility_channel(1));
+    let mut extra: Vec<(&str, &[f32])> = vec![("sun_visibility", &sun), ("sky_visibility", &sky)];
+    extra.extend(images.weight.iter().map(|w| ("W", w.as_slice())));
+    write_exr(path, images.width, images.height, &images.hdr, &images.depth, &extra)
+}
+
 fn bench(args: BenchArgs) -> Result<ExitCode> {
     check_output_path(&args.json, "JSON")?;
     check_output_path(&args.trace, "trace")?;
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
+    let (rig, specs) = views(&args.scene)?;
     let scene = load_scene(&args.scene)?;
-    let camera = camera(&args.scene, &scene)?;
+    let cameras = rig::frame_cameras(rig.as_ref(), &camera(&args.scene, &scene)?)?;
     let ctx = context(&args.scene.device)?;
     let report = ctx.validation_report();
     let device = ctx.info().clone();
@@ -361,13 +389,13 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     let texture_stats;
     let settle_frames;
     let profiles = {
-        let settings = render_settings(&args.scene, &scene, false)?;
+        let settings = render_settings(&args.scene, &scene, &specs, false)?;
         let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
         // A still view: first every texture tile (untimed), then warm-up and timed frames.
-        settle_frames = renderer.render_settled(&camera, MAX_SETTLE_FRAMES)?.frame + 1;
+        settle_frames = renderer.render_views_settled(&cameras, MAX_SETTLE_FRAMES)?.frame + 1;
         let mut last = std::time::Instant::now();
         for i in 0..args.warmup + args.frames {
-            renderer.render(&camera)?;
+            renderer.render_views(&cameras)?;
             if i >= args.warmup {
                 intervals.push(last.elapsed().as_secs_f64() * 1e3);
             }
@@ -387,13 +415,13 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
         return Err(anyhow!("no frame timings were collected"));
     }
     let (passes, frame) = summarize(&timed);
+    let sizes: Vec<String> = specs.iter().map(|v| format!("{}x{}", v.width, v.height)).collect();
     println!(
-        "{} ({}, {}), {}x{}, {} frames: median frame {:.3} ms GPU, {:.3} ms CPU",
+        "{} ({}, {}), {}, {} frames: median frame {:.3} ms GPU, {:.3} ms CPU",
         device.name,
         device.device_type,
         device.driver_info,
-        args.scene.width,
-        args.scene.height,
+        sizes.join("+"),
         frame.frames,
         frame.median_gpu_ms,
         frame.median_cpu_ms
@@ -424,6 +452,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
             "device": device,
             "width": args.scene.width,
             "height": args.scene.height,
+            "views": specs.iter().map(|v| serde_json::json!({"name": v.name, "width": v.width, "height": v.height})).collect::<Vec<_>>(),
             "frames": frame.frames,
             "median_frame_gpu_ms": frame.median_gpu_ms,
             "median_frame_cpu_ms": frame.median_cpu_ms,

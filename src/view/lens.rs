@@ -40,7 +40,7 @@ impl Intrinsics {
         for (name, v) in [("fx", self.fx), ("fy", self.fy)] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(Error::invalid(
-                    &format!("camera.{name}"),
+                    format!("camera.{name}"),
                     format!("{v} pixels; must be finite and > 0"),
                 ));
             }
@@ -48,7 +48,7 @@ impl Intrinsics {
         for (name, v, side) in [("cx", self.cx, w), ("cy", self.cy, h)] {
             if !(v.is_finite() && v.abs() <= 4.0 * side.max(1.0) + side) {
                 return Err(Error::invalid(
-                    &format!("camera.{name}"),
+                    format!("camera.{name}"),
                     format!("{v} pixels; must be finite and within 4 image sizes of the {side}-pixel image"),
                 ));
             }
