@@ -384,6 +384,15 @@ impl Context {
         self.shared.info.optional_features.iter().any(|f| f == name)
     }
 
+    /// Device memory in use by this context's allocations, in bytes (what
+    /// the allocator handed out, not the blocks it reserved).
+    pub fn allocated_bytes(&self) -> u64 {
+        match self.shared.allocator.lock() {
+            Ok(allocator) => allocator.generate_report().total_allocated_bytes,
+            Err(_) => 0,
+        }
+    }
+
     /// The largest 2-D image side the device accepts.
     pub fn max_image_dimension(&self) -> u32 {
         self.shared.limits.max_image_dimension2_d
