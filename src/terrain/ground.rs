@@ -126,6 +126,12 @@ impl<'a> Ground<'a> {
         self.d0
     }
 
+    /// Bound of the noise: the tile's largest |texel| (its evaluation
+    /// weights are non-negative and sum to one).
+    pub fn noise_bound(&self) -> f64 {
+        self.noise_max
+    }
+
     /// Amplitude of detail octave `k` (metres), `A·d0·2^(−k·H)`; 0 with the
     /// detail off.
     pub fn octave_amplitude(&self, k: u32) -> f64 {
