@@ -16,7 +16,7 @@
 #ifndef ALPENGLOW_TERRAIN_DETAIL_GLSL
 #define ALPENGLOW_TERRAIN_DETAIL_GLSL
 
-// Must match src/terrain/detail.rs.
+// Must match src/terrain/geometry_image.rs and its CPU twin src/terrain/ground.rs.
 const float SPLIT_BIAS = 0.5;    // conservative shift of detail to shading (octaves)
 const int MAX_DETAIL_OCTAVES = 8;
 const int NOISE_TILE = 128;

@@ -8,6 +8,8 @@ use crate::error::Result;
 use crate::io::heightmap::HeightField;
 use crate::points::build::spt::{epsilon_from_pixels, SptOptions};
 use crate::points::scene::{scatter_rocks, PointScene};
+use crate::terrain::geometry_image::TerrainSettings;
+use crate::terrain::ground::Ground;
 use crate::terrain::procedural::ProceduralTerrain;
 use crate::view::camera::Camera;
 use crate::view::{Lighting, SunPosition};
@@ -106,6 +108,27 @@ impl Scene {
     /// Height range in metres.
     pub fn height_range(&self) -> (f32, f32) {
         self.heights.min_max()
+    }
+
+    /// Height (metres) of the ground at world `(x, y)` as the terrain is
+    /// drawn with the default [`TerrainSettings`]: the B-spline with its
+    /// procedural detail at the finest level ([`crate::terrain::ground`]
+    /// says how far a drawn view may differ). Errors, naming the point,
+    /// outside the terrain. Each call builds the noise tile (about a
+    /// millisecond): for many queries or other settings use [`Scene::ground`].
+    pub fn ground_height(&self, x: f64, y: f64) -> Result<f64> {
+        self.ground(&TerrainSettings::default())?.height(x, y)
+    }
+
+    /// Unit upward normal of [`Scene::ground_height`]'s surface at `(x, y)`.
+    pub fn ground_normal(&self, x: f64, y: f64) -> Result<DVec3> {
+        self.ground(&TerrainSettings::default())?.normal(x, y)
+    }
+
+    /// The ground as drawn with `terrain` (the renderer's
+    /// [`crate::renderer::RenderSettings::terrain`]), for repeated queries.
+    pub fn ground(&self, terrain: &TerrainSettings) -> Result<Ground<'_>> {
+        Ground::new(&self.heights, terrain)
     }
 
     /// A camera that shows the whole terrain: from beyond its southern edge,

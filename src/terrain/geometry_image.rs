@@ -38,6 +38,9 @@ pub const VERTEX_STRIDE: u32 = 32;
 pub const SPLIT_BIAS: f32 = 0.5;
 /// Side of the wavelet noise tile (also `NOISE_TILE` in the shader).
 pub const NOISE_TILE: usize = 128;
+/// Detail octaves at most, in geometry and shading (also
+/// `MAX_DETAIL_OCTAVES` in `glsl/include/terrain_detail.glsl`).
+pub const MAX_DETAIL_OCTAVES: u32 = 8;
 
 /// What `terrain.draw` shows.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

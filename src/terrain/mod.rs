@@ -3,9 +3,11 @@
 //! [`importance`] → [`warp`] (combined per frame by [`lod`], in
 //! [`Terrain`]'s `prepare`) → [`geometry_image`] (`terrain.warp`) →
 //! [`shading`] (`terrain.draw`); [`technique`] ties them into the frame.
+//! [`ground`] is the CPU twin of the drawn surface, for height queries.
 
 pub mod bspline;
 pub mod geometry_image;
+pub mod ground;
 pub mod importance;
 pub mod lod;
 pub mod procedural;

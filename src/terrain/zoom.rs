@@ -25,16 +25,24 @@ pub fn zoom_positions(field: &HeightField, warped: &[DVec3], n: usize, side: usi
         ));
     }
     let extent = field.extent();
-    let scale = (n - 1) as f64 / (side - 1) as f64;
     let mut out = Vec::with_capacity(side * side);
     for j in 0..side {
         for i in 0..side {
-            let g = DVec2::new(i as f64, j as f64) * scale;
-            let xy = bilinear(warped, n, g).truncate().clamp(DVec2::ZERO, extent);
+            let xy = zoom_xy(warped, n, side, extent, i, j);
             out.push(DVec3::new(xy.x, xy.y, sample_bspline(field, xy.x, xy.y)));
         }
     }
     Ok(out)
+}
+
+/// World xy of output vertex `(i, j)` of the `side×side` grid (`side ≥ 2`):
+/// `Φ` (the `n×n` warped sketch map, `warped.len() = n²`, `n ≥ 2`)
+/// bilinearly interpolated at `(i, j)·(n−1)/(side−1)`, clamped onto the
+/// terrain rectangle `[0, extent]` (`phi` in `glsl/terrain/warp.comp`).
+pub fn zoom_xy(warped: &[DVec3], n: usize, side: usize, extent: DVec2, i: usize, j: usize) -> DVec2 {
+    let scale = (n - 1) as f64 / (side - 1) as f64;
+    let g = DVec2::new(i as f64, j as f64) * scale;
+    bilinear(warped, n, g).truncate().clamp(DVec2::ZERO, extent)
 }
 
 /// Projected area in pixels of every grid quad of `positions`
