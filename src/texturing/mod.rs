@@ -19,6 +19,7 @@
 //! * [`reference`]: the CPU twin of the shaders' evaluation, for tests.
 
 pub mod atlas;
+pub mod bounds;
 pub mod generation;
 pub mod gpu_layout;
 pub mod input_maps;
