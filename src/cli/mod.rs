@@ -181,7 +181,7 @@ fn render_settings(args: &SceneArgs, scene: &Scene, readback: bool) -> Result<Re
             args::TexturingArg::Direct => alpenglow::texturing::gpu_layout::TexturingMode::Direct,
             args::TexturingArg::Atlas => alpenglow::texturing::gpu_layout::TexturingMode::Atlas,
         },
-        texture_streaming: texture_streaming(args),
+        texture_streaming: texture_streaming(args)?,
         lighting: Some(lighting),
         cache_dir: lighting::cache_dir(&args.lighting),
         ..RenderSettings::new(args.width, args.height)
@@ -189,15 +189,9 @@ fn render_settings(args: &SceneArgs, scene: &Scene, readback: bool) -> Result<Re
 }
 
 /// Atlas streaming with the tile budget of the arguments.
-fn texture_streaming(args: &SceneArgs) -> alpenglow::texturing::generation::TextureStreaming {
-    let mut streaming = alpenglow::texturing::generation::TextureStreaming::for_image(args.width, args.height);
-    let tiles = args.terrain.tile_budget as usize;
-    let aim = u64::from(streaming.quadtree.aim_texels);
-    streaming.budget = alpenglow::texturing::atlas::GenerationBudget {
-        tiles,
-        texels: tiles as u64 * aim * aim,
-    };
-    streaming
+fn texture_streaming(args: &SceneArgs) -> Result<alpenglow::texturing::generation::TextureStreaming> {
+    let streaming = alpenglow::texturing::generation::TextureStreaming::for_image(args.width, args.height);
+    Ok(streaming.with_tile_budget(args.terrain.tile_budget)?)
 }
 
 fn load_terrain(args: &SceneArgs) -> Result<Scene> {

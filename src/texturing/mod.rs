@@ -20,11 +20,14 @@
 
 pub mod atlas;
 pub mod bounds;
+pub mod fit;
 pub mod generation;
 pub mod gpu_layout;
 pub mod input_maps;
 pub mod layers;
+pub mod pacing;
 pub mod page_table;
+mod passes;
 pub mod quadtree;
 pub mod reference;
 pub mod stats;

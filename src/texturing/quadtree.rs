@@ -477,10 +477,13 @@ mod tests {
             ..view(eye)
         };
         // East looks from the eye, west from 500 m west of it: different needs.
-        let (east, west) = (facing(1.0), View {
-            eye: eye - DVec3::new(500.0, 0.0, 0.0),
-            ..facing(-1.0)
-        });
+        let (east, west) = (
+            facing(1.0),
+            View {
+                eye: eye - DVec3::new(500.0, 0.0, 0.0),
+                ..facing(-1.0)
+            },
+        );
         let s = QuadtreeSettings::default();
         let one = |v: &View| select_tiles(EXTENT, v, &s, &flat).unwrap();
         let (a, b) = (density_map(&one(&east)), density_map(&one(&west)));
@@ -494,7 +497,10 @@ mod tests {
             only_a += usize::from(a.is_some() && b.is_none());
             only_b += usize::from(b.is_some() && a.is_none());
         }
-        assert!(only_a > 0 && only_b > 0, "the views must each see something the other does not");
+        assert!(
+            only_a > 0 && only_b > 0,
+            "the views must each see something the other does not"
+        );
         // Every leaf has the texels each view that sees it needs (rule 2),
         // unless clamped to the largest size.
         for t in &both {
