@@ -284,7 +284,8 @@ fn print_profile(device: &str, frame: &FrameProfile) {
     );
 }
 
-/// Most frames a still render takes to generate every texture tile.
+/// Frames in a row without a texture tile more before a still render gives
+/// up (every frame generates at least one, so this means a fault).
 const MAX_SETTLE_FRAMES: u32 = 64;
 
 fn render(args: RenderArgs) -> Result<ExitCode> {
