@@ -266,6 +266,26 @@ fn texturing_modes_and_input_maps_render() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `--tile-budget` has one range, 1..=255 (one frame's texels fit one
+/// dispatch): its ends render the same image, values outside it are one-line
+/// errors naming the flag and the range.
+#[test]
+fn tile_budget_range_ends_render_and_outside_is_refused() {
+    let dir = fresh_dir("tile_budget");
+    let one = render_png(&dir, "one.png", SMALL_TERRAIN, &["--tile-budget", "1"]);
+    let most = render_png(&dir, "most.png", SMALL_TERRAIN, &["--tile-budget", "255"]);
+    assert_eq!(differing_bytes(&one, &most), 0, "a settled frame does not depend on the budget");
+    let _ = std::fs::remove_dir_all(&dir);
+    for value in ["0", "256", "4294967295"] {
+        expect_render_error(
+            &format!("tile_budget_{value}"),
+            Some(SMALL_TERRAIN),
+            &["--tile-budget", value],
+            &["--tile-budget", value, "1..=255"],
+        );
+    }
+}
+
 #[test]
 fn layer_using_a_missing_input_map_is_refused() {
     let layers = data_arg("layers-rainfall.toml");

@@ -49,7 +49,6 @@ fn render(ctx: &Context, scene: &Scene, specs: Vec<ViewSpec>, cameras: &[Camera]
         exposure: Exposure::Ev100(14.0),
         ..scene.default_lighting()
     });
-    settings.texturing = alpenglow::texturing::gpu_layout::TexturingMode::Direct;
     let mut renderer = Renderer::new(ctx, scene, settings).expect("renderer");
     let frame = renderer.render_views_settled(cameras, SETTLE).expect("settled frame");
     let images = renderer.read_views(&frame).expect("readback");
@@ -73,7 +72,7 @@ fn every_view_of_a_ring6_rig_equals_its_camera_rendered_alone() {
                 assert_eq!(passes.iter().filter(|p| **p == name).count(), 1, "{name} in {passes:?}");
             }
         }
-        //TMP assert_eq!(passes.iter().filter(|p| p.starts_with("texturing.upsample")).count(), 1);
+        assert_eq!(passes.iter().filter(|p| p.starts_with("texturing.upsample")).count(), 1);
         for (k, (spec, camera)) in specs.iter().zip(&cameras).enumerate() {
             let alone = ViewSpec {
                 name: String::new(),

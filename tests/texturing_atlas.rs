@@ -217,6 +217,7 @@ fn flythrough_stays_within_budget_and_hits_the_cache() {
         budget: GenerationBudget {
             tiles: 8,
             texels: 8 * 128 * 128,
+            gpu_time: None,
         },
         ..TextureStreaming::default()
     };

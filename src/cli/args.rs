@@ -234,10 +234,10 @@ pub struct TerrainArgs {
     /// reference), or classic surface types (§7.4.3).
     #[arg(long, value_enum, default_value = "atlas")]
     pub texturing: TexturingArg,
-    /// Most texture tiles generated per frame (atlas texturing); the texel
-    /// budget is this many 128² tiles. Still renders keep rendering until
-    /// every tile is ready.
-    #[arg(long = "tile-budget", default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=256))]
+    /// Most texture tiles generated per frame (atlas texturing), 1..=255;
+    /// the texel budget is this many 128² tiles. Still renders keep
+    /// rendering until every tile is ready.
+    #[arg(long = "tile-budget", default_value_t = 32)]
     pub tile_budget: u32,
     /// Surface-layer tree (TOML; default: the built-in tree).
     #[arg(long)]

@@ -45,6 +45,7 @@ const FLAGS: &[(&str, &str)] = &[
     ("lighting.time", "--time"),
     ("lighting.latitude", "--latitude"),
     ("lighting.longitude", "--longitude"),
+    ("texturing.tile_budget", "--tile-budget"),
 ];
 
 /// The flag(s) that set library parameter `parameter`: a [`FLAGS`] entry;

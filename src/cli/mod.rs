@@ -197,7 +197,7 @@ fn render_settings(args: &SceneArgs, scene: &Scene, views: &[ViewSpec], readback
             args::TexturingArg::Direct => alpenglow::texturing::gpu_layout::TexturingMode::Direct,
             args::TexturingArg::Atlas => alpenglow::texturing::gpu_layout::TexturingMode::Atlas,
         },
-        texture_streaming: texture_streaming(args, views),
+        texture_streaming: texture_streaming(args, views)?,
         lighting: Some(lighting),
         cache_dir: lighting::cache_dir(&args.lighting),
         ..RenderSettings::new(args.width, args.height)
@@ -205,16 +205,13 @@ fn render_settings(args: &SceneArgs, scene: &Scene, views: &[ViewSpec], readback
 }
 
 /// Atlas streaming for `views` with the tile budget of the arguments.
-fn texture_streaming(args: &SceneArgs, views: &[ViewSpec]) -> alpenglow::texturing::generation::TextureStreaming {
+fn texture_streaming(
+    args: &SceneArgs,
+    views: &[ViewSpec],
+) -> Result<alpenglow::texturing::generation::TextureStreaming> {
     let sizes: Vec<(u32, u32)> = views.iter().map(|v| (v.width, v.height)).collect();
-    let mut streaming = alpenglow::texturing::generation::TextureStreaming::for_views(&sizes);
-    let tiles = args.terrain.tile_budget as usize;
-    let aim = u64::from(streaming.quadtree.aim_texels);
-    streaming.budget = alpenglow::texturing::atlas::GenerationBudget {
-        tiles,
-        texels: tiles as u64 * aim * aim,
-    };
-    streaming
+    let streaming = alpenglow::texturing::generation::TextureStreaming::for_views(&sizes);
+    Ok(streaming.with_tile_budget(args.terrain.tile_budget)?)
 }
 
 fn load_terrain(args: &SceneArgs) -> Result<Scene> {
@@ -307,7 +304,8 @@ fn print_profile(device: &str, frame: &FrameProfile) {
     );
 }
 
-/// Most frames a still render takes to generate every texture tile.
+/// Frames in a row without a texture tile more before a still render gives
+/// up (every frame generates at least one, so this means a fault).
 const MAX_SETTLE_FRAMES: u32 = 64;
 
 fn render(args: RenderArgs) -> Result<ExitCode> {

@@ -322,6 +322,11 @@ impl<P> BakedGraph<P> {
         Ok(())
     }
 
+    /// Timings of the frames completed so far and not yet taken (oldest first).
+    pub fn profiles(&self) -> &[FrameProfile] {
+        &self.profiles
+    }
+
     /// Timings of the frames completed so far (oldest first), removing them.
     pub fn take_profiles(&mut self) -> Vec<FrameProfile> {
         std::mem::take(&mut self.profiles)

@@ -338,6 +338,7 @@ impl Renderer {
             frame.prepare(terrain, &mut uploads, &mut stages)?;
         }
         if let Some(atlas) = &mut t.atlas {
+            atlas.observe_profiles(self.graph.profiles());
             frame.prepare(atlas, &mut uploads, &mut stages)?;
         }
         if let Some(points) = &mut t.points {
@@ -349,26 +350,47 @@ impl Renderer {
     }
 
     /// Renders `camera` until every texture tile the view needs is ready
-    /// (the atlas generates at most its budget per frame) and returns that
-    /// frame; at most `max_frames` frames, then errors. Same as
-    /// [`Renderer::render`] without the atlas.
+    /// and returns that frame. The atlas generates at most its tile budget
+    /// per frame (not its GPU time budget: these frames are not shown), at
+    /// least one tile, and coarsens what does not fit, so a still view
+    /// always settles; errors only if `max_frames` frames in a row bring no
+    /// tile closer. Same as [`Renderer::render`] without the atlas.
     pub fn render_settled(&mut self, camera: &Camera, max_frames: u32) -> Result<FrameOutcome> {
         self.render_views_settled(std::slice::from_ref(camera), max_frames)
     }
 
     /// [`Renderer::render_settled`] of every view.
     pub fn render_views_settled(&mut self, cameras: &[Camera], max_frames: u32) -> Result<FrameOutcome> {
-        for _ in 0..max_frames.max(1) {
+        if let Some(atlas) = &mut self.techniques.atlas {
+            atlas.set_paced(false);
+        }
+        let settled = self.render_until_settled(cameras, max_frames.max(1));
+        if let Some(atlas) = &mut self.techniques.atlas {
+            atlas.set_paced(true);
+        }
+        settled
+    }
+
+    fn render_until_settled(&mut self, cameras: &[Camera], max_frames: u32) -> Result<FrameOutcome> {
+        let (mut fewest, mut stalled) = (usize::MAX, 0);
+        loop {
             let outcome = self.render_views(cameras)?;
-            match &self.techniques.atlas {
-                Some(atlas) if atlas.last_deferred() > 0 => continue,
-                _ => return Ok(outcome),
+            let missing = self.techniques.atlas.as_ref().map_or(0, |a| a.last_deferred());
+            if missing == 0 {
+                return Ok(outcome);
+            }
+            (fewest, stalled) = if missing < fewest {
+                (missing, 0)
+            } else {
+                (fewest, stalled + 1)
+            };
+            if stalled >= max_frames {
+                return Err(Error::invalid(
+                    "texture atlas",
+                    format!("{missing} tiles still missing after {max_frames} frames without progress"),
+                ));
             }
         }
-        Err(Error::invalid(
-            "texture atlas",
-            format!("tiles still missing after {max_frames} frames: raise the tile budget or the atlas size"),
-        ))
     }
 
     /// Waits for `frame` and copies the first view's images out of the
@@ -425,6 +447,9 @@ impl Renderer {
     /// Waits for all frames and returns the timings of those not yet taken.
     pub fn finish(&mut self) -> Result<Vec<FrameProfile>> {
         self.graph.finish(&mut self.frames)?;
+        if let Some(atlas) = &mut self.techniques.atlas {
+            atlas.observe_profiles(self.graph.profiles());
+        }
         Ok(self.graph.take_profiles())
     }
 

@@ -25,7 +25,11 @@
 //!    resident root tile is never evicted.
 //! 2. **Hits.** Needed tiles already resident at their needed size are used.
 //! 3. **Misses** are ordered coarse levels first, then nearer, then by node
-//!    id, and the first tiles within the cap are generated. The resident
+//!    id, and the first tiles within the cap are generated; a frame that
+//!    generates no root generates its first miss even when it alone exceeds
+//!    the texel cap (a tile larger than the cap would never be generated
+//!    otherwise), so every frame with misses and a tile cap ≥ 1 makes
+//!    progress. The resident
 //!    fallbacks of the tiles over the cap are marked used first, so
 //!    generation does not evict what they will be drawn from.
 //! 4. **Slots.** A tile takes the lowest free slot of its layer, else the
@@ -45,6 +49,7 @@
 use std::collections::{HashMap, HashSet};
 
 use crate::error::{Error, Result};
+pub use crate::texturing::pacing::GpuTimeBudget;
 use crate::texturing::quadtree::{NeededTile, NodeId, QuadtreeSettings};
 
 /// Atlas size and the range of tile sizes it holds.
@@ -214,12 +219,22 @@ pub struct TilePlan {
     pub border: u32,
 }
 
-/// How much one frame may generate: tiles and texels (border included).
-/// The root exception of the module documentation applies to both.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// How much one frame may generate: tiles and texels (border included),
+/// and GPU time. The root and first-miss exceptions of the module
+/// documentation apply, so one frame generates at most
+/// `max(texels, largest tile²)` texels.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GenerationBudget {
     pub tiles: usize,
     pub texels: u64,
+    /// GPU time of generation per frame, measured from earlier frames
+    /// ([`crate::texturing::pacing`]); [`TextureAtlas`] turns it into a
+    /// lower texel cap before [`TileCache::plan_frame`], which reads only
+    /// the counts. None: the counts alone, so which frame generates which
+    /// tile does not depend on timings (deterministic frames).
+    ///
+    /// [`TextureAtlas`]: crate::texturing::generation::TextureAtlas
+    pub gpu_time: Option<GpuTimeBudget>,
 }
 
 impl GenerationBudget {
@@ -227,15 +242,17 @@ impl GenerationBudget {
     pub const UNLIMITED: GenerationBudget = GenerationBudget {
         tiles: usize::MAX,
         texels: u64::MAX,
+        gpu_time: None,
     };
 }
 
 impl From<usize> for GenerationBudget {
-    /// At most `tiles` tiles, any size.
+    /// At most `tiles` tiles, any size, no time limit.
     fn from(tiles: usize) -> GenerationBudget {
         GenerationBudget {
             tiles,
             texels: u64::MAX,
+            gpu_time: None,
         }
     }
 }
@@ -321,7 +338,7 @@ impl TileCache {
     /// (a count, or a [`GenerationBudget`]) are (re)generated, by the rules
     /// in the module documentation.
     pub fn plan_frame(&mut self, frame: u64, needed: &[NeededTile], cap: impl Into<GenerationBudget>) -> TilePlan {
-        let GenerationBudget { tiles: cap, texels } = cap.into();
+        let GenerationBudget { tiles: cap, texels, .. } = cap.into();
         let mut stats = TileStats::default();
         let mut generate = Vec::new();
         let settings = self.settings;
@@ -354,10 +371,13 @@ impl TileCache {
         let mut texels_left = texels.saturating_sub(generate.iter().map(|g| u64::from(g.1.size).pow(2)).sum());
         let mut budget = 0;
         for &(_, size, _) in missing.iter().take(cap.saturating_sub(generate.len())) {
-            let Some(rest) = texels_left.checked_sub(u64::from(size).pow(2)) else {
-                break;
+            texels_left = match texels_left.checked_sub(u64::from(size).pow(2)) {
+                Some(rest) => rest,
+                // A frame's first tile goes even over the texel budget.
+                None if generate.is_empty() && budget == 0 => 0,
+                None => break,
             };
-            (texels_left, budget) = (rest, budget + 1);
+            budget += 1;
         }
         for &(node, size, _) in &missing[budget..] {
             if let Some((source, source_size)) = self.fallback(node, size) {
@@ -571,6 +591,7 @@ mod tests {
         let budget = GenerationBudget {
             tiles: 10,
             texels: 2 * 64 * 64 + 100,
+            gpu_time: None,
         };
         let plan = cache.plan_frame(2, &needed, budget);
         assert_eq!((plan.stats.generated, plan.stats.deferred), (2, 2));
@@ -579,9 +600,14 @@ mod tests {
             [needed[0].node, needed[2].node],
             "nearest, then node id"
         );
+        // A texel cap below one tile still generates one per frame.
+        let tiny = GenerationBudget { texels: 100, ..budget };
+        let plan = cache.plan_frame(3, &needed, tiny);
+        assert_eq!((plan.stats.generated, plan.stats.deferred), (1, 1));
+        assert_eq!(plan.generate[0].0, needed[1].node);
         // An unlimited budget takes the rest.
-        let plan = cache.plan_frame(3, &needed, GenerationBudget::UNLIMITED);
-        assert_eq!((plan.stats.generated, plan.stats.hits), (2, 2));
+        let plan = cache.plan_frame(4, &needed, GenerationBudget::UNLIMITED);
+        assert_eq!((plan.stats.generated, plan.stats.hits), (1, 3));
     }
 
     #[test]

@@ -2,10 +2,13 @@
 //! `ALGORITHMS.md` §4 items 3–4), as render-graph passes over **all** dirty
 //! tiles of a frame at once:
 //!
-//! 1. CPU, in [`TextureAtlas`]'s `prepare` (before recording): the quadtree picks the nodes
-//!    the view needs ([`select_tiles`]), the tile cache plans what to
-//!    generate within the [`GenerationBudget`] and what to draw from where
-//!    ([`TileCache::plan_frame`]), and the page table is built
+//! 1. CPU, in [`TextureAtlas`]'s `prepare` (before recording): the quadtree
+//!    picks the nodes all the frame's views need, one partition of what any
+//!    of them sees ([`select_tiles_for_views`]), coarsened where it would not
+//!    fit the atlas ([`fit_to_atlas`]); the tile cache plans what to
+//!    generate within the [`GenerationBudget`] (its GPU time turned into
+//!    texels by the [`GenerationPacer`]) and what to draw from where
+//!    ([`TileCache::plan_frame`]), and one page table for all views is built
 //!    ([`PageTable`]). The dirty tiles become [`TileJob`]s: one thread per
 //!    texel, border included, of all of them.
 //! 2. `texturing.upsample`: the base surface (the height field as a cubic
@@ -26,28 +29,30 @@ use bytemuck::{Pod, Zeroable};
 use glam::DVec2;
 
 use crate::error::{Error, Result};
-use crate::graph::{BufferAccess, BufferId, BufferInfo, ImageAccess, ImageId, RenderGraph, Stage, UploadRegion};
+use crate::graph::{BufferId, BufferInfo, ImageId, RenderGraph, UploadRegion};
 use crate::io::heightmap::HeightField;
-use crate::shaders;
+use crate::profile::FrameProfile;
+#[cfg(doc)]
+use crate::texturing::atlas::GenerationBudget;
 use crate::texturing::atlas::{TileCache, TilePlan};
+use crate::texturing::fit::{fit_to_atlas, Coarsening};
 use crate::texturing::input_maps::InputMaps;
 use crate::texturing::layers::LayerTree;
+use crate::texturing::pacing::{GenerationPacer, GpuTimeBudget};
 use crate::texturing::page_table::PageTable;
-use crate::texturing::quadtree::{select_tiles, HeightBounds, NodeId, View};
+use crate::texturing::passes::{add_atlas_readback, base_push, GenerationPasses};
+use crate::texturing::quadtree::{select_tiles_for_views, HeightBounds, NeededTile, NodeId, View};
 pub use crate::texturing::stats::TextureFrameStats;
-pub use crate::texturing::streaming::{TextureStreaming, MAX_ATLAS_TEXTURES};
+pub use crate::texturing::streaming::{TextureStreaming, MAX_ATLAS_TEXTURES, MAX_VIEWS};
 use crate::view::{frustum_planes, Frame, FrameContext, Technique};
-use crate::vulkan::{
-    Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, Format, Image, ImageDesc, ImageUsageFlags,
-    MemoryLocation,
-};
+use crate::vulkan::{Buffer, Context, Format, Image, ImageDesc, ImageUsageFlags, MemoryLocation};
 
 /// Bytes of one texel's state in the scratch buffer (`TexelState`).
 pub const TEXEL_STATE_BYTES: u64 = 32;
 /// Capacity of the per-frame page-table buffer in 16-byte words.
 pub const PAGE_TABLE_WORDS: usize = 1 << 16;
 /// Texels per workgroup of the generation passes.
-const GROUP: u64 = 64;
+pub(crate) const GROUP: u64 = 64;
 /// Most texels one frame generates: one-dimensional dispatches of 65 535 groups.
 pub const MAX_DISPATCH_TEXELS: u64 = 65_535 * GROUP;
 
@@ -115,6 +120,10 @@ pub struct TextureAtlas {
     /// The last prepared frame's page table.
     table: PageTable,
     stats: Vec<TextureFrameStats>,
+    /// GPU cost of generation, measured (the budget's GPU time).
+    pacer: GenerationPacer,
+    /// Whether the GPU time budget applies ([`TextureAtlas::set_paced`]).
+    paced: bool,
     /// Host copies of the colour textures, per texture and frame slot
     /// ([`TextureStreaming::readback`]).
     readback: Option<Vec<Vec<Arc<Buffer>>>>,
@@ -140,26 +149,6 @@ pub struct AtlasBindings {
     pub page_table: UploadRegion,
     /// Texels per atlas side.
     pub atlas_size: u32,
-}
-
-/// Push constants of every `texturing.*` pass (`Push` in
-/// glsl/include/texture_tiles.glsl).
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct TileGenerationPush {
-    /// Tile jobs, texel states (storage buffers), layers (storage buffer),
-    /// noise tile (sampled).
-    handles: [u32; 4],
-    /// Jobs, texels, layer index, height field (sampled).
-    counts: [u32; 4],
-    /// Height-field columns, rows.
-    grid: [u32; 4],
-    /// Sample spacing x, y (metres), lowest and highest height.
-    spacing_range: [f32; 4],
-    /// Input maps ([`InputMaps::handles`]).
-    maps: [u32; 4],
-    /// Terrain rectangle x, y (metres).
-    extent: [f32; 4],
 }
 
 /// What the passes read besides their own resources.
@@ -277,6 +266,8 @@ impl TextureAtlas {
             scratch_texels,
             table: PageTable::default(),
             stats: Vec::new(),
+            pacer: GenerationPacer::default(),
+            paced: true,
             readback,
             streaming,
         })
@@ -307,12 +298,65 @@ impl TextureAtlas {
         self.readback.as_deref()
     }
 
-    /// Selects the needed tiles of `view`, plans the frame within the
-    /// budget, builds the page table and the jobs of the dirty tiles.
-    fn plan(&mut self, frame: u64, view: &View) -> Result<(TilePlan, PageTable, Vec<TileJob>, u64)> {
+    /// Whether the budget's GPU time applies (default true). A still
+    /// render that only waits for every tile clears it: its frames are not
+    /// shown, so only the tile and texel counts bound them.
+    pub fn set_paced(&mut self, paced: bool) {
+        self.paced = paced;
+    }
+
+    /// Sets the budget's GPU time per frame (a simulator's frame time may
+    /// change at run time); errors on a value that is not finite and positive.
+    pub fn set_gpu_time(&mut self, gpu_time: Option<GpuTimeBudget>) -> Result<()> {
+        if let Some(t) = gpu_time.filter(|t| !t.is_valid()) {
+            return Err(Error::invalid(
+                "texturing.gpu_time",
+                format!("{t:?}; must be finite and positive"),
+            ));
+        }
+        self.streaming.budget.gpu_time = gpu_time;
+        Ok(())
+    }
+
+    /// Takes the GPU timings of completed frames (the renderer passes its
+    /// graph's profiles; frames already seen are skipped), from which the
+    /// budget's GPU time becomes a texel cap ([`GenerationPacer`]).
+    pub fn observe_profiles(&mut self, profiles: &[FrameProfile]) {
+        self.pacer.observe(profiles);
+    }
+
+    /// The measured generation cost: GPU milliseconds per texel, once known.
+    pub fn gpu_ms_per_texel(&self) -> Option<f64> {
+        self.pacer.ms_per_texel()
+    }
+
+    /// The tiles `views` need, coarsened to fit the atlas and the page table.
+    fn select(&self, views: &[View]) -> Result<(Vec<NeededTile>, Coarsening)> {
+        let bounds = |n| self.bounds.bounds(n);
+        let mut needed = select_tiles_for_views(self.extent, views, &self.streaming.quadtree, &bounds)?;
+        // Entries take two words, inner nodes one: start at a third.
+        let mut max_tiles = PAGE_TABLE_WORDS / 3;
+        let mut done = fit_to_atlas(&mut needed, &self.streaming.atlas, max_tiles);
+        while PageTable::words_for(needed.iter().map(|t| t.node)) > PAGE_TABLE_WORDS && max_tiles > 1 {
+            max_tiles /= 2;
+            let more = fit_to_atlas(&mut needed, &self.streaming.atlas, max_tiles);
+            (done.halved, done.merged) = (done.halved + more.halved, done.merged + more.merged);
+        }
+        Ok((needed, done))
+    }
+
+    /// Selects the tiles `views` need, plans the frame within the budget,
+    /// builds the page table and the jobs of the dirty tiles.
+    fn plan(&mut self, frame: u64, views: &[View]) -> Result<PlannedFrame> {
         let extent = self.extent;
-        let needed = select_tiles(extent, view, &self.streaming.quadtree, &|n| self.bounds.bounds(n))?;
-        let plan = self.cache.plan_frame(frame, &needed, self.streaming.budget);
+        let (needed, coarsening) = self.select(views)?;
+        let mut budget = self.streaming.budget;
+        if self.paced {
+            if let Some(cap) = self.pacer.texel_cap(budget.gpu_time) {
+                budget.texels = budget.texels.min(cap);
+            }
+        }
+        let plan = self.cache.plan_frame(frame, &needed, budget);
         let table = PageTable::build(&plan, extent)?;
         let storage = &self.storage;
         let (jobs, texels) = tile_jobs(&plan, extent, &|t| storage[t as usize]);
@@ -322,7 +366,34 @@ impl TextureAtlas {
                 jobs.len()
             )));
         }
-        Ok((plan, table, jobs, texels))
+        Ok(PlannedFrame {
+            plan,
+            table,
+            jobs,
+            texels,
+            coarsening,
+            texel_cap: budget.texels,
+        })
+    }
+}
+
+/// A frame's plan, before its uploads.
+struct PlannedFrame {
+    plan: TilePlan,
+    table: PageTable,
+    jobs: Vec<TileJob>,
+    texels: u64,
+    coarsening: Coarsening,
+    texel_cap: u64,
+}
+
+/// What the quadtree measures of a view.
+fn quadtree_view(view: &crate::view::View) -> View {
+    let camera = &view.camera;
+    View {
+        eye: camera.eye,
+        pixel_footprint: View::pixel_footprint_for(camera.fov_y_deg.to_radians(), view.height),
+        frustum: Some(frustum_planes(camera.view_proj_f64(view.aspect()))),
     }
 }
 
@@ -333,204 +404,59 @@ impl Technique for TextureAtlas {
         "texturing"
     }
 
-    /// Plans the frame (module documentation, step 1) and uploads its jobs
-    /// and page table. A frame whose plan cannot be generated forgets the
+    /// Plans the frame for all its views (1 to [`MAX_VIEWS`]; module
+    /// documentation, step 1) and uploads its jobs and the page table every
+    /// view samples. A frame whose plan cannot be generated forgets the
     /// cache, so that no tile stays marked resident without being generated.
     fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<TextureFrame> {
         let start = std::time::Instant::now();
-        let [view] = frame.views else {
+        if !(1..=MAX_VIEWS).contains(&frame.views.len()) {
             return Err(Error::invalid(
                 "views",
-                format!("the texture atlas serves one view per frame, not {}", frame.views.len()),
+                format!(
+                    "{}; the texture atlas serves 1..={MAX_VIEWS} views per frame",
+                    frame.views.len()
+                ),
             ));
-        };
-        let camera = &view.camera;
-        let quadtree_view = View {
-            eye: camera.eye,
-            pixel_footprint: view.pixel_angle(),
-            frustum: Some(frustum_planes(view.view_proj_f64())),
-        };
-        let planned = self
-            .plan(frame.index, &quadtree_view)
-            .and_then(|(plan, table, jobs, texels)| {
-                let words = table.words();
-                if words.len() > PAGE_TABLE_WORDS {
-                    return Err(Error::invalid(
-                        "texture page table",
-                        format!("{} words exceed the capacity of {PAGE_TABLE_WORDS}", words.len()),
-                    ));
-                }
-                frame.uploads.write(self.jobs, bytemuck::cast_slice(&jobs))?;
-                frame
-                    .uploads
-                    .write(self.bindings.page_table, bytemuck::cast_slice(&words))?;
-                Ok((plan, table, jobs.len() as u32, texels))
-            });
-        let (plan, table, jobs, texels) = match planned {
+        }
+        let views: Vec<View> = frame.views.iter().map(quadtree_view).collect();
+        let planned = self.plan(frame.index, &views).and_then(|p| {
+            let words = p.table.words();
+            if words.len() > PAGE_TABLE_WORDS {
+                return Err(Error::invalid(
+                    "texture page table",
+                    format!("{} words exceed the capacity of {PAGE_TABLE_WORDS}", words.len()),
+                ));
+            }
+            frame.uploads.write(self.jobs, bytemuck::cast_slice(&p.jobs))?;
+            frame
+                .uploads
+                .write(self.bindings.page_table, bytemuck::cast_slice(&words))?;
+            Ok(p)
+        });
+        let p = match planned {
             Ok(p) => p,
             Err(e) => {
                 self.cache.clear();
                 return Err(e);
             }
         };
-        self.table = table;
+        self.pacer.record(frame.index, p.texels);
+        self.table = p.table;
         self.stats.push(TextureFrameStats {
             frame: frame.index,
-            tiles: plan.stats,
-            hit_rate: plan.stats.hit_rate(),
-            texels_generated: texels,
+            tiles: p.plan.stats,
+            hit_rate: p.plan.stats.hit_rate(),
+            texels_generated: p.texels,
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
+            coarsened: p.coarsening.halved + p.coarsening.merged,
+            texel_cap: p.texel_cap,
         });
-        Ok(TextureFrame { jobs, texels })
+        Ok(TextureFrame {
+            jobs: p.jobs.len() as u32,
+            texels: p.texels,
+        })
     }
-}
-
-/// The push constants every generation pass starts from.
-fn base_push(field: &HeightField) -> TileGenerationPush {
-    let (lo, hi) = field.min_max();
-    let extent = field.extent();
-    TileGenerationPush {
-        handles: [0; 4],
-        counts: [0; 4],
-        grid: [field.columns, field.rows, 0, 0],
-        spacing_range: [field.spacing.x as f32, field.spacing.y as f32, lo, hi],
-        maps: [0; 4],
-        extent: [extent.x as f32, extent.y as f32, 0.0, 0.0],
-    }
-}
-
-/// The resources every generation pass shares.
-struct GenerationPasses {
-    jobs: UploadRegion,
-    scratch: BufferId,
-    base_push: TileGenerationPush,
-}
-
-impl GenerationPasses {
-    /// `texturing.upsample`: the base surface at every dirty texel.
-    fn declare_upsample(&self, ctx: &Context, graph: &mut RenderGraph<Frame>, heights: ImageId) -> Result<()> {
-        let pipeline = ComputePipeline::new(ctx, shaders::TEXTURING_UPSAMPLE)?;
-        let (jobs, scratch, base_push) = (self.jobs, self.scratch, self.base_push);
-        graph
-            .pass("texturing.upsample")
-            .read(heights, ImageAccess::Sampled(Stage::Compute))
-            .read(jobs, BufferAccess::StorageRead(Stage::Compute))
-            .write(scratch, BufferAccess::StorageWrite(Stage::Compute))
-            .record(move |pass, frame| {
-                let tiles = frame.prepared::<TextureFrame>()?;
-                let push = TileGenerationPush {
-                    handles: [pass.upload(jobs)?, pass.storage_buffer(scratch)?, 0, 0],
-                    counts: [tiles.jobs, tiles.texels as u32, 0, pass.sampled(heights)?],
-                    ..base_push
-                };
-                dispatch(pass.cmd(), &pipeline, &push)
-            });
-        Ok(())
-    }
-
-    /// `texturing.layer<i>.<name>`: one layer over every dirty texel.
-    fn declare_layers(&self, ctx: &Context, graph: &mut RenderGraph<Frame>, inputs: &GenerationInputs) -> Result<()> {
-        let layer_pipeline = Arc::new(ComputePipeline::new(ctx, shaders::TEXTURING_LAYER)?);
-        let (jobs, scratch, base_push) = (self.jobs, self.scratch, self.base_push);
-        let (layers, noise, maps) = (inputs.layers, inputs.noise, inputs.maps);
-        for (i, flat) in inputs.tree.layers.iter().enumerate() {
-            let name = format!(
-                "texturing.layer{i}.{}",
-                flat.layer.name.replace(char::is_whitespace, "_")
-            );
-            let pipeline = layer_pipeline.clone();
-            let mut pass = graph
-                .pass(&name)
-                .read(jobs, BufferAccess::StorageRead(Stage::Compute))
-                .read(layers, BufferAccess::StorageRead(Stage::Compute))
-                .read(noise, ImageAccess::Sampled(Stage::Compute));
-            for map in maps.present() {
-                pass = pass.read(map, ImageAccess::Sampled(Stage::Compute));
-            }
-            pass.write(scratch, BufferAccess::StorageReadWrite(Stage::Compute))
-                .record(move |pass, frame| {
-                    let tiles = frame.prepared::<TextureFrame>()?;
-                    let push = TileGenerationPush {
-                        handles: [
-                            pass.upload(jobs)?,
-                            pass.storage_buffer(scratch)?,
-                            pass.storage_buffer(layers)?,
-                            pass.sampled(noise)?,
-                        ],
-                        counts: [tiles.jobs, tiles.texels as u32, i as u32, 0],
-                        maps: maps.handles(),
-                        ..base_push
-                    };
-                    dispatch(pass.cmd(), &pipeline, &push)
-                });
-        }
-        Ok(())
-    }
-
-    /// `texturing.finish`: colour and normal into the atlas.
-    fn declare_finish(&self, ctx: &Context, graph: &mut RenderGraph<Frame>, images: &[ImageId]) -> Result<()> {
-        let pipeline = ComputePipeline::new(ctx, shaders::TEXTURING_FINISH)?;
-        let (jobs, scratch, base_push) = (self.jobs, self.scratch, self.base_push);
-        let mut pass = graph
-            .pass("texturing.finish")
-            .read(jobs, BufferAccess::StorageRead(Stage::Compute))
-            .read(scratch, BufferAccess::StorageRead(Stage::Compute));
-        for &image in images {
-            pass = pass.write(image, ImageAccess::StorageReadWrite(Stage::Compute));
-        }
-        pass.record(move |pass, frame| {
-            let tiles = frame.prepared::<TextureFrame>()?;
-            let push = TileGenerationPush {
-                handles: [pass.upload(jobs)?, pass.storage_buffer(scratch)?, 0, 0],
-                counts: [tiles.jobs, tiles.texels as u32, 0, 0],
-                ..base_push
-            };
-            dispatch(pass.cmd(), &pipeline, &push)
-        });
-        Ok(())
-    }
-}
-
-/// `texturing.readback`: every colour texture into host buffers.
-fn add_atlas_readback(
-    ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
-    colors: &[(ImageId, u32)],
-    atlas_size: u32,
-) -> Result<Vec<Vec<Arc<Buffer>>>> {
-    let mut copies = Vec::new();
-    let mut buffers = Vec::new();
-    for (k, &(image, _)) in colors.iter().enumerate() {
-        let per_frame = Buffer::per_frame(
-            ctx,
-            BufferDesc {
-                name: format!("texture atlas {k} readback"),
-                size: u64::from(atlas_size).pow(2) * 4,
-                usage: BufferUsageFlags::TRANSFER_DST,
-                location: MemoryLocation::GpuToCpu,
-            },
-        )?;
-        copies.push((image, graph.import_buffers_per_frame(per_frame.clone())));
-        buffers.push(per_frame);
-    }
-    graph.read_back_images("texturing.readback", copies);
-    Ok(buffers)
-}
-
-/// One thread per dirty texel; nothing when no tile is dirty.
-fn dispatch(
-    cmd: &mut crate::vulkan::CommandRecorder,
-    pipeline: &ComputePipeline,
-    push: &TileGenerationPush,
-) -> Result<()> {
-    let groups = u64::from(push.counts[1]).div_ceil(GROUP);
-    if groups == 0 {
-        return Ok(());
-    }
-    cmd.bind_compute(pipeline);
-    cmd.push_constants(push)?;
-    cmd.dispatch(groups as u32, 1, 1);
-    Ok(())
 }
 
 #[cfg(test)]

@@ -7,23 +7,32 @@
 //!   functions and coverage, the CPU reference evaluation;
 //! * [`input_maps`]: rainfall, radiation and temperature maps registered
 //!   to the height field;
-//! * [`quadtree`]: per frame, the nodes the view needs and their tile sizes;
+//! * [`quadtree`]: per frame, the nodes the views need and their tile
+//!   sizes, one partition for all views; [`bounds`]: the height field's
+//!   per-node bounds it measures;
+//! * [`fit`]: the selection coarsened until it fits the atlas;
 //! * [`atlas`]: tile slots in the atlases, least-recently-used eviction, the
 //!   per-frame generation plan under a cap;
-//! * [`generation`]: the GPU passes that evaluate the tree into the dirty
-//!   tiles of a frame, all at once, one pass per layer;
+//! * [`pacing`]: the GPU time budget, from the measured cost per texel;
+//! * [`generation`]: the technique: the frame's plan, and the GPU passes that
+//!   evaluate the tree into the dirty tiles of a frame, all at once, one
+//!   pass per layer (declared by `passes.rs`);
 //! * [`page_table`]: the per-frame indirection the terrain shading reads;
 //! * [`streaming`]: quadtree, atlas and budget settings, sized from the
-//!   output image;
+//!   frame's views;
 //! * [`stats`]: streaming statistics per frame and over a run;
 //! * [`reference`]: the CPU twin of the shaders' evaluation, for tests.
 
 pub mod atlas;
+pub mod bounds;
+pub mod fit;
 pub mod generation;
 pub mod gpu_layout;
 pub mod input_maps;
 pub mod layers;
+pub mod pacing;
 pub mod page_table;
+mod passes;
 pub mod quadtree;
 pub mod reference;
 pub mod stats;

@@ -114,6 +114,22 @@ impl PageTable {
         Ok(table)
     }
 
+    /// Words of the table of a plan drawing `needed` nodes (with a root
+    /// tile): the header, one per inner node (every proper ancestor of a
+    /// needed node), two per entry.
+    pub fn words_for(needed: impl Iterator<Item = NodeId>) -> usize {
+        let mut inner = std::collections::HashSet::new();
+        let mut entries = 1;
+        for node in needed {
+            entries += 1;
+            let mut up = node.parent();
+            while let Some(n) = up.filter(|n| inner.insert(*n)) {
+                up = n.parent();
+            }
+        }
+        1 + inner.len() + 2 * entries
+    }
+
     fn insert(&mut self, d: &DrawTile, extent: DVec2, border: u32) -> Result<()> {
         let node = d.needed;
         let side = 1u64.checked_shl(node.level).unwrap_or(0);
@@ -254,6 +270,7 @@ mod tests {
         let plan = cache.plan_frame(1, &[tile(1, 0, 0, 32), tile(1, 1, 1, 32)], 10);
         let table = PageTable::build(&plan, EXTENT).unwrap();
         let words = table.words();
+        assert_eq!(PageTable::words_for(plan.draw.iter().map(|d| d.needed)), words.len());
         assert_eq!(words[0], [0, LEAF, 2, 1]);
         assert_eq!(words[1], [LEAF | 1, NONE, NONE, LEAF | 2]);
         assert_eq!(words.len(), 2 + 2 * 3);

@@ -33,6 +33,9 @@
 //! The leaves partition the visible part of the rectangle exactly (no
 //! overlaps, no gaps except culled nodes) and are returned coarse to fine,
 //! then nearest first, then by node id, so the order is deterministic.
+//! Several views of one frame select together
+//! ([`select_tiles_for_views`]): one partition of everything any of them
+//! sees, each node as fine as the view that needs it finest.
 //!
 //! [`HeightBounds`] supplies the bounds from a height field: a min/max
 //! pyramid built once, with `geometric_error = (z_max − z_min)/2`.
@@ -40,7 +43,7 @@
 use glam::{DVec2, DVec3, DVec4};
 
 use crate::error::{Error, Result};
-use crate::io::heightmap::HeightField;
+pub use crate::texturing::bounds::HeightBounds;
 
 /// Smallest eye-to-node distance in metres, so nodes around the eye need a
 /// finite number of texels.
@@ -207,21 +210,21 @@ pub struct NodeBounds {
     pub geometric_error: f32,
 }
 
-/// The leaves the view needs, by the rules in the module documentation.
-/// Errors on invalid settings, a non-finite or non-positive extent, a bad
-/// view, or bounds that are not finite with `z_min ≤ z_max` and
-/// `geometric_error ≥ 0`.
+/// The leaves the view needs, by the rules in the module documentation:
+/// [`select_tiles_for_views`] of one view.
 pub fn select_tiles(
     extent: DVec2,
     view: &View,
     settings: &QuadtreeSettings,
     bounds: &dyn Fn(NodeId) -> NodeBounds,
 ) -> Result<Vec<NeededTile>> {
-    settings.validate()?;
+    select_tiles_for_views(extent, std::slice::from_ref(view), settings, bounds)
+}
+
+/// Checks a view: finite eye, finite positive footprint, finite planes.
+fn check_view(view: &View) -> Result<()> {
     let footprint = view.pixel_footprint;
-    let why = if !(extent.is_finite() && extent.x > 0.0 && extent.y > 0.0) {
-        format!("extent {extent} must be finite and positive")
-    } else if !(view.eye.is_finite() && footprint.is_finite() && footprint > 0.0) {
+    let why = if !(view.eye.is_finite() && footprint.is_finite() && footprint > 0.0) {
         format!(
             "eye {} and pixel footprint {footprint} must be finite (footprint > 0)",
             view.eye
@@ -229,15 +232,50 @@ pub fn select_tiles(
     } else if view.frustum.is_some_and(|planes| planes.iter().any(|p| !p.is_finite())) {
         "frustum planes must be finite".to_string()
     } else {
-        String::new()
+        return Ok(());
     };
-    if !why.is_empty() {
-        return Err(Error::invalid("texture view", why));
+    Err(Error::invalid("texture view", why))
+}
+
+/// How one view measures a node it sees: distance to its box, texels it
+/// needs across, its geometric error in pixels.
+struct Measure {
+    distance: f64,
+    needed: f64,
+    error_pixels: f64,
+}
+
+/// The leaves several views of one frame need together (rules 1–4 of the
+/// module documentation, applied to all views at once): a node is culled
+/// when every view culls it, split when any view that sees it would split
+/// it, and a leaf gets the largest size any of those views needs and the
+/// smallest distance. So the leaves partition the union of the visible
+/// parts exactly, the finest need wins where views overlap, and no node is
+/// selected twice. Errors on an empty `views`, invalid settings, a
+/// non-finite or non-positive extent, a bad view, or bounds that are not
+/// finite with `z_min ≤ z_max` and `geometric_error ≥ 0`.
+pub fn select_tiles_for_views(
+    extent: DVec2,
+    views: &[View],
+    settings: &QuadtreeSettings,
+    bounds: &dyn Fn(NodeId) -> NodeBounds,
+) -> Result<Vec<NeededTile>> {
+    settings.validate()?;
+    if !(extent.is_finite() && extent.x > 0.0 && extent.y > 0.0) {
+        return Err(Error::invalid(
+            "texture view",
+            format!("extent {extent} must be finite and positive"),
+        ));
     }
+    if views.is_empty() {
+        return Err(Error::invalid("texture view", "no view to select tiles for"));
+    }
+    views.iter().try_for_each(check_view)?;
     let upper = settings.upper_tile();
     let border2 = 2.0 * f64::from(settings.border);
     let mut leaves = Vec::new();
     let mut stack = vec![NodeId::ROOT];
+    let mut seen: Vec<Measure> = Vec::with_capacity(views.len());
     while let Some(node) = stack.pop() {
         let b = bounds(node);
         let error_ok = b.geometric_error.is_finite() && b.geometric_error >= 0.0;
@@ -250,25 +288,43 @@ pub fn select_tiles(
         let (lo, hi) = node.rect(extent);
         let box_min = lo.extend(f64::from(b.z_min));
         let box_max = hi.extend(f64::from(b.z_max));
-        let outside = |p: &DVec4| box_outside(p, box_min, box_max);
-        if view.frustum.is_some_and(|planes| planes.iter().any(outside)) {
+        seen.clear();
+        for view in views {
+            let outside = |p: &DVec4| box_outside(p, box_min, box_max);
+            if view.frustum.is_some_and(|planes| planes.iter().any(outside)) {
+                continue;
+            }
+            let distance = view.eye.clamp(box_min, box_max).distance(view.eye).max(MIN_DISTANCE);
+            let per_metre = 1.0 / (view.pixel_footprint * distance);
+            seen.push(Measure {
+                distance,
+                needed: (hi - lo).max_element() * per_metre,
+                error_pixels: f64::from(b.geometric_error) * per_metre,
+            });
+        }
+        if seen.is_empty() {
             continue;
         }
-        let distance = view.eye.clamp(box_min, box_max).distance(view.eye).max(MIN_DISTANCE);
-        let per_metre = 1.0 / (footprint * distance);
-        let needed = (hi - lo).max_element() * per_metre;
-        let error_pixels = f64::from(b.geometric_error) * per_metre;
-        let coarse =
-            needed + border2 > f64::from(settings.aim_texels) || error_pixels > f64::from(settings.pixel_error);
+        let coarse = seen.iter().any(|m| {
+            m.needed + border2 > f64::from(settings.aim_texels) || m.error_pixels > f64::from(settings.pixel_error)
+        });
         if node.level < settings.max_depth && coarse {
             stack.extend(node.children());
             continue;
         }
         let at_max_depth = node.level == settings.max_depth;
         let largest = if at_max_depth { settings.max_tile } else { upper };
-        let want = needed.ceil() + border2;
         let fit = |w: f64| (w as u32).next_power_of_two().clamp(settings.min_tile, largest);
-        let size = if want >= f64::from(largest) { largest } else { fit(want) };
+        let size_for = |m: &Measure| {
+            let want = m.needed.ceil() + border2;
+            if want >= f64::from(largest) {
+                largest
+            } else {
+                fit(want)
+            }
+        };
+        let size = seen.iter().map(size_for).max().unwrap_or(settings.min_tile);
+        let distance = seen.iter().map(|m| m.distance).fold(f64::INFINITY, f64::min);
         leaves.push(NeededTile { node, size, distance });
     }
     leaves.sort_by(|a, b| {
@@ -286,117 +342,10 @@ fn box_outside(plane: &DVec4, min: DVec3, max: DVec3) -> bool {
     n.dot(farthest) + plane.w < 0.0
 }
 
-/// Per-node height bounds of a height field: a min/max pyramid built once
-/// down to `min(max_depth, MAX_PYRAMID_DEPTH)`; deeper nodes are measured
-/// from the samples. A node covers the samples whose positions lie in its
-/// closed rectangle, widened to the enclosing sample cells (so edge samples
-/// count for both neighbours). `geometric_error = (z_max − z_min)/2`: the
-/// largest deviation of the node's mid-height plane from its samples. This
-/// upper bound is very conservative: on rough terrain with `pixel_error = 1`
-/// it refines most visible nodes down to `max_depth`. Callers whose terrain
-/// mesh knows its own per-node error should pass that instead, or set the
-/// error to 0 to refine by texel density alone.
-#[derive(Clone, Debug)]
-pub struct HeightBounds {
-    columns: u32,
-    rows: u32,
-    heights: Vec<f32>,
-    /// `pyramid[l][y·2^l + x]` = (z_min, z_max) of node (l, x, y).
-    pyramid: Vec<Vec<(f32, f32)>>,
-}
-
-impl HeightBounds {
-    /// Builds the pyramid; errors on a height field that fails
-    /// [`HeightField::validate`] or `max_depth > 15`.
-    pub fn new(field: &HeightField, max_depth: u32) -> Result<HeightBounds> {
-        field.validate(std::path::Path::new("height field for texture bounds"))?;
-        if max_depth > 15 {
-            return Err(Error::invalid(
-                "texture bounds depth",
-                format!("{max_depth} exceeds 15"),
-            ));
-        }
-        let mut bounds = HeightBounds {
-            columns: field.columns,
-            rows: field.rows,
-            heights: field.heights.clone(),
-            pyramid: Vec::new(),
-        };
-        let depth = max_depth.min(MAX_PYRAMID_DEPTH);
-        let n = 1u32 << depth;
-        let mut level: Vec<(f32, f32)> = Vec::with_capacity((n as usize).pow(2));
-        for y in 0..n {
-            for x in 0..n {
-                level.push(bounds.sample_range(NodeId { level: depth, x, y }));
-            }
-        }
-        let mut levels = vec![level];
-        for l in (0..depth).rev() {
-            let (fine, n) = (&levels[levels.len() - 1], 1usize << l);
-            let mut coarse = Vec::with_capacity(n * n);
-            for y in 0..n {
-                for x in 0..n {
-                    let at = |dx: usize, dy: usize| fine[(2 * y + dy) * 2 * n + 2 * x + dx];
-                    let kids = [at(0, 0), at(1, 0), at(0, 1), at(1, 1)];
-                    coarse.push(
-                        kids.iter()
-                            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &(a, b)| {
-                                (lo.min(a), hi.max(b))
-                            }),
-                    );
-                }
-            }
-            levels.push(coarse);
-        }
-        levels.reverse();
-        bounds.pyramid = levels;
-        Ok(bounds)
-    }
-
-    /// The bounds of `node`; nodes outside the tree are clamped to its edge.
-    pub fn bounds(&self, node: NodeId) -> NodeBounds {
-        let side = 1u64.checked_shl(node.level).unwrap_or(0);
-        let pyramid = self.pyramid.get(node.level as usize);
-        let inside = u64::from(node.x) < side && u64::from(node.y) < side;
-        let (z_min, z_max) = match pyramid {
-            Some(level) if inside => level[(u64::from(node.y) * side + u64::from(node.x)) as usize],
-            _ => self.sample_range(node),
-        };
-        NodeBounds {
-            z_min,
-            z_max,
-            geometric_error: (z_max - z_min) / 2.0,
-        }
-    }
-
-    /// (z_min, z_max) over the samples `node` covers.
-    fn sample_range(&self, node: NodeId) -> (f32, f32) {
-        let (c0, c1) = sample_span(node.x, node.level, self.columns);
-        let (r0, r1) = sample_span(node.y, node.level, self.rows);
-        let mut range = (f32::INFINITY, f32::NEG_INFINITY);
-        for r in r0..=r1 {
-            let row = &self.heights[r as usize * self.columns as usize..][..self.columns as usize];
-            for &h in &row[c0 as usize..=c1 as usize] {
-                range = (range.0.min(h), range.1.max(h));
-            }
-        }
-        range
-    }
-}
-
-/// First and last sample index (of `samples` ≥ 2) covered by node index `i`
-/// at `level`: `floor(i·cells/2^level) ..= ceil((i+1)·cells/2^level)`.
-fn sample_span(i: u32, level: u32, samples: u32) -> (u32, u32) {
-    let cells = u128::from(samples - 1);
-    let shift = level.min(64);
-    let last = u128::from(samples - 1);
-    let lo = (u128::from(i) * cells) >> shift;
-    let hi = ((u128::from(i) + 1) * cells).div_ceil(1u128 << shift);
-    (lo.min(last) as u32, hi.min(last) as u32)
-}
-
 #[cfg(test)]
 mod tests {
+    use std::collections::HashSet;
+
     use super::*;
 
     const EXTENT: DVec2 = DVec2::new(8000.0, 4000.0);
@@ -498,6 +447,96 @@ mod tests {
         assert!(culled.iter().all(|t| t.node.rect(EXTENT).1.x >= eye.x));
     }
 
+    /// Texel density (texels per metre) of the leaf over each cell of the
+    /// finest grid (`max_depth` 10), None where no leaf is; panics where
+    /// leaves overlap.
+    fn density_map(tiles: &[NeededTile]) -> Vec<Option<f64>> {
+        const GRID: u32 = 10;
+        let n = 1u32 << GRID;
+        let mut cover = vec![None; (n * n) as usize];
+        for t in tiles {
+            let k = n >> t.node.level;
+            let density = f64::from(t.size - 8) / (EXTENT.x / f64::from(1u32 << t.node.level));
+            for y in t.node.y * k..(t.node.y + 1) * k {
+                for x in t.node.x * k..(t.node.x + 1) * k {
+                    let cell = &mut cover[(y * n + x) as usize];
+                    assert!(cell.is_none(), "{t:?} overlaps another leaf");
+                    *cell = Some(density);
+                }
+            }
+        }
+        cover
+    }
+
+    #[test]
+    fn views_looking_apart_get_the_union_finest_first() {
+        let eye = DVec3::new(4000.0, 2000.0, 50.0);
+        let keep = DVec4::new(0.0, 0.0, 0.0, 1.0);
+        let facing = |sign: f64| View {
+            frustum: Some([DVec4::new(sign, 0.0, 0.0, -sign * eye.x), keep, keep, keep, keep, keep]),
+            ..view(eye)
+        };
+        // East looks from the eye, west from 500 m west of it: different needs.
+        let (east, west) = (
+            facing(1.0),
+            View {
+                eye: eye - DVec3::new(500.0, 0.0, 0.0),
+                ..facing(-1.0)
+            },
+        );
+        let s = QuadtreeSettings::default();
+        let one = |v: &View| select_tiles(EXTENT, v, &s, &flat).unwrap();
+        let (a, b) = (density_map(&one(&east)), density_map(&one(&west)));
+        let both = select_tiles_for_views(EXTENT, &[east, west], &s, &flat).unwrap();
+        let union = density_map(&both);
+        let keys: HashSet<NodeId> = both.iter().map(|t| t.node).collect();
+        assert_eq!(keys.len(), both.len(), "a node selected twice");
+        let (mut only_a, mut only_b) = (0, 0);
+        for ((u, a), b) in union.iter().zip(&a).zip(&b) {
+            assert_eq!(u.is_some(), a.is_some() || b.is_some(), "cover is not the union");
+            only_a += usize::from(a.is_some() && b.is_none());
+            only_b += usize::from(b.is_some() && a.is_none());
+        }
+        assert!(
+            only_a > 0 && only_b > 0,
+            "the views must each see something the other does not"
+        );
+        // Every leaf has the texels each view that sees it needs (rule 2),
+        // unless clamped to the largest size.
+        for t in &both {
+            let (lo, hi) = t.node.rect(EXTENT);
+            let (min, max) = (lo.extend(0.0), hi.extend(100.0));
+            for v in [&east, &west] {
+                if v.frustum.unwrap().iter().any(|p| box_outside(p, min, max)) {
+                    continue;
+                }
+                let distance = v.eye.clamp(min, max).distance(v.eye).max(MIN_DISTANCE);
+                let needed = (hi - lo).max_element() / (v.pixel_footprint * distance);
+                let inner = f64::from(t.size - 2 * s.border);
+                assert!(inner >= needed || t.size == s.max_tile, "{t:?}: {needed} texels needed");
+            }
+        }
+        assert!(both.len() > one(&east).len().max(one(&west).len()));
+    }
+
+    #[test]
+    fn overlapping_views_do_not_duplicate_tiles() {
+        let s = QuadtreeSettings::default();
+        let v = view(DVec3::new(1000.0, 1000.0, 300.0));
+        let single = select_tiles(EXTENT, &v, &s, &flat).unwrap();
+        let twice = select_tiles_for_views(EXTENT, &[v, v], &s, &flat).unwrap();
+        assert_eq!(single, twice);
+        // A view a little to the side shares most of the tiles.
+        let near = View {
+            eye: v.eye + DVec3::new(50.0, 0.0, 0.0),
+            ..v
+        };
+        let pair = select_tiles_for_views(EXTENT, &[v, near], &s, &flat).unwrap();
+        density_map(&pair);
+        assert!(pair.len() < single.len() * 3 / 2, "{} vs {}", pair.len(), single.len());
+        assert!(select_tiles_for_views(EXTENT, &[], &s, &flat).is_err());
+    }
+
     #[test]
     fn invalid_settings_and_inputs_are_errors() {
         let d = QuadtreeSettings::default();
@@ -539,47 +578,5 @@ mod tests {
         assert!(NodeId::ROOT.contains(&n) && n.contains(&n) && !n.contains(&NodeId::ROOT));
         assert!(!NodeId { level: 2, x: 1, y: 1 }.contains(&n));
         assert_eq!(n.rect(EXTENT), (DVec2::new(5000.0, 1000.0), DVec2::new(6000.0, 1500.0)));
-    }
-
-    #[test]
-    fn height_bounds_match_brute_force() {
-        let (columns, rows) = (13u32, 9u32);
-        let heights: Vec<f32> = (0..columns * rows).map(|i| ((i * 37) % 101) as f32).collect();
-        let field = HeightField {
-            columns,
-            rows,
-            spacing: DVec2::new(10.0, 20.0),
-            heights,
-        };
-        let hb = HeightBounds::new(&field, 4).unwrap();
-        for level in 0..=5 {
-            for y in 0..1 << level {
-                for x in 0..1 << level {
-                    let node = NodeId { level, x, y };
-                    let (lo, hi) = node.rect(field.extent());
-                    let mut want = (f32::INFINITY, f32::NEG_INFINITY);
-                    for r in 0..rows {
-                        for c in 0..columns {
-                            let p = DVec2::new(f64::from(c) * 10.0, f64::from(r) * 20.0);
-                            // Samples in the rectangle widened to whole cells.
-                            let cell = DVec2::new(10.0, 20.0);
-                            let (a, b) = ((lo / cell).floor() * cell, (hi / cell).ceil() * cell);
-                            if p.cmpge(a).all() && p.cmple(b).all() {
-                                let h = field.height(c, r);
-                                want = (want.0.min(h), want.1.max(h));
-                            }
-                        }
-                    }
-                    let got = hb.bounds(node);
-                    assert_eq!((got.z_min, got.z_max), want, "{node:?}");
-                    assert_eq!(got.geometric_error, (want.1 - want.0) / 2.0);
-                }
-            }
-        }
-        let bad = HeightField {
-            heights: vec![0.0; 3],
-            ..field
-        };
-        assert!(HeightBounds::new(&bad, 4).is_err());
     }
 }

@@ -21,6 +21,13 @@ pub struct TextureFrameStats {
     pub texels_generated: u64,
     /// CPU time of selection, planning and the page table, milliseconds.
     pub cpu_ms: f64,
+    /// Coarsenings the selection took to fit the atlas (halved tile sizes
+    /// and leaves merged into parents, `crate::texturing::fit`): 0 when
+    /// every view got the texels it needs.
+    pub coarsened: usize,
+    /// The frame's texel cap: the budget's, or lower where its GPU time
+    /// allowed fewer (`crate::texturing::pacing`).
+    pub texel_cap: u64,
 }
 
 /// Texture streaming over a run of frames.
@@ -40,6 +47,8 @@ pub struct TextureSummary {
     pub evicted: usize,
     /// Frames that drew some tile from a coarser one.
     pub frames_deferred: usize,
+    /// Frames whose selection was coarsened to fit the atlas.
+    pub frames_coarsened: usize,
     pub median_visible: f64,
     /// GPU time of the `texturing.*` passes per frame: min, median, max (ms).
     pub generation_gpu_ms: [f64; 3],
@@ -113,6 +122,7 @@ impl TextureSummary {
             generated: stats.iter().map(|s| s.tiles.generated).sum(),
             evicted: stats.iter().map(|s| s.tiles.evicted).sum(),
             frames_deferred: stats.iter().filter(|s| s.tiles.deferred > 0).count(),
+            frames_coarsened: stats.iter().filter(|s| s.coarsened > 0).count(),
             median_visible: median(stats.iter().map(|s| s.tiles.visible as f64)),
             generation_gpu_ms: match times.is_empty() {
                 true => [0.0; 3],
@@ -149,8 +159,12 @@ impl TextureSummary {
             0 => String::new(),
             _ => format!(", {:.3} ms per tile", self.gpu_ms_per_tile),
         };
+        let coarsened = match self.frames_coarsened {
+            0 => String::new(),
+            n => format!(", {n} frames coarsened to fit the atlas"),
+        };
         format!(
-            "textures: hit rate {:.4}{steady} over {} frames, {:.0} tiles visible (median), {} generated (at most {} per frame), {} evicted, {} frames with deferred tiles; generation GPU min {lo:.3} median {med:.3} max {hi:.3} ms/frame{per_tile}",
+            "textures: hit rate {:.4}{steady} over {} frames, {:.0} tiles visible (median), {} generated (at most {} per frame), {} evicted, {} frames with deferred tiles{coarsened}; generation GPU min {lo:.3} median {med:.3} max {hi:.3} ms/frame{per_tile}",
             self.hit_rate, self.frames, self.median_visible, self.generated, self.max_generated, self.evicted, self.frames_deferred
         )
     }

@@ -87,6 +87,7 @@ pub fn mean_flip(reference_rgba: &[u8], test_rgba: &[u8], width: u32, height: u3
     let mean = nv_flip::FlipPool::from_image(&error).mean();
     (mean, heatmap)
 }
+pub mod atlas;
 #[cfg(feature = "cli")]
 pub mod cli;
 pub mod points;
