@@ -1,5 +1,6 @@
-//! `alpenglow fly`: a camera path rendered to a PNG sequence with a
-//! progress bar, and the per-frame times. The vertex count of the warped
+//! `alpenglow fly`: a camera path rendered to a PNG sequence (and with
+//! `--exr` an EXR sequence with every channel, motion relative to the
+//! path's previous frame) with a progress bar, and the per-frame times. The vertex count of the warped
 //! terrain is constant (§7.4), so frame times should barely vary.
 //!
 //! Frames go into a temporary sibling of the output directory, renamed into
@@ -58,8 +59,8 @@ impl Drop for StagingGuard {
     }
 }
 
-fn frame_path(dir: &Path, index: usize) -> PathBuf {
-    dir.join(format!("frame_{index:05}.png"))
+fn frame_path(dir: &Path, index: usize, extension: &str) -> PathBuf {
+    dir.join(format!("frame_{index:05}.{extension}"))
 }
 
 fn stats(values: &[f64]) -> (f64, f64, f64) {
@@ -117,7 +118,15 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
         );
         let write = |images: &FrameImages, index: usize| -> Result<()> {
             if let Some(dir) = &staging {
-                write_png_rgba8(&frame_path(dir, index), &images.rgba8, images.width, images.height)?;
+                write_png_rgba8(
+                    &frame_path(dir, index, "png"),
+                    &images.rgba8,
+                    images.width,
+                    images.height,
+                )?;
+                if args.exr {
+                    super::exr::write_frame_exr(&frame_path(dir, index, "exr"), images)?;
+                }
             }
             Ok(())
         };

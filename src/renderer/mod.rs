@@ -12,8 +12,10 @@
 //! §8.2) → `terrain.draw` (graphics, reads the vertex buffer) → the points
 //! passes (`points.visibility` → `points.accumulate` → `points.normalize`
 //! for EWA splats, or `points.opaque`; see [`crate::points::render`]) →
-//! `tonemap` (compute) → `readback` (transfer).
+//! `aovs` (full screen: distance and motion from view depth,
+//! [`crate::post::aovs`]) → `tonemap` (compute) → `readback` (transfer).
 
+mod aov_readback;
 mod lighting;
 pub mod scene;
 
@@ -23,11 +25,12 @@ pub use crate::view::{validate_size, Camera, MAX_IMAGE_SIDE};
 pub use scene::Scene;
 
 use crate::error::{Error, Result};
-use crate::graph::{BakedGraph, BufferId, FrameOutcome, ImageId, RenderGraph};
+use crate::graph::{BakedGraph, FrameOutcome, RenderGraph};
 use crate::lighting::shadows::ShadowSettings;
 use crate::lighting::sky::Sky;
 use crate::lighting::technique::SceneLighting;
 use crate::points::render::{PointFrameStats, PointRenderer, SplatSettings};
+use crate::post::aovs::Aovs;
 use crate::post::exposure::ExposureMeter;
 use crate::post::tonemap::Tonemap;
 use crate::profile::FrameProfile;
@@ -102,6 +105,20 @@ pub struct FrameImages {
     /// shadow, 1 = lit; the filtered shadow term) and sky visibility (the
     /// ambient-occlusion term, 1 = open sky); (1, 1) for sky pixels.
     pub visibility: Vec<f32>,
+    /// The simulator AOVs (`crate::view::aov`): world-space shading normal,
+    /// 3 floats per pixel (0 for sky).
+    pub normal: Vec<f32>,
+    /// Semantic class per pixel (sky 0, terrain 1 or 10 + its dominant
+    /// surface layer, rock 2, other point objects 3).
+    pub class: Vec<u32>,
+    /// Point instance id per pixel (1-based; 0 for terrain and sky).
+    pub instance: Vec<u32>,
+    /// Motion from the previous frame in pixels, 2 floats per pixel (this
+    /// frame's position minus the previous one's; +x right, +y down; 0 on
+    /// the first frame).
+    pub motion: Vec<f32>,
+    /// Euclidean distance from the eye along the pixel's ray, metres; +inf for sky.
+    pub distance: Vec<f32>,
 }
 
 impl FrameImages {
@@ -117,6 +134,7 @@ struct Readback {
     ldr: Vec<Arc<Buffer>>,
     weight: Option<Vec<Arc<Buffer>>>,
     visibility: Vec<Arc<Buffer>>,
+    aovs: aov_readback::AovReadback,
 }
 
 /// The techniques of a scene, each with its persistent state.
@@ -127,6 +145,7 @@ struct Techniques {
     terrain: Option<Terrain>,
     atlas: Option<TextureAtlas>,
     points: Option<PointRenderer>,
+    aovs: Aovs,
 }
 
 /// Renders one scene, frame after frame. `Send`: a simulator may hand it to
@@ -159,7 +178,9 @@ fn host_buffers(ctx: &Context, name: &str, size: u64) -> Result<Vec<Arc<Buffer>>
 /// Declares `readback`: the view's images into per-frame host buffers.
 fn declare_readback(ctx: &Context, graph: &mut RenderGraph<Frame>, targets: &SceneTargets) -> Result<Readback> {
     let pixels = u64::from(targets.width) * u64::from(targets.height);
+    let mut copies = Vec::new();
     let rb = Readback {
+        aovs: aov_readback::AovReadback::declare(ctx, graph, targets, &mut copies)?,
         hdr: host_buffers(ctx, "hdr", pixels * 16)?,
         depth: host_buffers(ctx, "depth", pixels * 4)?,
         ldr: host_buffers(ctx, "srgb", pixels * 4)?,
@@ -169,7 +190,7 @@ fn declare_readback(ctx: &Context, graph: &mut RenderGraph<Frame>, targets: &Sce
             None => None,
         },
     };
-    let mut copies: Vec<(ImageId, BufferId)> = vec![
+    copies.extend([
         (targets.radiance, graph.import_buffers_per_frame(rb.hdr.clone())),
         (targets.view_depth, graph.import_buffers_per_frame(rb.depth.clone())),
         (targets.display, graph.import_buffers_per_frame(rb.ldr.clone())),
@@ -177,7 +198,7 @@ fn declare_readback(ctx: &Context, graph: &mut RenderGraph<Frame>, targets: &Sce
             targets.visibility,
             graph.import_buffers_per_frame(rb.visibility.clone()),
         ),
-    ];
+    ]);
     if let (Some(image), Some(buffers)) = (targets.weight, &rb.weight) {
         copies.push((image, graph.import_buffers_per_frame(buffers.clone())));
     }
@@ -268,6 +289,8 @@ impl Renderer {
         if let Some(points) = &mut points {
             points.declare(ctx, &mut graph, (0, &view), &targets, !scene.draw_terrain)?;
         }
+        let mut aovs = Aovs::new(ctx, &targets.formats)?;
+        aovs.declare(&mut graph, (0, &view), &targets);
         let exposure = ExposureMeter::new(ctx)?.declare(&mut graph, &view, &targets);
         Tonemap::new(ctx)?.declare(&mut graph, &view, &targets, exposure);
         let readback = match settings.readback {
@@ -292,6 +315,7 @@ impl Renderer {
                 terrain,
                 atlas,
                 points,
+                aovs,
             },
         })
     }
@@ -348,6 +372,7 @@ impl Renderer {
         if let Some(points) = &mut t.points {
             frame.prepare(points, &mut uploads, &mut stages)?;
         }
+        frame.prepare(&mut t.aovs, &mut uploads, &mut stages)?;
         let outcome = self.graph.execute(&mut self.frames, &frame, &stages)?;
         self.frames_rendered = outcome.frame + 1;
         Ok(outcome)
@@ -390,6 +415,7 @@ impl Renderer {
         self.ctx.wait(frame.timeline)?;
         let slot = frame.frame as usize % FRAMES_IN_FLIGHT;
         let floats = |b: &Buffer| -> Result<Vec<f32>> { Ok(bytemuck::pod_collect_to_vec(b.mapped()?)) };
+        let aovs = rb.aovs.read(slot)?;
         Ok(FrameImages {
             width: self.settings.width,
             height: self.settings.height,
@@ -401,6 +427,11 @@ impl Renderer {
                 None => None,
             },
             visibility: floats(&rb.visibility[slot])?,
+            normal: aovs.normal,
+            class: aovs.class,
+            instance: aovs.instance,
+            motion: aovs.motion,
+            distance: aovs.distance,
         })
     }
 

@@ -16,9 +16,11 @@
 //! * [`streaming`]: quadtree, atlas and budget settings, sized from the
 //!   output image;
 //! * [`stats`]: streaming statistics per frame and over a run;
-//! * [`reference`]: the CPU twin of the shaders' evaluation, for tests.
+//! * [`reference`]: the CPU twin of the shaders' evaluation, for tests;
+//! * [`dominant`]: the dominant layer of a point (the class AOV).
 
 pub mod atlas;
+pub mod dominant;
 pub mod generation;
 pub mod gpu_layout;
 pub mod input_maps;
