@@ -312,7 +312,7 @@ pub struct FlyArgs {
     #[arg(long = "out-dir")]
     pub out_dir: Option<PathBuf>,
     /// Also write DIR/frame_00000.exr… with every channel (as render --exr; motion from the path's previous frame).
-    #[arg(long, requires = "out_dir")]
+    #[arg(long)]
     pub exr: bool,
     /// Per-frame times and pass medians as JSON.
     #[arg(long)]

@@ -75,6 +75,9 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
+    if args.exr && args.out_dir.is_none() {
+        bail!("--exr needs --out-dir DIR (the EXR frames go beside the PNG frames)");
+    }
     if let Some(dir) = &args.out_dir {
         if dir.exists() && (!dir.is_dir() || std::fs::read_dir(dir)?.next().is_some()) {
             bail!("--out-dir {} exists and is not an empty directory", dir.display());
