@@ -13,7 +13,8 @@
 //!   texturing's four surface types;
 //! * rocks and scans: class 2 and 3 with their instance ids exactly where
 //!   their splats are (W > 0), in both splat modes, over terrain and alone;
-//! * normals: unit length and facing the camera on every surface, 0 for sky.
+//! * normals: unit length and facing the camera on every surface, 0 for sky;
+//! * `Renderer::reset_motion` makes the next frame's motion 0.
 
 mod common;
 
@@ -439,4 +440,34 @@ fn a_rock_on_the_terrain_keeps_its_ids_where_it_is_seen() {
     let terrain = pixels().filter(|&(i, _, _)| frame.class[i] >= CLASS_LAYER_BASE).count();
     assert!(terrain > 1000, "{terrain} terrain pixels");
     check_normals("rock on terrain", frame, &camera, |i| frame.depth[i].is_finite(), 0.02);
+}
+
+#[test]
+fn a_reset_forgets_the_previous_camera() {
+    let field = ProceduralTerrain::default()
+        .try_generate(65, 65, DVec2::splat(40.0))
+        .expect("terrain");
+    let scene = Scene::new(field);
+    let first = scene.default_camera();
+    let second = Camera {
+        eye: first.eye + DVec3::new(150.0, 0.0, 0.0),
+        ..first
+    };
+    let (ctx, report) = validated_context();
+    {
+        let mut renderer = Renderer::new(&ctx, &scene, RenderSettings::new(WIDTH, HEIGHT)).expect("renderer");
+        let mut motion = |camera: &Camera, reset: bool| {
+            if reset {
+                renderer.reset_motion();
+            }
+            let frame = renderer.render(camera).and_then(|f| renderer.read(&f)).expect("frame");
+            frame.motion.iter().fold(0.0f32, |m, v| m.max(v.abs()))
+        };
+        assert_eq!(motion(&first, false), 0.0, "first frame");
+        assert!(motion(&second, false) > 1.0, "the camera moved");
+        assert_eq!(motion(&first, true), 0.0, "after a reset");
+        renderer.finish().expect("finish");
+    }
+    drop(ctx);
+    assert_validation_clean(&report);
 }

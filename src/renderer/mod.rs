@@ -335,6 +335,12 @@ impl Renderer {
         Ok(())
     }
 
+    /// Forgets the previous frame's cameras: the next frame's motion AOV is
+    /// 0 (a cut, or a camera that jumped).
+    pub fn reset_motion(&mut self) {
+        self.techniques.aovs.reset();
+    }
+
     /// The context the renderer draws with.
     pub fn context(&self) -> &Context {
         &self.ctx
