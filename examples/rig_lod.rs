@@ -23,7 +23,12 @@ const GRID: usize = 512;
 
 fn main() -> alpenglow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let value = |flag: &str| args.iter().position(|a| a == flag).and_then(|k| args.get(k + 1)).cloned();
+    let value = |flag: &str| {
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|k| args.get(k + 1))
+            .cloned()
+    };
     let scene = match value("--dem") {
         Some(path) => Scene::new(load_heightmap(
             std::path::Path::new(&path),

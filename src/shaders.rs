@@ -24,6 +24,8 @@ pub const TERRAIN_DRAW_FRAG: SpirV = spirv!("terrain/draw.frag");
 pub const FULL_SCREEN_VERT: SpirV = spirv!("post/full_screen.vert");
 /// sky: analytic sky radiance.
 pub const SKY_FRAG: SpirV = spirv!("lighting/sky.frag");
+/// aovs: distance and motion from view depth and the cameras (full-screen fragment stage).
+pub const AOVS_FRAG: SpirV = spirv!("post/aovs.frag");
 /// tonemap: HDR → sRGB8.
 pub const TONEMAP: SpirV = spirv!("post/tonemap.comp");
 /// exposure.meter: mean log luminance → the exposure multiplier.

@@ -142,6 +142,16 @@ fn hybrid_bunny_matches_points_only() {
                 c.hybrid_only * 100.0
             );
             assert!(c.holes <= HOLES, "{} at {distance} m: {} holes", mode.name(), c.holes);
+            // Triangles and splats alike carry the scan's ids (src/view/aov.rs).
+            for (i, &seen) in covered(&hybrid).iter().enumerate() {
+                let ids = (hybrid.class[i], hybrid.instance[i]);
+                assert_eq!(
+                    ids,
+                    if seen { (3, 1) } else { (0, 0) },
+                    "{} at {distance} m: pixel {i}",
+                    mode.name()
+                );
+            }
         }
     }
 }

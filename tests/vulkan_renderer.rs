@@ -62,6 +62,7 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
                 "shadow.clear",
                 "terrain.shadow",
                 "terrain.draw",
+                "aovs",
                 "exposure.meter",
                 "tonemap",
                 "readback",
@@ -132,6 +133,13 @@ fn renders_are_deterministic() {
         assert!(
             a.hdr.iter().zip(&b.hdr).all(|(x, y)| x.to_bits() == y.to_bits()),
             "HDR differs between identical frames"
+        );
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<u32>>();
+        assert!(
+            (a.class == b.class && a.instance == b.instance)
+                && (bits(&a.normal) == bits(&b.normal) && bits(&a.distance) == bits(&b.distance))
+                && bits(&a.motion) == bits(&b.motion),
+            "the AOVs differ between identical frames"
         );
         first.finish().unwrap();
         second.finish().unwrap();

@@ -6,6 +6,7 @@
 #extension GL_EXT_nonuniform_qualifier : require
 
 layout(set = 0, binding = 0) uniform texture2D g_textures[];
+layout(set = 0, binding = 0) uniform utexture2D g_utextures[];  // the same heap, unsigned-integer views
 layout(set = 0, binding = 1, rgba32f) uniform image2D g_images_rgba32f[];
 layout(set = 0, binding = 1, rgba8) uniform image2D g_images_rgba8[];
 layout(set = 0, binding = 1, r32f) uniform image2D g_images_r32f[];

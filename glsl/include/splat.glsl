@@ -17,7 +17,8 @@ struct Splat {
 
 struct Instance {
     mat4 model_view;     // object → camera (rigid motion × uniform scale), computed in f64
-    vec4 params;         // scale, first splat (bits), prefix length (bits), 0
+    vec4 params;         // scale, first splat (bits), prefix length (bits), first hybrid triangle (bits)
+    uvec4 ids;           // semantic class, instance id (src/view/aov.rs), 0, 0
 };
 
 layout(set = 0, binding = 2, std430) readonly buffer Splats { Splat s[]; } g_splats[];
@@ -89,6 +90,11 @@ vec3 pixel_ray(vec2 pixel) {
     uint f = pc.handles.y;
     return vec3(dot(g_point_frame[f].k_inv[0].xyz, x), dot(g_point_frame[f].k_inv[1].xyz, x),
                 dot(g_point_frame[f].k_inv[2].xyz, x));
+}
+
+// Class and instance id of the draw's instance (the ids AOV).
+uvec2 instance_ids() {
+    return g_point_frame[pc.handles.y].instances[pc.mode.w].ids.xy;
 }
 
 // Depth-buffer value of a camera-space z (< 0).

@@ -15,6 +15,13 @@ vec3 camera_to_world(vec3 v) {
                 dot(g_point_frame[f].camera_to_world[2].xyz, v));
 }
 
+// The world normal AOV of a camera-space normal at camera-space `position`,
+// turned towards the viewer as shade_splat turns it; w = 1.
+vec4 world_normal(vec3 normal, vec3 position) {
+    vec3 n = normalize(normal);
+    return vec4(camera_to_world(dot(n, position) > 0.0 ? -n : n), 1.0);
+}
+
 // Radiance of albedo `albedo` at camera-space `position` with normal `normal`
 // (two-sided: the normal is turned towards the viewer), and the lighting
 // AOVs in `visibility`. Unlit (albedo out, visibility 1) when the frame's

@@ -86,11 +86,13 @@ struct LayerState {
     float slope;        // slope of the base surface (degrees)
     vec3 color;         // blended linear colour so far
     vec4 coverage;      // C_S of the last layer seen per tree level
+    uint dominant;      // the layer with the largest share of the colour so far
+    float share;        // its share (src/texturing/dominant.rs)
 };
 
 // The state before the root: base height h with gradient grad.
 LayerState layer_state(float h, vec2 grad) {
-    return LayerState(h, vec2(0.0), degrees(atan(length(grad))), vec3(0.0), vec4(1.0));
+    return LayerState(h, vec2(0.0), degrees(atan(length(grad))), vec3(0.0), vec4(1.0), 0u, 0.0);
 }
 
 // Layer i of the flat depth-first tree applied at world xy: coverage from
@@ -123,6 +125,13 @@ void apply_layer(uint layers, uint i, uint tile, vec2 xy, float footprint, vec2 
     }
     s.coverage[min(level, 3u)] = c_s;
     s.color = mix(s.color, color_roughness.rgb, c_s);
+    // The dominant layer (src/texturing/dominant.rs): every earlier share
+    // scales by 1 − C_S, this layer's share is C_S.
+    s.share *= 1.0 - c_s;
+    if (c_s > s.share) {
+        s.dominant = i;
+        s.share = c_s;
+    }
     if (color_roughness.w > 0.0 && c_s > 0.0) {
         vec2 dg;
         float d = layer_noise(tile, xy, noise.w, vec2(29.1, 7.7) * float(i + 1u), footprint, dg);
@@ -133,14 +142,15 @@ void apply_layer(uint layers, uint i, uint tile, vec2 xy, float footprint, vec2 
 }
 
 // The whole tree at world xy of the base surface (height h, gradient grad):
-// colour, and the displacement gradient in `extra`.
+// colour, the displacement gradient in `extra` and the dominant layer.
 vec3 evaluate_layers(uint layers, uint count, uint tile, vec2 xy, float footprint, float h, vec2 grad, vec2 range,
-                     vec3 maps, out vec2 extra) {
+                     vec3 maps, out vec2 extra, out uint dominant) {
     LayerState s = layer_state(h, grad);
     for (uint i = 0u; i < count && i < MAX_SURFACE_LAYERS; ++i) {
         apply_layer(layers, i, tile, xy, footprint, range, maps, s);
     }
     extra = s.extra;
+    dominant = s.dominant;
     return s.color;
 }
 

@@ -36,9 +36,10 @@ vec3 srgb_to_linear(vec3 c) {
     return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
 }
 
-// Colour (linear) and displacement gradient of the atlas at world xy;
-// false when no tile covers it (nothing resident yet).
-bool sample_atlas(uint texturing, vec2 xy, out vec3 color, out vec2 extra) {
+// Colour (linear), displacement gradient and dominant layer (the nearest
+// texel's normal alpha, texturing.finish) of the atlas at world xy; false
+// when no tile covers it (nothing resident yet).
+bool sample_atlas(uint texturing, vec2 xy, out vec3 color, out vec2 extra, out uint layer) {
     uvec4 atlas = g_texturing[texturing].atlas;
     uint table = atlas.x;
     uvec4 header = g_page_tables[table].w[0];
@@ -56,6 +57,7 @@ bool sample_atlas(uint texturing, vec2 xy, out vec3 color, out vec2 extra) {
     if (r == PAGE_NONE) {
         color = vec3(0.0);
         extra = vec2(0.0);
+        layer = 0u;
         return false;
     }
     uint e = header.z + 2u * (r & ~PAGE_LEAF);
@@ -69,6 +71,9 @@ bool sample_atlas(uint texturing, vec2 xy, out vec3 color, out vec2 extra) {
     color = srgb_to_linear(textureLod(sampler2D(g_textures[nonuniformEXT(color_handle)], g_samplers[SAMPLER_LINEAR_CLAMP]), at, 0.0).rgb);
     vec3 n = textureLod(sampler2D(g_textures[nonuniformEXT(normal_handle)], g_samplers[SAMPLER_LINEAR_CLAMP]), at, 0.0).xyz * 2.0 - 1.0;
     extra = -n.xy / max(n.z, 1e-3);
+    ivec2 nearest = clamp(ivec2(floor(texel)), ivec2(0), ivec2(int(atlas.z) - 1));
+    float a = texelFetch(sampler2D(g_textures[nonuniformEXT(normal_handle)], g_samplers[SAMPLER_NEAREST_CLAMP]), nearest, 0).a;
+    layer = uint(round(a * 255.0));
     return true;
 }
 

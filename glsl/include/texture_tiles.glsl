@@ -17,7 +17,10 @@ struct TileJob {
 };
 
 // Per texel: (modified height, displacement gradient x, y, base slope) and
-// packed halves (colour rg, colour b, coverage of levels 0–1, 2–3).
+// packed halves (colour rg; colour b and the dominant layer; coverage of
+// levels 0–1, 2–3). The dominant layer takes the upper 16 bits of the
+// second word: its index (5 bits, MAX_SURFACE_LAYERS = 32) and its share
+// as an 11-bit fraction.
 struct TexelState {
     vec4 surface;
     uvec4 blend;
@@ -70,16 +73,21 @@ float texel_footprint(TileJob job) {
     return max(job.world.z, job.world.w);
 }
 
+const float SHARE_STEPS = 2047.0;
+
 TexelState pack_state(LayerState s) {
+    uint dominant = min(s.dominant, 31u) | (uint(round(clamp(s.share, 0.0, 1.0) * SHARE_STEPS)) << 5u);
+    uint b = (packHalf2x16(vec2(s.color.b, 0.0)) & 0xffffu) | (dominant << 16u);
     return TexelState(vec4(s.h, s.extra, s.slope),
-                      uvec4(packHalf2x16(s.color.rg), packHalf2x16(vec2(s.color.b, 0.0)),
-                            packHalf2x16(s.coverage.xy), packHalf2x16(s.coverage.zw)));
+                      uvec4(packHalf2x16(s.color.rg), b, packHalf2x16(s.coverage.xy), packHalf2x16(s.coverage.zw)));
 }
 
 LayerState unpack_state(TexelState t) {
-    vec3 color = vec3(unpackHalf2x16(t.blend.x), unpackHalf2x16(t.blend.y).x);
+    vec3 color = vec3(unpackHalf2x16(t.blend.x), unpackHalf2x16(t.blend.y & 0xffffu).x);
     vec4 coverage = vec4(unpackHalf2x16(t.blend.z), unpackHalf2x16(t.blend.w));
-    return LayerState(t.surface.x, t.surface.yz, t.surface.w, color, coverage);
+    uint dominant = t.blend.y >> 16u;
+    return LayerState(t.surface.x, t.surface.yz, t.surface.w, color, coverage, dominant & 31u,
+                      float(dominant >> 5u) / SHARE_STEPS);
 }
 
 #endif

@@ -1,8 +1,10 @@
 #version 460
 // sky (§6.3; ALGORITHMS.md §6): the frame's sky model along each pixel's
 // view ray plus the sun disc, in absolute units; view depth +inf; the
-// lighting AOVs of sky pixels are (1, 1).
+// lighting AOVs of sky pixels are (1, 1), the world normal 0 and the ids
+// (class, instance) sky's (0, 0; src/view/aov.rs).
 #include "../include/sky.glsl"
+#include "../include/aov.glsl"
 
 layout(push_constant) uniform Push {
     vec4 right;       // xyz: camera right · tan(fov_x/2)
@@ -15,6 +17,8 @@ layout(location = 0) in vec2 in_ndc;
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_depth;
 layout(location = 2) out vec2 out_visibility;
+layout(location = 3) out vec4 out_normal;
+layout(location = 4) out uvec2 out_ids;
 
 void main() {
     // Vulkan NDC y points down the image: row 0 is the top, so negate.
@@ -23,4 +27,6 @@ void main() {
     out_color = vec4(sky_radiance(l, dir) + sun_disc_radiance(l, dir), 1.0);
     out_depth = POSITIVE_INFINITY;
     out_visibility = vec2(1.0);
+    out_normal = vec4(0.0);
+    out_ids = uvec2(CLASS_SKY, 0u);
 }

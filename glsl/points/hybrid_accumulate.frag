@@ -7,8 +7,10 @@
 
 layout(location = 0) out vec4 out_color_weight;
 layout(location = 1) out vec4 out_normal_depth;
+layout(location = 2) out uvec2 out_ids;  // class, instance (never blended)
 
 void main() {
     out_color_weight = vec4(in_color, 1.0);
     out_normal_depth = vec4(normalize(in_normal), -in_position.z);
+    out_ids = instance_ids();
 }

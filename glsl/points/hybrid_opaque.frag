@@ -1,6 +1,6 @@
 #version 460
 // points.opaque, hybrid triangles (dissertation §10.1.8): shaded directly
-// like the opaque discs, weight 1.
+// like the opaque discs, weight 1, with the world normal and ids AOVs.
 #include "../include/hybrid_fragment.glsl"
 #include "../include/splat_shading.glsl"
 
@@ -8,9 +8,13 @@ layout(location = 0) out vec4 out_radiance;
 layout(location = 1) out float out_view_depth;
 layout(location = 2) out float out_weight;
 layout(location = 3) out vec2 out_visibility;
+layout(location = 4) out vec4 out_normal;
+layout(location = 5) out uvec2 out_ids;
 
 void main() {
     out_radiance = vec4(shade_splat(in_color, in_normal, in_position, out_visibility), 1.0);
     out_view_depth = -in_position.z;
     out_weight = 1.0;
+    out_normal = world_normal(in_normal, in_position);
+    out_ids = instance_ids();
 }

@@ -5,7 +5,10 @@
 // blended with it in the accumulation pass.
 #include "../include/hybrid_fragment.glsl"
 
+layout(location = 0) out uvec2 out_ids;  // class, instance of the winning triangle
+
 void main() {
     vec3 pushed = in_position * (1.0 + in_offset / length(in_position));
     gl_FragDepth = depth_of(pushed.z);
+    out_ids = instance_ids();
 }

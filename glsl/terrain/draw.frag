@@ -5,7 +5,9 @@
 // surface type from altitude, slope and orientation with turbulence-perturbed
 // boundaries; lit by the frame's sun (with shadows) and sky light, seen
 // through aerial perspective (§9; glsl/include/surface_lighting.glsl).
-// Writes HDR radiance (absolute), view depth and the lighting AOVs.
+// Writes HDR radiance (absolute), view depth, the lighting AOVs, the world
+// shading normal and the semantic class (src/view/aov.rs: 10 + the dominant
+// surface layer; 1 in the debug views or where no atlas tile is resident).
 // The debug views colour the same surface by a diagnostic instead.
 #include "../include/heap.glsl"
 #include "../include/terrain_detail.glsl"
@@ -14,6 +16,7 @@
 #include "../include/surface_layers.glsl"
 #include "../include/texture_atlas.glsl"
 #include "../include/surface_lighting.glsl"
+#include "../include/aov.glsl"
 
 
 layout(location = 0) in vec3 in_world;
@@ -25,6 +28,12 @@ layout(location = 4) in vec2 in_grid;
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_depth;
 layout(location = 2) out vec2 out_visibility;
+layout(location = 3) out vec4 out_normal;
+layout(location = 4) out uvec2 out_ids;
+
+// Layers of the built-in tree the classic surface types are reported as
+// (src/terrain/shading.rs, CLASSIC_LAYERS): grass, dry grass, rock, snow.
+const uint CLASSIC_LAYER[4] = uint[](1u, 3u, 0u, 6u);
 
 // Blue → green → yellow → red for t in [0, 1].
 vec3 ramp(float t) {
@@ -34,7 +43,9 @@ vec3 ramp(float t) {
 
 // Surface type → albedo. Boundaries are perturbed by low-frequency
 // turbulence (the wavelet tile at coarse scales) before classification.
-vec3 albedo(vec3 n, vec3 p, uint tile, vec3 sun, float snow_line_base) {
+// `type`: the type with the largest share of the blend (0 grass, 1 dry
+// grass, 2 rock, 3 snow; the first of equal shares).
+vec3 albedo(vec3 n, vec3 p, uint tile, vec3 sun, float snow_line_base, out uint type) {
     // Turbulence needs no smooth derivative: one bilinear fetch per octave.
     float turb = 0.0;
     float scale = 1.0 / 180.0;
@@ -56,7 +67,17 @@ vec3 albedo(vec3 n, vec3 p, uint tile, vec3 sun, float snow_line_base) {
     vec3 c = mix(grass, dry_grass, smoothstep(0.1, 0.6, facing + 0.8 * (turb - 0.3)));
     c = mix(c, rock, smoothstep(0.22, 0.34, slope));
     float snow_line = snow_line_base - 60.0 * clamp(-facing, -1.0, 1.0);
-    return mix(c, snow, smoothstep(snow_line, snow_line + 40.0, altitude) * (1.0 - smoothstep(0.38, 0.55, slope)));
+    float dry = smoothstep(0.1, 0.6, facing + 0.8 * (turb - 0.3));
+    float bare = smoothstep(0.22, 0.34, slope);
+    float snowy = smoothstep(snow_line, snow_line + 40.0, altitude) * (1.0 - smoothstep(0.38, 0.55, slope));
+    vec4 shares = vec4((1.0 - dry) * (1.0 - bare), dry * (1.0 - bare), bare, 0.0) * (1.0 - snowy) + vec4(0.0, 0.0, 0.0, snowy);
+    type = 0u;
+    for (uint k = 1u; k < 4u; ++k) {
+        if (shares[k] > shares[type]) {
+            type = k;
+        }
+    }
+    return mix(c, snow, snowy);
 }
 
 void main() {
@@ -84,13 +105,16 @@ void main() {
     }
 
     vec3 radiance;
+    uint semantic = CLASS_TERRAIN;
     if (view == VIEW_SHADED) {
         vec3 a;
         uint mode = texturing != 0xffffu ? g_texturing[texturing].handles.w : TEXTURING_CLASSIC;
         vec2 extra;
-        if (mode == TEXTURING_ATLAS && sample_atlas(texturing, in_world.xy, a, extra)) {
+        uint layer;
+        if (mode == TEXTURING_ATLAS && sample_atlas(texturing, in_world.xy, a, extra, layer)) {
             // §8.2 from the atlas: colour and displacement normal of the tile.
             n = normalize(n + vec3(-extra, 0.0) * n.z);
+            semantic = CLASS_LAYER_BASE + layer;
         } else if (mode == TEXTURING_DIRECT) {
             // §8.2 evaluated per pixel: the reference of the atlas.
             uvec4 th = g_texturing[texturing].handles;
@@ -100,11 +124,16 @@ void main() {
             float footprint = max(depth, 1e-3) * pc.forward.w;
             vec3 maps = input_maps(g_texturing[texturing].maps, in_world.xy / g_texturing[texturing].extent.xy);
             a = evaluate_layers(th.x, g_texturing[texturing].grid.z, th.z, in_world.xy, footprint, h, base_grad, sr.zw,
-                                maps, extra);
+                                maps, extra, layer);
             // The layers' displacement bumps the normal on top of the mesh's.
             n = normalize(n + vec3(-extra, 0.0) * n.z);
+            semantic = CLASS_LAYER_BASE + layer;
+        } else if (mode != TEXTURING_ATLAS) {
+            uint type;
+            a = albedo(n, in_world, tile, sun, g_lighting[lighting].f.exposure.z, type);
+            semantic = CLASS_LAYER_BASE + CLASSIC_LAYER[type];
         } else {
-            a = albedo(n, in_world, tile, sun, g_lighting[lighting].f.exposure.z);
+            a = albedo(n, in_world, tile, sun, g_lighting[lighting].f.exposure.z, layer);
         }
         radiance = shade_diffuse(lighting, a, in_world, n, depth, pc.eye.xyz, out_visibility);
     } else {
@@ -132,4 +161,6 @@ void main() {
         }
     }
     out_color = vec4(radiance, 1.0);
+    out_normal = vec4(n, 1.0);
+    out_ids = uvec2(semantic, 0u);
 }

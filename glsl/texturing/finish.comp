@@ -3,7 +3,8 @@
 // atlas"; ALGORITHMS.md §4): each dirty tile's texels, border included, go
 // to its slot in the atlas textures: sRGB-encoded colour, and the normal of
 // the layers' displacement alone (terrain.draw adds it to the mesh normal,
-// so lighting stays dynamic).
+// so lighting stays dynamic) with the dominant layer's index in alpha
+// (index / 255; the class AOV, src/view/aov.rs).
 #include "../include/heap.glsl"
 #include "../include/terrain_detail.glsl"
 #include "../include/surface_layers.glsl"
@@ -25,5 +26,5 @@ void main() {
     ivec2 at = ivec2(job.tile.zw + local);
     imageStore(g_images_rgba8[job.images.x], at, vec4(linear_to_srgb(s.color), 1.0));
     vec3 n = normalize(vec3(-s.extra, 1.0));
-    imageStore(g_images_rgba8[job.images.y], at, vec4(n * 0.5 + 0.5, 1.0));
+    imageStore(g_images_rgba8[job.images.y], at, vec4(n * 0.5 + 0.5, float(s.dominant) / 255.0));
 }

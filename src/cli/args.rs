@@ -267,7 +267,8 @@ pub struct RenderArgs {
     /// Tone-mapped sRGB PNG.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// OpenEXR: linear R,G,B,A, Z (view-space depth, +inf where nothing was hit) and, with points, W (EWA weight).
+    /// OpenEXR: linear R,G,B,A, Z (view-space depth, +inf where nothing was hit), the lighting and simulator AOVs
+    /// (distance, N.X/Y/Z, class, instance, motion.X/Y) and, with points, W (EWA weight).
     #[arg(long)]
     pub exr: Option<PathBuf>,
     /// Per-pass timings as JSON (name, GPU ms, CPU ms; frame totals).
@@ -312,6 +313,9 @@ pub struct FlyArgs {
     /// Directory for frame_00000.png…; must not exist or be empty (without it, frames are only timed).
     #[arg(long = "out-dir")]
     pub out_dir: Option<PathBuf>,
+    /// Also write DIR/frame_00000.exr… with every channel (as render --exr; motion from the path's previous frame).
+    #[arg(long)]
+    pub exr: bool,
     /// Per-frame times and pass medians as JSON.
     #[arg(long)]
     pub json: Option<PathBuf>,

@@ -1,5 +1,6 @@
-//! `alpenglow fly`: a camera path rendered to a PNG sequence with a
-//! progress bar, and the per-frame times. The vertex count of the warped
+//! `alpenglow fly`: a camera path rendered to a PNG sequence (and with
+//! `--exr` an EXR sequence with every channel, motion relative to the
+//! path's previous frame) with a progress bar, and the per-frame times. The vertex count of the warped
 //! terrain is constant (§7.4), so frame times should barely vary.
 //!
 //! Frames go into a temporary sibling of the output directory, renamed into
@@ -60,8 +61,8 @@ impl Drop for StagingGuard {
 }
 
 /// Frame `index` of the view `view` (a rig's views each get a folder).
-fn frame_path(dir: &Path, view: &str, index: usize) -> PathBuf {
-    dir.join(view).join(format!("frame_{index:05}.png"))
+fn frame_path(dir: &Path, view: &str, index: usize, extension: &str) -> PathBuf {
+    dir.join(view).join(format!("frame_{index:05}.{extension}"))
 }
 
 fn stats(values: &[f64]) -> (f64, f64, f64) {
@@ -75,6 +76,9 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     check_output_path(&args.trace, "trace")?;
     if args.frames == 0 {
         bail!("--frames must be at least 1");
+    }
+    if args.exr && args.out_dir.is_none() {
+        bail!("--exr needs --out-dir DIR (the EXR frames go beside the PNG frames)");
     }
     if let Some(dir) = &args.out_dir {
         if dir.exists() && (!dir.is_dir() || std::fs::read_dir(dir)?.next().is_some()) {
@@ -126,8 +130,11 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
         let write = |views: &[FrameImages], index: usize| -> Result<()> {
             if let Some(dir) = &staging {
                 for images in views {
-                    let path = frame_path(dir, &images.name, index);
-                    write_png_rgba8(&path, &images.rgba8, images.width, images.height)?;
+                    let path = |extension| frame_path(dir, &images.name, index, extension);
+                    write_png_rgba8(&path("png"), &images.rgba8, images.width, images.height)?;
+                    if args.exr {
+                        super::exr::write_frame_exr(&path("exr"), images)?;
+                    }
                 }
             }
             Ok(())

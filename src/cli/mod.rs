@@ -2,6 +2,7 @@
 
 mod args;
 mod errors;
+mod exr;
 mod fly;
 mod lighting;
 mod orbit;
@@ -18,9 +19,9 @@ use clap::Parser;
 use glam::DVec2;
 
 use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
-use alpenglow::io::image_out::{write_exr, write_png_rgba8};
+use alpenglow::io::image_out::write_png_rgba8;
 use alpenglow::profile::{summarize, write_chrome_trace, write_profile_json, FrameProfile};
-use alpenglow::renderer::{validate_size, Camera, FrameImages, RenderSettings, Scene, ViewSpec};
+use alpenglow::renderer::{validate_size, Camera, RenderSettings, Scene, ViewSpec};
 use alpenglow::terrain::geometry_image::{TerrainSettings, TerrainView};
 use alpenglow::terrain::lod::{ImportanceFactors, LodMode, LodSettings};
 use alpenglow::terrain::sketch_map::SketchAlignment;
@@ -351,7 +352,7 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
         outputs.write(&path(&args.out), |p| {
             write_png_rgba8(p, &images.rgba8, images.width, images.height)
         })?;
-        outputs.write(&path(&args.exr), |p| write_view_exr(p, images))?;
+        outputs.write(&path(&args.exr), |p| exr::write_frame_exr(p, images))?;
     }
     outputs.write(&args.profile, |p| write_profile_json(p, &device, &profiles))?;
     outputs.write(&args.trace, |p| write_chrome_trace(p, &device, &profiles))?;
@@ -360,14 +361,6 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
         print_profile(&device, frame);
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// A view's EXR: R, G, B, A, Z and its AOVs.
-fn write_view_exr(path: &Path, images: &FrameImages) -> alpenglow::Result<()> {
-    let (sun, sky) = (images.visibility_channel(0), images.visibility_channel(1));
-    let mut extra: Vec<(&str, &[f32])> = vec![("sun_visibility", &sun), ("sky_visibility", &sky)];
-    extra.extend(images.weight.iter().map(|w| ("W", w.as_slice())));
-    write_exr(path, images.width, images.height, &images.hdr, &images.depth, &extra)
 }
 
 fn bench(args: BenchArgs) -> Result<ExitCode> {

@@ -14,6 +14,23 @@ use crate::io::one_line;
 /// Named channels of an EXR image: `(name, samples)` per channel.
 pub type ExrChannels = Vec<(String, Vec<f32>)>;
 
+/// The samples of one extra EXR channel: 32-bit float, or 32-bit unsigned
+/// integer (exact ids).
+#[derive(Clone, Copy, Debug)]
+pub enum ExrSamples<'a> {
+    F32(&'a [f32]),
+    U32(&'a [u32]),
+}
+
+impl ExrSamples<'_> {
+    fn len(&self) -> usize {
+        match self {
+            ExrSamples::F32(v) => v.len(),
+            ExrSamples::U32(v) => v.len(),
+        }
+    }
+}
+
 /// Number of pixels of a `width`×`height` image, rejecting empty images and
 /// sizes that overflow `usize`.
 fn pixel_count(what: &str, width: u32, height: u32) -> Result<usize> {
@@ -78,6 +95,18 @@ pub fn write_exr(
     depth: &[f32],
     extra: &[(&str, &[f32])],
 ) -> Result<()> {
+    let extra: Vec<(&str, ExrSamples)> = extra.iter().map(|&(n, v)| (n, ExrSamples::F32(v))).collect();
+    write_exr_samples(path, (width, height), (rgba, depth), &extra)
+}
+
+/// [`write_exr`] with extra channels of float or unsigned integer samples
+/// (`UINT` channels: ids stay exact).
+pub fn write_exr_samples(
+    path: &Path,
+    (width, height): (u32, u32),
+    (rgba, depth): (&[f32], &[f32]),
+    extra: &[(&str, ExrSamples)],
+) -> Result<()> {
     use exr::prelude::{
         AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image, Layer, LayerAttributes, LineOrder,
         SmallVec, WritableImage,
@@ -120,7 +149,11 @@ pub fn write_exr(
     }
     list.push(AnyChannel::new("Z", FlatSamples::F32(depth.to_vec())));
     for (name, data) in extra {
-        list.push(AnyChannel::new(*name, FlatSamples::F32(data.to_vec())));
+        let samples = match data {
+            ExrSamples::F32(v) => FlatSamples::F32(v.to_vec()),
+            ExrSamples::U32(v) => FlatSamples::U32(v.to_vec()),
+        };
+        list.push(AnyChannel::new(*name, samples));
     }
     let encoding = Encoding {
         compression: Compression::ZIP16,

@@ -1,8 +1,9 @@
 //! `sky`: a full-screen triangle shading every pixel with the frame's sky
 //! model (the Perez/Preetham sky of §6.3 or the physical atmosphere;
 //! `glsl/include/sky.glsl`) along its view ray plus the sun disc, in
-//! absolute units, and clearing view-space depth to +inf and the lighting
-//! AOVs to (1, 1).
+//! absolute units, and clearing view-space depth to +inf, the lighting
+//! AOVs to (1, 1), the world normal to 0 and the class and instance ids to
+//! sky (0, 0; `crate::view::aov`).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -39,7 +40,13 @@ impl Sky {
             &GraphicsPipelineDesc::full_screen(
                 "sky",
                 (shaders::FULL_SCREEN_VERT, shaders::SKY_FRAG),
-                vec![formats.radiance, formats.view_depth, formats.visibility],
+                vec![
+                    formats.radiance,
+                    formats.view_depth,
+                    formats.visibility,
+                    formats.normal,
+                    formats.ids,
+                ],
             ),
         )?;
         Ok(Sky {
@@ -47,10 +54,12 @@ impl Sky {
         })
     }
 
-    /// Declares `sky` for view `index`: writes its radiance and view depth.
+    /// Declares `sky` for view `index`: writes its radiance, view depth,
+    /// lighting AOVs, normal and ids.
     pub fn declare(&self, graph: &mut RenderGraph<Frame>, (index, view): (ViewIndex, &View), targets: &SceneTargets) {
         let pipeline = self.pipeline.clone();
         let (radiance, view_depth, visibility) = (targets.radiance, targets.view_depth, targets.visibility);
+        let (normal, ids) = (targets.normal, targets.ids);
         let lighting = targets.lighting.constants;
         let builder = graph.pass(&pass_name("sky", &view.name)).graphics();
         targets
@@ -59,6 +68,8 @@ impl Sky {
             .write(radiance, ImageAccess::ColorAttachmentWrite)
             .write(view_depth, ImageAccess::ColorAttachmentWrite)
             .write(visibility, ImageAccess::ColorAttachmentWrite)
+            .write(normal, ImageAccess::ColorAttachmentWrite)
+            .write(ids, ImageAccess::ColorAttachmentWrite)
             .record(move |pass, frame| {
                 let view = frame.view(index)?;
                 let (right, up, forward) = view.ray_basis();
@@ -69,13 +80,15 @@ impl Sky {
                     lighting: [pass.upload(lighting)?, 0, 0, 0],
                 };
                 let (radiance, view_depth) = (pass.image(radiance)?, pass.image(view_depth)?);
-                let visibility = pass.image(visibility)?;
+                let (visibility, normal, ids) = (pass.image(visibility)?, pass.image(normal)?, pass.image(ids)?);
                 let cmd = pass.cmd();
                 cmd.begin_rendering(
                     &[
                         (radiance, LoadOp::DontCare),
                         (view_depth, LoadOp::DontCare),
                         (visibility, LoadOp::DontCare),
+                        (normal, LoadOp::DontCare),
+                        (ids, LoadOp::DontCare),
                     ],
                     None,
                 );

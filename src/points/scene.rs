@@ -76,12 +76,34 @@ impl PointTransform {
     }
 }
 
+/// What a point object is, for the semantic class AOV (`crate::view::aov`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum PointClass {
+    /// A procedural rock (§6.1.4).
+    Rock,
+    /// Anything loaded from a file: scans, meshes.
+    #[default]
+    Scan,
+}
+
+impl PointClass {
+    /// The class id of the ids AOV.
+    pub fn id(self) -> u32 {
+        match self {
+            PointClass::Rock => crate::view::aov::CLASS_ROCK,
+            PointClass::Scan => crate::view::aov::CLASS_SCAN,
+        }
+    }
+}
+
 /// A point object: one sequential point tree, and for hybrid point–polygon
 /// rendering (§10.1.8) the mesh's triangles.
 #[derive(Clone, Debug)]
 pub struct PointObject {
     /// For messages and statistics (file name, "rock 3").
     pub name: String,
+    /// Its semantic class (scan unless made a rock).
+    pub class: PointClass,
     /// The splat list (for a hybrid object, with the floors of [`HybridMesh::point_tree`]).
     pub tree: Arc<SequentialPointTree>,
     /// The triangles drawn where they are large in the image.
@@ -93,6 +115,7 @@ impl PointObject {
     pub fn new(name: impl Into<String>, tree: SequentialPointTree) -> PointObject {
         PointObject {
             name: name.into(),
+            class: PointClass::Scan,
             tree: Arc::new(tree),
             hybrid: None,
         }
@@ -111,9 +134,9 @@ impl PointObject {
             Some(hybrid) => {
                 let (tree, hybrid) = hybrid.with_epsilon(epsilon)?;
                 PointObject {
-                    name: self.name.clone(),
                     tree: Arc::new(tree),
                     hybrid: Some(Arc::new(hybrid)),
+                    ..self.clone()
                 }
             }
         })
@@ -238,6 +261,7 @@ pub fn load_point_object(path: &Path, options: &PointLoadOptions) -> Result<Poin
             let (tree, hybrid) = build_hybrid(&mesh, &sampling, &options.spt, &mut |_| {}).map_err(in_file)?;
             return Ok(PointObject {
                 name,
+                class: PointClass::Scan,
                 tree: Arc::new(tree),
                 hybrid: Some(Arc::new(hybrid)),
             });
@@ -279,7 +303,10 @@ pub fn scatter_rocks(
             },
         )?;
         let tree = build_spt(&surfels, spt, &mut |_| {})?;
-        scene.objects.push(PointObject::new(format!("rock {i}"), tree));
+        scene.objects.push(PointObject {
+            class: PointClass::Rock,
+            ..PointObject::new(format!("rock {i}"), tree)
+        });
     }
     let extent = heights.extent();
     let mut rng = SplitMix64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15));

@@ -16,8 +16,10 @@
 //! §8.2) → `terrain.draw` (graphics, reads the vertex buffer) → the points
 //! passes (`points.visibility` → `points.accumulate` → `points.normalize`
 //! for EWA splats, or `points.opaque`; see [`crate::points::render`]) →
-//! `tonemap` (compute) → `readback` (transfer).
+//! `aovs` (full screen: distance and motion from view depth,
+//! [`crate::post::aovs`]) → `tonemap` (compute) → `readback` (transfer).
 
+mod aov_readback;
 mod lighting;
 mod readback;
 pub mod scene;
@@ -37,6 +39,7 @@ use crate::lighting::shadows::ShadowSettings;
 use crate::lighting::sky::Sky;
 use crate::lighting::technique::SceneLighting;
 use crate::points::render::{PointFrameStats, PointRenderer, SplatSettings};
+use crate::post::aovs::Aovs;
 use crate::post::exposure::ExposureMeter;
 use crate::post::tonemap::Tonemap;
 use crate::profile::FrameProfile;
@@ -126,6 +129,7 @@ struct Techniques {
     terrain: Option<Terrain>,
     atlas: Option<TextureAtlas>,
     points: Option<PointRenderer>,
+    aovs: Aovs,
 }
 
 /// Renders one scene, frame after frame. `Send`: a simulator may hand it to
@@ -238,6 +242,10 @@ impl Renderer {
                 points.declare(ctx, &mut graph, (k, view), targets, !scene.draw_terrain)?;
             }
         }
+        let mut aovs = Aovs::new(ctx, &targets[0].formats)?;
+        for (k, (view, targets)) in views.iter().zip(&targets).enumerate() {
+            aovs.declare(&mut graph, (k, view), targets);
+        }
         let exposure = ExposureMeter::new(ctx)?;
         let tonemap = Tonemap::new(ctx)?;
         let mut readback = Vec::new();
@@ -264,6 +272,7 @@ impl Renderer {
                 terrain,
                 atlas,
                 points,
+                aovs,
             },
         })
     }
@@ -281,6 +290,12 @@ impl Renderer {
         lighting.validate()?;
         self.lighting = lighting;
         Ok(())
+    }
+
+    /// Forgets the previous frame's cameras: the next frame's motion AOV is
+    /// 0 (a cut, or a camera that jumped).
+    pub fn reset_motion(&mut self) {
+        self.techniques.aovs.reset();
     }
 
     /// The context the renderer draws with.
@@ -344,6 +359,7 @@ impl Renderer {
         if let Some(points) = &mut t.points {
             frame.prepare(points, &mut uploads, &mut stages)?;
         }
+        frame.prepare(&mut t.aovs, &mut uploads, &mut stages)?;
         let outcome = self.graph.execute(&mut self.frames, &frame, &stages)?;
         self.frames_rendered = outcome.frame + 1;
         Ok(outcome)

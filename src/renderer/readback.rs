@@ -4,8 +4,9 @@
 
 use std::sync::Arc;
 
+use super::aov_readback::AovReadback;
 use crate::error::Result;
-use crate::graph::{BufferId, ImageId, RenderGraph};
+use crate::graph::RenderGraph;
 use crate::view::{pass_name, Frame, SceneTargets, View};
 use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Context, MemoryLocation};
 
@@ -29,6 +30,20 @@ pub struct FrameImages {
     /// shadow, 1 = lit; the filtered shadow term) and sky visibility (the
     /// ambient-occlusion term, 1 = open sky); (1, 1) for sky pixels.
     pub visibility: Vec<f32>,
+    /// The simulator AOVs (`crate::view::aov`): world-space shading normal,
+    /// 3 floats per pixel (0 for sky).
+    pub normal: Vec<f32>,
+    /// Semantic class per pixel (sky 0, terrain 1 or 10 + its dominant
+    /// surface layer, rock 2, other point objects 3).
+    pub class: Vec<u32>,
+    /// Point instance id per pixel (1-based; 0 for terrain and sky).
+    pub instance: Vec<u32>,
+    /// Motion from the previous frame in pixels, 2 floats per pixel (this
+    /// frame's position minus the previous one's; +x right, +y down; 0 on
+    /// the first frame).
+    pub motion: Vec<f32>,
+    /// Euclidean distance from the eye along the pixel's ray, metres; +inf for sky.
+    pub distance: Vec<f32>,
 }
 
 impl FrameImages {
@@ -47,10 +62,11 @@ pub(super) struct Readback {
     ldr: Vec<Arc<Buffer>>,
     weight: Option<Vec<Arc<Buffer>>>,
     visibility: Vec<Arc<Buffer>>,
+    aovs: AovReadback,
 }
 
 /// One readback buffer per frame slot.
-fn host_buffers(ctx: &Context, name: &str, size: u64) -> Result<Vec<Arc<Buffer>>> {
+pub(super) fn host_buffers(ctx: &Context, name: &str, size: u64) -> Result<Vec<Arc<Buffer>>> {
     Buffer::per_frame(
         ctx,
         BufferDesc {
@@ -72,7 +88,9 @@ impl Readback {
     ) -> Result<Readback> {
         let pixels = u64::from(targets.width) * u64::from(targets.height);
         let buffers = |what: &str, size| host_buffers(ctx, &pass_name(what, &view.name), size);
+        let mut copies = Vec::new();
         let rb = Readback {
+            aovs: AovReadback::declare(ctx, graph, view, targets, &mut copies)?,
             name: view.name.clone(),
             size: (targets.width, targets.height),
             hdr: buffers("hdr", pixels * 16)?,
@@ -84,7 +102,7 @@ impl Readback {
                 None => None,
             },
         };
-        let mut copies: Vec<(ImageId, BufferId)> = vec![
+        copies.extend([
             (targets.radiance, graph.import_buffers_per_frame(rb.hdr.clone())),
             (targets.view_depth, graph.import_buffers_per_frame(rb.depth.clone())),
             (targets.display, graph.import_buffers_per_frame(rb.ldr.clone())),
@@ -92,7 +110,7 @@ impl Readback {
                 targets.visibility,
                 graph.import_buffers_per_frame(rb.visibility.clone()),
             ),
-        ];
+        ]);
         if let (Some(image), Some(buffers)) = (targets.weight, &rb.weight) {
             copies.push((image, graph.import_buffers_per_frame(buffers.clone())));
         }
@@ -103,6 +121,7 @@ impl Readback {
     /// The images of frame slot `slot` (its frame must have completed).
     pub(super) fn read(&self, slot: usize) -> Result<FrameImages> {
         let floats = |b: &Buffer| -> Result<Vec<f32>> { Ok(bytemuck::pod_collect_to_vec(b.mapped()?)) };
+        let aovs = self.aovs.read(slot)?;
         Ok(FrameImages {
             name: self.name.clone(),
             width: self.size.0,
@@ -115,6 +134,11 @@ impl Readback {
                 None => None,
             },
             visibility: floats(&self.visibility[slot])?,
+            normal: aovs.normal,
+            class: aovs.class,
+            instance: aovs.instance,
+            motion: aovs.motion,
+            distance: aovs.distance,
         })
     }
 }

@@ -4,6 +4,8 @@
 //! slope and orientation (dissertation §7.4.3 "Procedural Detail" and
 //! "Colour"; `ALGORITHMS.md` §3 items 6–8), or coloured by the surface-layer
 //! tree (§8.2) per pixel or from the texture atlas through the page table.
+//! Besides radiance and depth it writes the view's world shading normal and
+//! semantic class (`crate::view::aov`).
 //! Shaders: `glsl/terrain/draw.vert`, `glsl/terrain/draw.frag`.
 
 use bytemuck::{Pod, Zeroable};
@@ -19,6 +21,12 @@ use crate::vulkan::{
     Blend, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, PrimitiveTopology,
     VertexAttribute,
 };
+
+/// The classic surface types (§7.4.3) as the layers of the built-in tree
+/// ([`crate::texturing::layers::DEFAULT_LAYERS`]) their class reports:
+/// (name, layer index), in the order of `CLASSIC_LAYER` in
+/// `glsl/terrain/draw.frag`, which hard-codes the indices.
+pub const CLASSIC_LAYERS: [(&str, u32); 4] = [("grass", 1), ("dry grass", 3), ("rock", 0), ("snow", 6)];
 
 /// Push constants of `terrain.draw` (`glsl/include/terrain_draw.glsl`).
 #[repr(C)]
@@ -79,6 +87,8 @@ fn pipeline(ctx: &Context, targets: &SceneTargets) -> Result<GraphicsPipeline> {
                 targets.formats.radiance,
                 targets.formats.view_depth,
                 targets.formats.visibility,
+                targets.formats.normal,
+                targets.formats.ids,
             ],
             blend: Blend::None,
             depth_format: Some(targets.formats.depth),
@@ -119,24 +129,28 @@ pub fn declare_draw_pass(
         }
     }
     let (radiance, view_depth, depth) = (targets.radiance, targets.view_depth, targets.depth);
-    let visibility = targets.visibility;
+    let (visibility, normal, ids) = (targets.visibility, targets.normal, targets.ids);
     builder = targets.lighting.read_in(builder, Stage::Fragment);
     builder
         .write(radiance, ImageAccess::ColorAttachmentReadWrite)
         .write(visibility, ImageAccess::ColorAttachmentReadWrite)
         .write(view_depth, ImageAccess::ColorAttachmentReadWrite)
+        .write(normal, ImageAccess::ColorAttachmentReadWrite)
+        .write(ids, ImageAccess::ColorAttachmentReadWrite)
         .write(depth, ImageAccess::DepthAttachmentWrite)
         .record(move |ctx, frame| {
             let push = frame.prepared::<crate::terrain::TerrainFrame>()?.view(pass.view)?.draw;
             let (radiance, view_depth, depth) = (ctx.image(radiance)?, ctx.image(view_depth)?, ctx.image(depth)?);
             let (vertices, indices) = (ctx.buffer(pass.vertices)?, ctx.buffer(pass.indices)?);
-            let visibility = ctx.image(visibility)?;
+            let (visibility, normal, ids) = (ctx.image(visibility)?, ctx.image(normal)?, ctx.image(ids)?);
             let cmd = ctx.cmd();
             cmd.begin_rendering(
                 &[
                     (radiance, LoadOp::Load),
                     (view_depth, LoadOp::Load),
                     (visibility, LoadOp::Load),
+                    (normal, LoadOp::Load),
+                    (ids, LoadOp::Load),
                 ],
                 Some((depth, Some(1.0))),
             );
@@ -149,4 +163,18 @@ pub fn declare_draw_pass(
             Ok(())
         });
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::CLASSIC_LAYERS;
+    use crate::texturing::layers::LayerTree;
+
+    #[test]
+    fn classic_types_name_layers_of_the_built_in_tree() {
+        let tree = LayerTree::default_tree();
+        for (name, index) in CLASSIC_LAYERS {
+            assert_eq!(tree.layers[index as usize].layer.name, name);
+        }
+    }
 }

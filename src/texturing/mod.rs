@@ -21,10 +21,12 @@
 //! * [`streaming`]: quadtree, atlas and budget settings, sized from the
 //!   frame's views;
 //! * [`stats`]: streaming statistics per frame and over a run;
-//! * [`reference`]: the CPU twin of the shaders' evaluation, for tests.
+//! * [`reference`]: the CPU twin of the shaders' evaluation, for tests;
+//! * [`dominant`]: the dominant layer of a point (the class AOV).
 
 pub mod atlas;
 pub mod bounds;
+pub mod dominant;
 pub mod fit;
 pub mod generation;
 pub mod gpu_layout;

@@ -11,6 +11,7 @@
 //!   read.
 //! * [`Technique`]: the prepare step every technique implements.
 
+pub mod aov;
 pub mod camera;
 pub mod camera_path;
 mod frame;

@@ -28,6 +28,15 @@ pub struct TargetFormats {
     pub accumulation: Format,
     /// The lighting AOVs: sun visibility, sky visibility.
     pub visibility: Format,
+    /// The simulator AOVs ([`super::aov`]): world-space shading normal (xyz, w = 1 on
+    /// geometry, 0 for sky).
+    pub normal: Format,
+    /// Semantic class and instance id.
+    pub ids: Format,
+    /// Screen-space motion from the previous frame (pixels).
+    pub motion: Format,
+    /// Euclidean distance from the eye (metres).
+    pub distance: Format,
 }
 
 impl Default for TargetFormats {
@@ -40,6 +49,10 @@ impl Default for TargetFormats {
             display: Format::R8G8B8A8_UNORM,
             accumulation: Format::R32G32B32A32_SFLOAT,
             visibility: Format::R32G32_SFLOAT,
+            normal: Format::R16G16B16A16_SFLOAT,
+            ids: Format::R32G32_UINT,
+            motion: Format::R32G32_SFLOAT,
+            distance: Format::R32_SFLOAT,
         }
     }
 }
@@ -90,6 +103,16 @@ pub struct SceneTargets {
     /// The lighting AOVs (`formats.visibility`): sun visibility (0 = in
     /// shadow, 1 = lit) and sky visibility (1 = open sky); 1, 1 for sky.
     pub visibility: ImageId,
+    /// World-space shading normal (`formats.normal`): written by `sky` (0),
+    /// `terrain.draw` and the points passes.
+    pub normal: ImageId,
+    /// Class and instance id (`formats.ids`; [`super::aov`]): written by
+    /// `sky` (0, 0), `terrain.draw` and the points pass where one surfel wins.
+    pub ids: ImageId,
+    /// Motion in pixels from the previous frame (`formats.motion`), written by `aovs`.
+    pub motion: ImageId,
+    /// Distance from the eye, +inf for sky (`formats.distance`), written by `aovs`.
+    pub distance: ImageId,
     /// The view's lighting.
     pub lighting: LightingInputs,
 }
@@ -112,6 +135,10 @@ impl SceneTargets {
             display: image("srgb", formats.display),
             weight: weight.then(|| image("splat weight", formats.weight)),
             visibility: image("lighting visibility", formats.visibility),
+            normal: image("world normal", formats.normal),
+            ids: image("class and instance", formats.ids),
+            motion: image("motion", formats.motion),
+            distance: image("distance", formats.distance),
             lighting: LightingInputs {
                 constants,
                 images: Vec::new(),

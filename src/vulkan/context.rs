@@ -267,6 +267,7 @@ impl Context {
             vertex_pipeline_stores_and_atomics: offered.vertex_pipeline_stores_and_atomics == vk::TRUE,
         };
         let base = vk::PhysicalDeviceFeatures::default()
+            .independent_blend(true)
             .large_points(optional.large_points)
             .vertex_pipeline_stores_and_atomics(optional.vertex_pipeline_stores_and_atomics);
         let device_info = vk::DeviceCreateInfo::default()

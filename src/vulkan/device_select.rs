@@ -89,6 +89,7 @@ pub const REQUIRED_FEATURES: &[&str] = &[
     "shaderSampledImageArrayNonUniformIndexing",
     "shaderStorageImageArrayNonUniformIndexing",
     "shaderStorageBufferArrayNonUniformIndexing",
+    "independentBlend",
     "timestamp queries",
 ];
 
@@ -133,7 +134,9 @@ pub(crate) fn inspect(instance: &ash::Instance, physical: vk::PhysicalDevice, in
     } else {
         // SAFETY: the device supports Vulkan 1.3, so both feature structs are valid in the chain.
         unsafe { instance.get_physical_device_features2(physical, &mut features2) };
-        let checks: [(&str, vk::Bool32); 13] = [
+        // The ids AOV is an integer target beside blended float targets.
+        let independent_blend = features2.features.independent_blend;
+        let checks: [(&str, vk::Bool32); 14] = [
             ("dynamicRendering", v13.dynamic_rendering),
             ("synchronization2", v13.synchronization2),
             ("maintenance4", v13.maintenance4),
@@ -168,6 +171,7 @@ pub(crate) fn inspect(instance: &ash::Instance, physical: vk::PhysicalDevice, in
                 "shaderStorageBufferArrayNonUniformIndexing",
                 v12.shader_storage_buffer_array_non_uniform_indexing,
             ),
+            ("independentBlend", independent_blend),
         ];
         checks
             .iter()

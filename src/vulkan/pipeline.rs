@@ -80,7 +80,7 @@ pub struct VertexAttribute {
     pub offset: u32,
 }
 
-/// Blending of colour attachments.
+/// Blending of colour attachments (integer attachments are always replaced).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Blend {
     /// Replace.
@@ -89,6 +89,32 @@ pub enum Blend {
     Additive,
     /// Premultiplied-alpha over.
     PremultipliedOver,
+}
+
+/// Whether `format` holds unsigned or signed integers (no blending).
+fn is_integer_format(format: vk::Format) -> bool {
+    use vk::Format as F;
+    matches!(
+        format,
+        F::R8_UINT
+            | F::R8_SINT
+            | F::R8G8_UINT
+            | F::R8G8_SINT
+            | F::R8G8B8A8_UINT
+            | F::R8G8B8A8_SINT
+            | F::R16_UINT
+            | F::R16_SINT
+            | F::R16G16_UINT
+            | F::R16G16_SINT
+            | F::R16G16B16A16_UINT
+            | F::R16G16B16A16_SINT
+            | F::R32_UINT
+            | F::R32_SINT
+            | F::R32G32_UINT
+            | F::R32G32_SINT
+            | F::R32G32B32A32_UINT
+            | F::R32G32B32A32_SINT
+    )
 }
 
 /// Fixed-function state of a graphics pipeline.
@@ -226,7 +252,11 @@ impl GraphicsPipeline {
                 .alpha_blend_op(vk::BlendOp::ADD),
         }
         .color_write_mask(vk::ColorComponentFlags::RGBA);
-        let attachments = vec![attachment; desc.color_formats.len()];
+        // Integer attachments (ids) cannot blend: they are always replaced.
+        let replace = vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA);
+        let attachments: Vec<_> = (desc.color_formats.iter())
+            .map(|&f| if is_integer_format(f) { replace } else { attachment })
+            .collect();
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);

@@ -98,6 +98,9 @@ pub struct GpuInstance {
     pub model_view: [f32; 16],
     /// Scale, first splat (u32 bits), prefix length (u32 bits), first hybrid triangle (u32 bits).
     pub params: [f32; 4],
+    /// Semantic class, instance id (1-based index of the scene's instance;
+    /// `crate::view::aov`), 0, 0.
+    pub ids: [u32; 4],
 }
 
 /// Bytes of [`FrameHeader`].

@@ -5,10 +5,10 @@
 //! | pass | mode | what |
 //! |---|---|---|
 //! | (`prepare`) | both | CPU prefix per instance ([`selection`]) and instance records, before recording ([`PointRenderer`]) |
-//! | `points.visibility` | ewa | depth only: ray–plane depth pushed back by ε |
-//! | `points.accumulate` | ewa | depth test ≤ without writes, additive (w·colour, w), (w·normal, w·depth) into float targets |
-//! | `points.normalize` | ewa | full screen: divide by w, shade, write radiance, view depth and W |
-//! | `points.opaque` | opaque | opaque discs with ray–plane depth, shaded directly |
+//! | `points.visibility` | ewa | depth: ray–plane depth pushed back by ε; the ids of the winning surfel |
+//! | `points.accumulate` | ewa | depth test ≤ without writes, additive (w·colour, w), (w·normal, w·depth) into float targets; the ids of the last surfel |
+//! | `points.normalize` | ewa | full screen: divide by w, shade, write radiance, view depth, W, world normal and ids (the winner's, else the last surfel's) |
+//! | `points.opaque` | opaque | opaque discs with ray–plane depth, shaded directly, with normal and ids |
 //!
 //! The graph derives every barrier between them. Shaders: `glsl/points/`.
 

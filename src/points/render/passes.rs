@@ -66,7 +66,11 @@ struct NormalizePush {
     frame: u32,
     /// Sampled (normal·w, depth·w) target.
     normal_depth: u32,
-    _pad: [u32; 5],
+    _pad: u32,
+    /// Sampled ids of the nearest surfel and of any accumulated surfel.
+    nearest_ids: u32,
+    any_ids: u32,
+    _pad2: [u32; 2],
 }
 
 /// The buffers every points pass reads, and the splat settings they use.
@@ -92,6 +96,9 @@ pub(super) struct PointView {
     pub weight: ImageId,
     /// The lighting AOVs.
     pub visibility: ImageId,
+    /// The world normal and ids AOVs (`crate::view::aov`).
+    pub normal: ImageId,
+    pub ids: ImageId,
     /// The view's lighting constants.
     pub lighting: UploadRegion,
     /// Clear the depth buffer first (no terrain drew into it).
@@ -290,12 +297,8 @@ pub(super) fn declare_opaque(
     (buffers, view): (PointBuffers, PointView),
     targets: &SceneTargets,
 ) -> Result<()> {
-    let formats = vec![
-        targets.formats.radiance,
-        targets.formats.view_depth,
-        targets.formats.weight,
-        targets.formats.visibility,
-    ];
+    let f = &targets.formats;
+    let formats = vec![f.radiance, f.view_depth, f.weight, f.visibility, f.normal, f.ids];
     let spec = |name, fragment| PipelineSpec {
         name,
         shaders: (shaders::SPLAT_VERT, fragment),
@@ -321,6 +324,8 @@ pub(super) fn declare_opaque(
         .write(view.view_depth, ImageAccess::ColorAttachmentReadWrite)
         .write(view.weight, ImageAccess::ColorAttachmentWrite)
         .write(view.visibility, ImageAccess::ColorAttachmentReadWrite)
+        .write(view.normal, ImageAccess::ColorAttachmentReadWrite)
+        .write(view.ids, ImageAccess::ColorAttachmentReadWrite)
         .write(view.depth, ImageAccess::DepthAttachmentWrite)
         .record(move |pass, frame| {
             let plan = plan_of(frame, view.index)?;
@@ -328,7 +333,11 @@ pub(super) fn declare_opaque(
             let triangles = buffers.triangle_handle(pass)?;
             let (radiance, view_depth) = (pass.image(view.radiance)?, pass.image(view.view_depth)?);
             let (weight, depth) = (pass.image(view.weight)?, pass.image(view.depth)?);
-            let visibility = pass.image(view.visibility)?;
+            let (visibility, normal, ids) = (
+                pass.image(view.visibility)?,
+                pass.image(view.normal)?,
+                pass.image(view.ids)?,
+            );
             let cmd = pass.cmd();
             cmd.begin_rendering(
                 &[
@@ -336,6 +345,8 @@ pub(super) fn declare_opaque(
                     (view_depth, LoadOp::Load),
                     (weight, LoadOp::Clear([0.0; 4])),
                     (visibility, LoadOp::Load),
+                    (normal, LoadOp::Load),
+                    (ids, LoadOp::Load),
                 ],
                 Some((depth, view.clear_depth.then_some(1.0))),
             );
@@ -348,11 +359,16 @@ pub(super) fn declare_opaque(
 }
 
 /// The two float targets of EWA accumulation (§10.2): (colour·w, w) and
-/// (normal·w, depth·w).
+/// (normal·w, depth·w); and the ids (`crate::view::aov`) of the surfel that
+/// won the visibility pass, and of the last surfel accumulated (where the
+/// winner's pushed-back depth lost against the terrain's, but the surface
+/// is in front of it).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Accumulation {
     pub color_weight: ImageId,
     pub normal_depth: ImageId,
+    pub nearest_ids: ImageId,
+    pub any_ids: ImageId,
 }
 
 /// `points.visibility`, `points.accumulate` and `points.normalize`: the
@@ -364,29 +380,33 @@ pub(super) fn declare_ewa(
     (buffers, view): (PointBuffers, PointView),
     targets: &SceneTargets,
 ) -> Result<()> {
-    let info = crate::graph::ImageInfo::new(targets.width, targets.height, targets.formats.accumulation);
+    let info = |format| crate::graph::ImageInfo::new(targets.width, targets.height, format);
     let accumulation = Accumulation {
-        color_weight: graph.create_image("splat colour·w, w", info.clone()),
-        normal_depth: graph.create_image("splat normal·w, depth·w", info),
+        color_weight: graph.create_image("splat colour·w, w", info(targets.formats.accumulation)),
+        normal_depth: graph.create_image("splat normal·w, depth·w", info(targets.formats.accumulation)),
+        nearest_ids: graph.create_image("splat ids, nearest", info(targets.formats.ids)),
+        any_ids: graph.create_image("splat ids, any", info(targets.formats.ids)),
     };
-    declare_visibility(ctx, graph, names[0], (buffers, view), targets)?;
+    declare_visibility(ctx, graph, names[0], (buffers, view), targets, accumulation.nearest_ids)?;
     declare_accumulate(ctx, graph, names[1], (buffers, view), targets, accumulation)?;
     declare_normalize(ctx, graph, names[2], view, targets, accumulation)
 }
 
 /// `points.visibility`: ray–plane depth pushed back by ε (§10.2.3), hybrid
-/// triangles first.
+/// triangles first; the ids of the surfel that wins the depth test (a
+/// single surfel per pixel: ids are never blended) into `ids`.
 fn declare_visibility(
     ctx: &Context,
     graph: &mut RenderGraph<Frame>,
     name: &str,
     (buffers, view): (PointBuffers, PointView),
     targets: &SceneTargets,
+    ids: ImageId,
 ) -> Result<()> {
     let spec = |name, shaders| PipelineSpec {
         name,
         shaders,
-        color_formats: Vec::new(),
+        color_formats: vec![targets.formats.ids],
         blend: Blend::None,
         depth: (true, CompareOp::LESS),
     };
@@ -405,14 +425,16 @@ fn declare_visibility(
     )?;
     let builder = buffers.read_by(graph.pass(name).graphics(), view.frame, true);
     builder
+        .write(ids, ImageAccess::ColorAttachmentWrite)
         .write(view.depth, ImageAccess::DepthAttachmentWrite)
         .record(move |pass, frame| {
             let plan = plan_of(frame, view.index)?;
             let push = buffers.push(pass, view.frame, PASS_VISIBILITY, true)?;
             let triangles = buffers.triangle_handle(pass)?;
-            let depth = pass.image(view.depth)?;
+            let (ids, depth) = (pass.image(ids)?, pass.image(view.depth)?);
             let cmd = pass.cmd();
-            cmd.begin_rendering(&[], Some((depth, view.clear_depth.then_some(1.0))));
+            let clear = view.clear_depth.then_some(1.0);
+            cmd.begin_rendering(&[(ids, LoadOp::Clear([0.0; 4]))], Some((depth, clear)));
             pipelines.draw_hybrid(cmd, plan, push, triangles)?;
             pipelines.draw(cmd, plan, buffers.primitive, push)?;
             cmd.end_rendering();
@@ -422,7 +444,8 @@ fn declare_visibility(
 }
 
 /// `points.accumulate`: depth test ≤ without writes, additive (w·colour,
-/// w) and (w·normal, w·depth) into the float targets (§10.2).
+/// w) and (w·normal, w·depth) into the float targets (§10.2); the ids of
+/// the last accumulated surfel (never blended).
 fn declare_accumulate(
     ctx: &Context,
     graph: &mut RenderGraph<Frame>,
@@ -434,7 +457,11 @@ fn declare_accumulate(
     let spec = |name, shaders| PipelineSpec {
         name,
         shaders,
-        color_formats: vec![targets.formats.accumulation; 2],
+        color_formats: vec![
+            targets.formats.accumulation,
+            targets.formats.accumulation,
+            targets.formats.ids,
+        ],
         blend: Blend::Additive,
         depth: (false, CompareOp::LESS_OR_EQUAL),
     };
@@ -456,6 +483,7 @@ fn declare_accumulate(
         .read(view.depth, ImageAccess::DepthAttachmentRead)
         .write(accumulation.color_weight, ImageAccess::ColorAttachmentWrite)
         .write(accumulation.normal_depth, ImageAccess::ColorAttachmentWrite)
+        .write(accumulation.any_ids, ImageAccess::ColorAttachmentWrite)
         .record(move |pass, frame| {
             let plan = plan_of(frame, view.index)?;
             let push = buffers.push(pass, view.frame, PASS_ACCUMULATE, false)?;
@@ -464,12 +492,10 @@ fn declare_accumulate(
                 pass.image(accumulation.color_weight)?,
                 pass.image(accumulation.normal_depth)?,
             );
-            let depth = pass.image(view.depth)?;
+            let (ids, depth) = (pass.image(accumulation.any_ids)?, pass.image(view.depth)?);
+            let clear = LoadOp::Clear([0.0; 4]);
             let cmd = pass.cmd();
-            cmd.begin_rendering(
-                &[(cw, LoadOp::Clear([0.0; 4])), (nd, LoadOp::Clear([0.0; 4]))],
-                Some((depth, None)),
-            );
+            cmd.begin_rendering(&[(cw, clear), (nd, clear), (ids, clear)], Some((depth, None)));
             pipelines.draw(cmd, plan, buffers.primitive, push)?;
             pipelines.draw_hybrid(cmd, plan, push, triangles)?;
             cmd.end_rendering();
@@ -479,7 +505,8 @@ fn declare_accumulate(
 }
 
 /// `points.normalize`: full screen, divide by w, shade (sun, sky, haze),
-/// write radiance, view depth and W.
+/// write radiance, view depth, W, the world normal and the ids (the
+/// nearest surfel's, else the last accumulated one's).
 fn declare_normalize(
     ctx: &Context,
     graph: &mut RenderGraph<Frame>,
@@ -494,7 +521,14 @@ fn declare_normalize(
         &GraphicsPipelineDesc::full_screen(
             "points.normalize",
             (shaders::FULL_SCREEN_VERT, shaders::SPLAT_NORMALIZE_FRAG),
-            vec![formats.radiance, formats.view_depth, formats.weight, formats.visibility],
+            vec![
+                formats.radiance,
+                formats.view_depth,
+                formats.weight,
+                formats.visibility,
+                formats.normal,
+                formats.ids,
+            ],
         ),
     )?);
     let builder = graph.pass(name).graphics();
@@ -503,20 +537,27 @@ fn declare_normalize(
         .read_in(builder, Stage::Fragment)
         .read(accumulation.color_weight, ImageAccess::Sampled(Stage::Fragment))
         .read(accumulation.normal_depth, ImageAccess::Sampled(Stage::Fragment))
+        .read(accumulation.nearest_ids, ImageAccess::Sampled(Stage::Fragment))
+        .read(accumulation.any_ids, ImageAccess::Sampled(Stage::Fragment))
         .read(view.frame, BufferAccess::StorageRead(Stage::Fragment))
         .write(view.radiance, ImageAccess::ColorAttachmentReadWrite)
         .write(view.view_depth, ImageAccess::ColorAttachmentReadWrite)
         .write(view.weight, ImageAccess::ColorAttachmentWrite)
         .write(view.visibility, ImageAccess::ColorAttachmentReadWrite)
+        .write(view.normal, ImageAccess::ColorAttachmentReadWrite)
+        .write(view.ids, ImageAccess::ColorAttachmentReadWrite)
         .record(move |pass, _| {
             let push = NormalizePush {
                 color_weight: pass.sampled(accumulation.color_weight)?,
                 frame: pass.upload(view.frame)?,
                 normal_depth: pass.sampled(accumulation.normal_depth)?,
-                _pad: [0; 5],
+                nearest_ids: pass.sampled(accumulation.nearest_ids)?,
+                any_ids: pass.sampled(accumulation.any_ids)?,
+                ..NormalizePush::zeroed()
             };
             let (radiance, view_depth) = (pass.image(view.radiance)?, pass.image(view.view_depth)?);
             let (weight, visibility) = (pass.image(view.weight)?, pass.image(view.visibility)?);
+            let (normal, ids) = (pass.image(view.normal)?, pass.image(view.ids)?);
             let cmd = pass.cmd();
             cmd.begin_rendering(
                 &[
@@ -524,6 +565,8 @@ fn declare_normalize(
                     (view_depth, LoadOp::Load),
                     (weight, LoadOp::Clear([0.0; 4])),
                     (visibility, LoadOp::Load),
+                    (normal, LoadOp::Load),
+                    (ids, LoadOp::Load),
                 ],
                 None,
             );

@@ -71,7 +71,7 @@ pub fn plan_frame(
         instances: scene.instances.len(),
         ..FramePlan::default()
     };
-    for inst in &scene.instances {
+    for (index, inst) in scene.instances.iter().enumerate() {
         let object = &scene.objects[inst.object];
         let tree = &object.tree;
         let layout = &objects[inst.object];
@@ -106,6 +106,7 @@ pub fn plan_frame(
                 f32::from_bits(count as u32),
                 f32::from_bits(layout.first_triangle),
             ],
+            ids: [object.class.id(), index as u32 + 1, 0, 0],
         };
         let first_record = plan.records.len() as u32;
         let mut drawn = false;

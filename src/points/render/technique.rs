@@ -193,6 +193,8 @@ impl PointRenderer {
             depth: targets.depth,
             weight,
             visibility: targets.visibility,
+            normal: targets.normal,
+            ids: targets.ids,
             lighting: targets.lighting.constants,
             clear_depth,
         };
