@@ -19,15 +19,16 @@ layout(push_constant) uniform Push {
     uvec4 mode;     // x: kind
     vec4 radial;    // k1, k2, k3, p1
     vec4 tangential;  // p2
-    vec4 focal;     // fx, fy of the output; fx', fy' of the source
+    vec4 focal;     // fx', fy' of the source
     vec4 centre;    // cx', cy' of the source
+    vec4 ratios;    // fx/fx', fx/fy', fy/fx', fy/fy' (F·J·F'⁻¹ = J scaled by these)
 } pc;
 
 // The displacement `m` (source pixels) at source position `q`, in output pixels.
 vec2 carry_motion(vec2 m, vec2 q) {
     float k1 = pc.radial.x, k2 = pc.radial.y, k3 = pc.radial.z;
     float p1 = pc.radial.w, p2 = pc.tangential.x;
-    vec2 xy = (q - pc.centre.xy) / pc.focal.zw;
+    vec2 xy = (q - pc.centre.xy) / pc.focal.xy;
     float x = xy.x, y = xy.y;
     float r2 = x * x + y * y;
     float radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
@@ -35,8 +36,8 @@ vec2 carry_motion(vec2 m, vec2 q) {
     float jxx = radial + 2.0 * x * x * slope + 2.0 * p1 * y + 6.0 * p2 * x;
     float jxy = 2.0 * x * y * slope + 2.0 * p1 * x + 2.0 * p2 * y;
     float jyy = radial + 2.0 * y * y * slope + 6.0 * p1 * y + 2.0 * p2 * x;
-    vec2 n = m / pc.focal.zw;
-    return vec2(jxx * n.x + jxy * n.y, jxy * n.x + jyy * n.y) * pc.focal.xy;
+    vec4 r = pc.ratios;
+    return vec2(jxx * r.x * m.x + jxy * r.y * m.y, jxy * r.z * m.x + jyy * r.w * m.y);
 }
 
 void main() {

@@ -6,13 +6,15 @@
 //! Per pixel X with blur vector v_X = motion·shutter/dt (the motion AOV in
 //! pixels, previous → current frame; clamped to `max_length_px`), N fixed
 //! stratified samples Y = X + t·v_X, t = (i + ½)/N − ½ (no jitter: frames
-//! are deterministic), bilinear radiance at Y, the depth and blur of the
-//! texel under Y. Weights, with d = |t|·|v_X| the distance of Y from X:
+//! are deterministic), each the bilinear footprint of four texels T, each
+//! texel weighted by its bilinear weight times its own depth test (so no
+//! colour crosses a depth edge by interpolation). With d = |t|·|v_X| the
+//! distance of Y from X:
 //!
-//! * behind = clamp((z_Y − z_X)/(0.05·z_X), 0, 1) where z_Y > z_X (relative
+//! * behind = clamp((z_T − z_X)/(0.05·z_X), 0, 1) where z_T > z_X (relative
 //!   soft depth comparison: view depth spans metres to kilometres; +inf sky);
-//! * reach = clamp(|v_Y|/2 + 1 − d, 0, 1): Y's own blur covers X;
-//! * w = behind + (1 − behind)·reach.
+//! * reach = clamp(|v_T|/2 + 1 − d, 0, 1): T's own blur covers X;
+//! * w = bilinear weight · (behind + (1 − behind)·reach).
 //!
 //! A sample behind X counts fully (X is blurred over it, so it shows
 //! through); a sample in front of or level with X only as far as its own
@@ -34,7 +36,7 @@ use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 
-use super::resample::{add_weighted, bilinear, check_size, Plane};
+use super::resample::{add_weighted, check_size, Plane};
 use crate::error::{Error, Result};
 use crate::graph::{ImageAccess, ImageId, RenderGraph, Stage};
 use crate::shaders;
@@ -245,18 +247,28 @@ pub fn motion_blur_cpu(
                 (py as f32 + 0.5 + t * v[1]).clamp(0.5, h as f32 - 0.5),
             ];
             let d = t.abs() * len;
-            let (qx, qy) = (p[0].floor() as i64, p[1].floor() as i64);
-            let zy = depth.at(qx, qy)[0];
-            let behind = if zy > zx {
-                ((zy - zx) / (SOFT_DEPTH * zx)).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let reach = (0.5 * length(blur_of(qx, qy)) + 1.0 - d).clamp(0.0, 1.0);
-            let weight = behind + (1.0 - behind) * reach;
-            if weight > 0.0 {
-                add_weighted(&mut sum, weight, bilinear(radiance, [p[0] - 0.5, p[1] - 0.5]));
-                total += weight;
+            let q = [p[0] - 0.5, p[1] - 0.5];
+            let f = [q[0].floor(), q[1].floor()];
+            let s = [q[0] - f[0], q[1] - f[1]];
+            for dy in 0..2 {
+                for dx in 0..2 {
+                    let b = if dx == 0 { 1.0 - s[0] } else { s[0] } * if dy == 0 { 1.0 - s[1] } else { s[1] };
+                    if b > 0.0 {
+                        let (tx, ty) = (f[0] as i64 + dx, f[1] as i64 + dy);
+                        let zy = depth.at(tx, ty)[0];
+                        let behind = if zy > zx {
+                            ((zy - zx) / (SOFT_DEPTH * zx)).clamp(0.0, 1.0)
+                        } else {
+                            0.0
+                        };
+                        let reach = (0.5 * length(blur_of(tx, ty)) + 1.0 - d).clamp(0.0, 1.0);
+                        let weight = b * (behind + (1.0 - behind) * reach);
+                        if weight > 0.0 {
+                            add_weighted(&mut sum, weight, radiance.at(tx, ty));
+                            total += weight;
+                        }
+                    }
+                }
             }
         }
         if total > 0.0 {

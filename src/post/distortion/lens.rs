@@ -107,12 +107,16 @@ impl BrownConrady {
         let tolerance = 1e-12 * (1.0 + size(target));
         let (mut p, mut e) = (target, residual(target));
         for _ in 0..100 {
-            if !(size(e) > tolerance) {
-                return size(e).is_finite().then_some(p);
+            let error = size(e);
+            if error.is_nan() {
+                return None;
+            }
+            if error <= tolerance {
+                return Some(p);
             }
             let j = self.jacobian(p);
             let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-            if !(det > 0.0) {
+            if det.is_nan() || det <= 0.0 {
                 return None;
             }
             let step = [

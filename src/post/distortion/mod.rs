@@ -41,10 +41,12 @@ struct DistortionPush {
     radial: [f32; 4],
     /// p2; pad.
     tangential: [f32; 4],
-    /// fx, fy of the output; fx', fy' of the source.
+    /// fx', fy' of the source; pad.
     focal: [f32; 4],
     /// cx', cy' of the source; pad.
     centre: [f32; 4],
+    /// fx/fx', fx/fy', fy/fx', fy/fy'.
+    ratios: [f32; 4],
 }
 
 /// The lens parameters the shader (and its twin) use for motion, in f32.
@@ -52,8 +54,11 @@ struct DistortionPush {
 struct MotionLens {
     radial: [f32; 4],
     p2: f32,
-    focal: [f32; 4],
+    focal: [f32; 2],
     centre: [f32; 2],
+    /// F·J·F'⁻¹ is J with its entries scaled by these (exactly 1 without
+    /// distortion, so the identity carries motion bit for bit).
+    ratios: [f32; 4],
 }
 
 impl MotionLens {
@@ -62,8 +67,9 @@ impl MotionLens {
         MotionLens {
             radial: [l.k1 as f32, l.k2 as f32, l.k3 as f32, l.p1 as f32],
             p2: l.p2 as f32,
-            focal: [k.fx as f32, k.fy as f32, s.fx as f32, s.fy as f32],
+            focal: [s.fx as f32, s.fy as f32],
             centre: [s.cx as f32, s.cy as f32],
+            ratios: [k.fx / s.fx, k.fx / s.fy, k.fy / s.fx, k.fy / s.fy].map(|r| r as f32),
         }
     }
 
@@ -72,18 +78,18 @@ impl MotionLens {
     fn carry(&self, m: [f32; 2], q: [f32; 2]) -> [f32; 2] {
         let [k1, k2, k3, p1] = self.radial;
         let p2 = self.p2;
-        let x = (q[0] - self.centre[0]) / self.focal[2];
-        let y = (q[1] - self.centre[1]) / self.focal[3];
+        let x = (q[0] - self.centre[0]) / self.focal[0];
+        let y = (q[1] - self.centre[1]) / self.focal[1];
         let r2 = x * x + y * y;
         let radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
         let slope = k1 + r2 * (2.0 * k2 + r2 * 3.0 * k3);
         let jxx = radial + 2.0 * x * x * slope + 2.0 * p1 * y + 6.0 * p2 * x;
         let jxy = 2.0 * x * y * slope + 2.0 * p1 * x + 2.0 * p2 * y;
         let jyy = radial + 2.0 * y * y * slope + 6.0 * p1 * y + 2.0 * p2 * x;
-        let n = [m[0] / self.focal[2], m[1] / self.focal[3]];
+        let r = self.ratios;
         [
-            (jxx * n[0] + jxy * n[1]) * self.focal[0],
-            (jxy * n[0] + jyy * n[1]) * self.focal[1],
+            jxx * r[0] * m[0] + jxy * r[1] * m[1],
+            jxy * r[2] * m[0] + jyy * r[3] * m[1],
         ]
     }
 }
@@ -152,8 +158,9 @@ impl LensDistortion {
                     mode: [image.kind, 0, 0, 0],
                     radial: lens.radial,
                     tangential: [lens.p2, 0.0, 0.0, 0.0],
-                    focal: lens.focal,
+                    focal: [lens.focal[0], lens.focal[1], 0.0, 0.0],
                     centre: [lens.centre[0], lens.centre[1], 0.0, 0.0],
+                    ratios: lens.ratios,
                 })
             },
         );
