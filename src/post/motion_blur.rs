@@ -209,6 +209,9 @@ pub fn motion_blur_cpu(
     settings: &MotionBlurSettings,
 ) -> Result<Plane<[f32; 4]>> {
     settings.check()?;
+    radiance.check("motion_blur radiance")?;
+    depth.check("motion_blur depth")?;
+    motion.check("motion_blur motion")?;
     let (w, h) = (radiance.width, radiance.height);
     if (depth.width, depth.height) != (w, h) || (motion.width, motion.height) != (w, h) {
         return Err(Error::invalid(
@@ -318,6 +321,18 @@ mod tests {
             let e = s.check().unwrap_err().to_string();
             assert!(e.contains(name) && !e.contains('\n'), "{e}");
         }
+    }
+
+    #[test]
+    fn the_twin_refuses_planes_of_other_sizes() {
+        let (a, b) = (flat(4, 3, [1.0; 4]), flat(3, 4, [1.0; 4]));
+        let e = motion_blur_cpu(&a, &a, &b, &MotionBlurSettings::default()).unwrap_err();
+        assert!(e.to_string().contains("motion_blur size"), "{e}");
+        let hollow = Plane {
+            texels: Vec::new(),
+            ..a.clone()
+        };
+        assert!(motion_blur_cpu(&hollow, &a, &a, &MotionBlurSettings::default()).is_err());
     }
 
     #[test]

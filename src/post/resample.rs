@@ -116,8 +116,11 @@ pub(crate) fn check_images(pass: &str, images: &[ResampleImage]) -> Result<Vec<C
                     ),
                 ));
             }
-            if image.kind == ImageKind::Motion && matches!(image.format, Format::R32_SFLOAT) {
-                return Err(Error::invalid(&parameter, "a motion image needs two channels (x, y)"));
+            if image.kind == ImageKind::Motion && matches!(image.format, Format::R32_SFLOAT | Format::R8G8B8A8_UNORM) {
+                return Err(Error::invalid(
+                    &parameter,
+                    "a motion image needs two signed float channels (x, y)",
+                ));
             }
             if images.iter().any(|other| other.target == image.source) {
                 return Err(Error::invalid(&parameter, "its source is also a target of the pass"));
@@ -203,7 +206,19 @@ impl<T: Copy> Plane<T> {
         }
     }
 
-    /// The texel at (`x`, `y`), clamped to the edge.
+    /// Checks that the plane has a size and a texel per pixel; errors name `parameter`.
+    pub fn check(&self, parameter: &str) -> Result<()> {
+        check_size(parameter, (self.width, self.height))?;
+        if self.texels.len() != self.width as usize * self.height as usize {
+            return Err(Error::invalid(
+                parameter,
+                format!("{} texels for {}×{}", self.texels.len(), self.width, self.height),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The texel at (`x`, `y`), clamped to the edge (of a checked plane).
     pub fn at(&self, x: i64, y: i64) -> T {
         let x = x.clamp(0, i64::from(self.width) - 1) as usize;
         let y = y.clamp(0, i64::from(self.height) - 1) as usize;

@@ -215,29 +215,23 @@ pub fn nearest_source_texel(i: u32, target: u32, source: u32) -> u32 {
 }
 
 /// The CPU twin of `post.resolve` for a float image of `kind` (what the GPU
-/// must match to f32 rounding).
+/// must match to f32 rounding); errors as [`Resolve::declare`]'s.
 pub fn resolve_cpu(
     source: &Plane<[f32; 4]>,
     target_size: (u32, u32),
     kind: ImageKind,
     filter: ResolveFilter,
-) -> Plane<[f32; 4]> {
+) -> Result<Plane<[f32; 4]>> {
     let desc = ResolveDesc {
         source_size: (source.width, source.height),
         target_size,
         filter,
     };
+    desc.check()?;
+    source.check("resolve source")?;
     let (scale, motion) = (desc.scale(), desc.motion_factors());
-    match kind {
-        ImageKind::Exact => resolve_exact_cpu(source, target_size),
-        ImageKind::Motion => {
-            let mut plane = resolve_exact_cpu(source, target_size);
-            for m in &mut plane.texels {
-                m[0] *= motion[0];
-                m[1] *= motion[1];
-            }
-            plane
-        }
+    let mut plane = match kind {
+        ImageKind::Exact | ImageKind::Motion => resolve_exact_cpu(source, target_size)?,
         ImageKind::Filtered => Plane::from_fn(target_size.0, target_size.1, |i, j| {
             let (xs, ys) = (
                 taps(i, scale[0], source.width, filter),
@@ -256,17 +250,31 @@ pub fn resolve_cpu(
             }
             sum.map(|s| s / total)
         }),
+    };
+    if kind == ImageKind::Motion {
+        for m in &mut plane.texels {
+            m[0] *= motion[0];
+            m[1] *= motion[1];
+        }
     }
+    Ok(plane)
 }
 
 /// The CPU twin of `post.resolve` for an Exact image of any texel type.
-pub fn resolve_exact_cpu<T: Copy>(source: &Plane<T>, (width, height): (u32, u32)) -> Plane<T> {
-    Plane::from_fn(width, height, |i, j| {
+pub fn resolve_exact_cpu<T: Copy>(source: &Plane<T>, (width, height): (u32, u32)) -> Result<Plane<T>> {
+    ResolveDesc {
+        source_size: (source.width, source.height),
+        target_size: (width, height),
+        filter: ResolveFilter::Box,
+    }
+    .check()?;
+    source.check("resolve source")?;
+    Ok(Plane::from_fn(width, height, |i, j| {
         source.at(
             i64::from(nearest_source_texel(i, width, source.width)),
             i64::from(nearest_source_texel(j, height, source.height)),
         )
-    })
+    }))
 }
 
 #[cfg(test)]
@@ -310,6 +318,19 @@ mod tests {
         assert_eq!(nearest_source_texel(0, 10, 40), 2);
         assert_eq!(nearest_source_texel(9, 10, 14), 13);
         assert_eq!(nearest_source_texel(4, 7, 7), 4);
+    }
+
+    #[test]
+    fn twins_refuse_bad_planes() {
+        let short = Plane {
+            width: 4,
+            height: 4,
+            texels: vec![[0.0f32; 4]; 15],
+        };
+        let e = resolve_cpu(&short, (2, 2), ImageKind::Filtered, ResolveFilter::Box).unwrap_err();
+        assert!(e.to_string().contains("resolve source"), "{e}");
+        let empty: Plane<[u32; 4]> = Plane::from_fn(0, 3, |_, _| [0; 4]);
+        assert!(resolve_exact_cpu(&empty, (1, 1)).is_err());
     }
 
     #[test]

@@ -43,7 +43,7 @@ fn resolve_matches_its_cpu_twin_at_every_factor() {
                 let input = frame.input(&name, format, &Texels::Float(texels.clone()));
                 let output = frame.output(&format!("{name} resolved"), format, TARGET.0, TARGET.1);
                 images.push(ResampleImage::new(input, output, format, kind));
-                let cpu = resolve_cpu(&texels, TARGET, kind, filter);
+                let cpu = resolve_cpu(&texels, TARGET, kind, filter).expect("twin");
                 expected.push(Texels::Float(Plane {
                     texels: cpu.texels.iter().map(|&t| as_fetched(format, t)).collect(),
                     ..cpu
@@ -57,7 +57,7 @@ fn resolve_matches_its_cpu_twin_at_every_factor() {
             );
             let output = frame.output(&format!("{case} ids resolved"), Format::R32G32_UINT, TARGET.0, TARGET.1);
             images.push(ResampleImage::new(input, output, Format::R32G32_UINT, ImageKind::Exact));
-            expected.push(Texels::Uint(resolve_exact_cpu(&id_texels, TARGET)));
+            expected.push(Texels::Uint(resolve_exact_cpu(&id_texels, TARGET).expect("twin")));
             let desc = ResolveDesc {
                 source_size: source,
                 target_size: TARGET,
@@ -221,6 +221,9 @@ fn bad_image_lists_are_errors_naming_the_image() {
         // A valid declaration still runs cleanly after the refused ones.
         let ok = [ResampleImage::new(input, output, Format::R32G32_UINT, ImageKind::Exact)];
         resolve.declare(&mut frame.graph, "", &desc, &ok).expect("declare");
-        assert_eq!(frame.run()[0], Texels::Uint(resolve_exact_cpu(ids.uint(), (4, 4))));
+        assert_eq!(
+            frame.run()[0],
+            Texels::Uint(resolve_exact_cpu(ids.uint(), (4, 4)).expect("twin"))
+        );
     });
 }

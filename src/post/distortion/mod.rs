@@ -21,7 +21,7 @@ use bytemuck::{Pod, Zeroable};
 pub use lens::{source_intrinsics, source_map, BrownConrady, DistortedCamera, Intrinsics, SourceMap, SourceView};
 
 use super::resample::{bilinear, check_images, declare_pass, ImageKind, Plane, ResampleImage};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::graph::RenderGraph;
 use crate::shaders;
 use crate::view::pass_name;
@@ -175,10 +175,15 @@ fn nearest(q: [f32; 2]) -> (i64, i64) {
 
 /// The CPU twin of `post.distortion` for a float image of `kind`, sampled
 /// where `distortion`'s map says (what the GPU must match to f32 rounding).
-pub fn distortion_cpu(distortion: &LensDistortionCpu, source: &Plane<[f32; 4]>, kind: ImageKind) -> Plane<[f32; 4]> {
+pub fn distortion_cpu(
+    distortion: &LensDistortionCpu,
+    source: &Plane<[f32; 4]>,
+    kind: ImageKind,
+) -> Result<Plane<[f32; 4]>> {
     let map = &distortion.map;
+    check_planes(map, source)?;
     let lens = MotionLens::new(&distortion.camera, &distortion.source);
-    Plane::from_fn(map.width, map.height, |i, j| {
+    Ok(Plane::from_fn(map.width, map.height, |i, j| {
         let q = map.positions[(j * map.width + i) as usize];
         let (x, y) = nearest(q);
         match kind {
@@ -190,15 +195,28 @@ pub fn distortion_cpu(distortion: &LensDistortionCpu, source: &Plane<[f32; 4]>, 
                 [mx, my, m[2], m[3]]
             }
         }
-    })
+    }))
+}
+
+/// A map with a position per pixel, a source with a texel per pixel.
+fn check_planes<T: Copy>(map: &SourceMap, source: &Plane<T>) -> Result<()> {
+    source.check("distortion source")?;
+    if map.positions.len() != map.width as usize * map.height as usize {
+        return Err(Error::invalid(
+            "distortion map",
+            format!("{} positions for {}×{}", map.positions.len(), map.width, map.height),
+        ));
+    }
+    Ok(())
 }
 
 /// The CPU twin of `post.distortion` for an Exact image of any texel type.
-pub fn distortion_exact_cpu<T: Copy>(map: &SourceMap, source: &Plane<T>) -> Plane<T> {
-    Plane::from_fn(map.width, map.height, |i, j| {
+pub fn distortion_exact_cpu<T: Copy>(map: &SourceMap, source: &Plane<T>) -> Result<Plane<T>> {
+    check_planes(map, source)?;
+    Ok(Plane::from_fn(map.width, map.height, |i, j| {
         let (x, y) = nearest(map.positions[(j * map.width + i) as usize]);
         source.at(x, y)
-    })
+    }))
 }
 
 /// What the CPU twin needs of a lens distortion (no GPU).
