@@ -82,3 +82,9 @@ pub const ATMOSPHERE_TRANSMITTANCE: SpirV = spirv!("lighting/atmosphere_transmit
 pub const ATMOSPHERE_MULTISCATTERING: SpirV = spirv!("lighting/atmosphere_multiscattering.comp");
 /// lighting.sky_view: the physical atmosphere's sky-view table of a view (compute).
 pub const ATMOSPHERE_SKY_VIEW: SpirV = spirv!("lighting/atmosphere_sky_view.comp");
+/// post.resolve: a supersampled image down to the output size (§3.3).
+pub const POST_RESOLVE: SpirV = spirv!("post/resolve.comp");
+/// post.distortion: Brown–Conrady lens distortion by a per-pixel source map (§3.3).
+pub const POST_DISTORTION: SpirV = spirv!("post/distortion.comp");
+/// post.motion_blur: velocity-based motion blur (§3.3).
+pub const POST_MOTION_BLUR: SpirV = spirv!("post/motion_blur.comp");
