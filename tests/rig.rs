@@ -107,7 +107,8 @@ fn every_view_of_a_ring6_rig_equals_its_camera_rendered_alone() {
     assert_validation_clean(&report);
 }
 
-/// A principal point at the left edge shows the right half of a centred
+/// A principal point on the left edge (OpenCV's pixel centres at
+/// integers: the edge is −½) shows the right half of a centred
 /// camera twice as wide with the same focal length; views of different
 /// sizes render in one frame.
 #[test]
@@ -124,8 +125,8 @@ fn off_axis_intrinsics_render_a_crop_of_the_centred_camera() {
             intrinsics: Some(Intrinsics {
                 fx: f,
                 fy: f,
-                cx: 64.0,
-                cy: 32.0,
+                cx: 63.5,
+                cy: 31.5,
             }),
             distortion: None,
         };
@@ -136,8 +137,8 @@ fn off_axis_intrinsics_render_a_crop_of_the_centred_camera() {
             intrinsics: Some(Intrinsics {
                 fx: f,
                 fy: f,
-                cx: 0.0,
-                cy: 32.0,
+                cx: -0.5,
+                cy: 31.5,
             }),
             distortion: None,
         };

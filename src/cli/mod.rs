@@ -178,7 +178,7 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
 /// The rig of the scene arguments and the views a frame renders.
 pub(crate) fn views(args: &SceneArgs) -> Result<(Option<alpenglow::renderer::Rig>, Vec<ViewSpec>)> {
     let rig = args.camera.rig(args.width)?;
-    let specs = args.camera.view_specs(rig.as_ref(), (args.width, args.height))?;
+    let specs = args.camera.view_specs(rig.as_ref(), (args.width, args.height), args.fov_y)?;
     Ok((rig, specs))
 }
 
@@ -190,6 +190,8 @@ fn render_settings(args: &SceneArgs, scene: &Scene, views: &[ViewSpec], readback
         width: args.width,
         height: args.height,
         views: views.to_vec(),
+        msaa: args.camera.msaa,
+        motion_blur: args.camera.motion_blur()?,
         readback,
         terrain: terrain_settings(&args.terrain)?,
         points: points::splat_settings(&args.points, args.fov_y, args.height)?,

@@ -40,6 +40,18 @@ pub struct CameraArgs {
     /// A built-in rig: ring6 (six 60° views around the camera, 4:3, --width wide).
     #[arg(long = "rig-preset", value_enum, conflicts_with_all = ["intrinsics", "distortion"])]
     pub rig_preset: Option<RigPreset>,
+    /// Anti-aliasing: samples per pixel, 1, 2, 4, 8 or 16 (supersampled
+    /// render, each side ×√N, resolved with exact AOVs).
+    #[arg(long, default_value_t = 1)]
+    pub msaa: u32,
+    /// Motion blur: the shutter's open time in seconds (0: off), along the
+    /// motion AOV from frame to frame.
+    #[arg(long, default_value_t = 0.0)]
+    pub shutter: f32,
+    /// Frames per second of the sequence (`fly`, and the motion that the
+    /// shutter time is a part of).
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f32,
 }
 
 /// Built-in rigs.
@@ -60,12 +72,17 @@ impl CameraArgs {
     }
 
     /// The views a frame renders: the rig's, or one view of `size`.
-    pub fn view_specs(&self, rig: Option<&Rig>, size: (u32, u32)) -> Result<Vec<ViewSpec>> {
+    pub fn view_specs(&self, rig: Option<&Rig>, size: (u32, u32), fov_y: f64) -> Result<Vec<ViewSpec>> {
         Ok(match rig {
             Some(rig) => rig.specs(size)?,
             None => {
+                // A distorted lens needs fixed intrinsics: those of --fov-y by default.
+                let intrinsics = match (self.intrinsics, self.distortion) {
+                    (None, Some(_)) => Some(Intrinsics::from_fov_y(fov_y, size.0, size.1)),
+                    (k, _) => k,
+                };
                 let spec = ViewSpec {
-                    intrinsics: self.intrinsics,
+                    intrinsics,
                     distortion: self.distortion,
                     ..ViewSpec::new(size.0, size.1)
                 };
@@ -73,6 +90,23 @@ impl CameraArgs {
                 vec![spec]
             }
         })
+    }
+
+    /// The motion blur of --shutter and --fps (None for a shutter of 0).
+    pub fn motion_blur(&self) -> Result<Option<alpenglow::post::motion_blur::MotionBlurSettings>> {
+        if !(self.fps.is_finite() && self.fps > 0.0 && self.fps <= 1000.0) {
+            bail!("invalid --fps {}: must be in (0, 1000]", self.fps);
+        }
+        if self.shutter == 0.0 {
+            return Ok(None);
+        }
+        let settings = alpenglow::post::motion_blur::MotionBlurSettings {
+            shutter_s: self.shutter,
+            frame_interval_s: 1.0 / self.fps,
+            ..Default::default()
+        };
+        settings.check()?;
+        Ok(Some(settings))
     }
 
     /// `camera` placed by --pose or --eye with --rotation.

@@ -23,6 +23,7 @@ mod aov_readback;
 mod lighting;
 mod readback;
 pub mod scene;
+mod view_chain;
 
 use std::sync::Arc;
 
@@ -32,6 +33,7 @@ pub use readback::FrameImages;
 pub use scene::Scene;
 
 use readback::Readback;
+use view_chain::ViewChain;
 
 use crate::error::{Error, Result};
 use crate::graph::{BakedGraph, FrameOutcome, RenderGraph};
@@ -40,6 +42,8 @@ use crate::lighting::sky::Sky;
 use crate::lighting::technique::SceneLighting;
 use crate::points::render::{PointFrameStats, PointRenderer, SplatSettings};
 use crate::post::aovs::Aovs;
+use crate::post::motion_blur::{MotionBlur, MotionBlurSettings};
+use crate::post::resolve::Resolve;
 use crate::post::exposure::ExposureMeter;
 use crate::post::tonemap::Tonemap;
 use crate::profile::FrameProfile;
@@ -62,6 +66,11 @@ pub struct RenderSettings {
     /// The views every frame renders (1 to [`MAX_VIEWS`]); empty: one
     /// unnamed `width`×`height` view.
     pub views: Vec<ViewSpec>,
+    /// Anti-aliasing: samples per pixel (1, 2, 4, 8 or 16), rendered as a
+    /// supersampled image (each side ×√samples) and resolved.
+    pub msaa: u32,
+    /// Motion blur (§3.3) along the motion AOV; None: off.
+    pub motion_blur: Option<MotionBlurSettings>,
     /// Copy HDR, depth and sRGB images to host memory every frame.
     pub readback: bool,
     pub terrain: TerrainSettings,
@@ -87,6 +96,8 @@ impl RenderSettings {
             width,
             height,
             views: Vec::new(),
+            msaa: 1,
+            motion_blur: None,
             readback: true,
             terrain: TerrainSettings::default(),
             points: SplatSettings::default(),
@@ -138,7 +149,10 @@ pub struct Renderer {
     ctx: Context,
     frames: FrameRing,
     graph: BakedGraph<Frame>,
+    /// The output images.
     views: Vec<ViewSpec>,
+    /// What the techniques render for each (supersampled, undistorted).
+    render_specs: Vec<ViewSpec>,
     /// Per view, when reading back.
     readback: Option<Vec<Readback>>,
     lighting: Lighting,
@@ -171,8 +185,13 @@ impl Renderer {
             ));
         }
         let mut graph = RenderGraph::new();
+        let chains: Vec<ViewChain> = (specs.iter())
+            .map(|s| ViewChain::new(ctx, s, settings.msaa))
+            .collect::<Result<_>>()?;
         // The views the graph is declared for; every frame brings their cameras.
-        let views: Vec<View> = specs.iter().map(|s| s.view(scene.default_camera())).collect();
+        let views: Vec<View> = (chains.iter())
+            .map(|c| c.render.view(scene.default_camera()))
+            .collect();
         let lighting = settings.lighting.unwrap_or_else(|| scene.default_lighting());
         lighting.validate()?;
         let points_present = !scene.points.is_empty();
@@ -248,12 +267,19 @@ impl Renderer {
         }
         let exposure = ExposureMeter::new(ctx)?;
         let tonemap = Tonemap::new(ctx)?;
+        let resolve = Resolve::new(ctx)?;
+        let blur = match settings.motion_blur {
+            Some(s) if s.shutter_s > 0.0 => Some((MotionBlur::new(ctx)?, s)),
+            _ => None,
+        };
         let mut readback = Vec::new();
-        for (view, targets) in views.iter().zip(&targets) {
-            let exposure = exposure.declare(&mut graph, view, targets);
-            tonemap.declare(&mut graph, view, targets, exposure);
+        for ((view, rendered), chain) in views.iter().zip(&targets).zip(&chains) {
+            let blur = blur.as_ref().map(|(b, s)| (b, *s));
+            let targets = chain.declare(&mut graph, rendered, (&resolve, blur))?;
+            let exposure = exposure.declare(&mut graph, view, &targets);
+            tonemap.declare(&mut graph, view, &targets, exposure);
             match settings.readback {
-                true => readback.push(Readback::declare(ctx, &mut graph, view, targets)?),
+                true => readback.push(Readback::declare(ctx, &mut graph, view, &targets)?),
                 false => graph.keep(targets.display),
             }
         }
@@ -264,6 +290,7 @@ impl Renderer {
             graph,
             readback: settings.readback.then_some(readback),
             views: specs,
+            render_specs: chains.into_iter().map(|c| c.render).collect(),
             lighting,
             frames_rendered: 0,
             techniques: Techniques {
@@ -328,7 +355,7 @@ impl Renderer {
                 format!("{} cameras for {} views", cameras.len(), self.views.len()),
             ));
         }
-        let views: Vec<View> = (self.views.iter().zip(cameras))
+        let views: Vec<View> = (self.render_specs.iter().zip(cameras))
             .map(|(spec, camera)| {
                 let view = spec.view(*camera);
                 view.validate()?;

@@ -7,10 +7,10 @@ use glam::{DMat4, DVec4};
 
 use crate::error::{Error, Result};
 
-/// Pinhole intrinsics of an image, in pixels (OpenCV's K): a camera-space
-/// point (x right, y down, z forward) lands at pixel
-/// `(fx·x/z + cx, fy·y/z + cy)`, where pixel (0, 0) is the top-left corner
-/// of the first pixel (so the centre of a W×H image is (W/2, H/2)).
+/// Pinhole intrinsics of an image, in pixels (OpenCV's K and convention):
+/// a camera-space point (x right, y down, z forward) lands at pixel
+/// `(fx·x/z + cx, fy·y/z + cy)`, where pixel (i, j)'s centre is at (i, j)
+/// (so the centre of a W×H image is ((W − 1)/2, (H − 1)/2)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Intrinsics {
     pub fx: f64,
@@ -27,8 +27,8 @@ impl Intrinsics {
         Intrinsics {
             fx: fy,
             fy,
-            cx: 0.5 * f64::from(width),
-            cy: 0.5 * f64::from(height),
+            cx: 0.5 * f64::from(width) - 0.5,
+            cy: 0.5 * f64::from(height) - 0.5,
         }
     }
 
@@ -72,10 +72,8 @@ impl Intrinsics {
     /// principal point lies outside the image).
     pub fn half_tangents(&self, width: u32, height: u32) -> ((f64, f64), (f64, f64)) {
         let (w, h) = (f64::from(width), f64::from(height));
-        (
-            (self.cx / self.fx, (w - self.cx) / self.fx),
-            (self.cy / self.fy, (h - self.cy) / self.fy),
-        )
+        let (cx, cy) = (self.cx + 0.5, self.cy + 0.5);
+        ((cx / self.fx, (w - cx) / self.fx), (cy / self.fy, (h - cy) / self.fy))
     }
 
     /// The symmetric frustum enclosing this one: (vertical field of view in
@@ -88,6 +86,25 @@ impl Intrinsics {
         (2.0 * tan_y.atan().to_degrees(), tan_x / tan_y)
     }
 
+    /// The principal point in normalised device coordinates (x right, y down).
+    pub fn principal_ndc(&self, width: u32, height: u32) -> (f64, f64) {
+        let (w, h) = (f64::from(width), f64::from(height));
+        (2.0 * (self.cx + 0.5) / w - 1.0, 2.0 * (self.cy + 0.5) / h - 1.0)
+    }
+
+    /// These intrinsics for the image scaled to `width`×`height` from
+    /// `from` (the same rays through the same image area).
+    pub fn scaled(&self, from: (u32, u32), width: u32, height: u32) -> Intrinsics {
+        let sx = f64::from(width) / f64::from(from.0);
+        let sy = f64::from(height) / f64::from(from.1);
+        Intrinsics {
+            fx: self.fx * sx,
+            fy: self.fy * sy,
+            cx: (self.cx + 0.5) * sx - 0.5,
+            cy: (self.cy + 0.5) * sy - 0.5,
+        }
+    }
+
     /// View space (right-handed, looking down −z, y up) → Vulkan clip space
     /// of a `width`×`height` image: x right, y down (row 0 at the top),
     /// depth 0 at `near` and 1 at `far` (glam's `perspective_rh` depth).
@@ -95,7 +112,7 @@ impl Intrinsics {
         let (w, h) = (f64::from(width), f64::from(height));
         // With d = −z the view-space depth: ndc.x = (2fx/w)·x/d + (2cx/w − 1),
         // ndc.y (down) = (2fy/h)·(−y)/d + (2cy/h − 1).
-        let (ox, oy) = (2.0 * self.cx / w - 1.0, 2.0 * self.cy / h - 1.0);
+        let (ox, oy) = self.principal_ndc(width, height);
         let (a, b) = (far / (near - far), near * far / (near - far));
         DMat4::from_cols(
             DVec4::new(2.0 * self.fx / w, 0.0, 0.0, 0.0),
@@ -184,7 +201,8 @@ mod tests {
         let (x, y, z) = (1.5, -0.7, 4.0);
         let clip = k.projection(w, h, 0.1, 100.0) * DVec4::new(x, -y, -z, 1.0);
         let ndc = clip.truncate() / clip.w;
-        let pixel = ((ndc.x + 1.0) * 0.5 * 320.0, (ndc.y + 1.0) * 0.5 * 200.0);
+        // Pixel centres at integers: continuous position − ½.
+        let pixel = ((ndc.x + 1.0) * 0.5 * 320.0 - 0.5, (ndc.y + 1.0) * 0.5 * 200.0 - 0.5);
         let expected = (300.0 * x / z + 100.0, 260.0 * y / z + 120.0);
         assert!((pixel.0 - expected.0).abs() < 1e-9 && (pixel.1 - expected.1).abs() < 1e-9);
         assert!(ndc.z > 0.0 && ndc.z < 1.0);

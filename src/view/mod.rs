@@ -124,7 +124,7 @@ impl View {
         let (w, h) = (f64::from(self.width), f64::from(self.height));
         let right = c.right() * (0.5 * w / k.fx);
         let up = c.image_up() * (0.5 * h / k.fy);
-        let (ox, oy) = (2.0 * k.cx / w - 1.0, 2.0 * k.cy / h - 1.0);
+        let (ox, oy) = k.principal_ndc(self.width, self.height);
         let forward = c.forward() - ox * right + oy * up;
         (right.as_vec3(), up.as_vec3(), forward.as_vec3())
     }

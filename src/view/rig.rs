@@ -203,8 +203,10 @@ impl Rig {
                     name: v.name.clone(),
                     width,
                     height,
-                    intrinsics: match v.lens {
-                        RigLens::Pinhole(k) => Some(k),
+                    intrinsics: match (v.lens, v.distortion) {
+                        (RigLens::Pinhole(k), _) => Some(k),
+                        // A distorted lens needs fixed intrinsics.
+                        (RigLens::FovY(f), Some(_)) => Some(Intrinsics::from_fov_y(f, width, height)),
                         _ => None,
                     },
                     distortion: v.distortion,

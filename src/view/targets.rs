@@ -120,9 +120,19 @@ pub struct SceneTargets {
 impl SceneTargets {
     /// Declares the targets of `view` (and W when `weight`).
     pub fn declare<P: 'static>(graph: &mut RenderGraph<P>, view: &View, weight: bool) -> SceneTargets {
+        SceneTargets::declare_named(graph, &view.name, (view.width, view.height), weight)
+    }
+
+    /// Declares `width`×`height` targets whose images are named after
+    /// `view_name` (the targets a view's post-processing resamples into).
+    pub fn declare_named<P: 'static>(
+        graph: &mut RenderGraph<P>,
+        view_name: &str,
+        (w, h): (u32, u32),
+        weight: bool,
+    ) -> SceneTargets {
         let formats = TargetFormats::default();
-        let (w, h) = (view.width, view.height);
-        let name = |what: &str| super::pass_name(what, &view.name);
+        let name = |what: &str| super::pass_name(what, view_name);
         let constants = graph.upload_region(&name("lighting"), LIGHTING_CONSTANTS_BYTES);
         let mut image = |what: &str, format| graph.create_image(&name(what), ImageInfo::new(w, h, format));
         SceneTargets {

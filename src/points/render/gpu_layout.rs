@@ -126,11 +126,12 @@ pub fn view_and_intrinsics(view: &View) -> (DMat4, DMat3) {
     let camera = &view.camera;
     let matrix = DMat4::look_at_rh(camera.eye, camera.target, camera.up);
     let k = view.intrinsics();
-    // pixel x = cx + fx·X/(−Z), y = cy − fy·Y/(−Z) (row 0 at the top).
+    // Continuous pixel position (the image spans 0..w; OpenCV's pixel
+    // centres are at integers): x = cx + ½ + fx·X/(−Z), y = cy + ½ − fy·Y/(−Z).
     let k = DMat3::from_cols(
         DVec3::new(k.fx, 0.0, 0.0),
         DVec3::new(0.0, -k.fy, 0.0),
-        DVec3::new(-k.cx, -k.cy, -1.0),
+        DVec3::new(-(k.cx + 0.5), -(k.cy + 0.5), -1.0),
     );
     (matrix, k)
 }
