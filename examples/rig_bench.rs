@@ -88,7 +88,7 @@ fn measure(renderers: &mut [(Renderer, Vec<Camera>)], frames: u32) -> alpenglow:
             gpu[k] += p.gpu_ms;
         }
     }
-    Ok((median(gpu.into_iter()), median(wall.into_iter())))
+    Ok((median(gpu), median(wall)))
 }
 
 fn main() -> alpenglow::Result<()> {

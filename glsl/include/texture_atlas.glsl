@@ -71,7 +71,12 @@ bool sample_atlas(uint texturing, vec2 xy, out vec3 color, out vec2 extra, out u
     color = srgb_to_linear(textureLod(sampler2D(g_textures[nonuniformEXT(color_handle)], g_samplers[SAMPLER_LINEAR_CLAMP]), at, 0.0).rgb);
     vec3 n = textureLod(sampler2D(g_textures[nonuniformEXT(normal_handle)], g_samplers[SAMPLER_LINEAR_CLAMP]), at, 0.0).xyz * 2.0 - 1.0;
     extra = -n.xy / max(n.z, 1e-3);
-    ivec2 nearest = clamp(ivec2(floor(texel)), ivec2(0), ivec2(int(atlas.z) - 1));
+    // The nearest texel of the tile's own inner texels (a point on the
+    // node's far edge must not read the neighbouring slot).
+    vec2 origin = uintBitsToFloat(where.xy);
+    float inner = uintBitsToFloat(where.z);
+    ivec2 nearest = ivec2(clamp(floor(texel), origin, origin + vec2(inner - 1.0)));
+    nearest = clamp(nearest, ivec2(0), ivec2(int(atlas.z) - 1));
     float a = texelFetch(sampler2D(g_textures[nonuniformEXT(normal_handle)], g_samplers[SAMPLER_NEAREST_CLAMP]), nearest, 0).a;
     layer = uint(round(a * 255.0));
     return true;

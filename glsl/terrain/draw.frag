@@ -114,7 +114,8 @@ void main() {
         if (mode == TEXTURING_ATLAS && sample_atlas(texturing, in_world.xy, a, extra, layer)) {
             // §8.2 from the atlas: colour and displacement normal of the tile.
             n = normalize(n + vec3(-extra, 0.0) * n.z);
-            semantic = CLASS_LAYER_BASE + layer;
+            // A layer index beyond the tree is no layer: plain terrain.
+            semantic = layer < g_texturing[texturing].grid.z ? CLASS_LAYER_BASE + layer : CLASS_TERRAIN;
         } else if (mode == TEXTURING_DIRECT) {
             // §8.2 evaluated per pixel: the reference of the atlas.
             uvec4 th = g_texturing[texturing].handles;

@@ -178,7 +178,9 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
 /// The rig of the scene arguments and the views a frame renders.
 pub(crate) fn views(args: &SceneArgs) -> Result<(Option<alpenglow::renderer::Rig>, Vec<ViewSpec>)> {
     let rig = args.camera.rig(args.width)?;
-    let specs = args.camera.view_specs(rig.as_ref(), (args.width, args.height), args.fov_y)?;
+    let specs = args
+        .camera
+        .view_specs(rig.as_ref(), (args.width, args.height), args.fov_y)?;
     Ok((rig, specs))
 }
 

@@ -42,9 +42,9 @@ use crate::lighting::sky::Sky;
 use crate::lighting::technique::SceneLighting;
 use crate::points::render::{PointFrameStats, PointRenderer, SplatSettings};
 use crate::post::aovs::Aovs;
+use crate::post::exposure::ExposureMeter;
 use crate::post::motion_blur::{MotionBlur, MotionBlurSettings};
 use crate::post::resolve::Resolve;
-use crate::post::exposure::ExposureMeter;
 use crate::post::tonemap::Tonemap;
 use crate::profile::FrameProfile;
 use crate::terrain::geometry_image::TerrainSettings;
@@ -189,9 +189,7 @@ impl Renderer {
             .map(|s| ViewChain::new(ctx, s, settings.msaa))
             .collect::<Result<_>>()?;
         // The views the graph is declared for; every frame brings their cameras.
-        let views: Vec<View> = (chains.iter())
-            .map(|c| c.render.view(scene.default_camera()))
-            .collect();
+        let views: Vec<View> = (chains.iter()).map(|c| c.render.view(scene.default_camera())).collect();
         let lighting = settings.lighting.unwrap_or_else(|| scene.default_lighting());
         lighting.validate()?;
         let points_present = !scene.points.is_empty();
@@ -236,7 +234,7 @@ impl Renderer {
                 ctx,
                 &mut graph,
                 terrain.generation_inputs(&scene.layers),
-                settings.texture_streaming,
+                streaming_for(&settings, &chains),
             )?),
             _ => None,
         };
@@ -520,6 +518,23 @@ impl Renderer {
             Some(p) => p.take_stats(),
             None => Ok(Vec::new()),
         }
+    }
+}
+
+/// The atlas streaming of `settings`, resized for supersampled renders
+/// (their tiles are finer than the outputs'); the budget stays the caller's.
+fn streaming_for(settings: &RenderSettings, chains: &[ViewChain]) -> TextureStreaming {
+    if chains
+        .iter()
+        .all(|c| (c.render.width, c.render.height) == (c.output.width, c.output.height))
+    {
+        return settings.texture_streaming;
+    }
+    let sizes: Vec<(u32, u32)> = chains.iter().map(|c| (c.render.width, c.render.height)).collect();
+    TextureStreaming {
+        budget: settings.texture_streaming.budget,
+        readback: settings.texture_streaming.readback,
+        ..TextureStreaming::for_views(&sizes)
     }
 }
 

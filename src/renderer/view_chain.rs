@@ -55,7 +55,10 @@ impl ViewChain {
                 let k = intrinsics.ok_or_else(|| {
                     Error::invalid(
                         "distortion",
-                        format!("view '{}' needs pinhole intrinsics with its lens distortion", output.name),
+                        format!(
+                            "view '{}' needs pinhole intrinsics with its lens distortion",
+                            output.name
+                        ),
                     )
                 })?;
                 let camera = DistortedCamera {
