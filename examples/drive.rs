@@ -1,0 +1,202 @@
+//! A driving simulator's frame loop (issue 14, part 8): a car drives over
+//! the real Jacksboro DEM (`tests/data/jacksboro-fault.png`) at 25 m/s in
+//! fixed steps of 1/30 s, the driver's eye 1.7 m above the ground query
+//! ([`alpenglow::terrain::ground`]: the terrain as drawn, with its
+//! procedural detail, §7.4.3), looking along the path; every step renders
+//! through [`Renderer`].
+//!
+//! `cargo run --release --example drive -- [--steps N] [--width W] [--height H]`
+//! (default 300 steps at 320×200). Prints the median, p99 and largest
+//! frame time per step: wall-clock (CPU: ground query, prepare, record,
+//! submit, and any wait for a free frame slot) and GPU (the sum of the
+//! frame's pass timestamps from [`Renderer::finish`]).
+
+use std::time::Instant;
+
+use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
+use alpenglow::profile::{median, summarize};
+use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
+use alpenglow::terrain::ground::Ground;
+use alpenglow::terrain::zoom::quantile;
+use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
+use glam::{DVec2, DVec3};
+
+/// Car speed (m/s) and the fixed step (s).
+const SPEED: f64 = 25.0;
+const DT: f64 = 1.0 / 30.0;
+/// The driver's eye above the ground (metres).
+const EYE_HEIGHT: f64 = 1.7;
+/// Where the path starts (in the valley of the Jacksboro fault) and its
+/// mean heading (radians from +x: up the valley, to the north-east).
+const START: DVec2 = DVec2::new(13600.0, 9600.0);
+const HEADING: f64 = 1.18;
+
+struct Args {
+    steps: usize,
+    width: u32,
+    height: u32,
+}
+
+/// `--steps N --width W --height H`; errors name the argument.
+fn parse_args() -> Result<Args, String> {
+    let mut args = Args {
+        steps: 300,
+        width: 320,
+        height: 200,
+    };
+    let mut it = std::env::args().skip(1);
+    while let Some(flag) = it.next() {
+        let value = it.next().ok_or_else(|| format!("{flag}: missing value"))?;
+        let number = |min: u64| match value.parse::<u64>() {
+            Ok(v) if v >= min => Ok(v),
+            _ => Err(format!("{flag}: {value:?} is not a whole number ≥ {min}")),
+        };
+        match flag.as_str() {
+            "--steps" => args.steps = number(1)? as usize,
+            "--width" => {
+                args.width = number(1)?
+                    .try_into()
+                    .map_err(|_| format!("{flag}: {value} is too large"))?
+            }
+            "--height" => {
+                args.height = number(1)?
+                    .try_into()
+                    .map_err(|_| format!("{flag}: {value} is too large"))?
+            }
+            _ => return Err(format!("unknown argument {flag:?} (use --steps, --width, --height)")),
+        }
+    }
+    Ok(args)
+}
+
+/// The car on its path: the heading swings ±0.35 rad around [`HEADING`]
+/// over 600 m of path; the position is the integral of that unit-speed
+/// heading over the path length `s`.
+struct Car {
+    s: f64,
+    xy: DVec2,
+}
+
+impl Car {
+    fn heading_at(s: f64) -> f64 {
+        HEADING + 0.35 * (std::f64::consts::TAU / 600.0 * s).sin()
+    }
+
+    fn heading(&self) -> f64 {
+        Car::heading_at(self.s)
+    }
+
+    /// Drives `ds` metres on (Simpson's rule: far below a millimetre of
+    /// error per step).
+    fn advance(&mut self, ds: f64) {
+        let direction = |s: f64| DVec2::from_angle(Car::heading_at(s));
+        let s = self.s;
+        self.xy += ds / 6.0 * (direction(s) + 4.0 * direction(s + 0.5 * ds) + direction(s + ds));
+        self.s += ds;
+    }
+}
+
+/// The cameras of one step, the driver's eye at `xy` looking along
+/// `heading`, 3° down.
+fn rig(ground: &Ground, xy: DVec2, heading: f64) -> alpenglow::Result<Vec<Camera>> {
+    let eye = xy.extend(ground.height(xy.x, xy.y)? + EYE_HEIGHT);
+    let pitch = 3f64.to_radians();
+    let forward = DVec2::from_angle(heading).extend(0.0) * pitch.cos() - DVec3::Z * pitch.sin();
+    Ok(vec![Camera {
+        eye,
+        target: eye + forward,
+        up: DVec3::Z,
+        fov_y_deg: 60.0,
+        near: 0.1,
+        far: 100_000.0,
+    }])
+}
+
+/// One row of the table: median, p99, largest and first value (ms).
+fn row(name: &str, values: &[f64]) {
+    println!(
+        "| {name:<26} | {:>8.2} | {:>8.2} | {:>8.2} | {:>8.2} |",
+        median(values.iter().copied()),
+        quantile(values, 0.99),
+        values.iter().copied().fold(f64::NAN, f64::max),
+        values.first().copied().unwrap_or(f64::NAN)
+    );
+}
+
+fn run(args: &Args) -> alpenglow::Result<()> {
+    let dem = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/jacksboro-fault.png");
+    let heights = load_heightmap(
+        &dem,
+        &HeightmapOptions {
+            scale: 1.0,
+            offset: 0.0,
+            spacing: DVec2::new(74.4, 92.6),
+        },
+    )?;
+    let scene = Scene::new(heights);
+    let ctx = Context::new(&ContextOptions {
+        validation: false,
+        device: DeviceSelector::Best,
+    })?;
+    let settings = RenderSettings {
+        readback: false,
+        ..RenderSettings::new(args.width, args.height)
+    };
+    let ground = scene.ground(&settings.terrain)?;
+    let started = Instant::now();
+    let mut renderer = Renderer::new(&ctx, &scene, settings)?;
+    let setup = started.elapsed().as_secs_f64();
+    let mut wall = Vec::with_capacity(args.steps);
+    let mut frames_per_step = 1;
+    let mut car = Car { s: 0.0, xy: START };
+    for _ in 0..args.steps {
+        let t = Instant::now();
+        let cameras = rig(&ground, car.xy, car.heading())?;
+        for camera in &cameras {
+            renderer.render(camera)?;
+        }
+        frames_per_step = cameras.len();
+        wall.push(t.elapsed().as_secs_f64() * 1e3);
+        car.advance(SPEED * DT);
+    }
+    let profiles = renderer.finish()?;
+    let gpu: Vec<f64> = profiles
+        .chunks(frames_per_step)
+        .map(|step| step.iter().flat_map(|f| &f.passes).map(|p| p.gpu_ms).sum())
+        .collect();
+    let cpu: Vec<f64> = profiles
+        .chunks(frames_per_step)
+        .map(|step| step.iter().map(|f| f.cpu_ms).sum())
+        .collect();
+    let info = ctx.info();
+    println!(
+        "drive: {} steps of 1/30 s at {SPEED} m/s ({:.0} m over the Jacksboro DEM), {}×{}, {frames_per_step} view(s), {} ({})",
+        args.steps,
+        SPEED * DT * args.steps as f64,
+        args.width,
+        args.height,
+        info.name,
+        info.driver_info
+    );
+    println!("renderer set-up (sky-light bake included): {setup:.2} s\n");
+    println!("| per step (ms)              |   median |      p99 |      max |    first |");
+    println!("|----------------------------|----------|----------|----------|----------|");
+    row("wall (CPU)", &wall);
+    row("  prepare, record, submit", &cpu);
+    row("GPU (sum of passes)", &gpu);
+    let (mut passes, _) = summarize(&profiles);
+    passes.sort_by(|a, b| b.median_gpu_ms.total_cmp(&a.median_gpu_ms));
+    println!("\ncostliest passes (GPU ms per frame): median, max");
+    for p in passes.iter().take(6) {
+        println!("  {:<32} {:>8.2} {:>8.2}", p.name, p.median_gpu_ms, p.max_gpu_ms);
+    }
+    Ok(())
+}
+
+fn main() {
+    let outcome = parse_args().and_then(|args| run(&args).map_err(|e| e.to_string()));
+    if let Err(e) = outcome {
+        eprintln!("drive: {e}");
+        std::process::exit(2);
+    }
+}
