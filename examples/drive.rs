@@ -5,8 +5,8 @@
 //! procedural detail, §7.4.3), looking along the path; every step renders
 //! through [`Renderer`].
 //!
-//! `cargo run --release --example drive -- [--steps N] [--width W] [--height H]`
-//! (default 300 steps at 320×200). Prints the median, p99 and largest
+//! `cargo run --release --example drive -- [--steps N] [--width W] [--height H] [--views 6|1]`
+//! (default: a `ring6` rig of 320×240 views, 300 steps). Prints the median, p99 and largest
 //! frame time per step: wall-clock (CPU: ground query, prepare, record,
 //! submit, and any wait for a free frame slot) and GPU (the sum of the
 //! frame's pass timestamps from [`Renderer::finish`]).
@@ -15,7 +15,7 @@ use std::time::Instant;
 
 use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
 use alpenglow::profile::{median, summarize};
-use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
+use alpenglow::renderer::{Camera, RenderSettings, Renderer, Rig, Scene, ViewSpec};
 use alpenglow::terrain::ground::Ground;
 use alpenglow::terrain::zoom::quantile;
 use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
@@ -31,10 +31,15 @@ const EYE_HEIGHT: f64 = 1.7;
 const START: DVec2 = DVec2::new(13600.0, 9600.0);
 const HEADING: f64 = 1.18;
 
+/// Steps left out of the steady-state figures.
+const WARM_UP: usize = 10;
+
 struct Args {
     steps: usize,
     width: u32,
     height: u32,
+    /// 6: the `ring6` rig (each view --width wide, 4:3); 1: one view.
+    views: u32,
 }
 
 /// `--steps N --width W --height H`; errors name the argument.
@@ -43,6 +48,7 @@ fn parse_args() -> Result<Args, String> {
         steps: 300,
         width: 320,
         height: 200,
+        views: 6,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -53,6 +59,11 @@ fn parse_args() -> Result<Args, String> {
         };
         match flag.as_str() {
             "--steps" => args.steps = number(1)? as usize,
+            "--views" => match number(1)? {
+                1 => args.views = 1,
+                6 => args.views = 6,
+                _ => return Err(format!("{flag}: {value} is not 1 or 6 (ring6)")),
+            },
             "--width" => {
                 args.width = number(1)?
                     .try_into()
@@ -63,7 +74,11 @@ fn parse_args() -> Result<Args, String> {
                     .try_into()
                     .map_err(|_| format!("{flag}: {value} is too large"))?
             }
-            _ => return Err(format!("unknown argument {flag:?} (use --steps, --width, --height)")),
+            _ => {
+                return Err(format!(
+                    "unknown argument {flag:?} (use --steps, --width, --height, --views)"
+                ))
+            }
         }
     }
     Ok(args)
@@ -96,20 +111,19 @@ impl Car {
     }
 }
 
-/// The cameras of one step, the driver's eye at `xy` looking along
-/// `heading`, 3° down.
-fn rig(ground: &Ground, xy: DVec2, heading: f64) -> alpenglow::Result<Vec<Camera>> {
+/// The car's camera: the driver's eye at `xy` looking along `heading`, 3° down.
+fn car_camera(ground: &Ground, xy: DVec2, heading: f64) -> alpenglow::Result<Camera> {
     let eye = xy.extend(ground.height(xy.x, xy.y)? + EYE_HEIGHT);
     let pitch = 3f64.to_radians();
     let forward = DVec2::from_angle(heading).extend(0.0) * pitch.cos() - DVec3::Z * pitch.sin();
-    Ok(vec![Camera {
+    Ok(Camera {
         eye,
         target: eye + forward,
         up: DVec3::Z,
         fov_y_deg: 60.0,
         near: 0.1,
         far: 100_000.0,
-    }])
+    })
 }
 
 /// One row of the table: median, p99, largest and first value (ms).
@@ -138,24 +152,31 @@ fn run(args: &Args) -> alpenglow::Result<()> {
         validation: false,
         device: DeviceSelector::Best,
     })?;
+    let rig = (args.views == 6).then(|| Rig::ring6(args.width));
+    let specs = match &rig {
+        Some(rig) => rig.specs((args.width, args.height))?,
+        None => vec![ViewSpec::new(args.width, args.height)],
+    };
     let settings = RenderSettings {
         readback: false,
-        ..RenderSettings::new(args.width, args.height)
+        ..RenderSettings::for_views(specs.clone())
     };
     let ground = scene.ground(&settings.terrain)?;
     let started = Instant::now();
     let mut renderer = Renderer::new(&ctx, &scene, settings)?;
     let setup = started.elapsed().as_secs_f64();
     let mut wall = Vec::with_capacity(args.steps);
-    let mut frames_per_step = 1;
+    let frames_per_step = 1;
     let mut car = Car { s: 0.0, xy: START };
     for _ in 0..args.steps {
         let t = Instant::now();
-        let cameras = rig(&ground, car.xy, car.heading())?;
-        for camera in &cameras {
-            renderer.render(camera)?;
-        }
-        frames_per_step = cameras.len();
+        let camera = car_camera(&ground, car.xy, car.heading())?;
+        let cameras = match &rig {
+            Some(rig) => rig.cameras(&camera)?,
+            None => vec![camera],
+        };
+        // Every view in one submission.
+        renderer.render_views(&cameras)?;
         wall.push(t.elapsed().as_secs_f64() * 1e3);
         car.advance(SPEED * DT);
     }
@@ -170,11 +191,12 @@ fn run(args: &Args) -> alpenglow::Result<()> {
         .collect();
     let info = ctx.info();
     println!(
-        "drive: {} steps of 1/30 s at {SPEED} m/s ({:.0} m over the Jacksboro DEM), {}×{}, {frames_per_step} view(s), {} ({})",
+        "drive: {} steps of 1/30 s at {SPEED} m/s ({:.0} m over the Jacksboro DEM), {} view(s) of {}×{}, {} ({})",
         args.steps,
         SPEED * DT * args.steps as f64,
-        args.width,
-        args.height,
+        specs.len(),
+        specs[0].width,
+        specs[0].height,
         info.name,
         info.driver_info
     );
@@ -184,6 +206,38 @@ fn run(args: &Args) -> alpenglow::Result<()> {
     row("wall (CPU)", &wall);
     row("  prepare, record, submit", &cpu);
     row("GPU (sum of passes)", &gpu);
+    // The steady state: after the first WARM_UP steps (the atlas's first
+    // tiles, pipeline and cache warm-up; the time budget needs timings).
+    let steady = |v: &[f64]| v.get(WARM_UP..).unwrap_or(&[]).to_vec();
+    println!("| after the first {WARM_UP} steps      |          |          |          |          |");
+    row("wall (CPU)", &steady(&wall));
+    row("  prepare, record, submit", &steady(&cpu));
+    row("GPU (sum of passes)", &steady(&gpu));
+    let spread = |v: &[f64]| quantile(v, 0.99) / median(v.iter().copied());
+    println!(
+        "\np99/median after the first {WARM_UP} steps: wall {:.2}, GPU {:.2}",
+        spread(&steady(&wall)),
+        spread(&steady(&gpu))
+    );
+    // The CPU stages of a step (prepare per technique).
+    let mut stages: Vec<(String, Vec<f64>)> = Vec::new();
+    for f in profiles.iter().skip(WARM_UP) {
+        for s in &f.prepare {
+            match stages.iter_mut().find(|(n, _)| *n == s.name) {
+                Some((_, v)) => v.push(s.cpu_ms),
+                None => stages.push((s.name.clone(), vec![s.cpu_ms])),
+            }
+        }
+    }
+    println!("\nCPU stages after the first {WARM_UP} steps (ms): median, p99, max");
+    for (name, v) in &stages {
+        let max = v.iter().copied().fold(f64::NAN, f64::max);
+        println!(
+            "  {name:<32} {:>8.2} {:>8.2} {max:>8.2}",
+            median(v.iter().copied()),
+            quantile(v, 0.99)
+        );
+    }
     let (mut passes, _) = summarize(&profiles);
     passes.sort_by(|a, b| b.median_gpu_ms.total_cmp(&a.median_gpu_ms));
     println!("\ncostliest passes (GPU ms per frame): median, max");

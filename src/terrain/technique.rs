@@ -252,6 +252,37 @@ impl Terrain {
     }
 }
 
+impl Terrain {
+    /// The CPU LOD of every view (§7.4.2: sketch map, importance, warp),
+    /// the views in parallel threads: they share only the height field.
+    fn plan_views(&mut self, views: &[View]) -> Result<()> {
+        let field = &self.geometry.field;
+        let settings = self.geometry.settings;
+        let debug = settings.view.debug_scalar();
+        let plan = |state: &mut TerrainViewState| -> Result<()> {
+            let view = (views.get(state.index))
+                .ok_or_else(|| Error::Graph(format!("terrain: the frame has no view {}", state.index)))?;
+            let culling = view.culling_camera();
+            state
+                .lod
+                .plan(field, &culling, view.culling_aspect(), &settings.lod, debug)
+        };
+        if self.views.len() == 1 {
+            return self.views.iter_mut().try_for_each(plan);
+        }
+        std::thread::scope(|scope| {
+            let plan = &plan;
+            let threads: Vec<_> = (self.views.iter_mut())
+                .map(|state| scope.spawn(move || plan(state)))
+                .collect();
+            threads.into_iter().try_for_each(|t| {
+                t.join()
+                    .unwrap_or_else(|_| Err(Error::Graph("terrain: a view's LOD thread panicked".into())))
+            })
+        })
+    }
+}
+
 impl Technique for Terrain {
     type Prepared = TerrainFrame;
 
@@ -264,6 +295,7 @@ impl Technique for Terrain {
     fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<TerrainFrame> {
         let mut views = Vec::with_capacity(self.views.len());
         let settings = self.geometry.settings;
+        self.plan_views(frame.views)?;
         for k in 0..self.views.len() {
             let state = &self.views[k];
             let view = frame
@@ -288,16 +320,7 @@ impl Technique for Terrain {
                 ],
                 ..self.geometry.warp_push()
             };
-            let state = &mut self.views[k];
-            let debug = settings.view.debug_scalar();
-            let culling = view.culling_camera();
-            state.lod.plan(
-                &self.geometry.field,
-                &culling,
-                view.culling_aspect(),
-                &settings.lod,
-                debug,
-            )?;
+            let state = &self.views[k];
             frame
                 .uploads
                 .write(warp_region, bytemuck::cast_slice(&state.lod.upload))?;
