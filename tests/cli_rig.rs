@@ -198,6 +198,10 @@ fn bad_cameras_and_rigs_are_one_line_errors() {
             vec!["--pose"],
         ),
         (vec!["--rotation".into(), "0,0,0,1".into()], vec!["--eye"]),
+        (vec!["--msaa".into(), "3".into()], vec!["--msaa", "3"]),
+        (vec!["--shutter".into(), "0.5".into()], vec!["--shutter"]),
+        (vec!["--fps".into(), "0".into()], vec!["--fps"]),
+        (vec!["--distortion=-5,0,0,0,0".into()], vec!["--distortion", "k1"]),
     ];
     for (extra, needles) in cases {
         let mut args: Vec<String> = ["render", "--terrain", SMALL_TERRAIN, "--width", "32", "--height", "24"]
