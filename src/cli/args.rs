@@ -239,6 +239,11 @@ pub struct TerrainArgs {
     /// rendering until every tile is ready.
     #[arg(long = "tile-budget", default_value_t = 32)]
     pub tile_budget: u32,
+    /// Spread tile generation by GPU time as well (a quarter of the rest of
+    /// the frame, measured): steady frame times for moving cameras. off:
+    /// tile counts only, so a camera path's frames are the same on every run.
+    #[arg(long = "tile-pacing", value_enum, default_value = "on")]
+    pub tile_pacing: Switch,
     /// Surface-layer tree (TOML; default: the built-in tree).
     #[arg(long)]
     pub layers: Option<PathBuf>,

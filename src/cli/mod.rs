@@ -215,7 +215,10 @@ fn texture_streaming(
     views: &[ViewSpec],
 ) -> Result<alpenglow::texturing::generation::TextureStreaming> {
     let sizes: Vec<(u32, u32)> = views.iter().map(|v| (v.width, v.height)).collect();
-    let streaming = alpenglow::texturing::generation::TextureStreaming::for_views(&sizes);
+    let mut streaming = alpenglow::texturing::generation::TextureStreaming::for_views(&sizes);
+    if args.terrain.tile_pacing == Switch::Off {
+        streaming.budget.gpu_time = None;
+    }
     Ok(streaming.with_tile_budget(args.terrain.tile_budget)?)
 }
 
