@@ -274,7 +274,11 @@ fn tile_budget_range_ends_render_and_outside_is_refused() {
     let dir = fresh_dir("tile_budget");
     let one = render_png(&dir, "one.png", SMALL_TERRAIN, &["--tile-budget", "1"]);
     let most = render_png(&dir, "most.png", SMALL_TERRAIN, &["--tile-budget", "255"]);
-    assert_eq!(differing_bytes(&one, &most), 0, "a settled frame does not depend on the budget");
+    assert_eq!(
+        differing_bytes(&one, &most),
+        0,
+        "a settled frame does not depend on the budget"
+    );
     let _ = std::fs::remove_dir_all(&dir);
     for value in ["0", "256", "4294967295"] {
         expect_render_error(
