@@ -15,14 +15,14 @@
 mod common;
 
 use alpenglow::graph::{BakedGraph, FrameOutcome, RenderGraph};
-use alpenglow::renderer::{Camera, Scene};
+use alpenglow::renderer::Scene;
 use alpenglow::terrain::geometry_image::TerrainSettings;
 use alpenglow::terrain::{Terrain, TerrainTexturing};
 use alpenglow::texturing::atlas::{AtlasSettings, GpuTimeBudget};
-use alpenglow::texturing::generation::{TextureAtlas, TextureFrameStats, TextureStreaming};
+use alpenglow::texturing::generation::{quadtree_view, TextureAtlas, TextureFrameStats, TextureStreaming};
 use alpenglow::texturing::gpu_layout::TexturingMode;
-use alpenglow::texturing::quadtree::{select_tiles, HeightBounds, View as QuadtreeView};
-use alpenglow::view::{frustum_planes, Frame, Lighting, View};
+use alpenglow::texturing::quadtree::{select_tiles, HeightBounds};
+use alpenglow::view::{Frame, Lighting, View};
 use alpenglow::vulkan::{Context, FrameRing, FRAMES_IN_FLIGHT};
 use common::atlas::{check_texels_against_cpu, ground_camera};
 use common::{assert_validation_clean, jacksboro_field, validated_context};
@@ -97,26 +97,24 @@ impl Rig {
     }
 }
 
-fn view(camera: Camera, (width, height): (u32, u32)) -> View {
-    View::new(camera, width, height)
+/// Two driver's views of `size` from the same eye on the real DEM: east
+/// (north-east) and west (south-west).
+fn ground_views(scene: &Scene, size: (u32, u32)) -> [View; 2] {
+    [DVec2::new(100.0, 60.0), DVec2::new(-100.0, -60.0)]
+        .map(|look| View::new(ground_camera(scene, look), size.0, size.1))
 }
 
-/// The quadtree's view of `view` (as the atlas measures it).
-fn quadtree_view(view: &View) -> QuadtreeView {
-    let c = &view.camera;
-    QuadtreeView {
-        eye: c.eye,
-        pixel_footprint: QuadtreeView::pixel_footprint_for(c.fov_y_deg.to_radians(), view.height),
-        frustum: Some(frustum_planes(c.view_proj_f64(view.aspect()))),
-    }
+/// Streaming for one view of `size` with a budget of `tiles` per frame.
+fn streaming_for(size: (u32, u32), tiles: u32) -> TextureStreaming {
+    let streaming = TextureStreaming::for_image(size.0, size.1);
+    streaming.with_tile_budget(tiles).expect("budget in range")
 }
 
 #[test]
 fn two_views_share_one_atlas_and_page_table() {
     let scene = Scene::new(jacksboro_field());
     let size = (160, 90);
-    let east = view(ground_camera(&scene, DVec2::new(100.0, 60.0)), size);
-    let west = view(ground_camera(&scene, DVec2::new(-100.0, -60.0)), size);
+    let [east, west] = ground_views(&scene, size);
     let streaming = TextureStreaming {
         readback: true,
         ..TextureStreaming::for_views(&[size, size])
@@ -191,7 +189,7 @@ fn two_views_share_one_atlas_and_page_table() {
 fn ground_view_settles_at_every_tile_budget() {
     let scene = Scene::new(jacksboro_field());
     let size = (160, 90);
-    let ground = view(ground_camera(&scene, DVec2::new(100.0, 60.0)), size);
+    let [ground, _] = ground_views(&scene, size);
     let (ctx, report) = validated_context();
     let base = TextureStreaming::for_image(size.0, size.1);
     let max = base.max_tile_budget();
@@ -228,7 +226,7 @@ fn ground_view_settles_at_every_tile_budget() {
 fn ground_view_640x360_settles_in_the_default_atlas() {
     let scene = Scene::new(jacksboro_field());
     let size = (640, 360);
-    let ground = view(ground_camera(&scene, DVec2::new(100.0, 60.0)), size);
+    let [ground, _] = ground_views(&scene, size);
     let streaming = TextureStreaming::for_image(size.0, size.1);
     let (ctx, report) = validated_context();
     let stats = {
@@ -256,10 +254,8 @@ fn ground_view_640x360_settles_in_the_default_atlas() {
 fn atlas_too_small_for_the_view_coarsens_and_settles() {
     let scene = Scene::new(jacksboro_field());
     let size = (320, 180);
-    let ground = view(ground_camera(&scene, DVec2::new(100.0, 60.0)), size);
-    let mut streaming = TextureStreaming::for_image(size.0, size.1)
-        .with_tile_budget(128)
-        .expect("budget");
+    let [ground, _] = ground_views(&scene, size);
+    let mut streaming = streaming_for(size, 128);
     streaming.readback = true;
     // One 1024² texture per tile size: 63 tiles of 128², the view needs 73.
     streaming.atlas = AtlasSettings {
@@ -291,11 +287,8 @@ fn atlas_too_small_for_the_view_coarsens_and_settles() {
 fn gpu_time_budget_spreads_generation() {
     let scene = Scene::new(jacksboro_field());
     let size = (320, 180);
-    let east = view(ground_camera(&scene, DVec2::new(100.0, 60.0)), size);
-    let west = view(ground_camera(&scene, DVec2::new(-100.0, -60.0)), size);
-    let mut streaming = TextureStreaming::for_image(size.0, size.1)
-        .with_tile_budget(255)
-        .expect("budget");
+    let [east, west] = ground_views(&scene, size);
+    let mut streaming = streaming_for(size, 255);
     streaming.budget.gpu_time = None;
     let (ctx, report) = validated_context();
     let (unpaced, paced, per_texel) = {

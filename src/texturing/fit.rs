@@ -24,7 +24,7 @@
 use std::collections::BTreeMap;
 
 use crate::texturing::atlas::AtlasSettings;
-use crate::texturing::quadtree::{NeededTile, NodeId};
+use crate::texturing::quadtree::{selection_order, NeededTile, NodeId};
 
 /// What fitting did to a selection.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -87,11 +87,7 @@ pub fn fit_to_atlas(needed: &mut Vec<NeededTile>, atlas: &AtlasSettings, max_til
             break;
         }
     }
-    needed.sort_by(|a, b| {
-        (a.node.level.cmp(&b.node.level))
-            .then(a.distance.total_cmp(&b.distance))
-            .then(a.node.cmp(&b.node))
-    });
+    needed.sort_by(selection_order);
     done
 }
 
@@ -207,10 +203,7 @@ mod tests {
         let nearest = tiles.iter().min_by(|a, b| a.distance.total_cmp(&b.distance)).unwrap();
         let largest = tiles.iter().map(|t| t.size).max().unwrap();
         assert_eq!(nearest.size, largest);
-        let sorted = tiles
-            .windows(2)
-            .all(|w| (w[0].node.level, w[0].distance) <= (w[1].node.level, w[1].distance));
-        assert!(sorted);
+        assert!(tiles.windows(2).all(|w| selection_order(&w[0], &w[1]).is_lt()));
     }
 
     #[test]

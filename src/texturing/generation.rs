@@ -387,8 +387,9 @@ struct PlannedFrame {
     texel_cap: u64,
 }
 
-/// What the quadtree measures of a view.
-fn quadtree_view(view: &crate::view::View) -> View {
+/// What the quadtree measures of a frame's view: its eye, the pixel
+/// footprint of its image rows, its frustum.
+pub fn quadtree_view(view: &crate::view::View) -> View {
     let camera = &view.camera;
     View {
         eye: camera.eye,

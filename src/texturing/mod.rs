@@ -11,8 +11,9 @@
 //!   sizes, one partition for all views; [`bounds`]: the height field's
 //!   per-node bounds it measures;
 //! * [`fit`]: the selection coarsened until it fits the atlas;
-//! * [`atlas`]: tile slots in the atlases, least-recently-used eviction, the
-//!   per-frame generation plan under a cap;
+//! * [`atlas`]: tile slots in the atlases ([`atlas_settings`]: their
+//!   layout), least-recently-used eviction, the per-frame generation plan
+//!   under a cap;
 //! * [`pacing`]: the GPU time budget, from the measured cost per texel;
 //! * [`generation`]: the technique: the frame's plan, and the GPU passes that
 //!   evaluate the tree into the dirty tiles of a frame, all at once, one
@@ -25,6 +26,7 @@
 //! * [`dominant`]: the dominant layer of a point (the class AOV).
 
 pub mod atlas;
+pub mod atlas_settings;
 pub mod bounds;
 pub mod dominant;
 pub mod fit;

@@ -118,22 +118,10 @@ impl GenerationPacer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::profile::PassTiming;
+    use crate::texturing::stats::test_profile;
 
     fn profile(frame: u64, other_ms: f64, texturing_ms: f64) -> FrameProfile {
-        let pass = |name: &str, gpu_ms| PassTiming {
-            name: name.into(),
-            gpu_ms,
-            cpu_ms: 0.0,
-            gpu_start_ms: 0.0,
-            cpu_start_ms: 0.0,
-        };
-        FrameProfile {
-            frame,
-            passes: vec![pass("terrain.draw", other_ms), pass("texturing.finish", texturing_ms)],
-            gpu_ms: other_ms + texturing_ms,
-            ..FrameProfile::default()
-        }
+        test_profile(frame, &[("terrain.draw", other_ms), ("texturing.finish", texturing_ms)])
     }
 
     #[test]

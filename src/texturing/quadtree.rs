@@ -327,12 +327,16 @@ pub fn select_tiles_for_views(
         let distance = seen.iter().map(|m| m.distance).fold(f64::INFINITY, f64::min);
         leaves.push(NeededTile { node, size, distance });
     }
-    leaves.sort_by(|a, b| {
-        (a.node.level.cmp(&b.node.level))
-            .then(a.distance.total_cmp(&b.distance))
-            .then(a.node.cmp(&b.node))
-    });
+    leaves.sort_by(selection_order);
     Ok(leaves)
+}
+
+/// The order of selected tiles: coarse to fine, then nearest first, then
+/// by node id.
+pub fn selection_order(a: &NeededTile, b: &NeededTile) -> std::cmp::Ordering {
+    (a.node.level.cmp(&b.node.level))
+        .then(a.distance.total_cmp(&b.distance))
+        .then(a.node.cmp(&b.node))
 }
 
 /// Whether the box `[min, max]` lies entirely on the outer side of `plane`.
@@ -389,10 +393,7 @@ mod tests {
                 }
             }
             assert!(cover.iter().all(|&c| c == 1), "eye {eye}: {} tiles", tiles.len());
-            let sorted = tiles
-                .windows(2)
-                .all(|w| (w[0].node.level, w[0].distance) <= (w[1].node.level, w[1].distance));
-            assert!(sorted);
+            assert!(tiles.windows(2).all(|w| selection_order(&w[0], &w[1]).is_lt()));
         }
     }
 

@@ -170,10 +170,31 @@ impl TextureSummary {
     }
 }
 
+/// A profile of `frame` whose passes took `passes` (name, GPU ms) one
+/// after the other, for tests.
+#[cfg(test)]
+pub(crate) fn test_profile(frame: u64, passes: &[(&str, f64)]) -> FrameProfile {
+    let passes: Vec<crate::profile::PassTiming> = (passes.iter())
+        .map(|&(name, gpu_ms)| crate::profile::PassTiming {
+            name: name.into(),
+            gpu_ms,
+            cpu_ms: 0.0,
+            gpu_start_ms: 0.0,
+            cpu_start_ms: 0.0,
+        })
+        .collect();
+    FrameProfile {
+        frame,
+        gpu_ms: passes.iter().map(|p| p.gpu_ms).sum(),
+        passes,
+        cpu_ms: 1.0,
+        ..FrameProfile::default()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::profile::PassTiming;
 
     fn frame(frame: u64, visible: usize, hits: usize, generated: usize, deferred: usize) -> TextureFrameStats {
         TextureFrameStats {
@@ -190,21 +211,7 @@ mod tests {
     }
 
     fn profile(frame: u64, layer_ms: f64) -> FrameProfile {
-        let pass = |name: &str, gpu_ms: f64| PassTiming {
-            name: name.into(),
-            gpu_ms,
-            cpu_ms: 0.0,
-            gpu_start_ms: 0.0,
-            cpu_start_ms: 0.0,
-        };
-        FrameProfile {
-            prepare: Vec::new(),
-            frame,
-            passes: vec![pass("terrain.draw", 100.0), pass("texturing.layer0.rock", layer_ms)],
-            gpu_ms: 100.0 + layer_ms,
-            cpu_ms: 1.0,
-            cpu_start_ms: 0.0,
-        }
+        test_profile(frame, &[("terrain.draw", 100.0), ("texturing.layer0.rock", layer_ms)])
     }
 
     #[test]
