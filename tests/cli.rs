@@ -181,7 +181,7 @@ fn bench_failing_trace_leaves_no_json() {
         "32".as_ref(),
         "--height".as_ref(),
         "32".as_ref(),
-        "--json".as_ref(),
+        "--profile".as_ref(),
         json.as_os_str(),
         "--trace".as_ref(),
         blocker.as_os_str(),
@@ -421,7 +421,7 @@ fn bench_writes_json_summary() {
         "64".as_ref(),
         "--height".as_ref(),
         "64".as_ref(),
-        "--json".as_ref(),
+        "--profile".as_ref(),
         json.as_os_str(),
     ]);
     assert_success("bench", &out);

@@ -217,7 +217,7 @@ fn bad_cameras_and_rigs_are_one_line_errors() {
 }
 
 /// `fly` of a rig writes each view's frames in its own folder, and with
-/// `--tile-pacing off` a camera path renders the same bytes every run.
+/// `--no-tile-pacing` a camera path renders the same bytes every run.
 #[test]
 fn fly_with_a_rig_is_deterministic_without_tile_pacing() {
     let dir = fresh_dir("fly-rig");
@@ -234,8 +234,7 @@ fn fly_with_a_rig_is_deterministic_without_tile_pacing() {
             "32",
             "--frames",
             "3",
-            "--tile-pacing",
-            "off",
+            "--no-tile-pacing",
             "--shutter",
             "0.01",
             "--out-dir",

@@ -1,5 +1,5 @@
 //! End-to-end tests of the terrain options of the `alpenglow` binary
-//! (`--view`, `--lod`, `--terrain-detail`, `--terrain`, `--grid`,
+//! (`--view`, `--lod`, `--no-terrain-detail`, `--terrain`, `--grid`,
 //! `--sketch`, `--importance-off`, `--texturing`, `--layers`,
 //! `--input-map`, `--tile-budget`) and of the `fly` subcommand (orbit and
 //! keyframe paths, the frame directory, the JSON summary, error paths).
@@ -124,21 +124,21 @@ fn every_view_renders_and_debug_views_differ() {
 
 // ---------------------------------------------------------------- LOD, detail
 
-/// `--lod uniform` and `--terrain-detail off` render, and each differs from
+/// `--lod uniform` and `--no-terrain-detail` render, and each differs from
 /// the default (warped, with detail) render.
 #[test]
 fn uniform_lod_and_detail_off_differ_from_default() {
     let dir = fresh_dir("lod_detail");
     let default = render_png(&dir, "default.png", SMALL_TERRAIN, &[]);
     let uniform = render_png(&dir, "uniform.png", SMALL_TERRAIN, &["--lod", "uniform"]);
-    let no_detail = render_png(&dir, "no-detail.png", SMALL_TERRAIN, &["--terrain-detail", "off"]);
+    let no_detail = render_png(&dir, "no-detail.png", SMALL_TERRAIN, &["--no-terrain-detail"]);
     assert!(
         differing_bytes(&default, &uniform) > 0,
         "--lod uniform rendered the same image as --lod warped"
     );
     assert!(
         differing_bytes(&default, &no_detail) > 0,
-        "--terrain-detail off rendered the same image as --terrain-detail on"
+        "--no-terrain-detail rendered the same image as the default"
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -371,7 +371,7 @@ enum OutDir {
 
 /// Runs `fly` with 3 frames, `path_args` (`--orbit …` or `--path …`),
 /// `--out-dir ROOT/frames` (created first for [`OutDir::Empty`]) and
-/// `--json ROOT/fly.json`; checks the frames, the JSON and stdout and
+/// `--profile ROOT/fly.json`; checks the frames, the JSON and stdout and
 /// returns the frame directory's images.
 fn fly_frames(root: &Path, path_args: &[OsString], out_dir: OutDir) -> Vec<Vec<u8>> {
     let frames = root.join("frames");
@@ -384,7 +384,7 @@ fn fly_frames(root: &Path, path_args: &[OsString], out_dir: OutDir) -> Vec<Vec<u
     args.extend([
         OsString::from("--out-dir"),
         frames.clone().into_os_string(),
-        OsString::from("--json"),
+        OsString::from("--profile"),
         json.clone().into_os_string(),
     ]);
     let out = run(&args);
@@ -582,7 +582,7 @@ fn fly_refuses_zero_frames() {
     args.extend([
         OsString::from("--out-dir"),
         frames.into_os_string(),
-        OsString::from("--json"),
+        OsString::from("--profile"),
         json.into_os_string(),
     ]);
     let out = run(&args);

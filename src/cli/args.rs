@@ -11,11 +11,21 @@ use alpenglow::view::camera_path::Orbit;
 
 /// alpenglow: a Vulkan renderer for large outdoor scenes.
 #[derive(Parser, Debug)]
-#[command(name = "alpenglow", version, about)]
+#[command(name = "alpenglow", version, about, after_help = ENVIRONMENT_HELP)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
 }
+
+/// The environment variables, shown under every command's `--help`.
+pub const ENVIRONMENT_HELP: &str = "Environment:
+  ALPENGLOW_DEVICE  Vulkan device by index or name substring (as --device)
+  RUST_LOG          log filter: error, warn (default), info, debug or trace,
+                    also per module, e.g. RUST_LOG=alpenglow::texturing=debug
+  VK_LAYER_PATH     where the Khronos validation layer is found (--validation)
+
+Boolean options are flags: --X turns a feature on, --no-X turns off one that
+is on by default. Lengths are in metres, angles in degrees, times in seconds.";
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
@@ -36,50 +46,67 @@ pub enum Command {
 pub struct DeviceArgs {
     /// Enable the Khronos validation layers (and synchronization validation);
     /// exit non-zero if any validation error or warning was reported.
-    #[arg(long)]
+    #[arg(long, help_heading = "Debug")]
     pub validation: bool,
     /// Vulkan device by index or name substring (default: discrete, integrated, then CPU).
-    #[arg(long, env = "ALPENGLOW_DEVICE")]
+    #[arg(long, env = "ALPENGLOW_DEVICE", value_name = "INDEX|NAME", help_heading = "Debug")]
     pub device: Option<String>,
 }
 
 #[derive(Args, Debug, Clone)]
 pub struct SceneArgs {
     /// Image width in pixels.
-    #[arg(long, default_value_t = 1280)]
+    #[arg(long, default_value_t = 1280, value_name = "PIXELS", value_parser = clap::value_parser!(u32).range(1..), help_heading = "Camera")]
     pub width: u32,
     /// Image height in pixels.
-    #[arg(long, default_value_t = 720)]
+    #[arg(long, default_value_t = 720, value_name = "PIXELS", value_parser = clap::value_parser!(u32).range(1..), help_heading = "Camera")]
     pub height: u32,
     /// Camera position X,Y,Z in metres (default: framing the whole terrain).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z", help_heading = "Camera")]
     pub eye: Option<DVec3>,
-    /// Point looked at, X,Y,Z.
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    /// Point looked at X,Y,Z in metres (default: the terrain's centre).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z", help_heading = "Camera")]
     pub target: Option<DVec3>,
-    /// Up direction X,Y,Z.
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1")]
+    /// Up direction X,Y,Z (a direction, any length; +Z is up in the world).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,1", value_name = "X,Y,Z", help_heading = "Camera")]
     pub up: DVec3,
-    /// Vertical field of view in degrees.
-    #[arg(long = "fov-y", default_value_t = 50.0)]
+    /// Vertical field of view in degrees, (0, 180).
+    #[arg(
+        long = "fov-y",
+        default_value_t = 50.0,
+        value_name = "DEGREES",
+        help_heading = "Camera"
+    )]
     pub fov_y: f64,
     /// Near plane distance in metres (default: from the terrain size).
-    #[arg(long)]
+    #[arg(long, value_name = "METRES", help_heading = "Camera")]
     pub near: Option<f64>,
     /// Far plane distance in metres (default: from the terrain size).
-    #[arg(long)]
+    #[arg(long, value_name = "METRES", help_heading = "Camera")]
     pub far: Option<f64>,
     /// Height field: 16-bit PNG (value·scale + offset) or EXR (first channel, metres·scale + offset).
-    #[arg(long)]
+    #[arg(long, value_name = "FILE", help_heading = "Terrain")]
     pub heightmap: Option<PathBuf>,
-    /// Metres per height sample: DX or DX,DY.
-    #[arg(long, value_parser = parse_spacing, default_value = "1")]
+    /// Metres between height samples: DX, or DX,DY for columns and rows.
+    #[arg(long, value_parser = parse_spacing, default_value = "1", value_name = "DX[,DY]", help_heading = "Terrain")]
     pub spacing: (f64, f64),
-    /// Multiplier of height-map values.
-    #[arg(long = "height-scale", default_value_t = 1.0, allow_hyphen_values = true)]
+    /// Multiplier of height-map values (to metres).
+    #[arg(
+        long = "height-scale",
+        default_value_t = 1.0,
+        allow_hyphen_values = true,
+        value_name = "FACTOR",
+        help_heading = "Terrain"
+    )]
     pub height_scale: f32,
-    /// Added to height-map values after scaling, metres.
-    #[arg(long = "height-offset", default_value_t = 0.0, allow_hyphen_values = true)]
+    /// Added to height-map values after scaling, in metres.
+    #[arg(
+        long = "height-offset",
+        default_value_t = 0.0,
+        allow_hyphen_values = true,
+        value_name = "METRES",
+        help_heading = "Terrain"
+    )]
     pub height_offset: f32,
     #[command(flatten)]
     pub terrain: TerrainArgs,
@@ -89,6 +116,8 @@ pub struct SceneArgs {
     pub camera: super::rig::CameraArgs,
     #[command(flatten)]
     pub lighting: super::lighting::LightingArgs,
+    #[command(flatten)]
+    pub debug: TerrainDebugArgs,
     #[command(flatten)]
     pub device: DeviceArgs,
 }
@@ -114,28 +143,39 @@ pub enum SplatPrimitiveArg {
 }
 
 #[derive(Args, Debug, Clone)]
+#[command(next_help_heading = "Points")]
 pub struct PointArgs {
     /// Point object: PLY (points or mesh), OBJ (mesh) or SPT file; repeatable.
-    #[arg(long = "points")]
+    #[arg(long = "points", value_name = "FILE")]
     pub points: Vec<PathBuf>,
-    /// Placement of the n-th --points object: t=X,Y,Z;r=RX,RY,RZ;s=S (degrees; each part optional); repeatable.
-    #[arg(long = "points-transform", allow_hyphen_values = true)]
+    /// Placement of the n-th --points object: t=X,Y,Z;r=RX,RY,RZ;s=S (metres,
+    /// degrees, a factor; each part optional); repeatable.
+    #[arg(
+        long = "points-transform",
+        allow_hyphen_values = true,
+        value_name = "t=X,Y,Z;r=RX,RY,RZ;s=S"
+    )]
     pub transforms: Vec<String>,
     /// Splat mode.
-    #[arg(long, value_enum, default_value = "ewa")]
+    #[arg(long, value_enum, default_value = "ewa", value_name = "MODE")]
     pub splat: SplatArg,
     /// Splat primitive.
-    #[arg(long = "splat-primitive", value_enum, default_value = "quad")]
+    #[arg(
+        long = "splat-primitive",
+        value_enum,
+        default_value = "quad",
+        value_name = "PRIMITIVE"
+    )]
     pub splat_primitive: SplatPrimitiveArg,
     /// SPT error threshold in pixels of this image (r_min = e_g / ε).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_name = "PIXELS")]
     pub epsilon: f32,
     /// Surfels sampled from PLY/OBJ meshes given to --points.
-    #[arg(long = "points-samples", default_value_t = 50_000)]
+    #[arg(long = "points-samples", default_value_t = 50_000, value_name = "COUNT", value_parser = clap::builder::RangedI64ValueParser::<usize>::new().range(0..))]
     pub samples: usize,
-    /// Splat shading; off writes the splats' albedo (debugging, tests).
-    #[arg(long = "splat-shading", value_enum, default_value = "on")]
-    pub shading: Switch,
+    /// No splat shading: write the splats' albedo (debugging, tests).
+    #[arg(long = "no-splat-shading")]
+    pub no_shading: bool,
     /// Draw back-facing splats (open surfaces); by default they are culled.
     #[arg(long = "two-sided")]
     pub two_sided: bool,
@@ -147,18 +187,11 @@ pub struct PointArgs {
     #[arg(long)]
     pub hybrid: bool,
     /// Procedural boulders scattered over the built-in terrain (0: none).
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = 300, value_name = "COUNT", value_parser = clap::builder::RangedI64ValueParser::<usize>::new().range(0..))]
     pub rocks: usize,
     /// Draw no terrain: point objects against the sky.
     #[arg(long = "no-terrain")]
     pub no_terrain: bool,
-}
-
-/// On or off.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Switch {
-    On,
-    Off,
 }
 
 /// Terrain LOD placement.
@@ -198,59 +231,98 @@ pub enum FactorArg {
     Surface,
 }
 
+/// Debugging views and switches of the terrain (listed last in `--help`).
 #[derive(Args, Debug, Clone)]
+#[command(next_help_heading = "Debug")]
+pub struct TerrainDebugArgs {
+    /// Vertex placement.
+    #[arg(
+        long,
+        value_enum,
+        default_value = "warped",
+        value_name = "PLACEMENT",
+        help_heading = "Debug"
+    )]
+    pub lod: LodArg,
+    /// Debug view of the terrain.
+    #[arg(
+        long,
+        value_enum,
+        default_value = "shaded",
+        value_name = "MODE",
+        help_heading = "Debug"
+    )]
+    pub view: ViewArg,
+    /// Sketch map orientation.
+    #[arg(
+        long = "sketch-align",
+        value_enum,
+        default_value = "view",
+        value_name = "ALIGNMENT",
+        help_heading = "Debug"
+    )]
+    pub sketch_align: AlignArg,
+    /// Switch importance factors off (comma-separated), for debugging.
+    #[arg(
+        long = "importance-off",
+        value_enum,
+        value_delimiter = ',',
+        value_name = "FACTOR,...",
+        help_heading = "Debug"
+    )]
+    pub importance_off: Vec<FactorArg>,
+}
+
+#[derive(Args, Debug, Clone)]
+#[command(next_help_heading = "Terrain")]
 pub struct TerrainArgs {
     /// Procedural terrain instead of a height map: procedural:MODEL[,key=value...]
     /// with MODEL fbm|multifractal|heterogeneous|hybrid|ridged and keys seed, octaves,
     /// lacunarity, h, offset, gain, wavelength, amplitude, size, spacing (DX or DX:DY).
-    #[arg(long, conflicts_with = "heightmap")]
+    #[arg(long, conflicts_with = "heightmap", value_name = "procedural:MODEL[,KEY=VALUE...]")]
     pub terrain: Option<TerrainSpec>,
-    /// Procedural displacement and bump mapping; off shows the sketch atlas surface alone.
-    #[arg(long = "terrain-detail", value_enum, default_value = "on")]
-    pub terrain_detail: Switch,
-    /// Detail amplitude relative to the height-sample spacing.
-    #[arg(long = "detail-amplitude", default_value_t = 0.15)]
+    /// No procedural displacement and bump mapping: the height field's
+    /// B-spline surface alone.
+    #[arg(long = "no-terrain-detail")]
+    pub no_terrain_detail: bool,
+    /// Amplitude of the procedural detail, as a fraction of the
+    /// height-sample spacing (0.15: 15 cm for 1 m samples).
+    #[arg(long = "detail-amplitude", default_value_t = 0.15, value_name = "FRACTION")]
     pub detail_amplitude: f32,
-    /// Vertex placement.
-    #[arg(long, value_enum, default_value = "warped")]
-    pub lod: LodArg,
-    /// Debug view of the terrain.
-    #[arg(long, value_enum, default_value = "shaded")]
-    pub view: ViewArg,
-    /// Output grid side (vertices per side of the geometry image).
-    #[arg(long, default_value_t = 512)]
+    /// Geometry-image side in vertices (the terrain mesh has GRID² vertices).
+    #[arg(long, default_value_t = 512, value_name = "VERTICES", value_parser = clap::value_parser!(u32).range(2..))]
     pub grid: u32,
-    /// Sketch map side (texels per side).
-    #[arg(long, default_value_t = 128)]
+    /// Sketch map side in texels.
+    #[arg(long, default_value_t = 128, value_name = "TEXELS", value_parser = clap::builder::RangedI64ValueParser::<usize>::new().range(0..))]
     pub sketch: usize,
-    /// Sketch map orientation.
-    #[arg(long = "sketch-align", value_enum, default_value = "view")]
-    pub sketch_align: AlignArg,
-    /// Switch importance factors off (comma-separated), for debugging.
-    #[arg(long = "importance-off", value_enum, value_delimiter = ',')]
-    pub importance_off: Vec<FactorArg>,
     /// Terrain colouring: the surface-layer tree cached in a texture atlas
     /// (atlas, §8.2), the same tree evaluated per pixel (direct, the atlas's
     /// reference), or classic surface types (§7.4.3).
-    #[arg(long, value_enum, default_value = "atlas")]
+    #[arg(
+        long,
+        value_enum,
+        default_value = "atlas",
+        value_name = "MODE",
+        help_heading = "Texturing"
+    )]
     pub texturing: TexturingArg,
     /// Most texture tiles generated per frame (atlas texturing), 1..=255;
     /// the texel budget is this many 128² tiles. Still renders keep
     /// rendering until every tile is ready.
-    #[arg(long = "tile-budget", default_value_t = 32)]
+    #[arg(long = "tile-budget", default_value_t = 32, value_name = "TILES", help_heading = "Texturing", value_parser = clap::value_parser!(u32).range(0..))]
     pub tile_budget: u32,
-    /// Spread tile generation by GPU time as well (a quarter of the rest of
-    /// the frame, measured): steady frame times for moving cameras. off:
-    /// tile counts only, so a camera path's frames are the same on every run.
-    #[arg(long = "tile-pacing", value_enum, default_value = "on")]
-    pub tile_pacing: Switch,
+    /// Tile counts only, no pacing of tile generation by measured GPU time
+    /// (by default a quarter of the rest of the frame, for steady frame
+    /// times): a camera path's frames are then the same on every run.
+    #[arg(long = "no-tile-pacing", help_heading = "Texturing")]
+    pub no_tile_pacing: bool,
     /// Surface-layer tree (TOML; default: the built-in tree).
-    #[arg(long)]
+    #[arg(long, value_name = "FILE", help_heading = "Texturing")]
     pub layers: Option<PathBuf>,
     /// Extra input map of the layers, NAME=FILE with NAME rainfall,
     /// radiation or temperature (repeatable): a greyscale PNG or EXR whose
     /// grid spans the terrain rectangle; the layers' hats use its raw values.
-    #[arg(long = "input-map", value_parser = parse_input_map)]
+    #[arg(long = "input-map", value_parser = parse_input_map, value_name = "NAME=FILE", help_heading = "Texturing")]
     pub input_maps: Vec<(usize, PathBuf)>,
 }
 
@@ -267,66 +339,69 @@ pub enum TexturingArg {
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    #[command(flatten)]
-    pub scene: SceneArgs,
     /// Tone-mapped sRGB PNG.
-    #[arg(long)]
+    #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub out: Option<PathBuf>,
     /// OpenEXR: linear R,G,B,A, Z (view-space depth, +inf where nothing was hit), the lighting and simulator AOVs
     /// (distance, N.X/Y/Z, class, instance, motion.X/Y) and, with points, W (EWA weight).
-    #[arg(long)]
+    #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub exr: Option<PathBuf>,
     /// Per-pass timings as JSON (name, GPU ms, CPU ms; frame totals).
-    #[arg(long)]
+    #[arg(long, alias = "json", value_name = "FILE", help_heading = "Output")]
     pub profile: Option<PathBuf>,
     /// Chrome trace (opens in Perfetto).
-    #[arg(long)]
+    #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub trace: Option<PathBuf>,
+    #[command(flatten)]
+    pub scene: SceneArgs,
 }
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
-    #[command(flatten)]
-    pub scene: SceneArgs,
     /// Frames to time (after warm-up).
-    #[arg(long, default_value_t = 60)]
+    #[arg(long, default_value_t = 60, value_name = "COUNT", value_parser = clap::value_parser!(u32).range(1..), help_heading = "Output")]
     pub frames: u32,
     /// Frames rendered first and not timed.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_name = "COUNT", help_heading = "Output", value_parser = clap::value_parser!(u32).range(0..))]
     pub warmup: u32,
-    /// Write the summary as JSON.
-    #[arg(long)]
+    /// The summary (per-pass medians, frame times) as JSON.
+    #[arg(long = "profile", alias = "json", value_name = "FILE", help_heading = "Output")]
     pub json: Option<PathBuf>,
-    /// Chrome trace of the timed frames.
-    #[arg(long)]
+    /// Chrome trace of the timed frames (opens in Perfetto).
+    #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub trace: Option<PathBuf>,
+    #[command(flatten)]
+    pub scene: SceneArgs,
 }
 
 #[derive(Args, Debug)]
 pub struct FlyArgs {
-    #[command(flatten)]
-    pub scene: SceneArgs,
-    /// Keyframes (TOML: [[keyframe]] time, eye = [x,y,z], target = [x,y,z]); fov, near, far from the camera options.
-    #[arg(long, conflicts_with = "orbit")]
+    /// Keyframes (TOML: [[keyframe]] time in seconds, eye = [x,y,z] and
+    /// target = [x,y,z] in metres); fov, near, far from the camera options.
+    #[arg(long, conflicts_with = "orbit", value_name = "FILE", help_heading = "Camera")]
     pub path: Option<PathBuf>,
-    /// Orbit CX,CY,CZ,RADIUS,HEIGHT[,TURNS] (default: one turn around the terrain's centre).
-    #[arg(long, value_parser = parse_orbit, allow_hyphen_values = true)]
+    /// Orbit around the centre CX,CY,CZ (metres) at RADIUS metres, HEIGHT
+    /// metres above the centre, TURNS turns over the frames (default 1;
+    /// default orbit: one turn around the terrain's centre).
+    #[arg(long, value_parser = parse_orbit, allow_hyphen_values = true, value_name = "CX,CY,CZ,RADIUS,HEIGHT[,TURNS]", help_heading = "Camera")]
     pub orbit: Option<Orbit>,
     /// Frames over the whole path.
-    #[arg(long, default_value_t = 60)]
+    #[arg(long, default_value_t = 60, value_name = "COUNT", value_parser = clap::value_parser!(u32).range(1..), help_heading = "Output")]
     pub frames: u32,
     /// Directory for frame_00000.png…; must not exist or be empty (without it, frames are only timed).
-    #[arg(long = "out-dir")]
+    #[arg(long = "out-dir", value_name = "DIR", help_heading = "Output")]
     pub out_dir: Option<PathBuf>,
     /// Also write DIR/frame_00000.exr… with every channel (as render --exr; motion from the path's previous frame).
-    #[arg(long)]
+    #[arg(long, help_heading = "Output")]
     pub exr: bool,
     /// Per-frame times and pass medians as JSON.
-    #[arg(long)]
+    #[arg(long = "profile", alias = "json", value_name = "FILE", help_heading = "Output")]
     pub json: Option<PathBuf>,
-    /// Chrome trace of all frames.
-    #[arg(long)]
+    /// Chrome trace of all frames (opens in Perfetto).
+    #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub trace: Option<PathBuf>,
+    #[command(flatten)]
+    pub scene: SceneArgs,
 }
 
 #[derive(Subcommand, Debug)]
@@ -349,22 +424,22 @@ pub struct SptBuildArgs {
     /// Output SPT file.
     pub output: PathBuf,
     /// Surfels sampled from a mesh (point clouds keep their points).
-    #[arg(long, default_value_t = 100_000)]
+    #[arg(long, default_value_t = 100_000, value_name = "COUNT", value_parser = clap::builder::RangedI64ValueParser::<usize>::new().range(0..))]
     pub samples: usize,
     /// Mesh sampling method.
-    #[arg(long, value_enum, default_value = "blue-noise")]
+    #[arg(long, value_enum, default_value = "blue-noise", value_name = "METHOD")]
     pub sampling: SamplingArg,
     /// Sampling seed.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_name = "SEED", value_parser = clap::value_parser!(u64).range(0..))]
     pub seed: u64,
     /// SPT error threshold in pixels (r_min = e_g / ε).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_name = "PIXELS")]
     pub epsilon: f32,
-    /// Vertical field of view the pixel threshold refers to, degrees.
-    #[arg(long = "fov-y", default_value_t = 60.0)]
+    /// Vertical field of view the pixel threshold refers to, in degrees.
+    #[arg(long = "fov-y", default_value_t = 60.0, value_name = "DEGREES")]
     pub fov_y: f32,
     /// Image rows the pixel threshold refers to.
-    #[arg(long, default_value_t = 1080)]
+    #[arg(long, default_value_t = 1080, value_name = "PIXELS", value_parser = clap::value_parser!(u32).range(0..))]
     pub rows: u32,
 }
 

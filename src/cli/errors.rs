@@ -4,6 +4,36 @@
 //! command line reports the flag that sets it (`--width`, `--fov-y`,
 //! `--grid`).
 
+/// A clap parse error on one line: its first line (and the next one for
+/// "the following required arguments were not provided:"), with clap's
+/// integer range ("-1 is not in 0..=4294967295") said in words.
+pub fn clap_error_line(e: &clap::Error) -> String {
+    let text = e.to_string();
+    let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
+    let mut first = lines
+        .next()
+        .unwrap_or("invalid arguments")
+        .trim_start_matches("error: ")
+        .to_string();
+    if first.ends_with(':') {
+        if let Some(next) = lines.next() {
+            first = format!("{first} {next}");
+        }
+    }
+    for (range, words) in [
+        (" is not in 0..", "must be 0 or more"),
+        (" is not in 1..", "must be 1 or more"),
+        (" is not in 2..", "must be 2 or more"),
+    ] {
+        if let Some(at) = first.find(range) {
+            if let Some(colon) = first[..at].rfind("': ") {
+                first = format!("{}': {words}", &first[..colon]);
+            }
+        }
+    }
+    first
+}
+
 /// Library parameter → the flag that sets it. Parameters without an entry
 /// are reported under their library name.
 const FLAGS: &[(&str, &str)] = &[
@@ -11,6 +41,9 @@ const FLAGS: &[(&str, &str)] = &[
     ("height", "--height"),
     ("camera.fov_y_deg", "--fov-y"),
     ("camera.near", "--near"),
+    ("camera.eye", "--eye"),
+    ("camera.target", "--target"),
+    ("camera.up", "--up"),
     ("camera.far", "--far"),
     ("orbit", "--orbit"),
     ("camera.pose", "--pose"),

@@ -9,58 +9,59 @@ use alpenglow::lighting::solar::{parse_date, parse_time, solar_position, Clock, 
 use alpenglow::view::{Exposure, Lighting, ShadowMode, SkyLightMode, SkyModel, SunPosition};
 
 #[derive(Args, Debug, Clone, Default)]
+#[command(next_help_heading = "Lighting")]
 pub struct LightingArgs {
     /// Sun elevation above the horizon, degrees (-90..90).
-    #[arg(long = "sun-elevation", allow_hyphen_values = true)]
+    #[arg(long = "sun-elevation", allow_hyphen_values = true, value_name = "DEGREES")]
     pub sun_elevation: Option<f32>,
     /// Sun azimuth, degrees clockwise from +Y (north of the height field).
-    #[arg(long = "sun-azimuth", allow_hyphen_values = true)]
+    #[arg(long = "sun-azimuth", allow_hyphen_values = true, value_name = "DEGREES")]
     pub sun_azimuth: Option<f32>,
     /// Date YYYY-MM-DD for the solar position (with --time, --latitude, --longitude).
-    #[arg(long)]
+    #[arg(long, value_name = "YYYY-MM-DD")]
     pub date: Option<String>,
     /// Local mean solar time HH:MM (with --date).
-    #[arg(long)]
+    #[arg(long, value_name = "HH:MM")]
     pub time: Option<String>,
     /// Latitude, degrees north (with --date).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_name = "DEGREES")]
     pub latitude: Option<f32>,
     /// Longitude, degrees east (with --date).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_name = "DEGREES")]
     pub longitude: Option<f32>,
     /// The text's environments of Fig. 9.3: morning (day 298 07:30) or noon (day 180 12:00), 49.6° N, T = 2.1.
-    #[arg(long = "sky-preset")]
+    #[arg(long = "sky-preset", value_name = "morning|noon")]
     pub sky_preset: Option<String>,
     /// Atmospheric turbidity T (1.7..10; default 3, or the preset's).
-    #[arg(long)]
+    #[arg(long, value_name = "T")]
     pub turbidity: Option<f32>,
     /// Sky model.
-    #[arg(long, value_enum, default_value_t = SkyArg::Physical)]
+    #[arg(long, value_enum, default_value_t = SkyArg::Physical, value_name = "MODEL")]
     pub sky: SkyArg,
     /// Exposure: EV100, or "auto" (metered from the frame).
-    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
+    #[arg(long, default_value = "auto", allow_hyphen_values = true, value_name = "EV100|auto")]
     pub exposure: String,
     /// Sun shadows.
-    #[arg(long, value_enum, default_value_t = ShadowArg::Cascaded)]
+    #[arg(long, value_enum, default_value_t = ShadowArg::Cascaded, value_name = "METHOD")]
     pub shadows: ShadowArg,
     /// Sky light on the terrain (§9.3–9.5).
-    #[arg(long, value_enum, default_value_t = LightingArg::Sh)]
+    #[arg(long, value_enum, default_value_t = LightingArg::Sh, value_name = "METHOD")]
     pub lighting: LightingArg,
     /// Spherical-harmonic bands of --lighting sh: 3 or 5.
-    #[arg(long = "sh-bands", default_value_t = 5)]
+    #[arg(long = "sh-bands", default_value_t = 5, value_name = "BANDS", value_parser = clap::value_parser!(u32).range(0..))]
     pub sh_bands: u32,
     /// Interreflection bounces of the sky-light transfer: 0, 1 or 2.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_name = "COUNT", value_parser = clap::value_parser!(u32).range(0..))]
     pub bounces: u32,
     /// Sky patches per side of --lighting patches: 4 (16 patches) or 8 (64).
-    #[arg(long = "sky-patches", default_value_t = 8)]
+    #[arg(long = "sky-patches", default_value_t = 8, value_name = "SIDE", value_parser = clap::value_parser!(u32).range(0..))]
     pub sky_patches: u32,
     /// Render every surface with this albedo (1: white diffuse).
-    #[arg(long = "albedo-override")]
+    #[arg(long = "albedo-override", value_name = "ALBEDO")]
     pub albedo_override: Option<f32>,
     /// Where the sky-light bake is cached (default: $XDG_CACHE_HOME/alpenglow
     /// or ~/.cache/alpenglow; "none": bake every time).
-    #[arg(long = "cache-dir")]
+    #[arg(long = "cache-dir", value_name = "DIR|none")]
     pub cache_dir: Option<PathBuf>,
 }
 

@@ -15,7 +15,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{anyhow, bail, Result};
-use clap::Parser;
 use glam::DVec2;
 
 use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
@@ -30,13 +29,36 @@ use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector, ValidationRepor
 pub use errors::error_line;
 
 use args::{
-    AlignArg, BenchArgs, Cli, Command, DeviceArgs, FactorArg, LodArg, RenderArgs, SceneArgs, Switch, TerrainArgs,
-    ViewArg,
+    AlignArg, BenchArgs, Cli, Command, DeviceArgs, FactorArg, LodArg, RenderArgs, SceneArgs, TerrainArgs,
+    TerrainDebugArgs, ViewArg,
 };
+
+/// Lets every option that takes a value accept a negative number (`--near
+/// -1` is then a range error naming `--near`, not "unexpected argument
+/// '-1'"), in every subcommand.
+fn allow_negative_values(command: clap::Command) -> clap::Command {
+    command
+        .mut_args(|arg| {
+            if arg.get_action().takes_values() && !arg.is_positional() {
+                arg.allow_negative_numbers(true)
+            } else {
+                arg
+            }
+        })
+        .mut_subcommands(allow_negative_values)
+}
+
+/// The parsed command line (negative numbers allowed as values).
+fn parse_command_line() -> std::result::Result<Cli, clap::Error> {
+    use clap::{CommandFactory, FromArgMatches};
+    let command = allow_negative_values(Cli::command()).mut_subcommands(|c| c.after_help(args::ENVIRONMENT_HELP));
+    let matches = command.try_get_matches()?;
+    Cli::from_arg_matches(&matches)
+}
 
 /// Parses the command line and runs the subcommand.
 pub fn run() -> Result<ExitCode> {
-    let cli = match Cli::try_parse() {
+    let cli = match parse_command_line() {
         Ok(cli) => cli,
         Err(e) => {
             use clap::error::ErrorKind;
@@ -44,20 +66,7 @@ pub fn run() -> Result<ExitCode> {
                 e.print()?;
                 return Ok(ExitCode::SUCCESS);
             }
-            // clap's message is multi-line; keep its first line.
-            let text = e.to_string();
-            let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
-            let mut first = lines
-                .next()
-                .unwrap_or("invalid arguments")
-                .trim_start_matches("error: ")
-                .to_string();
-            // "the following required arguments were not provided:" names them on the next line.
-            if first.ends_with(':') {
-                if let Some(next) = lines.next() {
-                    first = format!("{first} {next}");
-                }
-            }
+            let first = errors::clap_error_line(&e);
             bail!("{first} (see alpenglow --help)");
         }
     };
@@ -157,6 +166,21 @@ fn check_output_path(path: &Option<PathBuf>, what: &str) -> Result<()> {
     Ok(())
 }
 
+/// Warns when `--input-map NAME=FILE` has no effect: no layer of the tree
+/// constrains input `k`, or classic texturing uses no layer tree.
+fn warn_unused_input_map(args: &SceneArgs, scene: &Scene, k: usize) {
+    let name = alpenglow::texturing::layers::INPUT_NAMES[k];
+    let tree = match &args.terrain.layers {
+        Some(path) => format!("the layer tree {}", path.display()),
+        None => "the built-in layer tree".to_string(),
+    };
+    if args.terrain.texturing == args::TexturingArg::Classic {
+        log::warn!("--input-map {name} is ignored: --texturing classic uses no layer tree");
+    } else if !scene.layers.uses_input(k) {
+        log::warn!("--input-map {name} is ignored: no layer of {tree} constrains {name}");
+    }
+}
+
 fn load_scene(args: &SceneArgs) -> Result<Scene> {
     validate_size(args.width, args.height)?;
     let builtin = args.terrain.terrain.is_none() && args.heightmap.is_none();
@@ -171,6 +195,7 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
             bail!("--input-map {name} is given twice");
         }
         scene.input_maps[*k] = Some(load_heightmap(path, &HeightmapOptions::default())?);
+        warn_unused_input_map(args, &scene, *k);
     }
     Ok(scene)
 }
@@ -195,7 +220,7 @@ fn render_settings(args: &SceneArgs, scene: &Scene, views: &[ViewSpec], readback
         msaa: args.camera.msaa,
         motion_blur: args.camera.motion_blur()?,
         readback,
-        terrain: terrain_settings(&args.terrain)?,
+        terrain: terrain_settings(&args.terrain, &args.debug)?,
         points: points::splat_settings(&args.points, args.fov_y, args.height)?,
         texturing: match args.terrain.texturing {
             args::TexturingArg::Classic => alpenglow::texturing::gpu_layout::TexturingMode::Classic,
@@ -216,7 +241,7 @@ fn texture_streaming(
 ) -> Result<alpenglow::texturing::generation::TextureStreaming> {
     let sizes: Vec<(u32, u32)> = views.iter().map(|v| (v.width, v.height)).collect();
     let mut streaming = alpenglow::texturing::generation::TextureStreaming::for_views(&sizes);
-    if args.terrain.tile_pacing == Switch::Off {
+    if args.terrain.no_tile_pacing {
         streaming.budget.gpu_time = None;
     }
     Ok(streaming.with_tile_budget(args.terrain.tile_budget)?)
@@ -242,13 +267,13 @@ fn load_terrain(args: &SceneArgs) -> Result<Scene> {
     }
 }
 
-fn terrain_settings(args: &TerrainArgs) -> Result<TerrainSettings> {
-    let off = |f: FactorArg| args.importance_off.contains(&f);
+fn terrain_settings(args: &TerrainArgs, debug: &TerrainDebugArgs) -> Result<TerrainSettings> {
+    let off = |f: FactorArg| debug.importance_off.contains(&f);
     let settings = TerrainSettings {
         grid_side: args.grid,
         lod: LodSettings {
             sketch_side: args.sketch,
-            mode: match args.lod {
+            mode: match debug.lod {
                 LodArg::Warped => LodMode::Warped,
                 LodArg::Uniform => LodMode::Uniform,
             },
@@ -258,14 +283,14 @@ fn terrain_settings(args: &TerrainArgs) -> Result<TerrainSettings> {
                 backface: !off(FactorArg::Backface),
                 surface: !off(FactorArg::Surface),
             },
-            alignment: match args.sketch_align {
+            alignment: match debug.sketch_align {
                 AlignArg::View => SketchAlignment::View,
                 AlignArg::Axes => SketchAlignment::Axes,
             },
         },
-        detail: args.terrain_detail == Switch::On,
+        detail: !args.no_terrain_detail,
         detail_amplitude: args.detail_amplitude,
-        view: match args.view {
+        view: match debug.view {
             ViewArg::Shaded => TerrainView::Shaded,
             ViewArg::Importance => TerrainView::Importance,
             ViewArg::DensityRatio => TerrainView::DensityRatio,

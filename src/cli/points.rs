@@ -9,7 +9,7 @@ use alpenglow::points::render::{SplatMode, SplatPrimitive, SplatSettings};
 use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointTransform};
 use alpenglow::renderer::Scene;
 
-use super::args::{PointArgs, SplatArg, SplatPrimitiveArg, Switch};
+use super::args::{PointArgs, SplatArg, SplatPrimitiveArg};
 
 /// Adds the `--points` objects to `scene` (and, for the built-in terrain,
 /// the `--rocks`); `builtin` says whether the scene is the built-in one.
@@ -58,7 +58,7 @@ pub fn splat_settings(args: &PointArgs, fov_y_deg: f64, rows: u32) -> Result<Spl
             SplatPrimitiveArg::Quad => SplatPrimitive::Quad,
             SplatPrimitiveArg::Instanced => SplatPrimitive::Instanced,
         },
-        shaded: args.shading == Switch::On,
+        shaded: !args.no_shading,
         two_sided: args.two_sided,
         normal_clusters: args.normal_clusters,
         epsilon: Some(

@@ -16,41 +16,42 @@ use alpenglow::view::lens::{Distortion, Intrinsics};
 pub const VIEW_PATTERN: &str = "{view}";
 
 #[derive(Args, Debug, Clone, Default)]
+#[command(next_help_heading = "Camera")]
 pub struct CameraArgs {
     /// Camera pose: a 4×4 camera→world matrix, 16 comma-separated numbers
     /// row by row (OpenGL camera axes: x right, y up, looking down −z).
-    #[arg(long, value_parser = parse_pose, allow_hyphen_values = true, conflicts_with_all = ["eye", "target", "rotation"])]
+    #[arg(long, value_parser = parse_pose, allow_hyphen_values = true, conflicts_with_all = ["eye", "target", "rotation"], value_name = "M00,M01,...,M33")]
     pub pose: Option<DMat4>,
     /// Camera orientation as a unit quaternion X,Y,Z,W (camera→world, the
     /// --pose axes), placed at --eye.
-    #[arg(long, value_parser = parse_quaternion, allow_hyphen_values = true, requires = "eye", conflicts_with = "target")]
+    #[arg(long, value_parser = parse_quaternion, allow_hyphen_values = true, requires = "eye", conflicts_with = "target", value_name = "X,Y,Z,W")]
     pub rotation: Option<DQuat>,
     /// Pinhole intrinsics FX,FY,CX,CY in pixels (instead of --fov-y):
     /// off-centre principal points and non-square pixels.
-    #[arg(long, value_parser = parse_intrinsics, allow_hyphen_values = true)]
+    #[arg(long, value_parser = parse_intrinsics, allow_hyphen_values = true, value_name = "FX,FY,CX,CY")]
     pub intrinsics: Option<Intrinsics>,
     /// Brown–Conrady lens distortion K1,K2,K3,P1,P2 (OpenCV convention),
     /// applied by resampling the rendered image.
-    #[arg(long, value_parser = parse_distortion, allow_hyphen_values = true)]
+    #[arg(long, value_parser = parse_distortion, allow_hyphen_values = true, value_name = "K1,K2,K3,P1,P2")]
     pub distortion: Option<Distortion>,
     /// Several views per frame (TOML [[view]] tables, see the README), posed
     /// relative to the command's camera; --out and --exr then need `{view}`.
-    #[arg(long, conflicts_with_all = ["rig_preset", "intrinsics", "distortion"])]
+    #[arg(long, conflicts_with_all = ["rig_preset", "intrinsics", "distortion"], value_name = "FILE")]
     pub rig: Option<PathBuf>,
     /// A built-in rig: ring6 (six 60° views around the camera, 4:3, --width wide).
-    #[arg(long = "rig-preset", value_enum, conflicts_with_all = ["intrinsics", "distortion"])]
+    #[arg(long = "rig-preset", value_enum, conflicts_with_all = ["intrinsics", "distortion"], value_name = "PRESET")]
     pub rig_preset: Option<RigPreset>,
     /// Anti-aliasing: samples per pixel, 1, 2, 4, 8 or 16 (supersampled
     /// render, each side ×√N, resolved with exact AOVs).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_name = "SAMPLES", value_parser = clap::value_parser!(u32).range(0..))]
     pub msaa: u32,
     /// Motion blur: the shutter's open time in seconds (0: off), along the
     /// motion AOV from frame to frame.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_name = "SECONDS")]
     pub shutter: f32,
     /// Frames per second of the sequence (`fly`, and the motion that the
     /// shutter time is a part of).
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, value_name = "HZ")]
     pub fps: f32,
 }
 

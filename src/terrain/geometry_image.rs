@@ -79,7 +79,7 @@ pub struct TerrainSettings {
     /// Output grid side `N` (vertices per side, 2..=2048).
     pub grid_side: u32,
     pub lod: LodSettings,
-    /// Procedural displacement and bump mapping (`--terrain-detail`).
+    /// Procedural displacement and bump mapping (`--no-terrain-detail`).
     pub detail: bool,
     /// Detail amplitude relative to the atlas spacing: octave k has
     /// amplitude `amplitude · d0 · 2^(−k·H)`.

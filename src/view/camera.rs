@@ -5,6 +5,31 @@ use glam::{DMat4, DQuat, DVec3, DVec4, Mat4};
 
 use crate::error::{Error, Result};
 
+/// The largest coordinate of a camera's eye or target, metres (10⁸ m: the
+/// Earth is 1.3·10⁷ m across; beyond it f32 positions lose whole kilometres).
+pub const MAX_COORDINATE: f64 = 1e8;
+/// The smallest near-plane distance, metres (1 µm).
+pub const MIN_NEAR: f64 = 1e-6;
+/// The farthest far-plane distance, metres.
+pub const MAX_FAR: f64 = 1e9;
+/// The largest far / near ratio the 32-bit depth buffer resolves.
+pub const MAX_DEPTH_RATIO: f64 = 1e10;
+
+/// `x` in few characters: plain between 10⁻³ and 10⁷, else in scientific
+/// notation (`1e300`, not three hundred digits).
+pub fn short(x: f64) -> String {
+    if x == 0.0 || (1e-3..1e7).contains(&x.abs()) || !x.is_finite() {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// A vector as `X,Y,Z` with [`short`] components.
+fn short_vec(v: DVec3) -> String {
+    format!("{},{},{}", short(v.x), short(v.y), short(v.z))
+}
+
 /// A pinhole camera.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
@@ -18,12 +43,31 @@ pub struct Camera {
 }
 
 impl Camera {
-    /// Checks that the camera describes a view: finite values, eye ≠ target,
-    /// up not parallel to the view direction, 0 < fov < 180, 0 < near < far.
+    /// Checks that the camera describes a view: finite values, eye and
+    /// target within ±[`MAX_COORDINATE`] metres, eye ≠ target, up not zero
+    /// or parallel to the view direction, 0 < fov < 180, and
+    /// [`MIN_NEAR`] ≤ near < far ≤ [`MAX_FAR`] with far / near ≤
+    /// [`MAX_DEPTH_RATIO`] (the depth buffer's precision).
     pub fn validate(&self) -> Result<()> {
-        let finite = |v: DVec3| v.is_finite();
-        if !finite(self.eye) || !finite(self.target) || !finite(self.up) {
-            return Err(Error::invalid("camera", "eye, target and up must be finite numbers"));
+        for (name, v) in [
+            ("camera.eye", self.eye),
+            ("camera.target", self.target),
+            ("camera.up", self.up),
+        ] {
+            if !v.is_finite() {
+                return Err(Error::invalid(name, format!("{} must be finite numbers", short_vec(v))));
+            }
+        }
+        for (name, v) in [("camera.eye", self.eye), ("camera.target", self.target)] {
+            if v.abs().max_element() > MAX_COORDINATE {
+                return Err(Error::invalid(
+                    name,
+                    format!(
+                        "{} is beyond ±{MAX_COORDINATE:e} m, the largest coordinate a camera may have",
+                        short_vec(v)
+                    ),
+                ));
+            }
         }
         let dir = self.target - self.eye;
         if dir.length() <= 1e-9 * self.eye.length().max(1.0) {
@@ -32,8 +76,11 @@ impl Camera {
                 "eye equals target; there is no view direction",
             ));
         }
-        if self.up.length() == 0.0 || dir.normalize().cross(self.up.normalize()).length() < 1e-6 {
-            return Err(Error::invalid("camera", "up is zero or parallel to the view direction"));
+        let Some(up) = self.up.try_normalize() else {
+            return Err(Error::invalid("camera.up", "up is zero"));
+        };
+        if dir.normalize().cross(up).length() < 1e-6 {
+            return Err(Error::invalid("camera.up", "up is parallel to the view direction"));
         }
         if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
             return Err(Error::invalid(
@@ -47,6 +94,27 @@ impl Camera {
                 format!(
                     "near {} and far {}; need 0 < near < far, both finite",
                     self.near, self.far
+                ),
+            ));
+        }
+        if self.near < MIN_NEAR {
+            return Err(Error::invalid(
+                "camera.near",
+                format!("{} m is below the smallest near plane, {MIN_NEAR} m", short(self.near)),
+            ));
+        }
+        if self.far > MAX_FAR {
+            return Err(Error::invalid(
+                "camera.far",
+                format!("{} m is beyond the farthest far plane, {MAX_FAR:e} m", short(self.far)),
+            ));
+        }
+        if self.far / self.near > MAX_DEPTH_RATIO {
+            return Err(Error::invalid(
+                "camera.near/camera.far",
+                format!(
+                    "far / near = {:.3e} exceeds {MAX_DEPTH_RATIO:e}, beyond the depth buffer's precision; raise near or lower far",
+                    self.far / self.near
                 ),
             ));
         }
@@ -177,6 +245,39 @@ mod tests {
         let mut c = camera();
         c.eye.x = f64::NAN;
         assert!(c.validate().is_err());
+    }
+
+    /// Absurd magnitudes name the real problem, not "eye equals target"
+    /// or "up is parallel" (issue 15's probe).
+    #[test]
+    fn absurd_magnitudes_name_the_parameter_and_the_limit() {
+        let fails = |edit: &dyn Fn(&mut Camera)| {
+            let mut c = camera();
+            edit(&mut c);
+            c.validate().unwrap_err()
+        };
+        let e = fails(&|c| c.eye = DVec3::new(1e300, 0.0, 0.0));
+        assert_eq!(e.parameter(), Some("camera.eye"));
+        assert!(e.to_string().contains("1e300,0,0 is beyond ±1e8 m"), "{e}");
+        assert_eq!(fails(&|c| c.target.z = -1e9).parameter(), Some("camera.target"));
+        assert_eq!(
+            fails(&|c| c.up = DVec3::new(1e-320, 0.0, 0.0)).to_string(),
+            "invalid camera.up: up is zero"
+        );
+        assert_eq!(fails(&|c| c.near = 1e-300).parameter(), Some("camera.near"));
+        assert_eq!(fails(&|c| c.far = 1e300).parameter(), Some("camera.far"));
+        let e = fails(&|c| {
+            c.near = 1e-5;
+            c.far = 1e6;
+        });
+        assert!(e.to_string().contains("depth buffer"), "{e}");
+        // The limits themselves are legal.
+        let mut c = camera();
+        c.eye = DVec3::new(MAX_COORDINATE, 0.0, 10.0);
+        c.target = DVec3::new(MAX_COORDINATE - 100.0, 0.0, 10.0);
+        assert!(c.validate().is_ok());
+        assert_eq!(short(1e300), "1e300");
+        assert_eq!(short(12.5), "12.5");
     }
 
     #[test]
