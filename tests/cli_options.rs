@@ -78,6 +78,18 @@ fn every_command_writes_timings_with_profile_and_booleans_are_flags() {
     }
 }
 
+/// Runs `render` (16 pixels high) with each case's arguments and expects a
+/// one-line error mentioning its needles and never `symptom`.
+fn expect_errors(cases: &[(&[&str], &[&str])], symptom: &str) {
+    for (args, needles) in cases {
+        let mut all = vec!["render", "--height", "16"];
+        all.extend_from_slice(args);
+        let out = run(&all);
+        assert_one_line_error(&args.join(" "), &out, needles);
+        assert!(!text(&out.stderr).contains(symptom), "{args:?}");
+    }
+}
+
 /// Negative values reach the checks of their option (they used to be
 /// "unexpected argument '-1'").
 #[test]
@@ -90,13 +102,7 @@ fn negative_numbers_are_range_errors_naming_the_flag() {
         (&["--fov-y", "-5"], &["--fov-y"]),
         (&["--detail-amplitude", "-1"], &["--detail-amplitude"]),
     ];
-    for (args, needles) in cases {
-        let mut all = vec!["render", "--height", "16"];
-        all.extend_from_slice(args);
-        let out = run(&all);
-        assert_one_line_error(&args.join(" "), &out, needles);
-        assert!(!text(&out.stderr).contains("unexpected argument"), "{args:?}");
-    }
+    expect_errors(&cases, "unexpected argument");
 }
 
 /// Absurd cameras name the parameter and the limit, not a symptom.
@@ -108,13 +114,7 @@ fn absurd_cameras_name_the_real_problem() {
         (&["--near", "1e-300"], &["--near", "smallest near plane"]),
         (&["--up", "1e-320,0,0"], &["--up", "zero"]),
     ];
-    for (args, needles) in cases {
-        let mut all = vec!["render", "--width", "16", "--height", "16"];
-        all.extend_from_slice(args);
-        let out = run(&all);
-        assert_one_line_error(&args.join(" "), &out, needles);
-        assert!(!text(&out.stderr).contains("eye equals target"), "{args:?}");
-    }
+    expect_errors(&cases, "eye equals target");
 }
 
 /// `--input-map` with classic texturing (no layer tree) renders, with a
@@ -127,22 +127,26 @@ fn an_unused_input_map_is_a_warning() {
         .save(&map)
         .unwrap();
     let out_png = dir.join("o.png");
-    let out = run(&[
-        "render".as_ref(),
-        "--validation".as_ref(),
-        "--width".as_ref(),
-        "32".as_ref(),
-        "--height".as_ref(),
-        "20".as_ref(),
-        "--rocks".as_ref(),
-        "0".as_ref(),
+    let input_map = format!("rainfall={}", map.display());
+    let args = [
+        "render",
+        "--validation",
+        "--width",
+        "32",
+        "--height",
+        "20",
+        "--rocks",
+        "0",
+    ];
+    let mut args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_ref()).collect();
+    args.extend([
         "--texturing".as_ref(),
         "classic".as_ref(),
         "--input-map".as_ref(),
-        format!("rainfall={}", map.display()).as_ref(),
-        "--out".as_ref(),
-        out_png.as_os_str(),
+        input_map.as_ref(),
     ]);
+    args.extend(["--out".as_ref(), out_png.as_os_str()]);
+    let out = run(&args);
     assert_success("render with an unused input map", &out);
     let stderr = text(&out.stderr);
     assert!(
