@@ -137,15 +137,16 @@ fn an_unused_input_map_is_a_warning() {
         "20",
         "--rocks",
         "0",
+        "--texturing",
+        "classic",
     ];
-    let mut args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_ref()).collect();
+    let mut args: Vec<std::ffi::OsString> = args.iter().map(std::ffi::OsString::from).collect();
     args.extend([
-        "--texturing".as_ref(),
-        "classic".as_ref(),
-        "--input-map".as_ref(),
-        input_map.as_ref(),
+        "--input-map".into(),
+        input_map.into(),
+        "--out".into(),
+        out_png.clone().into_os_string(),
     ]);
-    args.extend(["--out".as_ref(), out_png.as_os_str()]);
     let out = run(&args);
     assert_success("render with an unused input map", &out);
     let stderr = text(&out.stderr);
