@@ -4,8 +4,7 @@
 //! within three standard errors, with two bounces, the sun separate and in
 //! the environment, chunked dispatches and progressive frames; the maps are
 //! not recomputed while the lighting stays the same. Under validation and
-//! synchronization validation. `timings` (ignored) measures 129² and 513²
-//! fields.
+//! synchronization validation. Timings: `examples/lighting_bench.rs`.
 
 mod common;
 
@@ -227,35 +226,6 @@ fn flat_field_and_v_valley_on_the_gpu_match_the_analytic_values() {
         let bottom = maps.sky[20 * 33 + 16];
         assert!((bottom[3] - std::f32::consts::FRAC_1_SQRT_2).abs() < 0.01, "{bottom:?}");
         assert!((bottom[0] - bottom[3]).abs() < 1e-4, "{bottom:?}");
-    }
-    drop(ctx);
-    assert_validation_clean(&report);
-}
-
-/// `cargo test --release --test lighting_reference timings -- --ignored --nocapture`
-#[test]
-#[ignore = "timing measurement"]
-fn timings() {
-    let (ctx, report) = validated_context();
-    eprintln!("device: {} ({})", ctx.info().name, ctx.info().driver_name);
-    for size in [129u32, 513] {
-        let field = HeightField::from_fn(size, size, DVec2::new(30.0, 30.0), |c, r| {
-            let (x, y) = (f64::from(c) * 0.05, f64::from(r) * 0.05);
-            (800.0 + 300.0 * x.sin() * y.cos() + 80.0 * (3.1 * x + 1.7 * y).sin() + 20.0 * (9.0 * x).cos()) as f32
-        });
-        for samples in [64u32, 256] {
-            let settings = ReferenceSettings {
-                samples,
-                bounces: 1,
-                ..ReferenceSettings::default()
-            };
-            let frame = lighting(false, 0.004_654);
-            let (_, _, elapsed) = run_gpu(&ctx, &field, settings, &[frame], None);
-            eprintln!(
-                "{size}² field, {samples} samples, 1 bounce: {:.2} s",
-                elapsed.as_secs_f64()
-            );
-        }
     }
     drop(ctx);
     assert_validation_clean(&report);
