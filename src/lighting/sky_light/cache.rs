@@ -23,6 +23,10 @@ use crate::io::heightmap::HeightField;
 const MAGIC: &[u8; 8] = b"ALPGSKYL";
 /// Bumped whenever the bake's algorithm or layout changes.
 pub const FORMAT_VERSION: u32 = 1;
+/// The largest cache file read (a 4097² field with 5 bands and its horizon
+/// maps is about 8 GiB; larger files are rebuilt, not read).
+const MAX_CACHE_BYTES: u64 = 8 << 30;
+
 const HEADER_BYTES: usize = 8 + 4 + 6 * 4 + 8 + 3 * 8;
 
 /// What a bake depends on.
@@ -186,8 +190,8 @@ fn parse(bytes: &[u8], key: &BakeKey) -> std::result::Result<BakeData, String> {
         return Err("stale (another height field or settings)".into());
     }
     let lengths = [u64_at(44), u64_at(52), u64_at(60)];
-    let total: u64 = lengths.iter().sum();
-    if total != body.len() as u64 - HEADER_BYTES as u64 {
+    let total = lengths.iter().try_fold(0u64, |sum, &l| sum.checked_add(l));
+    if total != Some(body.len() as u64 - HEADER_BYTES as u64) {
         return Err("payload lengths do not match the file size".into());
     }
     let (a, b) = (HEADER_BYTES, HEADER_BYTES + lengths[0] as usize);
@@ -204,6 +208,20 @@ fn parse(bytes: &[u8], key: &BakeKey) -> std::result::Result<BakeData, String> {
 /// none or it must be rebuilt (logged). Errors: the file exists but cannot
 /// be read.
 pub fn load(path: &Path, key: &BakeKey) -> Result<Option<BakeData>> {
+    // Checked before opening: a FIFO would block, a device never end.
+    match std::fs::metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Ok(meta) if !meta.is_file() => return Err(Error::input(path, "the sky-light cache is not a regular file")),
+        Ok(meta) if meta.len() > MAX_CACHE_BYTES => {
+            log::warn!(
+                "{}: sky-light cache of {} bytes is too large; rebuilding",
+                path.display(),
+                meta.len()
+            );
+            return Ok(None);
+        }
+        _ => {}
+    }
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
@@ -309,6 +327,35 @@ mod tests {
         assert!(e.contains(&path.display().to_string()) && !e.contains('\n'), "{e}");
         let e = store(&path, &data).unwrap_err().to_string();
         assert!(e.contains(&path.display().to_string()) && !e.contains('\n'), "{e}");
+        // A FIFO is refused before opening (reading it would block).
+        std::fs::remove_dir_all(&path).unwrap();
+        let made = std::process::Command::new("mkfifo").arg(&path).status();
+        if made.is_ok_and(|s| s.success()) {
+            let e = load(&path, &key).unwrap_err().to_string();
+            assert!(e.contains("not a regular file"), "{e}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Payload lengths whose sum overflows u64 (behind a valid checksum) are
+    /// a rebuild, not an arithmetic overflow.
+    #[test]
+    fn overflowing_lengths_are_rebuilt() {
+        let dir = temp_dir("overflow");
+        let (data, key) = sample();
+        let path = cache_path(&dir, &key);
+        store(&path, &data).unwrap();
+        let mut bytes = std::fs::read(&path).unwrap();
+        for o in [44, 52] {
+            bytes[o..o + 8].copy_from_slice(&(u64::MAX / 2 + 1).to_le_bytes());
+        }
+        let body = bytes.len() - 8;
+        let mut h = Hasher::new();
+        h.update(&bytes[..body]);
+        let sum = h.finish().to_le_bytes();
+        bytes[body..].copy_from_slice(&sum);
+        std::fs::write(&path, &bytes).unwrap();
+        assert!(load(&path, &key).unwrap().is_none());
         let _ = std::fs::remove_dir_all(&dir);
     }
 
