@@ -47,7 +47,8 @@ pub fn jacksboro_field() -> HeightField {
     let options = HeightmapOptions {
         scale: 1.0,
         offset: 0.0,
-        spacing: glam::DVec2::new(74.4, 92.6),
+        spacing: Some(glam::DVec2::new(74.4, 92.6)),
+        ..Default::default()
     };
     load_heightmap(&data("jacksboro-fault.png"), &options).expect("real DEM")
 }
