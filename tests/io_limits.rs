@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 
 use alpenglow::io::heightmap::{check_spacing, load_heightmap, HeightField, HeightmapOptions, RowOrder};
 use alpenglow::io::limits::InputLimits;
+use common::{absurd_png, crc32};
 use glam::DVec2;
 
 /// A fresh scratch directory under the system temp dir, removed on drop.
@@ -43,45 +44,6 @@ fn expect_error(path: &Path, opts: &HeightmapOptions, needle: &str) -> String {
     assert!(!msg.contains('\n'), "message is not one line: {msg:?}");
     assert!(msg.contains(needle), "expected {needle:?} in: {msg}");
     msg
-}
-
-/// CRC-32 (ISO-HDLC) as PNG chunks use it.
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut crc = !0u32;
-    for &b in bytes {
-        crc ^= u32::from(b);
-        for _ in 0..8 {
-            crc = if crc & 1 == 1 {
-                (crc >> 1) ^ 0xEDB8_8320
-            } else {
-                crc >> 1
-            };
-        }
-    }
-    !crc
-}
-
-/// A PNG chunk with its length and CRC.
-fn chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
-    let mut out = (data.len() as u32).to_be_bytes().to_vec();
-    let mut body = kind.to_vec();
-    body.extend_from_slice(data);
-    out.extend_from_slice(&body);
-    out.extend_from_slice(&crc32(&body).to_be_bytes());
-    out
-}
-
-/// A tiny PNG whose header claims a `width`×`height` 16-bit greyscale image.
-fn absurd_png(width: u32, height: u32) -> Vec<u8> {
-    let mut ihdr = width.to_be_bytes().to_vec();
-    ihdr.extend_from_slice(&height.to_be_bytes());
-    ihdr.extend_from_slice(&[16, 0, 0, 0, 0]);
-    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
-    png.extend(chunk(b"IHDR", &ihdr));
-    // An empty zlib stream: far too little data for the claimed size.
-    png.extend(chunk(b"IDAT", &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01]));
-    png.extend(chunk(b"IEND", &[]));
-    png
 }
 
 /// A valid 16-bit greyscale PNG of `values`.

@@ -208,6 +208,7 @@ impl Default for HeightmapOptions {
 }
 
 /// A decoded grid of raw values, before scaling.
+#[derive(Debug)]
 pub(crate) struct RawGrid {
     pub columns: u32,
     pub rows: u32,

@@ -46,17 +46,18 @@ pub fn latitude_from_name(path: &Path) -> Option<f64> {
 /// Decodes an SRTM `.hgt` file: its size gives the resolution, its name the
 /// latitude (for the spacing).
 pub(crate) fn decode_hgt(path: &Path, bytes: &[u8]) -> Result<RawGrid> {
-    let (side, arc_seconds) =
-        match bytes.len() {
-            n if n == 1201 * 1201 * 2 => (1201u32, 3.0),
-            n if n == 3601 * 3601 * 2 => (3601u32, 1.0),
-            n => return Err(Error::input(
+    let (side, arc_seconds) = match bytes.len() {
+        n if n == 1201 * 1201 * 2 => (1201u32, 3.0),
+        n if n == 3601 * 3601 * 2 => (3601u32, 1.0),
+        n => {
+            return Err(Error::input(
                 path,
                 format!(
                     "SRTM .hgt file of {n} bytes; expected 1201² or 3601² 16-bit samples (2884802 or 25934402 bytes)"
                 ),
-            )),
-        };
+            ))
+        }
+    };
     let lat = latitude_from_name(path).ok_or_else(|| {
         Error::input(
             path,
