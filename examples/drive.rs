@@ -144,7 +144,8 @@ fn run(args: &Args) -> alpenglow::Result<()> {
         &HeightmapOptions {
             scale: 1.0,
             offset: 0.0,
-            spacing: DVec2::new(74.4, 92.6),
+            spacing: Some(DVec2::new(74.4, 92.6)),
+            ..Default::default()
         },
     )?;
     let scene = Scene::new(heights);

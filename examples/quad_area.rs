@@ -25,7 +25,8 @@ fn main() -> alpenglow::Result<()> {
         &HeightmapOptions {
             scale: 1.0,
             offset: 0.0,
-            spacing: DVec2::new(74.4, 92.6),
+            spacing: Some(DVec2::new(74.4, 92.6)),
+            ..Default::default()
         },
     )?);
     let views: Vec<(&str, &Scene, Camera)> = vec![

@@ -46,7 +46,7 @@ fn scene_and_camera(dem: &Option<String>) -> alpenglow::Result<(Scene, Camera)> 
     let scene = match dem {
         Some(path) => {
             let options = HeightmapOptions {
-                spacing: DVec2::new(74.4, 92.6),
+                spacing: Some(DVec2::new(74.4, 92.6)),
                 ..HeightmapOptions::default()
             };
             Scene::new(load_heightmap(std::path::Path::new(path), &options)?)

@@ -33,7 +33,7 @@ fn main() -> alpenglow::Result<()> {
         Some(path) => Scene::new(load_heightmap(
             std::path::Path::new(&path),
             &HeightmapOptions {
-                spacing: DVec2::new(74.4, 92.6),
+                spacing: Some(DVec2::new(74.4, 92.6)),
                 ..HeightmapOptions::default()
             },
         )?),

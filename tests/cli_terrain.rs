@@ -590,3 +590,64 @@ fn fly_refuses_zero_frames() {
     assert!(entries(&root).is_empty(), "fly --frames 0 left {:?}", entries(&root));
     let _ = std::fs::remove_dir_all(&root);
 }
+
+// ------------------------------------------------- hostile inputs (issue 15)
+
+/// Absurd PNG headers as `--heightmap` and as `--input-map` are one-line
+/// errors (they aborted the process), so are a FIFO and /dev/zero, and
+/// out-of-range spacings name their option and the range.
+#[test]
+fn hostile_heightmaps_input_maps_and_spacings_are_one_line_errors() {
+    let dir = fresh_dir("hostile-inputs");
+    let absurd = dir.join("absurd.png");
+    std::fs::write(&absurd, common::absurd_png(150_000, 100_000)).unwrap();
+    let absurd = absurd.to_str().unwrap().to_string();
+    let map = format!("rainfall={absurd}");
+    expect_render_error(
+        "hostile-heightmap",
+        None,
+        &["--heightmap", &absurd],
+        &["absurd.png", "largest supported side"],
+    );
+    expect_render_error(
+        "hostile-input-map",
+        Some(SMALL_TERRAIN),
+        &["--input-map", &map],
+        &["absurd.png", "largest supported side"],
+    );
+    let fifo = dir.join("fifo.png");
+    assert!(std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let fifo = fifo.to_str().unwrap().to_string();
+    expect_render_error(
+        "hostile-fifo",
+        None,
+        &["--heightmap", &fifo],
+        &["is a FIFO, not a regular file"],
+    );
+    expect_render_error(
+        "hostile-dev-zero",
+        None,
+        &["--heightmap", "/dev/zero"],
+        &["/dev/zero: is a character device"],
+    );
+    for bad in ["1e30", "1e-30"] {
+        expect_render_error(
+            "hostile-spacing",
+            Some(SMALL_TERRAIN),
+            &["--spacing", bad],
+            &["--spacing", "0.001..=100000 m"],
+        );
+        let spec = format!("procedural:fbm,size=65,spacing={bad}");
+        expect_render_error(
+            "hostile-spec-spacing",
+            Some(&spec),
+            &[],
+            &["spacing=", "0.001..=100000 m"],
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -63,7 +63,8 @@ fn real_dem_loads_with_expected_size_range_and_spacing() {
     let opts = HeightmapOptions {
         scale: 2.0,
         offset: -100.0,
-        spacing: DVec2::new(74.4, 92.6),
+        spacing: Some(DVec2::new(74.4, 92.6)),
+        ..Default::default()
     };
     let scaled = load_heightmap(&path, &opts).unwrap();
     assert_eq!(scaled.min_max(), (372.0, 2052.0));

@@ -87,9 +87,11 @@ pub struct SceneArgs {
     /// Height field: 16-bit PNG (value·scale + offset) or EXR (first channel, metres·scale + offset).
     #[arg(long, value_name = "FILE", help_heading = "Terrain")]
     pub heightmap: Option<PathBuf>,
-    /// Metres between height samples: DX, or DX,DY for columns and rows.
-    #[arg(long, value_parser = parse_spacing, default_value = "1", value_name = "DX[,DY]", help_heading = "Terrain")]
-    pub spacing: (f64, f64),
+    /// Metres between height samples: DX, or DX,DY for columns and rows,
+    /// each 0.001..=100000 (default: a GeoTIFF's or .hgt's georeferencing,
+    /// else 1 with a warning).
+    #[arg(long, value_parser = parse_spacing, value_name = "DX[,DY]", help_heading = "Terrain")]
+    pub spacing: Option<(f64, f64)>,
     /// Multiplier of height-map values (to metres).
     #[arg(
         long = "height-scale",
@@ -324,6 +326,25 @@ pub struct TerrainArgs {
     /// grid spans the terrain rectangle; the layers' hats use its raw values.
     #[arg(long = "input-map", value_parser = parse_input_map, value_name = "NAME=FILE", help_heading = "Texturing")]
     pub input_maps: Vec<(usize, PathBuf)>,
+    /// Where a PNG, EXR or plain TIFF height map's first row lies: south-up
+    /// (default: rows kept, row 0 at y = 0, the south edge) or north-up
+    /// (flipped: row 0 is the north edge, as in nearly every GIS raster).
+    /// GeoTIFF and .hgt files carry their own orientation.
+    #[arg(long, value_enum, default_value = "south-up", value_name = "ORDER")]
+    pub rows: RowsArg,
+    /// Largest height-map or input-map file in MiB (default 2048); the
+    /// image-size and decode limits grow in proportion above it.
+    #[arg(long = "max-input-mb", default_value_t = 2048, value_name = "MIB", value_parser = clap::value_parser!(u64).range(1..))]
+    pub max_input_mb: u64,
+}
+
+/// Row order of `--rows`.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RowsArg {
+    /// Image row 0 is the south edge (rows kept).
+    SouthUp,
+    /// Image row 0 is the north edge (rows flipped).
+    NorthUp,
 }
 
 /// Terrain colouring.
@@ -470,11 +491,8 @@ fn parse_spacing(s: &str) -> Result<(f64, f64), String> {
         [dx, dy] => (*dx, *dy),
         _ => return Err(format!("'{s}' is not DX or DX,DY")),
     };
-    if dx > 0.0 && dy > 0.0 {
-        Ok((dx, dy))
-    } else {
-        Err(format!("'{s}': spacing must be positive"))
-    }
+    alpenglow::io::heightmap::check_spacing(glam::DVec2::new(dx, dy)).map_err(|m| format!("'{s}': {m}"))?;
+    Ok((dx, dy))
 }
 
 /// `NAME=FILE` of `--input-map`.

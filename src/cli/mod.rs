@@ -194,7 +194,13 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
         if scene.input_maps[*k].is_some() {
             bail!("--input-map {name} is given twice");
         }
-        scene.input_maps[*k] = Some(load_heightmap(path, &HeightmapOptions::default())?);
+        // The grid spans the terrain whatever its spacing: no spacing warning.
+        let opts = HeightmapOptions {
+            spacing: Some(DVec2::ONE),
+            limits: input_limits(&args.terrain),
+            ..HeightmapOptions::default()
+        };
+        scene.input_maps[*k] = Some(load_heightmap(path, &opts)?);
         warn_unused_input_map(args, &scene, *k);
     }
     Ok(scene)
@@ -258,13 +264,23 @@ fn load_terrain(args: &SceneArgs) -> Result<Scene> {
                 &HeightmapOptions {
                     scale: args.height_scale,
                     offset: args.height_offset,
-                    spacing: DVec2::new(args.spacing.0, args.spacing.1),
+                    spacing: args.spacing.map(|(dx, dy)| DVec2::new(dx, dy)),
+                    rows: match args.terrain.rows {
+                        args::RowsArg::NorthUp => alpenglow::io::heightmap::RowOrder::NorthUp,
+                        args::RowsArg::SouthUp => alpenglow::io::heightmap::RowOrder::SouthUp,
+                    },
+                    limits: input_limits(&args.terrain),
                 },
             )?;
             Ok(Scene::new(field))
         }
         None => Ok(Scene::default_terrain()?),
     }
+}
+
+/// The input limits of `--max-input-mb`.
+fn input_limits(args: &TerrainArgs) -> alpenglow::io::limits::InputLimits {
+    alpenglow::io::limits::InputLimits::with_max_file_mib(args.max_input_mb)
 }
 
 fn terrain_settings(args: &TerrainArgs, debug: &TerrainDebugArgs) -> Result<TerrainSettings> {

@@ -79,7 +79,7 @@ impl Default for TerrainSpec {
 impl TerrainSpec {
     /// Checks the terrain parameters ([`ProceduralTerrain::validate`]), the
     /// grid size ([`MIN_SIZE`]..=[`MAX_SIZE`] per side) and the spacing
-    /// (finite, positive).
+    /// (the height field's range, [`alpenglow::io::heightmap::check_spacing`]).
     pub fn validate(&self) -> Result<()> {
         self.terrain.validate()?;
         for (what, v) in [("columns", self.columns), ("rows", self.rows)] {
@@ -90,13 +90,8 @@ impl TerrainSpec {
                 ));
             }
         }
-        let s = self.spacing;
-        if !(s.x.is_finite() && s.y.is_finite() && s.x > 0.0 && s.y > 0.0) {
-            return Err(Error::invalid(
-                "terrain spacing",
-                format!("{}:{} (must be finite and positive)", s.x, s.y),
-            ));
-        }
+        alpenglow::io::heightmap::check_spacing(self.spacing)
+            .map_err(|m| Error::invalid("spacing= of the terrain", m))?;
         Ok(())
     }
 

@@ -1,22 +1,41 @@
-//! Height fields and loading them from 16-bit PNG or OpenEXR height maps.
+//! Height fields and loading them from PNG, OpenEXR, GeoTIFF or SRTM
+//! `.hgt` height maps.
 //!
 //! # Convention
 //!
 //! Sample (column `c`, row `r`) sits at world position `(c·dx, r·dy, h)`
-//! (right-handed, +Z up). Row `r` of the image is row `r` of the field: the
-//! image is **not** flipped. Image row 0 (the top row) therefore lies at
-//! `y = 0` and later rows at larger `y`. For a north-up map (such as the
-//! SRTM test DEM, whose row 0 is its northern edge) +Y points south, and a
-//! right-handed +Z-up world then shows the map mirrored north–south unless
-//! the caller flips the rows; this loader leaves that choice to the caller.
+//! (right-handed, +Z up, +Y north). Field row 0 is therefore the southern
+//! edge.
+//!
+//! How image rows map to field rows is [`HeightmapOptions::rows`] for PNG,
+//! EXR and plain TIFF: the default [`RowOrder::SouthUp`] keeps them
+//! (image row 0, its top row, becomes field row 0, the southern edge: the
+//! image appears mirrored north–south); [`RowOrder::NorthUp`] (`--rows
+//! north-up`, the convention of nearly every GIS raster) flips them so
+//! that the image's top row is the northern edge. GeoTIFF and `.hgt` files
+//! say where north is and are oriented by that, whatever the option.
+//!
+//! # Limits
+//!
+//! Heights must lie within ±[`MAX_ABS_HEIGHT`] m and spacings within
+//! [`MIN_SPACING`]..=[`MAX_SPACING`] m; files are read and decoded within
+//! [`HeightmapOptions::limits`] (declared image size checked before any
+//! allocation).
 
-use std::io::Cursor;
 use std::path::Path;
 
 use glam::DVec2;
 
 use crate::error::{Error, Result};
-use crate::io::{one_line, MAX_DECODE_BYTES};
+use crate::io::limits::InputLimits;
+
+/// Largest |height| of a field in metres (1000 km): far beyond any
+/// terrain, small enough that positions and normals stay finite in `f32`.
+pub const MAX_ABS_HEIGHT: f32 = 1.0e6;
+/// Smallest sample spacing in metres (1 mm).
+pub const MIN_SPACING: f64 = 1.0e-3;
+/// Largest sample spacing in metres (100 km).
+pub const MAX_SPACING: f64 = 1.0e5;
 
 /// A regular grid of heights in metres.
 #[derive(Clone, Debug, PartialEq)]
@@ -81,7 +100,8 @@ impl HeightField {
     }
 
     /// Checks the invariants: at least 2×2 samples, `heights.len() ==
-    /// columns·rows`, finite positive spacing, all heights finite. Errors
+    /// columns·rows`, spacing within [`MIN_SPACING`]..=[`MAX_SPACING`] m,
+    /// every height finite and within ±[`MAX_ABS_HEIGHT`] m. Errors
     /// name `origin` (the file or source the field came from) and, for bad
     /// heights, the first bad sample's column and row.
     pub fn validate(&self, origin: &Path) -> Result<()> {
@@ -107,31 +127,54 @@ impl HeightField {
             ));
         }
         check_spacing(self.spacing).map_err(|m| Error::input(origin, m))?;
-        if let Some(i) = self.heights.iter().position(|v| !v.is_finite()) {
+        let in_range = |v: f32| v.is_finite() && v.abs() <= MAX_ABS_HEIGHT;
+        if let Some(i) = self.heights.iter().position(|&v| !in_range(v)) {
             let (c, r) = (i % w as usize, i / w as usize);
             return Err(Error::input(
                 origin,
-                format!("height at column {c}, row {r} is {}", self.heights[i]),
+                format!(
+                    "height at column {c}, row {r} is {} m; heights must be finite and within ±{} km",
+                    self.heights[i],
+                    MAX_ABS_HEIGHT / 1000.0
+                ),
             ));
         }
         Ok(())
     }
 }
 
-/// Why a spacing is unusable, if it is.
-fn check_spacing(spacing: DVec2) -> std::result::Result<(), String> {
-    let ok = |v: f64| v.is_finite() && v > 0.0;
+/// Why a spacing is unusable, if it is: each of x and y must lie within
+/// [`MIN_SPACING`]..=[`MAX_SPACING`] metres. The message (one line) gives
+/// the value and the range; callers prefix the option or key it came from.
+pub fn check_spacing(spacing: DVec2) -> std::result::Result<(), String> {
+    let ok = |v: f64| (MIN_SPACING..=MAX_SPACING).contains(&v);
     if ok(spacing.x) && ok(spacing.y) {
         Ok(())
     } else {
+        let value = if spacing.x == spacing.y {
+            format!("{} m", spacing.x)
+        } else {
+            format!("({}, {}) m", spacing.x, spacing.y)
+        };
         Err(format!(
-            "sample spacing ({}, {}) must be finite and positive",
-            spacing.x, spacing.y
+            "sample spacing {value} is out of range; it must be within {MIN_SPACING}..={MAX_SPACING} m"
         ))
     }
 }
 
-/// How raw height-map values become metres.
+/// How the rows of an image map to the field's rows (north is +Y).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RowOrder {
+    /// Image row 0 (the top) is the southern edge: rows are kept as they
+    /// are (field row `r` = image row `r`). The default, for compatibility.
+    #[default]
+    SouthUp,
+    /// Image row 0 is the northern edge (nearly every GIS raster): rows are
+    /// flipped on loading.
+    NorthUp,
+}
+
+/// How raw height-map values become metres, and the limits of reading.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HeightmapOptions {
     /// Multiplies each raw value (PNG: the integer 0‥65535 or 0‥255; EXR:
@@ -139,20 +182,42 @@ pub struct HeightmapOptions {
     pub scale: f32,
     /// Added after scaling, in metres. Must be finite.
     pub offset: f32,
-    /// Metres between samples in x (columns) and y (rows). Must be finite
-    /// and positive.
-    pub spacing: DVec2,
+    /// Metres between samples in x (columns) and y (rows), within
+    /// [`MIN_SPACING`]..=[`MAX_SPACING`]. `None`: from the file's
+    /// georeferencing (GeoTIFF, `.hgt`), else 1 m with a warning.
+    pub spacing: Option<DVec2>,
+    /// Row order of PNG, EXR and plain TIFF files (GeoTIFF and `.hgt`
+    /// files carry their own).
+    pub rows: RowOrder,
+    /// Limits on the file's size and the declared image size.
+    pub limits: InputLimits,
 }
 
 impl Default for HeightmapOptions {
-    /// Scale 1, offset 0, spacing 1 m × 1 m.
+    /// Scale 1, offset 0, spacing from the file (else 1 m), rows south-up
+    /// (kept), default [`InputLimits`].
     fn default() -> Self {
         Self {
             scale: 1.0,
             offset: 0.0,
-            spacing: DVec2::ONE,
+            spacing: None,
+            rows: RowOrder::SouthUp,
+            limits: InputLimits::default(),
         }
     }
+}
+
+/// A decoded grid of raw values, before scaling.
+#[derive(Debug)]
+pub(crate) struct RawGrid {
+    pub columns: u32,
+    pub rows: u32,
+    /// Raw values, image row 0 first.
+    pub values: Vec<f32>,
+    /// Metres between samples, where the file says.
+    pub spacing: Option<DVec2>,
+    /// Whether image row 0 is north, where the file says.
+    pub north_up: Option<bool>,
 }
 
 const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
@@ -160,24 +225,63 @@ const EXR_MAGIC: &[u8] = &[0x76, 0x2f, 0x31, 0x01];
 
 /// Loads a height map: `height = raw · scale + offset` in metres.
 ///
-/// The format is recognised by content (file signature):
+/// The format is recognised by content (file signature), `.hgt` by name:
 ///
-/// * **PNG**, 16-bit greyscale (the usual DEM encoding) or 8-bit
+/// * **PNG**, 16-bit greyscale (the usual DEM encoding) or 1–8-bit
 ///   greyscale; raw values are the unsigned integers. Colour, palette and
-///   grey+alpha PNGs are rejected.
+///   grey+alpha PNGs are rejected, and so are bad CRCs and a bad zlib
+///   Adler-32 checksum.
 /// * **OpenEXR**: the first valid layer at full resolution; the channel
 ///   named `Y`, else `R`, else `Z` (also as the last component of a layer
 ///   name like `height.Y`), else the alphabetically first channel; raw
-///   values are the stored floats (half, float or uint).
+///   values are the stored floats (half, float or uint). Deep data is
+///   rejected.
+/// * **GeoTIFF** or plain TIFF, one sample per pixel (see
+///   [`crate::io::geotiff`]): spacing and orientation from the
+///   georeferencing.
+/// * **SRTM `.hgt`** (see [`crate::io::hgt`]): spacing from the file's size
+///   and the latitude in its name; voids are an error.
 ///
-/// Rows are not flipped; see the module documentation for the convention.
+/// Rows: see the module documentation. Spacing: `opts.spacing`, else the
+/// file's georeferencing, else 1 m (a warning is logged).
 ///
-/// Errors (one line, naming the file): options out of range (non-finite or
-/// non-positive scale or spacing, non-finite offset), missing or unreadable
-/// file, empty file, unsupported format, corrupt or truncated data, colour
-/// PNG, an image smaller than 2×2 samples, and NaN or infinite heights (the
+/// Errors (one line, naming the file): options out of range, missing,
+/// special (FIFO, device, directory) or too large file, declared image
+/// size beyond `opts.limits` (checked before decoding), empty file,
+/// unsupported format, corrupt or truncated data, colour images, an image
+/// smaller than 2×2 samples, and NaN, infinite or out-of-range heights (the
 /// first bad sample's column and row are named).
 pub fn load_heightmap(path: &Path, opts: &HeightmapOptions) -> Result<HeightField> {
+    check_options(path, opts)?;
+    let bytes = crate::io::read_input_limited(path, opts.limits.max_file_bytes)?;
+    if bytes.is_empty() {
+        return Err(Error::input(path, "file is empty"));
+    }
+    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let grid = if bytes.starts_with(PNG_MAGIC) {
+        let (columns, rows, values) = crate::io::png_height::decode_png(path, &bytes, &opts.limits)?;
+        RawGrid::plain(columns, rows, values)
+    } else if bytes.starts_with(EXR_MAGIC) {
+        decode_exr(path, &bytes, &opts.limits)?
+    } else if crate::io::geotiff::is_tiff(&bytes) {
+        crate::io::geotiff::decode_geotiff(path, &bytes, &opts.limits)?
+    } else if ext.as_deref() == Some("hgt") {
+        crate::io::hgt::decode_hgt(path, &bytes)?
+    } else {
+        let msg = match ext.as_deref() {
+            Some("png") => "not a PNG file (bad signature)",
+            Some("exr") => "not an OpenEXR file (bad signature)",
+            Some("tif" | "tiff") => "not a TIFF file (bad signature)",
+            _ => "unsupported height-map format (expected a greyscale PNG, OpenEXR, GeoTIFF or SRTM .hgt file)",
+        };
+        return Err(Error::input(path, msg));
+    };
+    drop(bytes);
+    field_from_grid(path, grid, opts)
+}
+
+/// Checks scale, offset and spacing before the file is read.
+fn check_options(path: &Path, opts: &HeightmapOptions) -> Result<()> {
     let name = path.display();
     if !(opts.scale.is_finite() && opts.scale > 0.0) {
         return Err(Error::invalid(
@@ -191,25 +295,35 @@ pub fn load_heightmap(path: &Path, opts: &HeightmapOptions) -> Result<HeightFiel
             format!("{} for {name}: must be finite", opts.offset),
         ));
     }
-    check_spacing(opts.spacing).map_err(|m| Error::invalid("height-map spacing", format!("{m} (for {name})")))?;
-
-    let bytes = crate::io::read_input(path)?;
-    if bytes.is_empty() {
-        return Err(Error::input(path, "file is empty"));
+    if let Some(spacing) = opts.spacing {
+        check_spacing(spacing).map_err(|m| Error::invalid("height-map spacing", format!("{m} (for {name})")))?;
     }
-    let (columns, rows, raw) = if bytes.starts_with(PNG_MAGIC) {
-        decode_png(path, &bytes)?
-    } else if bytes.starts_with(EXR_MAGIC) {
-        decode_exr(path, &bytes)?
-    } else {
-        let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
-        let msg = match ext.as_deref() {
-            Some("png") => "not a PNG file (bad signature)",
-            Some("exr") => "not an OpenEXR file (bad signature)",
-            _ => "unsupported height-map format (expected a greyscale PNG or an OpenEXR file)",
-        };
-        return Err(Error::input(path, msg));
-    };
+    Ok(())
+}
+
+impl RawGrid {
+    /// A grid without georeferencing.
+    pub(crate) fn plain(columns: u32, rows: u32, values: Vec<f32>) -> RawGrid {
+        RawGrid {
+            columns,
+            rows,
+            values,
+            spacing: None,
+            north_up: None,
+        }
+    }
+}
+
+/// Checks, orients and scales a decoded grid (in place: no second copy of
+/// the samples).
+fn field_from_grid(path: &Path, grid: RawGrid, opts: &HeightmapOptions) -> Result<HeightField> {
+    let RawGrid {
+        columns,
+        rows,
+        values: mut raw,
+        spacing,
+        north_up,
+    } = grid;
     if columns == 0 || rows == 0 {
         return Err(Error::input(path, format!("image is empty ({columns}×{rows})")));
     }
@@ -226,61 +340,49 @@ pub fn load_heightmap(path: &Path, opts: &HeightmapOptions) -> Result<HeightFiel
             format!("sample at column {c}, row {r} is {}", raw[i]),
         ));
     }
-    let heights: Vec<f32> = raw.iter().map(|&v| v * opts.scale + opts.offset).collect();
+    if north_up.unwrap_or(opts.rows == RowOrder::NorthUp) {
+        flip_rows(&mut raw, columns as usize);
+    }
+    for v in &mut raw {
+        *v = *v * opts.scale + opts.offset;
+    }
+    let spacing = match (opts.spacing, spacing) {
+        (Some(given), _) => given,
+        (None, Some(from_file)) => {
+            check_spacing(from_file).map_err(|m| Error::input(path, format!("georeferencing: {m}")))?;
+            from_file
+        }
+        (None, None) => {
+            log::warn!(
+                "{}: uses the default spacing of 1 m; pass --spacing (metres between samples)",
+                path.display()
+            );
+            DVec2::ONE
+        }
+    };
     let field = HeightField {
         columns,
         rows,
-        spacing: opts.spacing,
-        heights,
+        spacing,
+        heights: raw,
     };
-    // Catches overflow of value·scale + offset to infinity, among others.
+    // Catches overflow of value·scale + offset, among others.
     field.validate(path)?;
     Ok(field)
 }
 
-/// Decodes a greyscale PNG into raw values.
-fn decode_png(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<f32>)> {
-    use image::codecs::png::PngDecoder;
-    use image::{ColorType, ImageDecoder, Limits};
-    let corrupt = |e: image::ImageError| Error::input(path, format!("invalid PNG: {}", one_line(e)));
-    let mut limits = Limits::default();
-    limits.max_alloc = Some(MAX_DECODE_BYTES);
-    let decoder = PngDecoder::with_limits(Cursor::new(bytes), limits).map_err(corrupt)?;
-    let (w, h) = decoder.dimensions();
-    let color = decoder.color_type();
-    let bytes_per_sample = match color {
-        ColorType::L16 => 2,
-        ColorType::L8 => 1,
-        ColorType::La8 | ColorType::La16 => {
-            return Err(Error::input(
-                path,
-                "PNG has an alpha channel; save the height map as plain greyscale (16-bit)",
-            ))
-        }
-        other => {
-            return Err(Error::input(
-                path,
-                format!("PNG is a colour image ({other:?}); height maps must be greyscale (16-bit)"),
-            ))
-        }
-    };
-    let total = usize::try_from(decoder.total_bytes()).map_err(|_| Error::input(path, "image too large"))?;
-    let mut buf = vec![0u8; total];
-    decoder.read_image(&mut buf).map_err(corrupt)?;
-    let raw = if bytes_per_sample == 2 {
-        // `image` returns 16-bit samples in native byte order.
-        buf.chunks_exact(2)
-            .map(|b| f32::from(u16::from_ne_bytes([b[0], b[1]])))
-            .collect()
-    } else {
-        buf.iter().map(|&b| f32::from(b)).collect()
-    };
-    Ok((w, h, raw))
+/// Reverses the order of the rows of `values` (`columns` per row) in place.
+fn flip_rows(values: &mut [f32], columns: usize) {
+    let rows = values.len() / columns.max(1);
+    for r in 0..rows / 2 {
+        let (top, bottom) = values.split_at_mut((rows - 1 - r) * columns);
+        top[r * columns..(r + 1) * columns].swap_with_slice(&mut bottom[..columns]);
+    }
 }
 
 /// Decodes the height channel of an OpenEXR file into raw values.
-fn decode_exr(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<f32>)> {
-    let (w, h, channels) = crate::io::image_out::decode_exr_channels(path, bytes)?;
+fn decode_exr(path: &Path, bytes: &[u8], limits: &InputLimits) -> Result<RawGrid> {
+    let (w, h, channels) = crate::io::image_out::decode_exr_channels_limited(path, bytes, limits)?;
     let short = |n: &str| n.rsplit('.').next().unwrap_or(n).to_string();
     let pick = ["Y", "R", "Z"]
         .iter()
@@ -291,7 +393,7 @@ fn decode_exr(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<f32>)> {
         .nth(pick)
         .map(|(_, samples)| samples)
         .ok_or_else(|| Error::input(path, "OpenEXR file has no channels"))?;
-    Ok((w, h, raw))
+    Ok(RawGrid::plain(w, h, raw))
 }
 
 #[cfg(test)]
@@ -357,7 +459,11 @@ mod tests {
                 ..Default::default()
             },
             HeightmapOptions {
-                spacing: DVec2::new(1.0, -1.0),
+                spacing: Some(DVec2::new(1.0, -1.0)),
+                ..Default::default()
+            },
+            HeightmapOptions {
+                spacing: Some(DVec2::splat(1e30)),
                 ..Default::default()
             },
         ] {

@@ -9,6 +9,7 @@ use std::path::Path;
 
 use crate::error::{Error, Result};
 use crate::io::atomic::{write_atomically, write_bytes_atomically};
+use crate::io::limits::InputLimits;
 use crate::io::one_line;
 
 /// Named channels of an EXR image: `(name, samples)` per channel.
@@ -182,30 +183,35 @@ pub fn write_exr_samples(
 
 /// Channels of an EXR image as `(width, height, [(name, samples)])`, samples
 /// row-major from the top, converted to `f32`, channels in file
-/// (alphabetical) order. Reads the first valid layer at full resolution.
+/// (alphabetical) order. Reads the first valid layer at full resolution,
+/// within the default [`InputLimits`].
 pub(crate) fn decode_exr_channels(path: &Path, bytes: &[u8]) -> Result<(u32, u32, ExrChannels)> {
+    decode_exr_channels_limited(path, bytes, &InputLimits::default())
+}
+
+/// [`decode_exr_channels`] within `limits`: every header's data window is
+/// checked against them before any pixel is read, and deep data is
+/// rejected.
+pub(crate) fn decode_exr_channels_limited(
+    path: &Path,
+    bytes: &[u8],
+    limits: &InputLimits,
+) -> Result<(u32, u32, ExrChannels)> {
     use exr::prelude::{read, ReadChannels, ReadLayers};
     let invalid = |e: exr::error::Error| Error::input(path, format!("invalid OpenEXR file: {}", one_line(e)));
     // Check the claimed size before decoding: a corrupt header must not make
     // the decoder attempt a huge allocation (which aborts the process).
     let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(invalid)?;
     for header in &meta.headers {
-        let size = header.layer_size;
-        let per_pixel = header.channels.list.len() as u64 * 4;
-        let decoded = (size.width() as u64)
-            .checked_mul(size.height() as u64)
-            .and_then(|n| n.checked_mul(per_pixel));
-        if decoded.map_or(true, |n| n > crate::io::MAX_DECODE_BYTES) {
-            return Err(Error::input(
-                path,
-                format!(
-                    "image of {}×{} pixels with {} channels is too large (corrupt header?)",
-                    size.width(),
-                    size.height(),
-                    header.channels.list.len()
-                ),
-            ));
+        if header.deep || meta.requirements.has_deep_data {
+            return Err(Error::input(path, "OpenEXR deep data is not supported"));
         }
+        let size = header.layer_size;
+        let channels = header.channels.list.len() as u64;
+        // Each channel's samples, as stored (≤ 4 bytes) and as f32.
+        limits
+            .check_image(size.width() as u64, size.height() as u64, channels.max(1) * 8)
+            .map_err(|m| Error::input(path, m))?;
         if header.chunk_count > bytes.len() / 8 {
             return Err(Error::input(
                 path,

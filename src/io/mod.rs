@@ -2,15 +2,21 @@
 //!
 //! Every writer goes through [`atomic::write_atomically`], so a failed or
 //! interrupted write never leaves a partial file under the final name.
+//! Every reader goes through [`read_input_limited`]: only regular files,
+//! at most [`limits::InputLimits::max_file_bytes`] bytes.
 
 pub mod atomic;
+pub mod geotiff;
 pub mod heightmap;
+pub mod hgt;
 pub mod image_out;
+pub mod limits;
+mod png_height;
 
-/// Most memory a decoder may claim for one input image (4 GiB; a 32768²
-/// 16-bit height map needs 2 GiB). Corrupt headers that claim more are
-/// rejected instead of aborting the process on a failed allocation.
-pub(crate) const MAX_DECODE_BYTES: u64 = 4 << 30;
+use std::io::Read;
+use std::path::Path;
+
+use crate::error::{Error, Result};
 
 /// Collapses an error message from a dependency onto one line.
 pub(crate) fn one_line(message: impl std::fmt::Display) -> String {
@@ -19,17 +25,128 @@ pub(crate) fn one_line(message: impl std::fmt::Display) -> String {
     parts.join("; ")
 }
 
-/// Reads a whole input file, mapping I/O failures to one-line errors that
-/// name the file.
-pub(crate) fn read_input(path: &std::path::Path) -> crate::error::Result<Vec<u8>> {
-    use crate::error::Error;
-    use std::io::ErrorKind;
-    if path.is_dir() {
-        return Err(Error::input(path, "is a directory, not a file"));
+/// Reads a whole input file of at most the default
+/// [`limits::InputLimits::max_file_bytes`]; see [`read_input_limited`].
+pub(crate) fn read_input(path: &Path) -> Result<Vec<u8>> {
+    read_input_limited(path, limits::InputLimits::DEFAULT_FILE_BYTES)
+}
+
+/// Why `meta` is not a regular file, if it is not ("is a FIFO, not a
+/// regular file"…).
+fn not_regular(meta: &std::fs::Metadata) -> Option<&'static str> {
+    let t = meta.file_type();
+    if t.is_file() {
+        return None;
     }
-    std::fs::read(path).map_err(|e| match e.kind() {
+    if t.is_dir() {
+        return Some("is a directory, not a file");
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return Some("is a FIFO, not a regular file");
+        }
+        if t.is_char_device() {
+            return Some("is a character device, not a regular file");
+        }
+        if t.is_block_device() {
+            return Some("is a block device, not a regular file");
+        }
+        if t.is_socket() {
+            return Some("is a socket, not a regular file");
+        }
+    }
+    Some("is not a regular file")
+}
+
+/// Reads a whole input file of at most `max_bytes` bytes, mapping failures
+/// to one-line errors that name the file.
+///
+/// The file's metadata is checked before it is opened (which never blocks,
+/// not even on a FIFO): directories, FIFOs, devices and sockets are
+/// rejected by name, and so is a file larger than `max_bytes`. The read
+/// itself stops one byte past `max_bytes`, so a file that grows meanwhile
+/// (or whose size the metadata misstates) cannot exceed the limit either.
+pub fn read_input_limited(path: &Path, max_bytes: u64) -> Result<Vec<u8>> {
+    use std::io::ErrorKind;
+    let io_error = |e: std::io::Error| match e.kind() {
         ErrorKind::NotFound => Error::input(path, "file not found"),
         ErrorKind::PermissionDenied => Error::input(path, "permission denied"),
         _ => Error::input(path, format!("cannot read: {}", one_line(e))),
-    })
+    };
+    let too_large = |size: u64| {
+        Error::input(
+            path,
+            format!("file is {size} bytes, more than the limit of {max_bytes} (raise it with --max-input-mb)"),
+        )
+    };
+    let meta = std::fs::metadata(path).map_err(io_error)?;
+    if let Some(why) = not_regular(&meta) {
+        return Err(Error::input(path, why));
+    }
+    if meta.len() > max_bytes {
+        return Err(too_large(meta.len()));
+    }
+    let file = std::fs::File::open(path).map_err(io_error)?;
+    // The path may have been replaced between the two calls.
+    if let Some(why) = file.metadata().ok().as_ref().and_then(not_regular) {
+        return Err(Error::input(path, why));
+    }
+    let capacity = usize::try_from(meta.len()).unwrap_or(0);
+    let mut bytes = Vec::with_capacity(capacity);
+    file.take(max_bytes.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(io_error)?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(too_large(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn temp(name: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("alpenglow-io-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[test]
+    fn special_files_are_rejected_by_name() {
+        let dir = temp("special");
+        let e = read_input(&dir).unwrap_err().to_string();
+        assert!(e.contains("is a directory"), "{e}");
+        #[cfg(unix)]
+        {
+            let e = read_input(Path::new("/dev/zero")).unwrap_err().to_string();
+            assert!(
+                e.contains("/dev/zero: is a character device, not a regular file"),
+                "{e}"
+            );
+            let fifo = dir.join("fifo");
+            let made = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+            assert!(made.success());
+            // A FIFO without a writer: opening it would block forever.
+            let e = read_input(&fifo).unwrap_err().to_string();
+            assert!(e.contains("is a FIFO, not a regular file"), "{e}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn reads_are_capped() {
+        let dir = temp("cap");
+        let file = dir.join("ten.bin");
+        std::fs::write(&file, [7u8; 10]).unwrap();
+        assert_eq!(read_input_limited(&file, 10).unwrap(), vec![7u8; 10]);
+        let e = read_input_limited(&file, 9).unwrap_err().to_string();
+        assert!(e.contains("10 bytes, more than the limit of 9"), "{e}");
+        let e = read_input(&dir.join("missing")).unwrap_err().to_string();
+        assert!(e.contains("file not found"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

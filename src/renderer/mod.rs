@@ -175,6 +175,11 @@ impl Renderer {
         settings: RenderSettings,
         progress: &mut dyn FnMut(f32),
     ) -> Result<Renderer> {
+        // Before anything is uploaded: a field whose samples do not fill its
+        // grid would be read out of bounds.
+        scene
+            .heights
+            .validate(std::path::Path::new("the scene's height field"))?;
         let specs = settings.view_specs();
         validate_views(&specs)?;
         let max = ctx.max_image_dimension();

@@ -199,7 +199,34 @@ impl Drop for Image {
 impl Image {
     /// Creates a device-local image (with TRANSFER_DST added to `desc.usage`)
     /// holding `texels`, tightly packed rows, through a staging copy.
+    ///
+    /// Errors before creating anything when `texels.len()` is not
+    /// width·height·[`texel_bytes`] of the format (or the format's texel
+    /// size is not known).
     pub fn with_data(ctx: &Context, mut desc: ImageDesc, texels: &[u8]) -> Result<Image> {
+        let per_texel = texel_bytes(desc.format).ok_or_else(|| {
+            Error::invalid(
+                "image data",
+                format!(
+                    "'{}': uploading data to {:?} images is not supported",
+                    desc.name, desc.format
+                ),
+            )
+        })?;
+        let expected = u64::from(desc.width) * u64::from(desc.height) * per_texel;
+        if texels.len() as u64 != expected {
+            return Err(Error::invalid(
+                "image data",
+                format!(
+                    "'{}' is {}×{} {:?} ({expected} bytes) but {} bytes were given",
+                    desc.name,
+                    desc.width,
+                    desc.height,
+                    desc.format,
+                    texels.len()
+                ),
+            ));
+        }
         desc.usage |= vk::ImageUsageFlags::TRANSFER_DST;
         let name = desc.name.clone();
         let image = Image::new(ctx, desc)?;
@@ -223,6 +250,25 @@ impl Image {
         ));
         Ok(image)
     }
+}
+
+/// Bytes per texel of the uncompressed colour formats the renderer
+/// uploads; `None` for others (depth, compressed, multi-planar).
+pub fn texel_bytes(format: vk::Format) -> Option<u64> {
+    use vk::Format as F;
+    Some(match format {
+        F::R8_UNORM | F::R8_SNORM | F::R8_UINT | F::R8_SINT | F::R8_SRGB => 1,
+        F::R8G8_UNORM | F::R8G8_SNORM | F::R8G8_UINT | F::R8G8_SINT => 2,
+        F::R16_UNORM | F::R16_SNORM | F::R16_UINT | F::R16_SINT | F::R16_SFLOAT => 2,
+        F::R8G8B8A8_UNORM | F::R8G8B8A8_SNORM | F::R8G8B8A8_UINT | F::R8G8B8A8_SINT | F::R8G8B8A8_SRGB => 4,
+        F::B8G8R8A8_UNORM | F::B8G8R8A8_SRGB | F::A2B10G10R10_UNORM_PACK32 | F::B10G11R11_UFLOAT_PACK32 => 4,
+        F::R16G16_UNORM | F::R16G16_SNORM | F::R16G16_UINT | F::R16G16_SINT | F::R16G16_SFLOAT => 4,
+        F::R32_UINT | F::R32_SINT | F::R32_SFLOAT => 4,
+        F::R16G16B16A16_UNORM | F::R16G16B16A16_SNORM | F::R16G16B16A16_UINT | F::R16G16B16A16_SINT => 8,
+        F::R16G16B16A16_SFLOAT | F::R32G32_UINT | F::R32G32_SINT | F::R32G32_SFLOAT => 8,
+        F::R32G32B32A32_UINT | F::R32G32B32A32_SINT | F::R32G32B32A32_SFLOAT => 16,
+        _ => return None,
+    })
 }
 
 enum ImageMemory {

@@ -47,7 +47,8 @@ pub fn jacksboro_field() -> HeightField {
     let options = HeightmapOptions {
         scale: 1.0,
         offset: 0.0,
-        spacing: glam::DVec2::new(74.4, 92.6),
+        spacing: Some(glam::DVec2::new(74.4, 92.6)),
+        ..Default::default()
     };
     load_heightmap(&data("jacksboro-fault.png"), &options).expect("real DEM")
 }
@@ -133,4 +134,43 @@ pub fn linear_to_srgb8(c: f32) -> u8 {
         1.055 * c.powf(1.0 / 2.4) - 0.055
     };
     (s * 255.0).round() as u8
+}
+
+/// CRC-32 (ISO-HDLC), as PNG chunks use it.
+pub fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = if crc & 1 == 1 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+/// A PNG chunk with its length and CRC.
+pub fn png_chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
+    let mut out = (data.len() as u32).to_be_bytes().to_vec();
+    let mut body = kind.to_vec();
+    body.extend_from_slice(data);
+    out.extend_from_slice(&body);
+    out.extend_from_slice(&crc32(&body).to_be_bytes());
+    out
+}
+
+/// A tiny PNG whose header claims a `width`×`height` 16-bit greyscale
+/// image, with an empty zlib stream as its data.
+pub fn absurd_png(width: u32, height: u32) -> Vec<u8> {
+    let mut ihdr = width.to_be_bytes().to_vec();
+    ihdr.extend_from_slice(&height.to_be_bytes());
+    ihdr.extend_from_slice(&[16, 0, 0, 0, 0]);
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend(png_chunk(b"IHDR", &ihdr));
+    png.extend(png_chunk(b"IDAT", &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01]));
+    png.extend(png_chunk(b"IEND", &[]));
+    png
 }
