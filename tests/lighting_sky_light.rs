@@ -6,6 +6,9 @@
 //! * a flat plane under a constant sky gets sky light L per unit albedo in
 //!   every mode (sh with 3 and 5 bands, ao, patches 4 and 8, off);
 //! * a valley is less visible and darker than a crest, and a bounce adds light;
+//! * a field larger than the device's storage buffers hold bakes at its
+//!   capacity (area-averaged) and sees the sky as a bake of the same terrain
+//!   sampled at that size does;
 //! * the cache: a second bake loads; corrupt, truncated and stale files
 //!   are rebuilt to the same data; an unwritable cache is a one-line error.
 
@@ -308,6 +311,62 @@ fn the_cache_is_used_and_rebuilt_when_damaged() {
         assert!(e.contains("sub") && !e.contains('\n'), "{e}");
         let _ = std::fs::remove_file(&blocker);
         let _ = std::fs::remove_dir_all(&dir);
+    }
+    drop(ctx);
+    assert_validation_clean(&report);
+}
+
+/// A field beyond the device's storage-buffer range (lavapipe: about 677²
+/// texels of a 3-band transfer) used to be an error; it bakes at the
+/// capacity, area-averaged over the same extent, and its sky visibility
+/// matches an independent bake of the same continuous terrain sampled at
+/// that size.
+#[test]
+fn a_field_beyond_the_device_bakes_at_its_capacity() {
+    use alpenglow::lighting::sky_light::fit;
+    let (ctx, report) = validated_context();
+    {
+        let settings = BakeSettings {
+            sh_bands: 3,
+            bounces: 0,
+            ..BakeSettings::default()
+        };
+        let (side, texels) = fit::bake_capacity(&settings, ctx.max_storage_buffer_range(), ctx.max_image_dimension());
+        let n = ((texels as f64).sqrt() as u32 + 40).min(side + 40);
+        let extent = 5000.0;
+        let terrain = |x: f64, y: f64| {
+            (120.0 * (x / 400.0).sin() * (y / 300.0).cos() + 40.0 * (x / 170.0 + y / 230.0).cos()) as f32
+        };
+        let sampled = |n: u32| {
+            let step = extent / f64::from(n - 1);
+            HeightField::from_fn(n, n, DVec2::splat(step), |c, r| {
+                terrain(f64::from(c) * step, f64::from(r) * step)
+            })
+        };
+        let big = sampled(n);
+        let fitted = SkyLightBake::fitted(&ctx, &big, &settings).into_owned();
+        assert!(fitted.columns < n && u64::from(fitted.columns) * u64::from(fitted.rows) <= texels);
+        let coarse = bake(&ctx, &big, settings);
+        assert_eq!((coarse.columns, coarse.rows), (fitted.columns, fitted.rows));
+        let reference = bake(&ctx, &sampled(fitted.columns), settings);
+        let visibility = |b: &SkyLightBake| -> Vec<f32> {
+            let surface: Vec<f32> = bytemuck::pod_collect_to_vec(&b.read_back(&ctx).unwrap().surface);
+            surface.chunks_exact(8).map(|t| t[3]).collect()
+        };
+        let (got, want) = (visibility(&coarse), visibility(&reference));
+        assert_eq!(got.len(), want.len());
+        let diffs: Vec<f32> = got.iter().zip(&want).map(|(a, b)| (a - b).abs()).collect();
+        let mean = diffs.iter().sum::<f32>() / diffs.len() as f32;
+        let max = diffs.iter().copied().fold(0.0, f32::max);
+        assert!(
+            mean < 0.01 && max < 0.1,
+            "sky visibility differs: mean {mean}, max {max}"
+        );
+        let spread = want.iter().copied().fold(1.0, f32::min);
+        assert!(
+            spread < 0.95,
+            "the terrain should occlude some sky (min visibility {spread})"
+        );
     }
     drop(ctx);
     assert_validation_clean(&report);

@@ -399,6 +399,12 @@ impl Context {
         self.shared.limits.max_image_dimension2_d
     }
 
+    /// The most bytes one storage-buffer binding may span
+    /// (`maxStorageBufferRange`; 128 MiB on lavapipe).
+    pub fn max_storage_buffer_range(&self) -> u64 {
+        u64::from(self.shared.limits.max_storage_buffer_range)
+    }
+
     /// Submits `command_buffer`, signalling the timeline; returns the value
     /// that marks its completion.
     pub(crate) fn submit(&self, command_buffer: vk::CommandBuffer) -> Result<u64> {

@@ -4,6 +4,7 @@
 //! chunks of rows (one submission each, so the progress callback advances
 //! and no dispatch runs long), optionally through the [`super::cache`].
 
+use std::borrow::Cow;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -11,6 +12,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::DVec2;
 
 use super::cache::{self, BakeData, BakeKey};
+use super::fit;
 use super::horizon::{declare_horizon, HorizonPass, HorizonPush};
 use super::tables::{transfer_tables, ENTRIES};
 use super::{HORIZON_MAP_AZIMUTHS, PATCHES_PER_SIDE, SURFACE_FLOATS};
@@ -213,6 +215,7 @@ impl SkyLightBake {
     ) -> Result<SkyLightBake> {
         settings.validate()?;
         field.validate(Path::new("sky-light height field"))?;
+        let field = &*SkyLightBake::fitted(ctx, field, settings);
         let key = BakeKey::new(field, settings);
         let Some(dir) = cache else {
             return SkyLightBake::compute(ctx, field, settings, progress);
@@ -228,7 +231,27 @@ impl SkyLightBake {
         Ok(bake)
     }
 
-    /// The bake computed on the GPU (no cache).
+    /// The field the bake of `field` runs on: `field`, or its area average
+    /// at the most texels the device's storage buffers and images hold
+    /// ([`super::fit`]).
+    pub fn fitted<'f>(ctx: &Context, field: &'f HeightField, settings: &BakeSettings) -> Cow<'f, HeightField> {
+        let capacity = fit::bake_capacity(settings, ctx.max_storage_buffer_range(), ctx.max_image_dimension());
+        let fitted = fit::bake_field(field, capacity);
+        if let Cow::Owned(f) = &fitted {
+            log::info!(
+                "sky light: the {}×{} height field is baked at {}×{} (the device's storage buffers hold {} texels)",
+                field.columns,
+                field.rows,
+                f.columns,
+                f.rows,
+                capacity.1
+            );
+        }
+        fitted
+    }
+
+    /// The bake computed on the GPU (no cache), at the size
+    /// [`SkyLightBake::fitted`] gives.
     pub fn compute(
         ctx: &Context,
         field: &HeightField,
@@ -237,6 +260,7 @@ impl SkyLightBake {
     ) -> Result<SkyLightBake> {
         settings.validate()?;
         field.validate(Path::new("sky-light height field"))?;
+        let field = &*SkyLightBake::fitted(ctx, field, settings);
         let (columns, rows) = (field.columns, field.rows);
         let texels = u64::from(columns) * u64::from(rows);
         let (k, stride) = (settings.azimuths, settings.stride());

@@ -28,6 +28,7 @@
 pub mod bake;
 pub mod cache;
 pub mod evaluate;
+pub mod fit;
 pub mod horizon;
 mod tables;
 
