@@ -28,9 +28,18 @@ fn check_vec(what: &str, v: Vec3) -> Result<(), String> {
         return Err(format!("non-finite {what} ({}, {}, {})", v.x, v.y, v.z));
     }
     if v.abs().max_element() > MAX_SPT_COORDINATE {
+        let s = |x: f32| {
+            if x.abs() >= 1e16 {
+                format!("{x:e}")
+            } else {
+                x.to_string()
+            }
+        };
         return Err(format!(
             "{what} ({}, {}, {}) exceeds ±{MAX_SPT_COORDINATE} m",
-            v.x, v.y, v.z
+            s(v.x),
+            s(v.y),
+            s(v.z)
         ));
     }
     Ok(())
@@ -62,7 +71,7 @@ fn check_node(node: &SptNode, centre: Vec3, radius: f32) -> Result<(), String> {
         }
         let is_length = !name.starts_with("r_");
         if is_length && v > MAX_SPT_LENGTH {
-            return Err(format!("{name} {v} exceeds {MAX_SPT_LENGTH} m"));
+            return Err(format!("{name} {v:e} exceeds {MAX_SPT_LENGTH} m"));
         }
     }
     if node.diameter <= 0.0 {
@@ -112,7 +121,7 @@ pub(super) fn validate(tree: &SequentialPointTree) -> Result<(), String> {
     check_vec("bounds centre", tree.bounds_centre)?;
     let radius = tree.bounds_radius;
     if !(radius.is_finite() && (0.0..=MAX_SPT_LENGTH).contains(&radius)) {
-        return Err(format!("bounds radius {radius} is not in 0..={MAX_SPT_LENGTH} m"));
+        return Err(format!("bounds radius {radius:e} is not in 0..={MAX_SPT_LENGTH} m"));
     }
     let mut roots = 0usize;
     let mut has_child = vec![false; n];
