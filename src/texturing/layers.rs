@@ -246,7 +246,8 @@ impl LayerTree {
                 .span()
                 .map(|s| format!("line {}: ", line_of(text, s.start)))
                 .unwrap_or_default();
-            Error::invalid(origin, format!("{line}{}", e.message().trim()))
+            let message = e.message().trim().replace('\n', "; ");
+            Error::invalid(origin, format!("{line}{message}"))
         })?;
         let mut layers = Vec::new();
         flatten(text, origin, file.root, 0, None, &mut layers)?;

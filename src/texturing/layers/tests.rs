@@ -217,3 +217,11 @@ fn layer_files_are_read_through_read_input_as_utf8() {
     let message = LayerTree::load(&std::env::temp_dir()).unwrap_err().to_string();
     assert!(message.contains("is a directory"), "{message}");
 }
+
+#[test]
+fn toml_syntax_errors_are_one_line() {
+    // toml's message for a bad float has two lines ("…\nexpected digit").
+    let text = "[root]\nname = \"r\"\ncolor = [0.1, 0.1, 0.1]\nroughness = 1.e\n";
+    let message = LayerTree::parse(text, "l.toml").unwrap_err().to_string();
+    assert!(message.contains("line 4: ") && !message.contains('\n'), "{message:?}");
+}
