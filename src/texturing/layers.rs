@@ -36,7 +36,11 @@
 //! * **Noise**: N and D_S are fractional Brownian motion of the project's
 //!   wavelet noise (three octaves, lacunarity 2, gain 0.5, normalised to
 //!   about [−1, 1]) at the layer's wavelengths, decorrelated per layer.
-//! * Colours are linear albedo in [0, 1].
+//! * Colours are linear albedo in [0, 1], exactly 3 components.
+//! * Ranges (errors otherwise): roughness in [0, [`MAX_ROUGHNESS`]] m,
+//!   wavelengths in [`WAVELENGTH_RANGE`] m, noise bias and scale within
+//!   ±[`MAX_NOISE_TERM`], constraint values within ±[`MAX_HAT_VALUE`];
+//!   unknown keys are errors.
 //!
 //! The file format is TOML: `[root]` and nested `[[….children]]` tables (see
 //! [`DEFAULT_LAYERS`]); errors name the file and line.
@@ -86,6 +90,9 @@ impl Hat {
     fn validate(&self) -> std::result::Result<(), String> {
         if !(self.min.is_finite() && self.max.is_finite() && self.fuzz.is_finite()) {
             return Err("range and fuzz must be finite".into());
+        }
+        if [self.min, self.max, self.fuzz].iter().any(|v| v.abs() > MAX_HAT_VALUE) {
+            return Err(format!("range and fuzz must lie within ±{MAX_HAT_VALUE}"));
         }
         if self.min > self.max {
             return Err(format!("min {} is above max {}", self.min, self.max));
@@ -149,7 +156,7 @@ struct TreeFile {
 #[serde(deny_unknown_fields)]
 struct LayerFile {
     name: String,
-    color: [f32; 3],
+    color: toml::Spanned<Vec<f32>>,
     #[serde(default)]
     roughness: f32,
     #[serde(default = "default_wavelength")]
@@ -178,6 +185,41 @@ fn one() -> f32 {
     1.0
 }
 
+/// Largest roughness B_S (metres).
+pub const MAX_ROUGHNESS: f32 = 1e4;
+/// Wavelengths of the noises (metres) lie in this range.
+pub const WAVELENGTH_RANGE: std::ops::RangeInclusive<f32> = 1e-3..=1e6;
+/// Largest magnitude of the noise bias c_S and scale n_S.
+pub const MAX_NOISE_TERM: f32 = 1e3;
+/// Largest magnitude of a constraint's min, max and fuzz (metres for
+/// altitude, degrees for slope, the maps' own units).
+pub const MAX_HAT_VALUE: f32 = 1e7;
+
+/// Checks a layer's numbers against the documented ranges.
+fn check_numbers(f: &LayerFile) -> std::result::Result<(), String> {
+    for (what, v) in [("noise_bias", f.noise_bias), ("noise_scale", f.noise_scale)] {
+        if !(v.is_finite() && v.abs() <= MAX_NOISE_TERM) {
+            return Err(format!("{what} {v} is not finite within ±{MAX_NOISE_TERM}"));
+        }
+    }
+    if !(0.0..=MAX_ROUGHNESS).contains(&f.roughness) {
+        return Err(format!("roughness {} is not in [0, {MAX_ROUGHNESS}] m", f.roughness));
+    }
+    for (what, v) in [
+        ("roughness_wavelength", f.roughness_wavelength),
+        ("noise_wavelength", f.noise_wavelength),
+    ] {
+        if !WAVELENGTH_RANGE.contains(&v) {
+            return Err(format!(
+                "{what} {v} is not in [{}, {}] m",
+                WAVELENGTH_RANGE.start(),
+                WAVELENGTH_RANGE.end()
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// 1-based line of byte offset `at` in `text`.
 fn line_of(text: &str, at: usize) -> usize {
     text[..at.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
@@ -192,8 +234,8 @@ impl LayerTree {
 
     /// Reads a tree from a TOML file; errors name the file and line.
     pub fn load(path: &Path) -> Result<LayerTree> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::invalid(path.display().to_string(), format!("cannot read: {e}")))?;
+        let bytes = crate::io::read_input(path)?;
+        let text = String::from_utf8(bytes).map_err(|_| Error::input(path, "not UTF-8 text"))?;
         LayerTree::parse(&text, &path.display().to_string())
     }
 
@@ -204,7 +246,8 @@ impl LayerTree {
                 .span()
                 .map(|s| format!("line {}: ", line_of(text, s.start)))
                 .unwrap_or_default();
-            Error::invalid(origin, format!("{line}{}", e.message().trim()))
+            let message = e.message().trim().replace('\n', "; ");
+            Error::invalid(origin, format!("{line}{message}"))
         })?;
         let mut layers = Vec::new();
         flatten(text, origin, file.root, 0, None, &mut layers)?;
@@ -243,29 +286,18 @@ fn flatten(
     if out.len() >= MAX_LAYERS {
         return Err(bad(format!("more than {MAX_LAYERS} layers")));
     }
-    if f.color.iter().any(|c| !(0.0..=1.0).contains(c)) {
-        return Err(bad(format!("color {:?} is not linear albedo in [0, 1]", f.color)));
+    let color: [f32; 3] = f.color.get_ref().as_slice().try_into().map_err(|_| {
+        let line = line_of(text, f.color.span().start);
+        let n = f.color.get_ref().len();
+        Error::invalid(
+            origin,
+            format!("line {line}: layer '{name}': color must have 3 components, has {n}"),
+        )
+    })?;
+    if color.iter().any(|c| !(0.0..=1.0).contains(c)) {
+        return Err(bad(format!("color {color:?} is not linear albedo in [0, 1]")));
     }
-    for (what, v) in [
-        ("roughness", f.roughness),
-        ("noise_bias", f.noise_bias),
-        ("noise_scale", f.noise_scale),
-    ] {
-        if !v.is_finite() {
-            return Err(bad(format!("{what} is not finite")));
-        }
-    }
-    if f.roughness < 0.0 {
-        return Err(bad(format!("roughness {} is negative", f.roughness)));
-    }
-    for (what, v) in [
-        ("roughness_wavelength", f.roughness_wavelength),
-        ("noise_wavelength", f.noise_wavelength),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(bad(format!("{what} {v} is not positive")));
-        }
-    }
+    check_numbers(&f).map_err(bad)?;
     let hats = [
         ("altitude", f.altitude),
         ("elevation", f.elevation),
@@ -286,7 +318,7 @@ fn flatten(
     out.push(FlatLayer {
         layer: Layer {
             name: f.name,
-            color: Vec3::from(f.color),
+            color: Vec3::from(color),
             roughness: f.roughness,
             roughness_wavelength: f.roughness_wavelength,
             noise_bias: f.noise_bias,
@@ -422,169 +454,4 @@ pub fn evaluate(tree: &LayerTree, base: &BasePoint, noise: &LayerNoise) -> Surfa
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn hat(min: f32, max: f32, fuzz: f32) -> Hat {
-        Hat { min, max, fuzz }
-    }
-
-    #[test]
-    fn hat_functions_ramp_over_twice_the_fuzz() {
-        let h = hat(100.0, 200.0, 10.0);
-        assert_eq!(h.eval(50.0), 0.0);
-        assert_eq!(h.eval(90.0), 0.0);
-        assert_eq!(h.eval(100.0), 0.5);
-        assert_eq!(h.eval(110.0), 1.0);
-        assert_eq!(h.eval(150.0), 1.0);
-        assert_eq!(h.eval(200.0), 0.5);
-        assert_eq!(h.eval(210.0), 0.0);
-        assert!((h.eval(95.0) - 0.25).abs() < 1e-6);
-        // No fuzz: a box.
-        let b = hat(0.0, 1.0, 0.0);
-        assert_eq!(
-            (b.eval(-0.1), b.eval(0.0), b.eval(1.0), b.eval(1.1)),
-            (0.0, 1.0, 1.0, 0.0)
-        );
-        // A range narrower than the ramps peaks below 1.
-        let narrow = hat(0.0, 0.0, 10.0);
-        assert_eq!(narrow.eval(0.0), 0.5);
-    }
-
-    fn leaf(name: &str, color: [f32; 3]) -> Layer {
-        Layer {
-            name: name.into(),
-            color: Vec3::from(color),
-            roughness: 0.0,
-            roughness_wavelength: 1.0,
-            noise_bias: 1.0,
-            noise_scale: 0.0,
-            noise_wavelength: 1.0,
-            altitude: None,
-            elevation: None,
-            slope: None,
-            inputs: [None; 3],
-        }
-    }
-
-    #[test]
-    fn coverage_multiplies_constraints_and_clamps_noise() {
-        let mut l = leaf("snow", [1.0; 3]);
-        l.altitude = Some(hat(1000.0, 5000.0, 100.0));
-        l.slope = Some(hat(0.0, 30.0, 5.0));
-        l.noise_bias = 0.5;
-        l.noise_scale = 1.0;
-        let at = |altitude, slope| LayerInputs {
-            altitude,
-            elevation: 0.5,
-            slope,
-            maps: [f32::NAN; 3],
-        };
-        assert_eq!(coverage(&l, &at(2000.0, 10.0), 0.5), 1.0);
-        assert_eq!(coverage(&l, &at(2000.0, 10.0), -0.5), 0.0);
-        assert_eq!(coverage(&l, &at(2000.0, 10.0), 0.0), 0.5);
-        // 0.5 (altitude ramp) × 1 × (0.5 + 0.5) = 0.5.
-        assert_eq!(coverage(&l, &at(1000.0, 10.0), 0.5), 0.5);
-        // Product of two half ramps.
-        assert_eq!(coverage(&l, &at(1000.0, 30.0), 0.5), 0.25);
-        assert_eq!(coverage(&l, &at(500.0, 10.0), 1.0), 0.0);
-        // Input maps: an absent map (NaN) fails its constraint.
-        l.inputs[0] = Some(hat(0.0, 1.0, 0.5));
-        assert_eq!(coverage(&l, &at(2000.0, 10.0), 0.5), 0.0);
-        let mut with_map = at(2000.0, 10.0);
-        with_map.maps[0] = 0.5;
-        assert_eq!(coverage(&l, &with_map, 0.5), 1.0);
-    }
-
-    #[test]
-    fn evaluation_blends_depth_first_and_coverage_feeds_children_only() {
-        let text = r#"
-            [root]
-            name = "rock"
-            color = [0.2, 0.2, 0.2]
-            [[root.children]]
-            name = "grass"
-            color = [0.0, 1.0, 0.0]
-            noise_bias = 0.5
-            roughness = 2.0
-            [[root.children.children]]
-            name = "dry"
-            color = [1.0, 1.0, 0.0]
-            noise_bias = 0.5
-            [[root.children]]
-            name = "snow"
-            color = [1.0, 1.0, 1.0]
-            altitude = { min = 101.0, max = 1e6 }
-        "#;
-        let tree = LayerTree::parse(text, "test").unwrap();
-        let names: Vec<&str> = tree.layers.iter().map(|l| l.layer.name.as_str()).collect();
-        assert_eq!(names, ["rock", "grass", "dry", "snow"]);
-        assert_eq!(tree.layers[2].parent, Some(1));
-        assert_eq!(tree.layers[3].level, 1);
-        // D_S = 1 everywhere: grass (C_S = 0.5) lifts the height by 0.5·2 = 1,
-        // which brings it above the snow line.
-        let noise = |_: usize, _: bool, _: DVec2, _: f32| (1.0f32, DVec2::new(0.1, 0.0));
-        let at = |height| BasePoint {
-            xy: DVec2::ZERO,
-            height,
-            gradient: DVec2::ZERO,
-            range: (0.0, 200.0),
-            maps: [f32::NAN; 3],
-        };
-        let s = evaluate(&tree, &at(100.5), &noise);
-        assert_eq!(s.coverage, vec![1.0, 0.5, 0.25, 1.0]);
-        assert_eq!(s.height, 101.5);
-        assert!((s.gradient.x - 0.1).abs() < 1e-9, "{:?}", s.gradient);
-        assert_eq!(s.color, Vec3::ONE);
-        // Below the snow line: rock 0.2 → grass half → dry a quarter.
-        let s = evaluate(&tree, &at(90.0), &noise);
-        let expected =
-            (Vec3::splat(0.2) * 0.5 + Vec3::new(0.0, 1.0, 0.0) * 0.5) * 0.75 + Vec3::new(1.0, 1.0, 0.0) * 0.25;
-        assert!((s.color - expected).length() < 1e-6, "{} vs {expected}", s.color);
-    }
-
-    #[test]
-    fn the_default_tree_parses_with_the_issue_layers() {
-        let tree = LayerTree::parse(DEFAULT_LAYERS, "built-in").unwrap();
-        let names: Vec<&str> = tree.layers.iter().map(|l| l.layer.name.as_str()).collect();
-        for name in [
-            "rock",
-            "grass",
-            "dark grass",
-            "dry grass",
-            "light grass",
-            "sand",
-            "snow",
-        ] {
-            assert!(names.contains(&name), "{name} missing from {names:?}");
-        }
-        assert_eq!(tree.layers[0].layer.name, "rock");
-        assert_eq!(LayerTree::default_tree(), tree);
-    }
-
-    #[test]
-    fn bad_files_name_the_line() {
-        let cases = [
-            ("[root]\nname = \"r\"\ncolor = [0.1, 0.1]\n", "line 3"),
-            ("[root]\nname = \"r\"\ncolor = [0.1, 0.1, 0.1]\nbogus = 1\n", "line 4"),
-            (
-                "[root]\nname = \"r\"\ncolor = [0.1, 0.1, 0.1]\n\n[[root.children]]\nname = \"c\"\ncolor = [0.5, 0.5, 0.5]\nslope = { min = 40.0, max = 10.0 }\n",
-                "line 5",
-            ),
-            ("[root]\nname = \"r\"\ncolor = [2.0, 0.1, 0.1]\n", "line 1"),
-            (
-                "[root]\nname = \"r\"\ncolor = [0.1, 0.1, 0.1]\naltitude = { min = 0.0, max = 1.0 }\n",
-                "takes no constraints",
-            ),
-            ("[root]\nname = \"r\"\ncolor = [0.1, 0.1, 0.1]\nroughness = -1.0\n", "negative"),
-        ];
-        for (text, needle) in cases {
-            let err = LayerTree::parse(text, "layers.toml").unwrap_err().to_string();
-            assert!(
-                err.contains("layers.toml") && err.contains(needle),
-                "{err:?} lacks {needle:?}"
-            );
-            assert!(!err.contains('\n'), "one line: {err:?}");
-        }
-    }
-}
+mod tests;

@@ -16,8 +16,10 @@
 //! target = [5120.0, 5120.0, 200.0]
 //! ```
 //!
-//! At least two keyframes, times finite and strictly increasing, positions
-//! finite with three components, eye ≠ target; any other key is an error.
+//! At least two and at most [`MAX_KEYFRAMES`] keyframes, times in
+//! `0..=`[`MAX_KEYFRAME_TIME`] seconds and strictly increasing, positions
+//! finite with three components within ±[`MAX_KEYFRAME_COORDINATE`] metres,
+//! eye ≠ target; any other key is an error.
 //! Field of view, near/far planes and the up vector come from a base
 //! [`Camera`].
 //!
@@ -39,6 +41,14 @@ use serde::Deserialize;
 
 use super::camera::Camera;
 use crate::error::{Error, Result};
+
+/// Latest keyframe time (seconds); times lie in `0..=MAX_KEYFRAME_TIME`, so
+/// a path's duration is finite (±1e308 once overflowed it to infinity).
+pub const MAX_KEYFRAME_TIME: f64 = 1e6;
+/// Largest magnitude of a keyframe eye or target coordinate (metres).
+pub const MAX_KEYFRAME_COORDINATE: f64 = 1e7;
+/// Most keyframes in a path.
+pub const MAX_KEYFRAMES: usize = 10_000;
 
 /// A camera position at a time (seconds).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -105,10 +115,19 @@ pub enum CameraPath {
     Orbit(Orbit),
 }
 
+/// `v` for a message: exponent notation when huge (`1e308`, not 309 digits).
+fn short(v: f64) -> String {
+    if v.abs() >= 1e16 {
+        format!("{v:e}")
+    } else {
+        v.to_string()
+    }
+}
+
 /// What is wrong with keyframe `k` (following `prev`), if anything.
 fn keyframe_problem(prev: Option<&Keyframe>, k: &Keyframe) -> Option<String> {
-    if !k.time.is_finite() {
-        return Some(format!("time {} is not finite", k.time));
+    if !(0.0..=MAX_KEYFRAME_TIME).contains(&k.time) {
+        return Some(format!("time {} is not in 0..={MAX_KEYFRAME_TIME} s", short(k.time)));
     }
     if let Some(p) = prev {
         if k.time <= p.time {
@@ -120,6 +139,16 @@ fn keyframe_problem(prev: Option<&Keyframe>, k: &Keyframe) -> Option<String> {
     }
     if !k.eye.is_finite() || !k.target.is_finite() {
         return Some("eye and target must be finite".into());
+    }
+    for (what, p) in [("eye", k.eye), ("target", k.target)] {
+        if p.abs().max_element() > MAX_KEYFRAME_COORDINATE {
+            return Some(format!(
+                "{what} ({}, {}, {}) exceeds ±{MAX_KEYFRAME_COORDINATE} m",
+                short(p.x),
+                short(p.y),
+                short(p.z)
+            ));
+        }
     }
     if k.eye.distance(k.target) <= 1e-9 * k.eye.length().max(1.0) {
         return Some("eye equals target; there is no view direction".into());
@@ -284,6 +313,15 @@ pub fn parse_keyframes(text: &str, origin: &Path) -> Result<CameraPath> {
             None => Error::input(origin, message),
         }
     })?;
+    if file.keyframe.len() > MAX_KEYFRAMES {
+        return Err(Error::input(
+            origin,
+            format!(
+                "{} [[keyframe]] tables, more than the limit of {MAX_KEYFRAMES}",
+                file.keyframe.len()
+            ),
+        ));
+    }
     if file.keyframe.len() < 2 {
         return Err(Error::input(
             origin,
@@ -321,256 +359,10 @@ pub fn parse_keyframes(text: &str, origin: &Path) -> Result<CameraPath> {
 /// are one line naming the file, and the line for syntax errors and bad
 /// keyframes.
 pub fn load_keyframes(path: &Path) -> Result<CameraPath> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::input(path, format!("cannot read keyframes: {e}")))?;
+    let bytes = crate::io::read_input(path)?;
+    let text = String::from_utf8(bytes).map_err(|_| Error::input(path, "not UTF-8 text"))?;
     parse_keyframes(&text, path)
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// An orbit starting at [`DEFAULT_START_ANGLE_DEG`].
-    fn orbit_around(centre: DVec3, radius: f64, height: f64, turns: f64) -> Orbit {
-        Orbit {
-            centre,
-            radius,
-            height,
-            turns,
-            start_angle_deg: DEFAULT_START_ANGLE_DEG,
-        }
-    }
-
-    fn base() -> Camera {
-        Camera {
-            eye: DVec3::ZERO,
-            target: DVec3::X,
-            up: DVec3::Z,
-            fov_y_deg: 50.0,
-            near: 1.0,
-            far: 100_000.0,
-        }
-    }
-
-    const FILE: &str = "\
-# a flythrough
-[[keyframe]]
-time = 0.0
-eye = [5120.0, -1200.0, 1400.0]
-target = [5120.0, 5120.0, 200.0]
-
-[[keyframe]]
-time = 4
-eye = [9000, 2000, 1100]
-target = [5120.0, 5120.0, 200.0]
-
-[[keyframe]]
-time = 5.5
-eye = [9500.0, 6000.0, 900.0]
-target = [4000.0, 6000.0, 300.0]
-
-[[keyframe]]
-time = 10.0
-eye = [6000.0, 9500.0, 1500.0]
-target = [5120.0, 5120.0, 0.0]
-";
-
-    fn parse(text: &str) -> Result<CameraPath> {
-        parse_keyframes(text, Path::new("path.toml"))
-    }
-
-    fn keys(path: &CameraPath) -> &[Keyframe] {
-        match path {
-            CameraPath::Keyframes(k) => k,
-            CameraPath::Orbit(_) => panic!("not keyframes"),
-        }
-    }
-
-    #[test]
-    fn keyframes_load_and_interpolate_through_every_keyframe() {
-        let path = parse(FILE).unwrap();
-        path.validate().unwrap();
-        let k = keys(&path);
-        assert_eq!(k.len(), 4);
-        assert_eq!(k[1].eye, DVec3::new(9000.0, 2000.0, 1100.0));
-        assert_eq!((path.start_time(), path.duration()), (0.0, 10.0));
-        for key in k {
-            let c = path.camera_at(key.time, &base());
-            assert_eq!((c.eye, c.target), (key.eye, key.target), "t = {}", key.time);
-            assert_eq!((c.up, c.fov_y_deg, c.near, c.far), (DVec3::Z, 50.0, 1.0, 100_000.0));
-        }
-        // Clamped outside the keyframe times.
-        assert_eq!(path.camera_at(-3.0, &base()).eye, k[0].eye);
-        assert_eq!(path.camera_at(f64::NAN, &base()).eye, k[0].eye);
-        assert_eq!(path.camera_at(99.0, &base()).eye, k[3].eye);
-        // Continuous across a keyframe, and between its neighbours' range.
-        let (a, b) = (path.camera_at(4.0 - 1e-7, &base()), path.camera_at(4.0 + 1e-7, &base()));
-        assert!(a.eye.distance(b.eye) < 1e-2, "{a:?} {b:?}");
-        // A fixed target stays fixed.
-        let mid = path.camera_at(2.0, &base());
-        assert!(mid.target.distance(k[0].target) < 1e-9, "{:?}", mid.target);
-        assert!(mid.eye.x > 5120.0 && mid.eye.x < 9000.0, "{:?}", mid.eye);
-        // Eases in: zero velocity at the start.
-        let early = path.camera_at(1e-4, &base());
-        assert!(early.eye.distance(k[0].eye) < 1e-3);
-    }
-
-    #[test]
-    fn uniform_spacing_gives_the_uniform_spline() {
-        // Collinear, evenly spaced points: the spline is the straight line,
-        // and in the interior segment a point moves linearly with time.
-        let keys: Vec<Keyframe> = (0..4)
-            .map(|i| Keyframe {
-                time: f64::from(i),
-                eye: DVec3::new(100.0 * f64::from(i), 0.0, 50.0),
-                target: DVec3::new(100.0 * f64::from(i), 500.0, 0.0),
-            })
-            .collect();
-        let path = CameraPath::Keyframes(keys);
-        let c = path.camera_at(1.25, &base());
-        assert!(c.eye.distance(DVec3::new(125.0, 0.0, 50.0)) < 1e-9, "{:?}", c.eye);
-    }
-
-    #[test]
-    fn times_must_strictly_increase() {
-        let text = FILE.replace("time = 5.5", "time = 4.0");
-        let e = parse(&text).unwrap_err().to_string();
-        assert!(
-            e.starts_with("path.toml: keyframe 3 (line 13): time 4 is not after"),
-            "{e}"
-        );
-        let text = FILE.replace("time = 5.5", "time = 3.0");
-        assert!(parse(&text).unwrap_err().to_string().contains("strictly increase"));
-        let text = FILE.replace("time = 5.5", "time = nan");
-        assert!(parse(&text).unwrap_err().to_string().contains("not finite"));
-        let mut path = parse(FILE).unwrap();
-        if let CameraPath::Keyframes(k) = &mut path {
-            k[2].time = 1.0;
-        }
-        assert!(path.validate().unwrap_err().to_string().contains("keyframe 3"));
-        // Must not panic on an invalid path.
-        let _ = path.sample(7, &base());
-    }
-
-    #[test]
-    fn too_few_keyframes() {
-        let one = "[[keyframe]]\ntime = 0\neye = [0, 0, 10]\ntarget = [1, 0, 0]\n";
-        let e = parse(one).unwrap_err().to_string();
-        assert!(
-            e.contains("path.toml") && e.contains("at least 2") && e.contains("found 1"),
-            "{e}"
-        );
-        assert!(parse("").unwrap_err().to_string().contains("found 0"));
-        assert!(CameraPath::Keyframes(vec![]).validate().is_err());
-        assert_eq!(CameraPath::Keyframes(vec![]).camera_at(1.0, &base()), base());
-        assert_eq!(CameraPath::Keyframes(vec![]).sample(3, &base()).len(), 3);
-    }
-
-    #[test]
-    fn bad_toml_reports_the_line() {
-        let text = FILE.replace("eye = [9000, 2000, 1100]", "eye = [9000, 2000 1100]");
-        let e = parse(&text).unwrap_err().to_string();
-        assert!(e.starts_with("path.toml: line 9: "), "{e}");
-        assert!(!e.contains('\n'), "{e}");
-        // An unclosed array may continue on the next line: toml reports where `]` was expected.
-        let text = FILE.replace("eye = [9000, 2000, 1100]", "eye = [9000, 2000, 1100");
-        let e = parse(&text).unwrap_err().to_string();
-        assert!(
-            e.starts_with("path.toml: line 10: ") && e.contains("expected `]`"),
-            "{e}"
-        );
-        let text = FILE.replace("time = 4\n", "time = 4\nfov = 30\n");
-        let e = parse(&text).unwrap_err().to_string();
-        assert!(e.starts_with("path.toml: line 9: ") && e.contains("fov"), "{e}");
-        let text = FILE.replace("target = [4000.0, 6000.0, 300.0]", "target = [4000.0, 6000.0]");
-        let e = parse(&text).unwrap_err().to_string();
-        assert!(e.contains("keyframe 3 (line 15): target has 2 components"), "{e}");
-        let text = FILE.replace("time = 4\n", "time = \"4\"\n");
-        assert!(parse(&text).unwrap_err().to_string().starts_with("path.toml: line 8: "));
-        let text = FILE.replace("[9500.0, 6000.0, 900.0]", "[4000.0, 6000.0, 300.0]");
-        assert!(parse(&text).unwrap_err().to_string().contains("eye equals target"));
-    }
-
-    #[test]
-    fn load_keyframes_names_the_file() {
-        let dir = std::env::temp_dir().join(format!("alpenglow-camera-path-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let file = dir.join("fly.toml");
-        std::fs::write(&file, FILE).unwrap();
-        assert_eq!(load_keyframes(&file).unwrap(), parse(FILE).unwrap());
-        std::fs::write(&file, "[[keyframe]\n").unwrap();
-        let e = load_keyframes(&file).unwrap_err().to_string();
-        assert!(e.contains("fly.toml: line 1"), "{e}");
-        let missing = dir.join("missing.toml");
-        let e = load_keyframes(&missing).unwrap_err().to_string();
-        assert!(e.contains("missing.toml: cannot read keyframes"), "{e}");
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn orbit_circles_the_centre_and_returns() {
-        let orbit = orbit_around(DVec3::new(5120.0, 5120.0, 200.0), 3000.0, 900.0, 1.0);
-        let path = CameraPath::Orbit(orbit);
-        assert_eq!((path.start_time(), path.duration()), (0.0, 1.0));
-        let start = path.camera_at(0.0, &base());
-        // Starts south of the centre.
-        assert!(
-            start.eye.distance(DVec3::new(5120.0, 2120.0, 1100.0)) < 1e-9,
-            "{:?}",
-            start.eye
-        );
-        for c in path.sample(37, &base()) {
-            let d = (c.eye - orbit.centre).truncate().length();
-            assert!((d - 3000.0).abs() < 1e-9, "{d}");
-            assert_eq!(c.eye.z, 1100.0);
-            assert_eq!(c.target, orbit.centre);
-        }
-        let end = path.camera_at(1.0, &base());
-        assert!(end.eye.distance(start.eye) < 1e-9);
-        let quarter = path.camera_at(0.25, &base());
-        assert!(
-            quarter.eye.distance(DVec3::new(8120.0, 5120.0, 1100.0)) < 1e-9,
-            "counter-clockwise"
-        );
-        let half = CameraPath::Orbit(orbit_around(DVec3::ZERO, 10.0, 5.0, 0.5));
-        assert!(half.camera_at(1.0, &base()).eye.distance(DVec3::new(0.0, 10.0, 5.0)) < 1e-12);
-    }
-
-    #[test]
-    fn orbit_validation_names_the_orbit() {
-        for bad in [
-            orbit_around(DVec3::ZERO, 0.0, 1.0, 1.0),
-            orbit_around(DVec3::ZERO, -1.0, 1.0, 1.0),
-            orbit_around(DVec3::ZERO, 1.0, f64::INFINITY, 1.0),
-            orbit_around(DVec3::new(0.0, f64::NAN, 0.0), 1.0, 1.0, 1.0),
-        ] {
-            let e = bad.validate().unwrap_err();
-            assert_eq!(e.parameter(), Some("orbit"), "{e}");
-            assert!(!e.to_string().contains("--"), "{e}");
-        }
-        orbit_around(DVec3::ZERO, 1.0, 0.0, 0.0).validate().unwrap();
-    }
-
-    #[test]
-    fn sample_counts_and_valid_cameras() {
-        let paths = [
-            parse(FILE).unwrap(),
-            CameraPath::Orbit(orbit_around(DVec3::ZERO, 1000.0, 300.0, 2.5)),
-        ];
-        for path in &paths {
-            assert!(path.sample(0, &base()).is_empty());
-            let one = path.sample(1, &base());
-            assert_eq!(one, vec![path.camera_at(path.start_time(), &base())]);
-            let two = path.sample(2, &base());
-            assert_eq!(two[1], path.camera_at(path.start_time() + path.duration(), &base()));
-            let many = path.sample(241, &base());
-            assert_eq!(many.len(), 241);
-            assert_eq!(
-                many[120],
-                path.camera_at(path.start_time() + path.duration() / 2.0, &base())
-            );
-            for c in &many {
-                c.validate().unwrap();
-            }
-        }
-    }
-}
+mod tests;

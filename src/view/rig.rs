@@ -24,6 +24,11 @@
 //! cy = 200
 //! k1 = -0.1                      # optional Brown–Conrady distortion: k1 k2 k3 p1 p2
 //! ```
+//!
+//! Limits (errors otherwise): coordinates within ±[`MAX_RIG_COORDINATE`] m,
+//! angles within ±[`MAX_RIG_ANGLE`]°, `0 < near < far ≤` [`MAX_RIG_FAR`] m,
+//! sizes as [`super::validate_size`], names 1 to 64 characters; the file is
+//! read through [`crate::io::read_input`] and must be UTF-8.
 
 use std::path::Path;
 
@@ -36,6 +41,13 @@ use crate::error::{Error, Result};
 
 /// Most views a frame renders.
 pub const MAX_VIEWS: usize = 16;
+/// Largest magnitude of a world `eye`/`target` coordinate or a rig-relative
+/// `position` component (metres).
+pub const MAX_RIG_COORDINATE: f64 = 1e7;
+/// Largest magnitude of a yaw, pitch or roll (degrees).
+pub const MAX_RIG_ANGLE: f64 = 360.0;
+/// Largest `far` clip distance (metres); `near` is positive and below it.
+pub const MAX_RIG_FAR: f64 = 1e9;
 
 /// Where a view looks from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -293,8 +305,8 @@ impl Rig {
 
     /// Reads a rig file.
     pub fn load(path: &Path) -> Result<Rig> {
-        let text =
-            std::fs::read_to_string(path).map_err(|e| Error::input(path, format!("cannot read the rig: {e}")))?;
+        let bytes = crate::io::read_input(path)?;
+        let text = String::from_utf8(bytes).map_err(|_| Error::input(path, "not UTF-8 text"))?;
         Rig::parse(&text, path)
     }
 }
@@ -337,8 +349,50 @@ struct RawView {
     far: Option<f64>,
 }
 
+/// Checks the pose and clip numbers of a raw view against the limits above.
+fn check_numbers(v: &RawView) -> std::result::Result<(), String> {
+    let vectors = [
+        ("eye", v.eye, MAX_RIG_COORDINATE),
+        ("target", v.target, MAX_RIG_COORDINATE),
+        ("up", v.up, f64::MAX),
+        ("position", v.position, MAX_RIG_COORDINATE),
+        ("yaw_pitch_roll", v.yaw_pitch_roll, MAX_RIG_ANGLE),
+    ];
+    for (what, value, limit) in vectors {
+        let Some(a) = value else { continue };
+        if !a.iter().all(|x| x.is_finite()) {
+            return Err(format!("{what} {a:?} is not finite"));
+        }
+        if a.iter().any(|x| x.abs() > limit) {
+            return Err(format!("{what} {a:?} exceeds ±{limit}"));
+        }
+    }
+    if v.up.is_some_and(|u| u == [0.0; 3]) {
+        return Err("up is zero".into());
+    }
+    if let (Some(e), Some(t)) = (v.eye, v.target) {
+        if e == t {
+            return Err("eye equals target; there is no view direction".into());
+        }
+    }
+    for (what, value) in [("near", v.near), ("far", v.far)] {
+        if let Some(x) = value {
+            if !(x > 0.0 && x <= MAX_RIG_FAR) {
+                return Err(format!("{what} {x} is not in (0, {MAX_RIG_FAR}] m"));
+            }
+        }
+    }
+    if let (Some(near), Some(far)) = (v.near, v.far) {
+        if near >= far {
+            return Err(format!("near {near} is not below far {far}"));
+        }
+    }
+    Ok(())
+}
+
 impl RawView {
     fn into_view(self) -> std::result::Result<RigView, String> {
+        check_numbers(&self)?;
         let name = self.name.ok_or("has no name")?;
         let v3 = |a: [f64; 3]| DVec3::from_array(a);
         let pose = match (self.eye, self.target, self.position, self.yaw_pitch_roll) {
@@ -374,14 +428,6 @@ impl RawView {
             if !(f > 0.0 && f < 180.0) {
                 return Err(format!("fov_y {f}; must be in (0, 180) degrees"));
             }
-        }
-        let finite = [self.eye, self.target, self.up, self.position, self.yaw_pitch_roll]
-            .iter()
-            .flatten()
-            .flatten()
-            .all(|x| x.is_finite());
-        if !finite {
-            return Err("a pose value is not finite".into());
         }
         Ok(RigView {
             name,
@@ -484,6 +530,31 @@ mod tests {
             ("[[view]]\nname = \"a\"\nwidth = 0\nheight = 10", "width"),
             ("[[view]]\nname = \"a\"\nspeed = 3", "unknown field"),
             ("[[view]]\nname = \"a\"\nk1 = 1e9", "k1"),
+            (
+                "[[view]]\nname = \"a\"\nposition = [3e38, 0, 0]",
+                "position [3e38, 0.0, 0.0] exceeds",
+            ),
+            (
+                "[[view]]\nname = \"a\"\nyaw_pitch_roll = [1e300, 0, 0]",
+                "yaw_pitch_roll",
+            ),
+            ("[[view]]\nname = \"a\"\neye = [0,0,1e8]\ntarget = [0,0,0]", "eye"),
+            (
+                "[[view]]\nname = \"a\"\neye = [0,0,1]\ntarget = [0,0,1]",
+                "eye equals target",
+            ),
+            (
+                "[[view]]\nname = \"a\"\neye = [0,0,1]\ntarget = [1,0,1]\nup = [0,0,0]",
+                "up is zero",
+            ),
+            ("[[view]]\nname = \"a\"\nnear = -1", "near -1 is not in"),
+            ("[[view]]\nname = \"a\"\nfar = inf", "far inf is not in"),
+            (
+                "[[view]]\nname = \"a\"\nnear = 10\nfar = 5",
+                "near 10 is not below far 5",
+            ),
+            ("[[view]]\nname = \"a\"\nfov_y = nan", "fov_y NaN"),
+            ("[[view]]\nname = \"a\"\nwidth = 99999\nheight = 10", "width"),
         ];
         for (text, expected) in bad {
             let e = Rig::parse(text, Path::new("cams.toml")).unwrap_err().to_string();

@@ -32,16 +32,25 @@
 //! clear message even though its layout may differ), length against the node
 //! count, checksum, then every value and the tree structure (one root, parent
 //! indices in range, depth = parent's depth + 1 so there are no cycles,
-//! leaves without children, sorted by decreasing `r_max`, non-negative
-//! errors, `r_min ≤ r_max`, finite clip lines).
+//! leaves without children, inner nodes with children, sorted by decreasing
+//! `r_max`, non-negative errors, `r_min ≤ r_max`, finite clip lines) and
+//! magnitudes: coordinates within ±[`MAX_SPT_COORDINATE`] (10⁷ m), lengths
+//! (bounds radius, diameters, errors, clip offsets, `r_min` and every
+//! `r_max` but the root's) at most [`MAX_SPT_LENGTH`], every node's disk
+//! inside the bounding sphere (a checksum proves only that the bytes were
+//! not damaged, not that an edited file makes sense).
 
 use std::path::Path;
 
 use glam::Vec3;
 
 use super::clip::{ClipLine, ClipLines};
-use super::spt::{SequentialPointTree, SptNode, NO_PARENT};
+use super::spt::{SequentialPointTree, SptNode};
 use crate::error::{Error, Result};
+use validate::validate;
+pub use validate::{MAX_SPT_COORDINATE, MAX_SPT_LENGTH};
+
+mod validate;
 
 /// The first eight bytes of every SPT file.
 pub const SPT_MAGIC: [u8; 8] = *b"ALPSPT\0\0";
@@ -69,93 +78,6 @@ fn fnv1a64(bytes: &[u8]) -> u64 {
         h = h.wrapping_mul(0x0000_0100_0000_01b3);
     }
     h
-}
-
-/// Checks the values and structure of a tree; the message is one line
-/// without the file name.
-fn validate(tree: &SequentialPointTree) -> std::result::Result<(), String> {
-    let n = tree.nodes.len();
-    if n == 0 {
-        return Err("the tree has no nodes".into());
-    }
-    if n >= NO_PARENT as usize {
-        return Err(format!("{n} nodes exceed the format's limit"));
-    }
-    if !(tree.epsilon.is_finite() && tree.epsilon > 0.0) {
-        return Err(format!("epsilon {} is not positive and finite", tree.epsilon));
-    }
-    if !tree.bounds_centre.is_finite() {
-        return Err("bounds centre is not finite".into());
-    }
-    if !(tree.bounds_radius.is_finite() && tree.bounds_radius >= 0.0) {
-        return Err(format!("bounds radius {} is not finite and ≥ 0", tree.bounds_radius));
-    }
-    let mut roots = 0usize;
-    for (i, node) in tree.nodes.iter().enumerate() {
-        let bad = |what: &str| Err(format!("node {i}: {what}"));
-        if !node.position.is_finite() {
-            return bad("non-finite position");
-        }
-        if !node.normal.is_finite() {
-            return bad("non-finite normal");
-        }
-        if (node.normal.length() - 1.0).abs() > 1e-3 {
-            return bad("normal is not unit length");
-        }
-        let scalars = [
-            ("diameter", node.diameter),
-            ("e_p", node.e_p),
-            ("e_t", node.e_t),
-            ("e_g", node.e_g),
-            ("r_min", node.r_min),
-            ("r_max", node.r_max),
-        ];
-        for (name, v) in scalars {
-            if !v.is_finite() {
-                return bad(&format!("non-finite {name}"));
-            }
-            if v < 0.0 {
-                return bad(&format!("negative {name}"));
-            }
-        }
-        if node.diameter <= 0.0 {
-            return bad("diameter is zero");
-        }
-        if node.r_min > node.r_max {
-            return bad("r_min exceeds r_max");
-        }
-        if !node.clip.packed().iter().all(|v| v.is_finite()) {
-            return bad("non-finite clip line");
-        }
-        if i > 0 && tree.nodes[i - 1].r_max < node.r_max {
-            return bad("nodes are not sorted by decreasing r_max");
-        }
-        if node.parent == NO_PARENT {
-            roots += 1;
-            if node.depth != 0 {
-                return bad("the root has a depth other than 0");
-            }
-        } else {
-            let p = node.parent as usize;
-            if p >= n || p == i {
-                return bad(&format!("parent index {p} is out of range"));
-            }
-            let parent = &tree.nodes[p];
-            if parent.is_leaf {
-                return bad(&format!("parent {p} is a leaf"));
-            }
-            if parent.depth.checked_add(1) != Some(node.depth) {
-                return bad(&format!(
-                    "depth {} does not follow its parent's {}",
-                    node.depth, parent.depth
-                ));
-            }
-        }
-    }
-    if roots != 1 {
-        return Err(format!("{roots} root nodes (expected exactly 1)"));
-    }
-    Ok(())
 }
 
 /// The file bytes of `tree` (assumed valid).
@@ -573,6 +495,66 @@ mod tests {
         b.extend_from_slice(&[0; CHECKSUM_BYTES]);
         reseal(&mut b);
         assert!(read_err(&path, &b).contains("no nodes"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn absurd_values_with_a_recomputed_checksum_are_rejected() {
+        let dir = scratch_dir("absurd");
+        let path = dir.join("a.spt");
+        let t = tree();
+        let good = encode(&t);
+        let leaf = t
+            .nodes
+            .iter()
+            .position(|n| n.is_leaf && n.clip != ClipLines::NONE)
+            .unwrap();
+        let at = HEADER_BYTES + NODE_BYTES * leaf;
+        let node1 = HEADER_BYTES + NODE_BYTES;
+        let huge = 3e38f32.to_le_bytes().to_vec();
+        let cases: Vec<(usize, Vec<u8>, String)> = vec![
+            (20, huge.clone(), "bounds centre (3e38, ".into()),
+            (28, (-2e7f32).to_le_bytes().to_vec(), "exceeds ±10000000 m".into()),
+            (32, huge.clone(), "bounds radius 3e38".into()),
+            // The sphere no longer holds the disks.
+            (32, 1e-3f32.to_le_bytes().to_vec(), "outside the bounds radius".into()),
+            (node1 + 4, huge.clone(), "node 1: position".into()),
+            (node1 + 24, huge.clone(), "node 1: diameter 3e38 exceeds".into()),
+            (
+                node1 + 28,
+                5e7f32.to_le_bytes().to_vec(),
+                "node 1: e_p 5e7 exceeds".into(),
+            ),
+            (at + 64, huge.clone(), format!("node {leaf}: clip line 0")),
+            (
+                at + 60,
+                1e30f32.to_le_bytes().to_vec(),
+                format!("node {leaf}: clip line 0"),
+            ),
+            (
+                node1 + 44,
+                f32::MAX.to_le_bytes().to_vec(),
+                "node 1: r_max is the root's".into(),
+            ),
+        ];
+        for (offset, patch, expected) in cases {
+            let mut b = good.clone();
+            b[offset..offset + patch.len()].copy_from_slice(&patch);
+            reseal(&mut b);
+            let err = read_err(&path, &b);
+            assert!(err.contains(&expected), "patch at {offset}: {err}");
+        }
+        // An inner node whose children are re-parented to the root.
+        let mut t2 = t.clone();
+        let inner = (1..t2.nodes.len()).find(|&i| !t2.nodes[i].is_leaf).unwrap();
+        for node in t2.nodes.iter_mut().filter(|n| n.parent == inner as u32) {
+            node.parent = 0;
+            node.depth = 1;
+        }
+        let mut b = encode(&t2);
+        reseal(&mut b);
+        let err = read_err(&path, &b);
+        assert!(err.contains("without children") || err.contains("depth"), "{err}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

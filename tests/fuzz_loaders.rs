@@ -1,0 +1,165 @@
+//! Fuzz suite of every file loader (issue 15): mutated seed files from
+//! `tests/data/fuzz/` must give a valid result or a one-line error naming
+//! the file, never a panic, an abort or unbounded memory. See `fuzz/mod.rs`
+//! for the environment variables and `docs/FUZZING.md` for longer runs.
+
+mod fuzz;
+
+use std::path::Path;
+
+use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
+use alpenglow::points::build::input::{load_points_file, PointInput};
+use alpenglow::points::build::spt_file::{read_spt, write_spt};
+use alpenglow::texturing::layers::LayerTree;
+use alpenglow::view::camera_path::load_keyframes;
+use alpenglow::view::rig::Rig;
+use fuzz::mutate::{fix_png_crcs, reseal_spt, Kind};
+use fuzz::{fuzz, no_fixup, Outcome, Target};
+
+#[global_allocator]
+static COUNTING: fuzz::alloc::Counting = fuzz::alloc::Counting;
+
+fn heightmap(path: &Path) -> Outcome {
+    let field = load_heightmap(path, &HeightmapOptions::default())?;
+    let expected = field.columns as usize * field.rows as usize;
+    if field.heights.len() != expected {
+        return Ok(Err(format!("{} heights for {expected} samples", field.heights.len())));
+    }
+    Ok(field.validate(path).map_err(|e| e.to_string()))
+}
+
+fn points(path: &Path) -> Outcome {
+    let input = load_points_file(path)?;
+    let n = input.positions().len();
+    let (normals, colors) = match &input {
+        PointInput::Mesh(m) => {
+            if m.triangles.is_empty() || m.triangles.iter().flatten().any(|&i| i as usize >= n) {
+                return Ok(Err("no triangles, or an index out of range".into()));
+            }
+            (m.normals.as_ref().map(Vec::len), m.colors.as_ref().map(Vec::len))
+        }
+        PointInput::Points(p) => {
+            if p.radii
+                .as_ref()
+                .is_some_and(|r| r.len() != n || r.iter().any(|r| !(r.is_finite() && *r > 0.0)))
+            {
+                return Ok(Err("bad radii".into()));
+            }
+            (p.normals.as_ref().map(Vec::len), p.colors.as_ref().map(Vec::len))
+        }
+    };
+    if n == 0 || input.positions().iter().any(|p| !p.is_finite()) {
+        return Ok(Err("no points, or a non-finite position".into()));
+    }
+    if normals.is_some_and(|k| k != n) || colors.is_some_and(|k| k != n) {
+        return Ok(Err("attribute count differs from the point count".into()));
+    }
+    Ok(Ok(()))
+}
+
+fn spt(path: &Path) -> Outcome {
+    let tree = read_spt(path)?;
+    // The writer runs the same validation again.
+    let copy = path.with_extension("copy.spt");
+    let written = write_spt(&copy, &tree).map_err(|e| e.to_string());
+    let _ = std::fs::remove_file(&copy);
+    Ok(written)
+}
+
+fn layers(path: &Path) -> Outcome {
+    let tree = LayerTree::load(path)?;
+    let ok = !tree.layers.is_empty()
+        && tree.layers.iter().all(|l| {
+            l.layer.color.is_finite() && l.layer.color.min_element() >= 0.0 && l.layer.color.max_element() <= 1.0
+        });
+    Ok(if ok {
+        Ok(())
+    } else {
+        Err("empty tree or a colour out of range".into())
+    })
+}
+
+fn keyframes(path: &Path) -> Outcome {
+    let camera_path = load_keyframes(path)?;
+    if !(camera_path.duration().is_finite() && camera_path.duration() > 0.0) {
+        return Ok(Err(format!("duration {}", camera_path.duration())));
+    }
+    Ok(camera_path.validate().map_err(|e| e.to_string()))
+}
+
+fn rig(path: &Path) -> Outcome {
+    let rig = Rig::load(path)?;
+    Ok(rig.specs((1, 1)).map(|_| ()).map_err(|e| e.to_string()))
+}
+
+fn reseal(bytes: &mut Vec<u8>) {
+    reseal_spt(bytes)
+}
+
+fn png_crcs(bytes: &mut Vec<u8>) {
+    fix_png_crcs(bytes)
+}
+
+fn target(corpus: &'static str, extension: &'static str, kind: Kind, load: fn(&Path) -> Outcome) -> Target {
+    Target {
+        corpus,
+        extension,
+        kind,
+        fixup: no_fixup,
+        load,
+    }
+}
+
+#[test]
+fn png_heightmap() {
+    fuzz(&Target {
+        fixup: png_crcs,
+        ..target("png", "png", Kind::Binary, heightmap)
+    });
+}
+
+#[test]
+fn exr_heightmap() {
+    fuzz(&target("exr", "exr", Kind::Binary, heightmap));
+}
+
+#[test]
+fn input_map() {
+    fuzz(&Target {
+        fixup: png_crcs,
+        ..target("input_map", "png", Kind::Binary, heightmap)
+    });
+}
+
+#[test]
+fn ply() {
+    fuzz(&target("ply", "ply", Kind::Text, points));
+}
+
+#[test]
+fn obj() {
+    fuzz(&target("obj", "obj", Kind::Text, points));
+}
+
+#[test]
+fn spt_file() {
+    fuzz(&Target {
+        fixup: reseal,
+        ..target("spt", "spt", Kind::Binary, spt)
+    });
+}
+
+#[test]
+fn layers_toml() {
+    fuzz(&target("layers", "toml", Kind::Text, layers));
+}
+
+#[test]
+fn keyframes_toml() {
+    fuzz(&target("keyframes", "toml", Kind::Text, keyframes));
+}
+
+#[test]
+fn rig_toml() {
+    fuzz(&target("rig", "toml", Kind::Text, rig));
+}
