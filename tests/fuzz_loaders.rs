@@ -14,7 +14,7 @@ use alpenglow::texturing::layers::LayerTree;
 use alpenglow::view::camera_path::load_keyframes;
 use alpenglow::view::rig::Rig;
 use fuzz::mutate::{fix_png_crcs, reseal_spt, Kind};
-use fuzz::{fuzz, no_fixup, Outcome, Target};
+use fuzz::{fuzz, no_fixup, regressions, Outcome, Target};
 
 #[global_allocator]
 static COUNTING: fuzz::alloc::Counting = fuzz::alloc::Counting;
@@ -162,4 +162,13 @@ fn keyframes_toml() {
 #[test]
 fn rig_toml() {
     fuzz(&target("rig", "toml", Kind::Text, rig));
+}
+
+/// Inputs AFL++ found (docs/FUZZING.md): EXR files whose data window makes
+/// the decoder claim ~1.8 GB and seconds, and a PNG whose header makes it
+/// abort on a failed allocation.
+#[test]
+fn afl_findings_stay_fixed() {
+    assert_eq!(regressions(&target("exr", "exr", Kind::Binary, heightmap), "exr"), 3);
+    assert_eq!(regressions(&target("png", "png", Kind::Binary, heightmap), "png"), 1);
 }
