@@ -92,14 +92,6 @@ fn rig(path: &Path) -> Outcome {
     Ok(rig.specs((1, 1)).map(|_| ()).map_err(|e| e.to_string()))
 }
 
-fn reseal(bytes: &mut Vec<u8>) {
-    reseal_spt(bytes)
-}
-
-fn png_crcs(bytes: &mut Vec<u8>) {
-    fix_png_crcs(bytes)
-}
-
 fn target(corpus: &'static str, extension: &'static str, kind: Kind, load: fn(&Path) -> Outcome) -> Target {
     Target {
         corpus,
@@ -113,7 +105,7 @@ fn target(corpus: &'static str, extension: &'static str, kind: Kind, load: fn(&P
 #[test]
 fn png_heightmap() {
     fuzz(&Target {
-        fixup: png_crcs,
+        fixup: fix_png_crcs,
         ..target("png", "png", Kind::Binary, heightmap)
     });
 }
@@ -126,7 +118,7 @@ fn exr_heightmap() {
 #[test]
 fn input_map() {
     fuzz(&Target {
-        fixup: png_crcs,
+        fixup: fix_png_crcs,
         ..target("input_map", "png", Kind::Binary, heightmap)
     });
 }
@@ -144,7 +136,7 @@ fn obj() {
 #[test]
 fn spt_file() {
     fuzz(&Target {
-        fixup: reseal,
+        fixup: reseal_spt,
         ..target("spt", "spt", Kind::Binary, spt)
     });
 }

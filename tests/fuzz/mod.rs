@@ -36,12 +36,12 @@ pub struct Target {
     pub extension: &'static str,
     pub kind: Kind,
     /// Repairs a checksum after mutation (most of the time), or nothing.
-    pub fixup: fn(&mut Vec<u8>),
+    pub fixup: fn(&mut [u8]),
     pub load: fn(&Path) -> Outcome,
 }
 
 /// No repair.
-pub fn no_fixup(_: &mut Vec<u8>) {}
+pub fn no_fixup(_: &mut [u8]) {}
 
 /// Cases of different loaders run one at a time: the heap counters are
 /// process-wide.
