@@ -14,7 +14,7 @@ use alpenglow::texturing::layers::LayerTree;
 use alpenglow::view::camera_path::load_keyframes;
 use alpenglow::view::rig::Rig;
 use fuzz::mutate::{fix_png_crcs, reseal_spt, Kind};
-use fuzz::{fuzz, no_fixup, Outcome, Target};
+use fuzz::{fuzz, no_fixup, regressions, Outcome, Target};
 
 #[global_allocator]
 static COUNTING: fuzz::alloc::Counting = fuzz::alloc::Counting;
@@ -92,14 +92,6 @@ fn rig(path: &Path) -> Outcome {
     Ok(rig.specs((1, 1)).map(|_| ()).map_err(|e| e.to_string()))
 }
 
-fn reseal(bytes: &mut Vec<u8>) {
-    reseal_spt(bytes)
-}
-
-fn png_crcs(bytes: &mut Vec<u8>) {
-    fix_png_crcs(bytes)
-}
-
 fn target(corpus: &'static str, extension: &'static str, kind: Kind, load: fn(&Path) -> Outcome) -> Target {
     Target {
         corpus,
@@ -113,7 +105,7 @@ fn target(corpus: &'static str, extension: &'static str, kind: Kind, load: fn(&P
 #[test]
 fn png_heightmap() {
     fuzz(&Target {
-        fixup: png_crcs,
+        fixup: fix_png_crcs,
         ..target("png", "png", Kind::Binary, heightmap)
     });
 }
@@ -126,7 +118,7 @@ fn exr_heightmap() {
 #[test]
 fn input_map() {
     fuzz(&Target {
-        fixup: png_crcs,
+        fixup: fix_png_crcs,
         ..target("input_map", "png", Kind::Binary, heightmap)
     });
 }
@@ -144,7 +136,7 @@ fn obj() {
 #[test]
 fn spt_file() {
     fuzz(&Target {
-        fixup: reseal,
+        fixup: reseal_spt,
         ..target("spt", "spt", Kind::Binary, spt)
     });
 }
@@ -162,4 +154,13 @@ fn keyframes_toml() {
 #[test]
 fn rig_toml() {
     fuzz(&target("rig", "toml", Kind::Text, rig));
+}
+
+/// Inputs AFL++ found (docs/FUZZING.md): EXR files whose data window makes
+/// the decoder claim ~1.8 GB and seconds, and a PNG whose header makes it
+/// abort on a failed allocation.
+#[test]
+fn afl_findings_stay_fixed() {
+    assert_eq!(regressions(&target("exr", "exr", Kind::Binary, heightmap), "exr"), 3);
+    assert_eq!(regressions(&target("png", "png", Kind::Binary, heightmap), "png"), 1);
 }

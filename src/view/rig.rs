@@ -272,6 +272,14 @@ impl Rig {
     /// Parses rig-file `text` (format in the module documentation); errors
     /// name `origin`, the view and the key.
     pub fn parse(text: &str, origin: &Path) -> Result<Rig> {
+        // Before the TOML parser builds every table: count the headers.
+        let headers = text.lines().filter(|l| l.trim_start().starts_with("[[view")).count();
+        if headers > MAX_VIEWS {
+            return Err(Error::input(
+                origin,
+                format!("{headers} [[view]] tables; a rig has 1 to {MAX_VIEWS}"),
+            ));
+        }
         let file: RigFile = toml::from_str(text).map_err(|e| {
             let message = e.message().trim().replace('\n', "; ");
             match e.span() {
@@ -555,6 +563,7 @@ mod tests {
             ),
             ("[[view]]\nname = \"a\"\nfov_y = nan", "fov_y NaN"),
             ("[[view]]\nname = \"a\"\nwidth = 99999\nheight = 10", "width"),
+            (&"[[view]]\nname = \"v\"\n".repeat(40), "40 [[view]] tables"),
         ];
         for (text, expected) in bad {
             let e = Rig::parse(text, Path::new("cams.toml")).unwrap_err().to_string();

@@ -36,12 +36,12 @@ pub struct Target {
     pub extension: &'static str,
     pub kind: Kind,
     /// Repairs a checksum after mutation (most of the time), or nothing.
-    pub fixup: fn(&mut Vec<u8>),
+    pub fixup: fn(&mut [u8]),
     pub load: fn(&Path) -> Outcome,
 }
 
 /// No repair.
-pub fn no_fixup(_: &mut Vec<u8>) {}
+pub fn no_fixup(_: &mut [u8]) {}
 
 /// Cases of different loaders run one at a time: the heap counters are
 /// process-wide.
@@ -181,4 +181,20 @@ pub fn fuzz(target: &Target) -> u64 {
         LOADED.load(Ordering::Relaxed)
     );
     n
+}
+
+/// Checks every file of `tests/data/fuzz-regressions/<folder>/` (inputs
+/// that once crashed, hung or blew up memory): each must give a valid result
+/// or a one-line error, within the memory limits. Returns the file count.
+pub fn regressions(target: &Target, folder: &str) -> usize {
+    let _guard = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/fuzz-regressions")
+        .join(folder);
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
+    paths.sort();
+    for (k, p) in paths.iter().enumerate() {
+        check(target, &std::fs::read(p).unwrap(), k as u64, false);
+    }
+    paths.len()
 }

@@ -465,17 +465,32 @@ fn read_ply(bytes: &[u8], path: &Path) -> Result<PointInput> {
     }
     drop(vertices);
 
+    let triangles = ply_triangles(&faces, &strips, n).map_err(bad)?;
+    if triangles.is_empty() {
+        return Err(bad("PLY faces and strips give no triangles".to_string()));
+    }
+    Ok(PointInput::Mesh(TriangleMesh {
+        positions,
+        normals,
+        colors,
+        triangles,
+    }))
+}
+
+/// The triangles of PLY faces (fanned) and strips (`-1` restarts) over `n`
+/// vertices; the message names the face or strip with a bad index.
+fn ply_triangles(faces: &[PlyFace], strips: &[PlyFace], n: usize) -> std::result::Result<Vec<[u32; 3]>, String> {
     let mut triangles = Vec::with_capacity(faces.len() + strips.len());
-    let index = |v: i64, what: &str, k: usize| -> Result<u32> {
+    let index = |v: i64, what: &str, k: usize| -> std::result::Result<u32, String> {
         match u32::try_from(v) {
             Ok(i) if (i as usize) < n => Ok(i),
-            _ => Err(bad(format!("{what} {k} refers to vertex {v} of {n}"))),
+            _ => Err(format!("{what} {k} refers to vertex {v} of {n}")),
         }
     };
     for (k, face) in faces.iter().enumerate() {
         let list = &face.indices;
         if list.len() < 3 {
-            return Err(bad(format!("face {k} has {} vertices (at least 3 needed)", list.len())));
+            return Err(format!("face {k} has {} vertices (at least 3 needed)", list.len()));
         }
         let first = index(list[0], "face", k)?;
         let mut previous = index(list[1], "face", k)?;
@@ -498,15 +513,7 @@ fn read_ply(bytes: &[u8], path: &Path) -> Result<PointInput> {
         }
         unroll_strip(&run, &mut triangles);
     }
-    if triangles.is_empty() {
-        return Err(bad("PLY faces and strips give no triangles".to_string()));
-    }
-    Ok(PointInput::Mesh(TriangleMesh {
-        positions,
-        normals,
-        colors,
-        triangles,
-    }))
+    Ok(triangles)
 }
 
 /// The clip lines of a PLY vertex (`present`: which of the two the header

@@ -132,37 +132,9 @@ pub(super) fn read_obj(bytes: &[u8], path: &Path) -> Result<TriangleMesh> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{load_points_file, PointInput};
+    use super::super::load_points_file;
+    use super::super::tests::{data, mesh, Scratch};
     use super::*;
-    use std::path::PathBuf;
-
-    fn data(name: &str) -> PathBuf {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
-    }
-
-    /// A scratch file in the system temporary directory, removed on drop.
-    struct Scratch(PathBuf);
-
-    impl Scratch {
-        fn new(name: &str, bytes: &[u8]) -> Scratch {
-            let path = std::env::temp_dir().join(format!("alpenglow-obj-input-{}-{name}", std::process::id()));
-            std::fs::write(&path, bytes).expect("write scratch file");
-            Scratch(path)
-        }
-    }
-
-    impl Drop for Scratch {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_file(&self.0);
-        }
-    }
-
-    fn mesh(input: PointInput) -> TriangleMesh {
-        match input {
-            PointInput::Mesh(m) => m,
-            PointInput::Points(_) => panic!("expected a mesh"),
-        }
-    }
 
     fn obj_err(text: &[u8]) -> String {
         let message = read_obj(text, Path::new("t.obj")).unwrap_err().to_string();

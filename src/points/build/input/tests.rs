@@ -3,15 +3,15 @@
 use super::*;
 use std::path::PathBuf;
 
-fn data(name: &str) -> PathBuf {
+pub(super) fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
 }
 
 /// A scratch file in the system temporary directory, removed on drop.
-struct Scratch(PathBuf);
+pub(super) struct Scratch(pub(super) PathBuf);
 
 impl Scratch {
-    fn new(name: &str, bytes: &[u8]) -> Scratch {
+    pub(super) fn new(name: &str, bytes: &[u8]) -> Scratch {
         let path = std::env::temp_dir().join(format!("alpenglow-points-input-{}-{name}", std::process::id()));
         std::fs::write(&path, bytes).expect("write scratch file");
         Scratch(path)
@@ -28,7 +28,7 @@ fn parse(bytes: &[u8]) -> Result<PointInput> {
     read_ply(bytes, Path::new("test.ply"))
 }
 
-fn mesh(input: PointInput) -> TriangleMesh {
+pub(super) fn mesh(input: PointInput) -> TriangleMesh {
     match input {
         PointInput::Mesh(m) => m,
         PointInput::Points(_) => panic!("expected a mesh"),

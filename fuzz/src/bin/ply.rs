@@ -1,0 +1,7 @@
+//! AFL++ target: `cargo afl fuzz -i ../tests/data/fuzz/ply -o out/ply target/debug/ply`.
+
+fn main() {
+    afl::fuzz!(|data: &[u8]| {
+        alpenglow_fuzz::run(data, "ply", alpenglow::points::build::input::load_points_file);
+    });
+}
