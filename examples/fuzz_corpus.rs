@@ -119,4 +119,55 @@ fn main() {
     }
     let tree = build_spt(&surfels, &SptOptions::default(), &mut |_| {}).unwrap();
     write_spt(&corpus("spt/grid.spt"), &tree).unwrap();
+    geotiff_seeds();
+}
+
+/// GeoTIFF: a 4×3 16-bit field in degrees (pixel scale and tie point,
+/// geographic model) and a 3×3 float field with a model transformation in
+/// metres and a no-data value not present in the data.
+fn geotiff_seeds() {
+    use tiff::encoder::colortype::{Gray16, Gray32Float};
+    use tiff::encoder::TiffEncoder;
+    use tiff::tags::Tag;
+    std::fs::create_dir_all(corpus("geotiff")).unwrap();
+    let file = std::fs::File::create(corpus("geotiff/degrees16.tif")).unwrap();
+    let mut tiff = TiffEncoder::new(file).unwrap();
+    let mut image = tiff.new_image::<Gray16>(4, 3).unwrap();
+    let e = image.encoder();
+    e.write_tag(Tag::ModelPixelScaleTag, &[1.0 / 1200.0, 1.0 / 1200.0, 0.0][..])
+        .unwrap();
+    e.write_tag(Tag::ModelTiepointTag, &[0.0, 0.0, 0.0, 7.0, 45.5, 0.0][..])
+        .unwrap();
+    e.write_tag(Tag::GeoKeyDirectoryTag, &[1u16, 1, 0, 1, 1024, 0, 1, 2][..])
+        .unwrap();
+    let values: Vec<u16> = (0..12u16).map(|i| 300 + 17 * i).collect();
+    image.write_data(&values).unwrap();
+    let file = std::fs::File::create(corpus("geotiff/metres-float.tif")).unwrap();
+    let mut tiff = TiffEncoder::new(file).unwrap();
+    let mut image = tiff.new_image::<Gray32Float>(3, 3).unwrap();
+    let e = image.encoder();
+    let transform = [
+        30.0,
+        0.0,
+        0.0,
+        500_000.0,
+        0.0,
+        -30.0,
+        0.0,
+        4_100_000.0,
+        0.0,
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        1.0,
+    ];
+    e.write_tag(Tag::ModelTransformationTag, &transform[..]).unwrap();
+    e.write_tag(Tag::GeoKeyDirectoryTag, &[1u16, 1, 0, 1, 1024, 0, 1, 1][..])
+        .unwrap();
+    e.write_tag(Tag::GdalNodata, "-9999").unwrap();
+    let floats: Vec<f32> = (0..9).map(|i| 12.5 * i as f32 - 3.0).collect();
+    image.write_data(&floats).unwrap();
 }

@@ -111,6 +111,11 @@ fn png_heightmap() {
 }
 
 #[test]
+fn geotiff_heightmap() {
+    fuzz(&target("geotiff", "tif", Kind::Binary, heightmap));
+}
+
+#[test]
 fn exr_heightmap() {
     fuzz(&target("exr", "exr", Kind::Binary, heightmap));
 }
@@ -163,4 +168,9 @@ fn rig_toml() {
 fn afl_findings_stay_fixed() {
     assert_eq!(regressions(&target("exr", "exr", Kind::Binary, heightmap), "exr"), 3);
     assert_eq!(regressions(&target("png", "png", Kind::Binary, heightmap), "png"), 1);
+    // A SampleFormat tag with no values panicked inside tiff 0.10.
+    assert_eq!(
+        regressions(&target("geotiff", "tif", Kind::Binary, heightmap), "geotiff"),
+        1
+    );
 }

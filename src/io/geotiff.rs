@@ -41,6 +41,10 @@ pub fn is_tiff(bytes: &[u8]) -> bool {
         .any(|m| bytes.starts_with(*m))
 }
 
+/// The most bytes one decoded TIFF tag may take (GeoTIFF's largest,
+/// ModelTransformation, is 16 doubles).
+const TAG_BYTES: usize = 1 << 20;
+
 /// Decodes a greyscale (Geo)TIFF into raw values with the spacing and row
 /// order of its georeferencing.
 pub(crate) fn decode_geotiff(path: &Path, bytes: &[u8], limits: &InputLimits) -> Result<RawGrid> {
@@ -60,12 +64,23 @@ pub(crate) fn decode_geotiff(path: &Path, bytes: &[u8], limits: &InputLimits) ->
     limits
         .check_image(u64::from(w), u64::from(h), decoded_bytes + 4)
         .map_err(|m| Error::input(path, m))?;
-    let mut tiff_limits = Limits::default();
-    tiff_limits.decoding_buffer_size = usize::try_from(limits.max_decode_bytes).unwrap_or(usize::MAX);
-    let mut decoder = decoder.with_limits(tiff_limits);
+    // Tags first, each at most 1 MiB decoded: the crate bounds a tag's
+    // value array by `decoding_buffer_size`, so the image's allowance must
+    // not apply to them (a tag claiming 10⁸ values would allocate it).
+    let mut tag_limits = Limits::default();
+    tag_limits.decoding_buffer_size = TAG_BYTES;
+    tag_limits.ifd_value_size = TAG_BYTES;
+    let mut decoder = decoder.with_limits(tag_limits);
     let georef = georeference(path, &mut decoder, h)?;
     let nodata = (decoder.get_tag_ascii_string(Tag::GdalNodata).ok())
         .and_then(|s| s.trim_matches(char::from(0)).trim().parse::<f64>().ok());
+    // Then the image, within its declared (and checked) size.
+    let image_bytes = u64::from(w) * u64::from(h) * decoded_bytes;
+    let mut image_limits = Limits::default();
+    image_limits.decoding_buffer_size = usize::try_from(image_bytes.min(limits.max_decode_bytes))
+        .unwrap_or(usize::MAX)
+        .max(TAG_BYTES);
+    let mut decoder = decoder.with_limits(image_limits);
     let values = samples(decoder.read_image().map_err(bad)?);
     if values.len() as u64 != u64::from(w) * u64::from(h) {
         return Err(Error::input(
