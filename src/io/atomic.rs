@@ -4,14 +4,32 @@
 //! and renames it into place only when the writer succeeded. Readers of the
 //! target therefore see either the old file or the complete new one, never a
 //! partial file, and a failed write leaves nothing behind.
+//!
+//! [`OutputTransaction`] does the same for all outputs of a command at once:
+//! every path checked first (no two outputs at one path, no symbolic link,
+//! FIFO, socket, device node or directory replaced), every output written
+//! to its temporary, then all renamed into place — or, on a failure, every
+//! previous file restored.
+//!
+//! Hidden siblings carry the writing process's id: `.NAME.tmp-PID-N`
+//! (temporary files), `.NAME.bak-PID-N` (previous files during a commit),
+//! `.NAME.partial-PID-N` (folders being filled) and
+//! `.alpenglow-commit-PID-N.journal`. When a run is killed they stay
+//! behind; [`clean_stale`], called by [`OutputTransaction`] for every
+//! directory it writes into, removes those of dead processes (and rolls
+//! back a commit that was interrupted).
+
+mod journal;
+mod names;
+mod stale;
+mod transaction;
+
+pub use stale::clean_stale;
+pub use transaction::OutputTransaction;
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::error::{Error, Result};
-
-/// Distinguishes temporary files of concurrent writes within one process.
-static COUNTER: AtomicU64 = AtomicU64::new(0);
 
 /// Removes the temporary file on drop unless disarmed (covers early returns
 /// and panics inside the writer).
@@ -32,14 +50,13 @@ impl Drop for TempGuard {
 /// The temporary path used while writing `path`:
 /// `.{file name}.tmp-{process id}-{counter}` in the same directory.
 fn temp_path(dir: &Path, file_name: &std::ffi::OsStr) -> PathBuf {
-    let mut name = std::ffi::OsString::from(".");
-    name.push(file_name);
-    name.push(format!(
-        ".tmp-{}-{}",
+    names::sibling(
+        &dir.join(file_name),
+        file_name,
+        names::Sibling::Temp,
         std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    dir.join(name)
+        names::next_id(),
+    )
 }
 
 /// Writes `path` atomically.
@@ -119,14 +136,16 @@ pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
 mod tests {
     use super::*;
 
-    fn scratch_dir(name: &str) -> PathBuf {
+    /// A fresh empty directory for test `name` of this process.
+    pub(in crate::io::atomic) fn scratch_dir(name: &str) -> PathBuf {
         let dir = std::env::temp_dir().join(format!("alpenglow-atomic-{}-{}", std::process::id(), name));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         dir
     }
 
-    fn entries(dir: &Path) -> Vec<String> {
+    /// The names in `dir`, sorted.
+    pub(in crate::io::atomic) fn entries(dir: &Path) -> Vec<String> {
         let mut v: Vec<String> = std::fs::read_dir(dir)
             .unwrap()
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
