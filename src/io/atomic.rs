@@ -71,7 +71,9 @@ fn temp_path(dir: &Path, file_name: &std::ffi::OsStr) -> PathBuf {
 ///
 /// Errors (one line, naming `path`): `path` has no file name, its parent
 /// directory does not exist or is not a directory, `path` is an existing
-/// directory, the writer did not create the temporary file, or the rename
+/// directory or anything else but a regular file (a symbolic link, FIFO,
+/// socket or device node is never replaced), the writer did not create the
+/// temporary file, or the rename
 /// failed. Errors returned by `write` are passed through unchanged, so
 /// writers should name `path` (not the temporary path) in their messages.
 pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
@@ -91,8 +93,13 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) ->
     if !dir.is_dir() {
         return Err(Error::output(path, format!("{} is not a directory", dir.display())));
     }
-    if path.is_dir() {
-        return Err(Error::output(path, "a directory of that name exists"));
+    if let Ok(meta) = std::fs::symlink_metadata(path) {
+        if let Some(thing) = transaction::non_regular(&meta) {
+            return Err(Error::output(
+                path,
+                format!("it is {thing}; only a regular file is replaced"),
+            ));
+        }
     }
 
     let mut guard = TempGuard {
@@ -204,6 +211,24 @@ mod tests {
         assert!(err.contains("does not exist"), "{err}");
         assert!(err.contains("x.png"), "{err}");
         assert!(!dir.join("nope").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn links_and_directories_are_never_replaced() {
+        let dir = scratch_dir("link");
+        std::fs::write(dir.join("real"), b"real").unwrap();
+        std::os::unix::fs::symlink(dir.join("real"), dir.join("link")).unwrap();
+        let err = write_bytes_atomically(&dir.join("link"), b"x").unwrap_err().to_string();
+        assert!(err.contains("symbolic link"), "{err}");
+        let err = write_bytes_atomically(&dir, b"x").unwrap_err().to_string();
+        assert!(err.contains("a directory"), "{err}");
+        assert!(std::fs::symlink_metadata(dir.join("link"))
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(entries(&dir), ["link", "real"]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

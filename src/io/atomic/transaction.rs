@@ -62,7 +62,7 @@ impl Default for OutputTransaction {
 
 /// What is at `path` when it is not a regular file; None when it is one or
 /// nothing is there.
-fn non_regular(meta: &std::fs::Metadata) -> Option<&'static str> {
+pub(crate) fn non_regular(meta: &std::fs::Metadata) -> Option<&'static str> {
     let t = meta.file_type();
     if t.is_file() {
         return None;
