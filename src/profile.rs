@@ -148,24 +148,27 @@ pub fn summarize(frames: &[FrameProfile]) -> (Vec<PassSummary>, FrameSummary) {
     (passes, frame)
 }
 
-/// Serialises `value` and writes it atomically to `path`.
-fn write_json(path: &Path, value: &Value) -> Result<()> {
-    let mut text =
-        serde_json::to_string_pretty(value).map_err(|e| Error::output(path, format!("JSON encoding failed: {e}")))?;
+/// Serialises `value` as pretty JSON with a final newline.
+fn json_text(value: &Value) -> Result<String> {
+    let mut text = serde_json::to_string_pretty(value).map_err(|e| Error::invalid("JSON encoding", e))?;
     text.push('\n');
-    write_bytes_atomically(path, text.as_bytes())
+    Ok(text)
+}
+
+/// The text of [`write_profile_json`].
+pub fn profile_json(device_name: &str, frames: &[FrameProfile]) -> Result<String> {
+    let (passes, frame) = summarize(frames);
+    json_text(&json!({
+        "device": device_name,
+        "frames": frames,
+        "summary": { "passes": passes, "frame": frame },
+    }))
 }
 
 /// Writes `{"device", "frames": [...], "summary": {"passes": [...], "frame": {...}}}`
 /// (see [`summarize`]). Non-finite numbers become `null`.
 pub fn write_profile_json(path: &Path, device_name: &str, frames: &[FrameProfile]) -> Result<()> {
-    let (passes, frame) = summarize(frames);
-    let value = json!({
-        "device": device_name,
-        "frames": frames,
-        "summary": { "passes": passes, "frame": frame },
-    });
-    write_json(path, &value)
+    write_bytes_atomically(path, profile_json(device_name, frames)?.as_bytes())
 }
 
 /// Milliseconds to whole nanoseconds; NaN, negative or infinite become 0.
@@ -252,6 +255,11 @@ fn push_track(
 /// is placed at its frame's CPU start, or right after the previous GPU frame
 /// if that is later, so the GPU track never overlaps itself.
 pub fn write_chrome_trace(path: &Path, device_name: &str, frames: &[FrameProfile]) -> Result<()> {
+    write_bytes_atomically(path, chrome_trace(device_name, frames)?.as_bytes())
+}
+
+/// The text of [`write_chrome_trace`].
+pub fn chrome_trace(device_name: &str, frames: &[FrameProfile]) -> Result<String> {
     let meta =
         |name: &str, tid: u32, args: Value| json!({ "name": name, "ph": "M", "pid": PID, "tid": tid, "args": args });
     let mut events = vec![
@@ -290,7 +298,7 @@ pub fn write_chrome_trace(path: &Path, device_name: &str, frames: &[FrameProfile
             .collect();
         gpu_end = push_track(&mut events, GPU_TID, frame, gpu_start, ns(frame.gpu_ms), gpu_spans);
     }
-    write_json(path, &json!({ "traceEvents": events, "displayTimeUnit": "ms" }))
+    json_text(&json!({ "traceEvents": events, "displayTimeUnit": "ms" }))
 }
 
 #[cfg(test)]

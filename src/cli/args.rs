@@ -387,7 +387,7 @@ pub struct BenchArgs {
     pub warmup: u32,
     /// The summary (per-pass medians, frame times) as JSON.
     #[arg(long = "profile", alias = "json", value_name = "FILE", help_heading = "Output")]
-    pub json: Option<PathBuf>,
+    pub profile: Option<PathBuf>,
     /// Chrome trace of the timed frames (opens in Perfetto).
     #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub trace: Option<PathBuf>,
@@ -417,7 +417,7 @@ pub struct FlyArgs {
     pub exr: bool,
     /// Per-frame times and pass medians as JSON.
     #[arg(long = "profile", alias = "json", value_name = "FILE", help_heading = "Output")]
-    pub json: Option<PathBuf>,
+    pub profile: Option<PathBuf>,
     /// Chrome trace of all frames (opens in Perfetto).
     #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub trace: Option<PathBuf>,

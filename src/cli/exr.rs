@@ -4,9 +4,7 @@
 //! `instance` (32-bit unsigned integer channels, exact), `motion.X`,
 //! `motion.Y`.
 
-use std::path::Path;
-
-use alpenglow::io::image_out::{write_exr_samples, ExrSamples};
+use alpenglow::io::image_out::{encode_exr_samples, ExrSamples};
 use alpenglow::renderer::FrameImages;
 
 /// Every other value of `values` from the `k`-th of each group of `n`.
@@ -14,8 +12,8 @@ fn channel(values: &[f32], n: usize, k: usize) -> Vec<f32> {
     values.iter().skip(k).step_by(n).copied().collect()
 }
 
-/// Writes `images` to `path` with every channel.
-pub(super) fn write_frame_exr(path: &Path, images: &FrameImages) -> alpenglow::Result<()> {
+/// The OpenEXR file of `images` with every channel.
+pub(super) fn encode_frame_exr(images: &FrameImages) -> alpenglow::Result<Vec<u8>> {
     let (sun, sky) = (images.visibility_channel(0), images.visibility_channel(1));
     let normal: Vec<Vec<f32>> = (0..3).map(|k| channel(&images.normal, 3, k)).collect();
     let motion: Vec<Vec<f32>> = (0..2).map(|k| channel(&images.motion, 2, k)).collect();
@@ -32,10 +30,5 @@ pub(super) fn write_frame_exr(path: &Path, images: &FrameImages) -> alpenglow::R
         ("motion.Y", ExrSamples::F32(&motion[1])),
     ];
     extra.extend(images.weight.iter().map(|w| ("W", ExrSamples::F32(w))));
-    write_exr_samples(
-        path,
-        (images.width, images.height),
-        (&images.hdr, &images.depth),
-        &extra,
-    )
+    encode_exr_samples((images.width, images.height), (&images.hdr, &images.depth), &extra)
 }

@@ -3,26 +3,37 @@
 //! path's previous frame) with a progress bar, and the per-frame times. The vertex count of the warped
 //! terrain is constant (§7.4), so frame times should barely vary.
 //!
-//! Frames go into a temporary sibling of the output directory, renamed into
-//! place when every frame was written: on any error no partial sequence is
-//! left behind.
+//! Frames go into a hidden staging sibling of the output directory
+//! (`.DIR.partial-PID-N`), renamed into place together with `--json` and
+//! `--trace` when every frame was written (one output transaction,
+//! `alpenglow::io::atomic::OutputTransaction`): on any error no partial
+//! sequence is left behind, and a run that was killed leaves a staging
+//! folder that the next run in that directory removes.
+//!
+//! The path's cameras are computed one frame at a time
+//! (`CameraPath::sample_at`), so memory does not grow with `--frames`
+//! beyond the per-frame timings (at most `MAX_FRAMES` frames).
+//!
+//! "wall per frame" is, for every frame alike (the first included), the
+//! CPU time to submit it plus, with `--out-dir`, to read it back and write
+//! its files; start-up (device, scene, renderer) is not part of it.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::{Duration, Instant};
 
 use super::lighting;
 use anyhow::{bail, Context as _, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use alpenglow::io::image_out::write_png_rgba8;
-use alpenglow::profile::{median, summarize, write_chrome_trace};
-use alpenglow::renderer::{FrameImages, Scene};
+use alpenglow::profile::{chrome_trace, median, summarize};
+use alpenglow::renderer::{Camera, FrameImages, Rig, Scene};
 use alpenglow::view::camera_path::{load_keyframes, CameraPath, Orbit, DEFAULT_START_ANGLE_DEG};
 
 use super::args::FlyArgs;
 use super::{
-    camera, check_output_path, check_validation, context, load_scene, render_settings, report_textures, rig, views,
-    OutputSet,
+    camera, check_frames, check_validation, context, load_scene, render_settings, report_textures, rig, views, Outputs,
 };
 
 /// The default path: one turn around the terrain's centre at 60 % of its
@@ -40,24 +51,11 @@ fn default_orbit(scene: &Scene) -> Orbit {
     }
 }
 
-/// A sibling of `dir` to write into first.
-fn staging_dir(dir: &Path) -> PathBuf {
-    let name = dir
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    dir.with_file_name(format!(".{name}.partial-{}", std::process::id()))
-}
-
-/// Removes the staging directory unless disarmed.
-struct StagingGuard(Option<PathBuf>);
-
-impl Drop for StagingGuard {
-    fn drop(&mut self) {
-        if let Some(dir) = self.0.take() {
-            let _ = std::fs::remove_dir_all(dir);
-        }
-    }
+/// The cameras of frame `i` of `frames` along `path` (a rig's views each).
+fn frame_cameras(path: &CameraPath, rig: Option<&Rig>, base: &Camera, i: u32, frames: u32) -> Result<Vec<Camera>> {
+    let c = path.sample_at(i, frames, base);
+    c.validate().with_context(|| format!("camera path frame {i}"))?;
+    rig::frame_cameras(rig, &c).with_context(|| format!("camera path frame {i}"))
 }
 
 /// Frame `index` of the view `view` (a rig's views each get a folder).
@@ -72,21 +70,15 @@ fn stats(values: &[f64]) -> (f64, f64, f64) {
 }
 
 pub fn fly(args: FlyArgs) -> Result<ExitCode> {
-    check_output_path(&args.json, "JSON")?;
-    check_output_path(&args.trace, "trace")?;
-    if args.frames == 0 {
-        bail!("--frames must be at least 1");
-    }
+    let mut outputs = Outputs::default();
+    outputs.add(args.profile.as_deref(), "--profile")?;
+    outputs.add(args.trace.as_deref(), "--trace")?;
+    check_frames(args.frames, 0)?;
     if args.exr && args.out_dir.is_none() {
         bail!("--exr needs --out-dir DIR (the EXR frames go beside the PNG frames)");
     }
     if let Some(dir) = &args.out_dir {
-        if dir.exists() && (!dir.is_dir() || std::fs::read_dir(dir)?.next().is_some()) {
-            bail!("--out-dir {} exists and is not an empty directory", dir.display());
-        }
-        if !dir.exists() {
-            check_output_path(&Some(dir.clone()), "frame directory")?;
-        }
+        outputs.add_dir(dir, "--out-dir")?;
     }
     let (rig, specs) = views(&args.scene)?;
     let scene = load_scene(&args.scene)?;
@@ -97,18 +89,16 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
         (None, None) => CameraPath::Orbit(default_orbit(&scene)),
     };
     path.validate()?;
-    let cameras = path.sample(args.frames, &base);
-    let mut frames = Vec::with_capacity(cameras.len());
-    for (i, c) in cameras.iter().enumerate() {
-        c.validate().with_context(|| format!("camera path frame {i}"))?;
-        frames.push(rig::frame_cameras(rig.as_ref(), c).with_context(|| format!("camera path frame {i}"))?);
+    // Every camera checked before start-up, none kept.
+    for i in 0..args.frames {
+        frame_cameras(&path, rig.as_ref(), &base, i, args.frames)?;
     }
 
-    let staging = args.out_dir.as_ref().map(|d| staging_dir(d));
-    let mut guard = StagingGuard(None);
+    let staging = match &args.out_dir {
+        Some(dir) => Some(outputs.stage_dir(dir)?),
+        None => None,
+    };
     if let Some(dir) = &staging {
-        std::fs::create_dir(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-        guard.0 = Some(dir.clone());
         for view in specs.iter().filter(|v| !v.name.is_empty()) {
             std::fs::create_dir(dir.join(&view.name)).with_context(|| format!("cannot create {}", dir.display()))?;
         }
@@ -117,12 +107,12 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     let ctx = context(&args.scene.device)?;
     let report = ctx.validation_report();
     let device = ctx.info().name.clone();
-    let mut wall_ms = Vec::with_capacity(cameras.len());
+    let mut wall = vec![Duration::ZERO; args.frames as usize];
     let texture_stats;
     let profiles = {
         let settings = render_settings(&args.scene, &scene, &specs, staging.is_some())?;
         let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
-        let bar = ProgressBar::new(cameras.len() as u64);
+        let bar = ProgressBar::new(u64::from(args.frames));
         bar.set_style(
             ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} frames {msg}")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -133,30 +123,35 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
                     let path = |extension| frame_path(dir, &images.name, index, extension);
                     write_png_rgba8(&path("png"), &images.rgba8, images.width, images.height)?;
                     if args.exr {
-                        super::exr::write_frame_exr(&path("exr"), images)?;
+                        let bytes = super::exr::encode_frame_exr(images)?;
+                        alpenglow::io::atomic::write_bytes_atomically(&path("exr"), &bytes)?;
                     }
                 }
             }
             Ok(())
         };
+        // A frame is read back and written while the next one renders; its
+        // wall time is its submission plus its read-back and writes.
         let mut pending = None;
-        let mut last = std::time::Instant::now();
-        for (i, cams) in frames.iter().enumerate() {
-            let outcome = renderer.render_views(cams)?;
+        for i in 0..args.frames {
+            let cams = frame_cameras(&path, rig.as_ref(), &base, i, args.frames)?;
+            let start = Instant::now();
+            let outcome = renderer.render_views(&cams)?;
+            wall[i as usize] += start.elapsed();
             if let Some((index, frame)) = pending.take() {
-                let images = renderer.read_views(&frame)?;
-                write(&images, index)?;
+                let start = Instant::now();
+                write(&renderer.read_views(&frame)?, index)?;
+                wall[index] += start.elapsed();
             }
             if staging.is_some() {
-                pending = Some((i, outcome));
+                pending = Some((i as usize, outcome));
             }
-            wall_ms.push(last.elapsed().as_secs_f64() * 1e3);
-            last = std::time::Instant::now();
             bar.inc(1);
         }
         if let Some((index, frame)) = pending.take() {
-            let images = renderer.read_views(&frame)?;
-            write(&images, index)?;
+            let start = Instant::now();
+            write(&renderer.read_views(&frame)?, index)?;
+            wall[index] += start.elapsed();
         }
         bar.finish_and_clear();
         let profiles = renderer.finish()?;
@@ -165,6 +160,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     };
     drop(ctx);
     check_validation(report)?;
+    let wall_ms: Vec<f64> = wall.iter().map(|d| d.as_secs_f64() * 1e3).collect();
 
     let gpu: Vec<f64> = profiles.iter().map(|p| p.gpu_ms).collect();
     let cpu_warp: Vec<f64> = profiles
@@ -186,37 +182,40 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
         args.scene.height
     );
     println!("  GPU frame time   min {gmin:.3}  median {gmed:.3}  max {gmax:.3} ms");
-    println!("  wall per frame   min {wmin:.3}  median {wmed:.3}  max {wmax:.3} ms");
+    println!(
+        "  wall per frame   min {wmin:.3}  median {wmed:.3}  max {wmax:.3} ms, first {:.3} ms \
+         (each frame's submission{}, start-up excluded)",
+        wall_ms[0],
+        if staging.is_some() {
+            " + read-back + file writes"
+        } else {
+            ""
+        }
+    );
     println!("  CPU warp         min {cmin:.3}  median {cmed:.3}  max {cmax:.3} ms");
     let textures = report_textures(&texture_stats, &profiles);
 
-    let mut outputs = OutputSet::default();
-    if args.json.is_some() {
+    if args.profile.is_some() {
         let (passes, frame) = summarize(&profiles);
         let value = serde_json::json!({
             "device": device,
             "frames": profiles.len(),
             "gpu_ms": {"min": gmin, "median": gmed, "max": gmax, "per_frame": gpu},
-            "wall_ms": {"min": wmin, "median": wmed, "max": wmax},
+            "wall_ms": {"min": wmin, "median": wmed, "max": wmax, "first": wall_ms[0]},
             "cpu_warp_ms": {"min": cmin, "median": cmed, "max": cmax},
             "median_frame_gpu_ms": frame.median_gpu_ms,
             "passes": passes,
             "textures": textures.as_ref().map(|t| serde_json::json!({"summary": t, "per_frame": texture_stats})),
         });
         let text = serde_json::to_string_pretty(&value)?;
-        outputs.write(&args.json, |p| {
-            alpenglow::io::atomic::write_bytes_atomically(p, text.as_bytes())
-        })?;
+        outputs.stage(args.profile.as_deref(), || Ok(text.into_bytes()))?;
     }
-    outputs.write(&args.trace, |p| write_chrome_trace(p, &device, &profiles))?;
-    if let (Some(dir), Some(staged)) = (&args.out_dir, &staging) {
-        if dir.is_dir() {
-            std::fs::remove_dir(dir).with_context(|| format!("cannot replace {}", dir.display()))?;
-        }
-        std::fs::rename(staged, dir).with_context(|| format!("cannot move frames into {}", dir.display()))?;
-        guard.0 = None;
-        println!("  {} frames written to {}", cameras.len(), dir.display());
+    outputs.stage(args.trace.as_deref(), || {
+        Ok(chrome_trace(&device, &profiles)?.into_bytes())
+    })?;
+    outputs.commit()?;
+    if let Some(dir) = &args.out_dir {
+        println!("  {} frames written to {}", args.frames, dir.display());
     }
-    outputs.commit();
     Ok(ExitCode::SUCCESS)
 }

@@ -6,20 +6,20 @@ mod exr;
 mod fly;
 mod lighting;
 mod orbit;
+mod outputs;
 mod points;
 mod rig;
 mod spt;
 mod terrain_spec;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{anyhow, bail, Result};
 use glam::DVec2;
 
 use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
-use alpenglow::io::image_out::write_png_rgba8;
-use alpenglow::profile::{summarize, write_chrome_trace, write_profile_json, FrameProfile};
+use alpenglow::profile::{chrome_trace, profile_json, summarize, FrameProfile};
 use alpenglow::renderer::{validate_size, Camera, RenderSettings, Scene, ViewSpec};
 use alpenglow::terrain::geometry_image::{TerrainSettings, TerrainView};
 use alpenglow::terrain::lod::{ImportanceFactors, LodMode, LodSettings};
@@ -27,6 +27,8 @@ use alpenglow::terrain::sketch_map::SketchAlignment;
 use alpenglow::texturing::stats::TextureSummary;
 use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector, ValidationReport};
 pub use errors::error_line;
+
+use outputs::Outputs;
 
 use args::{
     AlignArg, BenchArgs, Cli, Command, DeviceArgs, FactorArg, LodArg, RenderArgs, SceneArgs, TerrainArgs,
@@ -107,59 +109,6 @@ fn check_validation(report: Option<std::sync::Arc<ValidationReport>>) -> Result<
                 report.errors(),
                 report.warnings(),
                 first.lines().next().unwrap_or("")
-            );
-        }
-    }
-    Ok(())
-}
-
-/// The output files of one command: either all of them are written, or, when
-/// one write fails, those already written are removed again.
-#[derive(Default)]
-struct OutputSet {
-    written: Vec<PathBuf>,
-}
-
-impl OutputSet {
-    fn write(
-        &mut self,
-        path: &Option<PathBuf>,
-        write: impl FnOnce(&Path) -> alpenglow::Result<()>,
-    ) -> alpenglow::Result<()> {
-        let Some(path) = path else { return Ok(()) };
-        write(path)?;
-        self.written.push(path.clone());
-        Ok(())
-    }
-
-    /// Keeps the files written so far.
-    fn commit(mut self) {
-        self.written.clear();
-    }
-}
-
-impl Drop for OutputSet {
-    fn drop(&mut self) {
-        for path in &self.written {
-            let _ = std::fs::remove_file(path);
-        }
-    }
-}
-
-fn check_output_path(path: &Option<PathBuf>, what: &str) -> Result<()> {
-    if let Some(path) = path {
-        if path.is_dir() {
-            bail!("cannot write {what} {}: it is a directory", path.display());
-        }
-        let parent = path
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        if !parent.is_dir() {
-            bail!(
-                "cannot write {what} {}: directory {} does not exist",
-                path.display(),
-                parent.display()
             );
         }
     }
@@ -353,6 +302,22 @@ fn print_profile(device: &str, frame: &FrameProfile) {
     );
 }
 
+/// Most frames `bench` and `fly` render in one run (55 minutes at 30 fps):
+/// their per-frame timings stay in memory until the end, 2–3 KiB a frame
+/// (a name and four times per pass), so at most about 300 MiB.
+pub(crate) const MAX_FRAMES: u32 = 100_000;
+
+/// Checks `--frames` (1 to [`MAX_FRAMES`]) and `--warmup` (at most [`MAX_FRAMES`]).
+fn check_frames(frames: u32, warmup: u32) -> Result<()> {
+    if !(1..=MAX_FRAMES).contains(&frames) {
+        bail!("--frames {frames} is out of range: must be 1 to {MAX_FRAMES}");
+    }
+    if warmup > MAX_FRAMES {
+        bail!("--warmup {warmup} is out of range: must be at most {MAX_FRAMES}");
+    }
+    Ok(())
+}
+
 /// Frames in a row without a texture tile more before a still render gives
 /// up (every frame generates at least one, so this means a fault).
 const MAX_SETTLE_FRAMES: u32 = 64;
@@ -361,11 +326,16 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
     let (rig, specs) = views(&args.scene)?;
     rig::check_pattern(&args.out, "--out", &specs)?;
     rig::check_pattern(&args.exr, "--exr", &specs)?;
-    for path in [rig::view_paths(&args.out, &specs), rig::view_paths(&args.exr, &specs)].concat() {
-        check_output_path(&path, "output")?;
+    let mut outputs = Outputs::default();
+    for (out, exr) in rig::view_paths(&args.out, &specs)
+        .iter()
+        .zip(rig::view_paths(&args.exr, &specs))
+    {
+        outputs.add_image(out.as_deref(), "--out")?;
+        outputs.add_exr(exr.as_deref(), "--exr")?;
     }
-    check_output_path(&args.profile, "profile")?;
-    check_output_path(&args.trace, "trace")?;
+    outputs.add(args.profile.as_deref(), "--profile")?;
+    outputs.add(args.trace.as_deref(), "--trace")?;
     let scene = load_scene(&args.scene)?;
     let cameras = rig::frame_cameras(rig.as_ref(), &camera(&args.scene, &scene)?)?;
     let ctx = context(&args.scene.device)?;
@@ -394,17 +364,19 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
     };
     drop(ctx);
     check_validation(report)?;
-    let mut outputs = OutputSet::default();
     for images in &views {
         let path = |p: &Option<PathBuf>| p.as_ref().map(|p| rig::view_path(p, &images.name));
-        outputs.write(&path(&args.out), |p| {
-            write_png_rgba8(p, &images.rgba8, images.width, images.height)
-        })?;
-        outputs.write(&path(&args.exr), |p| exr::write_frame_exr(p, images))?;
+        let (w, h) = (images.width, images.height);
+        outputs.stage_image(path(&args.out).as_deref(), &images.rgba8, w, h)?;
+        outputs.stage(path(&args.exr).as_deref(), || exr::encode_frame_exr(images))?;
     }
-    outputs.write(&args.profile, |p| write_profile_json(p, &device, &profiles))?;
-    outputs.write(&args.trace, |p| write_chrome_trace(p, &device, &profiles))?;
-    outputs.commit();
+    outputs.stage(args.profile.as_deref(), || {
+        Ok(profile_json(&device, &profiles)?.into_bytes())
+    })?;
+    outputs.stage(args.trace.as_deref(), || {
+        Ok(chrome_trace(&device, &profiles)?.into_bytes())
+    })?;
+    outputs.commit()?;
     if let Some(frame) = profiles.last() {
         print_profile(&device, frame);
     }
@@ -412,11 +384,10 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
 }
 
 fn bench(args: BenchArgs) -> Result<ExitCode> {
-    check_output_path(&args.json, "JSON")?;
-    check_output_path(&args.trace, "trace")?;
-    if args.frames == 0 {
-        bail!("--frames must be at least 1");
-    }
+    let mut outputs = Outputs::default();
+    outputs.add(args.profile.as_deref(), "--profile")?;
+    outputs.add(args.trace.as_deref(), "--trace")?;
+    check_frames(args.frames, args.warmup)?;
     let (rig, specs) = views(&args.scene)?;
     let scene = load_scene(&args.scene)?;
     let cameras = rig::frame_cameras(rig.as_ref(), &camera(&args.scene, &scene)?)?;
@@ -484,8 +455,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     }
     let texture_stats: Vec<_> = texture_stats.into_iter().skip(untimed).collect();
     let textures = report_textures(&texture_stats, &timed);
-    let mut outputs = OutputSet::default();
-    if args.json.is_some() {
+    if args.profile.is_some() {
         let value = serde_json::json!({
             "textures": textures,
             "device": device,
@@ -501,12 +471,12 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
             "points": point_stats,
         });
         let text = serde_json::to_string_pretty(&value)?;
-        outputs.write(&args.json, |p| {
-            alpenglow::io::atomic::write_bytes_atomically(p, text.as_bytes())
-        })?;
+        outputs.stage(args.profile.as_deref(), || Ok(text.into_bytes()))?;
     }
-    outputs.write(&args.trace, |p| write_chrome_trace(p, &device.name, &timed))?;
-    outputs.commit();
+    outputs.stage(args.trace.as_deref(), || {
+        Ok(chrome_trace(&device.name, &timed)?.into_bytes())
+    })?;
+    outputs.commit()?;
     Ok(ExitCode::SUCCESS)
 }
 

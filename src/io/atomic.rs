@@ -4,14 +4,32 @@
 //! and renames it into place only when the writer succeeded. Readers of the
 //! target therefore see either the old file or the complete new one, never a
 //! partial file, and a failed write leaves nothing behind.
+//!
+//! [`OutputTransaction`] does the same for all outputs of a command at once:
+//! every path checked first (no two outputs at one path, no symbolic link,
+//! FIFO, socket, device node or directory replaced), every output written
+//! to its temporary, then all renamed into place — or, on a failure, every
+//! previous file restored.
+//!
+//! Hidden siblings carry the writing process's id: `.NAME.tmp-PID-N`
+//! (temporary files), `.NAME.bak-PID-N` (previous files during a commit),
+//! `.NAME.partial-PID-N` (folders being filled) and
+//! `.alpenglow-commit-PID-N.journal`. When a run is killed they stay
+//! behind; [`clean_stale`], called by [`OutputTransaction`] for every
+//! directory it writes into, removes those of dead processes (and rolls
+//! back a commit that was interrupted).
+
+mod journal;
+mod names;
+mod stale;
+mod transaction;
+
+pub use stale::clean_stale;
+pub use transaction::OutputTransaction;
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::error::{Error, Result};
-
-/// Distinguishes temporary files of concurrent writes within one process.
-static COUNTER: AtomicU64 = AtomicU64::new(0);
 
 /// Removes the temporary file on drop unless disarmed (covers early returns
 /// and panics inside the writer).
@@ -32,14 +50,13 @@ impl Drop for TempGuard {
 /// The temporary path used while writing `path`:
 /// `.{file name}.tmp-{process id}-{counter}` in the same directory.
 fn temp_path(dir: &Path, file_name: &std::ffi::OsStr) -> PathBuf {
-    let mut name = std::ffi::OsString::from(".");
-    name.push(file_name);
-    name.push(format!(
-        ".tmp-{}-{}",
+    names::sibling(
+        &dir.join(file_name),
+        file_name,
+        names::Sibling::Temp,
         std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    dir.join(name)
+        names::next_id(),
+    )
 }
 
 /// Writes `path` atomically.
@@ -54,7 +71,9 @@ fn temp_path(dir: &Path, file_name: &std::ffi::OsStr) -> PathBuf {
 ///
 /// Errors (one line, naming `path`): `path` has no file name, its parent
 /// directory does not exist or is not a directory, `path` is an existing
-/// directory, the writer did not create the temporary file, or the rename
+/// directory or anything else but a regular file (a symbolic link, FIFO,
+/// socket or device node is never replaced), the writer did not create the
+/// temporary file, or the rename
 /// failed. Errors returned by `write` are passed through unchanged, so
 /// writers should name `path` (not the temporary path) in their messages.
 pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
@@ -74,8 +93,13 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) ->
     if !dir.is_dir() {
         return Err(Error::output(path, format!("{} is not a directory", dir.display())));
     }
-    if path.is_dir() {
-        return Err(Error::output(path, "a directory of that name exists"));
+    if let Ok(meta) = std::fs::symlink_metadata(path) {
+        if let Some(thing) = transaction::non_regular(&meta) {
+            return Err(Error::output(
+                path,
+                format!("it is {thing}; only a regular file is replaced"),
+            ));
+        }
     }
 
     let mut guard = TempGuard {
@@ -119,14 +143,16 @@ pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
 mod tests {
     use super::*;
 
-    fn scratch_dir(name: &str) -> PathBuf {
+    /// A fresh empty directory for test `name` of this process.
+    pub(in crate::io::atomic) fn scratch_dir(name: &str) -> PathBuf {
         let dir = std::env::temp_dir().join(format!("alpenglow-atomic-{}-{}", std::process::id(), name));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         dir
     }
 
-    fn entries(dir: &Path) -> Vec<String> {
+    /// The names in `dir`, sorted.
+    pub(in crate::io::atomic) fn entries(dir: &Path) -> Vec<String> {
         let mut v: Vec<String> = std::fs::read_dir(dir)
             .unwrap()
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -185,6 +211,24 @@ mod tests {
         assert!(err.contains("does not exist"), "{err}");
         assert!(err.contains("x.png"), "{err}");
         assert!(!dir.join("nope").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn links_and_directories_are_never_replaced() {
+        let dir = scratch_dir("link");
+        std::fs::write(dir.join("real"), b"real").unwrap();
+        std::os::unix::fs::symlink(dir.join("real"), dir.join("link")).unwrap();
+        let err = write_bytes_atomically(&dir.join("link"), b"x").unwrap_err().to_string();
+        assert!(err.contains("symbolic link"), "{err}");
+        let err = write_bytes_atomically(&dir, b"x").unwrap_err().to_string();
+        assert!(err.contains("a directory"), "{err}");
+        assert!(std::fs::symlink_metadata(dir.join("link"))
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(entries(&dir), ["link", "real"]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

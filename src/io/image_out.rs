@@ -1,14 +1,16 @@
-//! Image output: 8-bit sRGB PNG screenshots and 32-bit float OpenEXR layers.
+//! Image output: 8-bit sRGB PNG (or JPEG) screenshots and 32-bit float
+//! OpenEXR layers. The `encode_*` functions return the file's bytes, for
+//! [`crate::io::atomic::OutputTransaction::stage_bytes`].
 //!
-//! Both writers go through [`write_atomically`], so a failed write leaves no
+//! Every writer goes through [`crate::io::atomic::write_bytes_atomically`], so a failed write leaves no
 //! file behind. Pixel data is row-major with row 0 at the top of the image.
 
 use std::collections::BTreeSet;
-use std::io::{BufWriter, Cursor, Write};
+use std::io::Cursor;
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::io::atomic::{write_atomically, write_bytes_atomically};
+use crate::io::atomic::write_bytes_atomically;
 use crate::io::limits::InputLimits;
 use crate::io::one_line;
 
@@ -43,6 +45,34 @@ fn pixel_count(what: &str, width: u32, height: u32) -> Result<usize> {
         .ok_or_else(|| Error::invalid(what, format!("image size {width}×{height} is too large")))
 }
 
+/// Checks that `rgba` holds 4 bytes per pixel of a `width`×`height` image.
+fn check_rgba8(what: &str, rgba: &[u8], width: u32, height: u32) -> Result<()> {
+    let pixels = pixel_count(&format!("{what} image size"), width, height)?;
+    if Some(rgba.len()) != pixels.checked_mul(4) {
+        return Err(Error::invalid(
+            format!("{what} pixel data"),
+            format!(
+                "{} bytes for a {width}×{height} RGBA image (expected {})",
+                rgba.len(),
+                pixels.saturating_mul(4)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Encodes an 8-bit RGBA PNG in memory (see [`write_png_rgba8`]).
+pub fn encode_png_rgba8(rgba: &[u8], width: u32, height: u32) -> Result<Vec<u8>> {
+    check_rgba8("PNG", rgba, width, height)?;
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    use image::{ExtendedColorType, ImageEncoder};
+    let mut bytes = Vec::new();
+    PngEncoder::new_with_quality(&mut bytes, CompressionType::Default, FilterType::Adaptive)
+        .write_image(rgba, width, height, ExtendedColorType::Rgba8)
+        .map_err(|e| Error::invalid("PNG encoding", one_line(e)))?;
+    Ok(bytes)
+}
+
 /// Writes an 8-bit RGBA PNG.
 ///
 /// `rgba` holds 4 bytes per pixel, row-major, row 0 at the top, already
@@ -53,24 +83,71 @@ fn pixel_count(what: &str, width: u32, height: u32) -> Result<usize> {
 /// Errors: empty size, `rgba.len() != 4·width·height`, encoder or I/O
 /// failure (the message names `path`).
 pub fn write_png_rgba8(path: &Path, rgba: &[u8], width: u32, height: u32) -> Result<()> {
-    let pixels = pixel_count("PNG image size", width, height)?;
-    if Some(rgba.len()) != pixels.checked_mul(4) {
+    let bytes = encode_png_rgba8(rgba, width, height)?;
+    write_bytes_atomically(path, &bytes)
+}
+
+/// The JPEG quality of [`encode_jpeg_rgba8`] (1–100; 90 keeps terrain
+/// texture detail with files about a fifth of the PNG's size).
+pub const JPEG_QUALITY: u8 = 90;
+
+/// Encodes 8-bit RGBA pixels (as for [`write_png_rgba8`]) as a baseline
+/// JPEG of quality [`JPEG_QUALITY`]; JPEG has no alpha, so alpha is dropped.
+pub fn encode_jpeg_rgba8(rgba: &[u8], width: u32, height: u32) -> Result<Vec<u8>> {
+    check_rgba8("JPEG", rgba, width, height)?;
+    if width > u32::from(u16::MAX) || height > u32::from(u16::MAX) {
         return Err(Error::invalid(
-            "PNG pixel data",
-            format!(
-                "{} bytes for a {width}×{height} RGBA image (expected {})",
-                rgba.len(),
-                pixels.saturating_mul(4)
-            ),
+            "JPEG image size",
+            format!("{width}×{height} exceeds the format's 65535 pixels per side; use .png"),
         ));
     }
-    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    let rgb: Vec<u8> = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+    use image::codecs::jpeg::JpegEncoder;
     use image::{ExtendedColorType, ImageEncoder};
     let mut bytes = Vec::new();
-    PngEncoder::new_with_quality(&mut bytes, CompressionType::Default, FilterType::Adaptive)
-        .write_image(rgba, width, height, ExtendedColorType::Rgba8)
-        .map_err(|e| Error::output(path, format!("PNG encoding failed: {}", one_line(e))))?;
-    write_bytes_atomically(path, &bytes)
+    JpegEncoder::new_with_quality(&mut bytes, JPEG_QUALITY)
+        .write_image(&rgb, width, height, ExtendedColorType::Rgb8)
+        .map_err(|e| Error::invalid("JPEG encoding", one_line(e)))?;
+    Ok(bytes)
+}
+
+/// Image formats of 8-bit outputs, chosen by file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// `.png`: lossless, with alpha.
+    Png,
+    /// `.jpg` or `.jpeg`: quality [`JPEG_QUALITY`], no alpha.
+    Jpeg,
+}
+
+impl ImageFormat {
+    /// The format of `path`'s extension (case-insensitive): `.png`, `.jpg`
+    /// or `.jpeg`. Errors name the extension: "unsupported extension .bmp;
+    /// use .png or .jpg".
+    pub fn from_path(path: &Path) -> std::result::Result<ImageFormat, String> {
+        let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match ext.as_deref() {
+            Some("png") => Ok(ImageFormat::Png),
+            Some("jpg" | "jpeg") => Ok(ImageFormat::Jpeg),
+            Some(other) => Err(format!("unsupported extension .{other}; use .png or .jpg")),
+            None => Err("no file extension; use .png or .jpg".into()),
+        }
+    }
+
+    /// Encodes 8-bit RGBA pixels (as for [`write_png_rgba8`]) in this format.
+    pub fn encode_rgba8(self, rgba: &[u8], width: u32, height: u32) -> Result<Vec<u8>> {
+        match self {
+            ImageFormat::Png => encode_png_rgba8(rgba, width, height),
+            ImageFormat::Jpeg => encode_jpeg_rgba8(rgba, width, height),
+        }
+    }
+}
+
+/// Writes 8-bit RGBA pixels as PNG or JPEG by `path`'s extension (see
+/// [`ImageFormat::from_path`]), atomically.
+pub fn write_image_by_extension(path: &Path, rgba: &[u8], width: u32, height: u32) -> Result<()> {
+    let format = ImageFormat::from_path(path).map_err(|m| Error::output(path, m))?;
+    write_bytes_atomically(path, &format.encode_rgba8(rgba, width, height)?)
 }
 
 /// Writes a 32-bit float OpenEXR file with channels R, G, B, A, Z and any
@@ -104,10 +181,20 @@ pub fn write_exr(
 /// (`UINT` channels: ids stay exact).
 pub fn write_exr_samples(
     path: &Path,
+    size: (u32, u32),
+    rgba_depth: (&[f32], &[f32]),
+    extra: &[(&str, ExrSamples)],
+) -> Result<()> {
+    let bytes = encode_exr_samples(size, rgba_depth, extra)?;
+    write_bytes_atomically(path, &bytes)
+}
+
+/// Encodes the OpenEXR file of [`write_exr_samples`] in memory.
+pub fn encode_exr_samples(
     (width, height): (u32, u32),
     (rgba, depth): (&[f32], &[f32]),
     extra: &[(&str, ExrSamples)],
-) -> Result<()> {
+) -> Result<Vec<u8>> {
     use exr::prelude::{
         AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image, Layer, LayerAttributes, LineOrder,
         SmallVec, WritableImage,
@@ -169,16 +256,12 @@ pub fn write_exr_samples(
     );
     let image = Image::from_layer(layer);
 
-    write_atomically(path, |tmp| {
-        let file = std::fs::File::create(tmp)
-            .map_err(|e| Error::output(path, format!("creating the temporary file failed: {}", one_line(e))))?;
-        let mut writer = BufWriter::new(file);
-        image
-            .write()
-            .to_buffered(&mut writer)
-            .map_err(|e| Error::output(path, format!("EXR encoding failed: {}", one_line(e))))?;
-        writer.flush().map_err(|e| Error::output(path, one_line(e)))
-    })
+    let mut bytes = Cursor::new(Vec::new());
+    image
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(|e| Error::invalid("EXR encoding", one_line(e)))?;
+    Ok(bytes.into_inner())
 }
 
 /// Channels of an EXR image as `(width, height, [(name, samples)])`, samples
@@ -272,5 +355,21 @@ mod tests {
         assert!(write_exr(&p, 0, 2, &[], &[], &[]).is_err());
         assert!(write_png_rgba8(&p, &[0; 7], 1, 2).is_err());
         assert!(!p.exists());
+    }
+
+    #[test]
+    fn formats_by_extension() {
+        let f = |s: &str| ImageFormat::from_path(Path::new(s));
+        assert_eq!(f("a.png"), Ok(ImageFormat::Png));
+        assert_eq!(f("a.JPG"), Ok(ImageFormat::Jpeg));
+        assert_eq!(f("a.jpeg"), Ok(ImageFormat::Jpeg));
+        assert_eq!(f("a.bmp"), Err("unsupported extension .bmp; use .png or .jpg".into()));
+        assert!(f("a").unwrap_err().contains("no file extension"));
+        let rgba: Vec<u8> = (0..4 * 16 * 8).map(|i| (i % 251) as u8).collect();
+        let jpeg = ImageFormat::Jpeg.encode_rgba8(&rgba, 16, 8).unwrap();
+        assert_eq!(&jpeg[..3], &[0xFF, 0xD8, 0xFF], "JPEG start-of-image marker");
+        let png = ImageFormat::Png.encode_rgba8(&rgba, 16, 8).unwrap();
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+        assert!(encode_jpeg_rgba8(&rgba[1..], 16, 8).is_err());
     }
 }

@@ -219,21 +219,24 @@ impl CameraPath {
     }
 
     /// `frames` cameras evenly spaced over the whole path, both ends
-    /// included; one frame gives just the start, zero none.
+    /// included; one frame gives just the start, zero none. Allocates all of
+    /// them: for long paths use [`CameraPath::sample_at`].
     pub fn sample(&self, frames: u32, base: &Camera) -> Vec<Camera> {
+        (0..frames).map(|i| self.sample_at(i, frames, base)).collect()
+    }
+
+    /// Camera `i` of [`CameraPath::sample`]`(frames, base)`, computed alone
+    /// (a path of any length in constant memory).
+    pub fn sample_at(&self, i: u32, frames: u32, base: &Camera) -> Camera {
         let (start, duration) = (self.start_time(), self.duration());
-        (0..frames)
-            .map(|i| {
-                let t = if i + 1 == frames && frames > 1 {
-                    start + duration
-                } else if frames > 1 {
-                    start + duration * f64::from(i) / f64::from(frames - 1)
-                } else {
-                    start
-                };
-                self.camera_at(t, base)
-            })
-            .collect()
+        let t = if i + 1 == frames && frames > 1 {
+            start + duration
+        } else if frames > 1 {
+            start + duration * f64::from(i) / f64::from(frames - 1)
+        } else {
+            start
+        };
+        self.camera_at(t, base)
     }
 }
 

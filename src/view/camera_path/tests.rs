@@ -244,6 +244,9 @@ fn sample_counts_and_valid_cameras() {
         for c in &many {
             c.validate().unwrap();
         }
+        // Any frame of the longest path, without allocating the path.
+        let end = path.camera_at(path.start_time() + path.duration(), &base());
+        assert_eq!(path.sample_at(u32::MAX - 1, u32::MAX, &base()), end);
     }
 }
 
