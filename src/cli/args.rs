@@ -379,10 +379,10 @@ pub struct RenderArgs {
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
-    /// Frames to time (after warm-up).
+    /// Frames to time (after warm-up), 1–100000.
     #[arg(long, default_value_t = 60, value_name = "COUNT", value_parser = clap::value_parser!(u32).range(1..), help_heading = "Output")]
     pub frames: u32,
-    /// Frames rendered first and not timed.
+    /// Frames rendered first and not timed, at most 100000.
     #[arg(long, default_value_t = 5, value_name = "COUNT", help_heading = "Output", value_parser = clap::value_parser!(u32).range(0..))]
     pub warmup: u32,
     /// The summary (per-pass medians, frame times) as JSON.
@@ -406,7 +406,7 @@ pub struct FlyArgs {
     /// default orbit: one turn around the terrain's centre).
     #[arg(long, value_parser = parse_orbit, allow_hyphen_values = true, value_name = "CX,CY,CZ,RADIUS,HEIGHT[,TURNS]", help_heading = "Camera")]
     pub orbit: Option<Orbit>,
-    /// Frames over the whole path.
+    /// Frames over the whole path, 1–100000.
     #[arg(long, default_value_t = 60, value_name = "COUNT", value_parser = clap::value_parser!(u32).range(1..), help_heading = "Output")]
     pub frames: u32,
     /// Directory for frame_00000.png…; must not exist or be empty (without it, frames are only timed).
