@@ -51,6 +51,24 @@ pub enum Error {
     Graph(String),
 }
 
+/// `text` with line breaks and other control characters escaped (`\n`), so
+/// that a message quoting user input (a rig's view name, a file's value)
+/// stays on one line.
+fn single_line(text: String) -> String {
+    if !text.chars().any(char::is_control) {
+        return text;
+    }
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
 /// `Result` with [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
@@ -59,7 +77,7 @@ impl Error {
     pub fn input(path: impl Into<PathBuf>, message: impl std::fmt::Display) -> Self {
         Error::Input {
             path: path.into(),
-            message: message.to_string(),
+            message: single_line(message.to_string()),
         }
     }
 
@@ -67,7 +85,7 @@ impl Error {
     pub fn output(path: impl Into<PathBuf>, message: impl std::fmt::Display) -> Self {
         Error::Output {
             path: path.into(),
-            message: message.to_string(),
+            message: single_line(message.to_string()),
         }
     }
 
@@ -76,7 +94,7 @@ impl Error {
     pub fn invalid(parameter: impl Into<String>, message: impl std::fmt::Display) -> Self {
         Error::InvalidArgument {
             parameter: parameter.into(),
-            message: message.to_string(),
+            message: single_line(message.to_string()),
         }
     }
 
@@ -103,5 +121,17 @@ mod tests {
             "invalid camera.fov_y_deg: 0 degrees; must be in (0, 180)"
         );
         assert_eq!(Error::input("a.png", "truncated").parameter(), None);
+    }
+
+    /// Quoted user input cannot break a message onto two lines (the fuzz
+    /// suite found a rig view named "fr\nt").
+    #[test]
+    fn messages_stay_on_one_line() {
+        let e = Error::invalid("view.name", "'fr\nt'; use letters");
+        assert_eq!(e.to_string(), "invalid view.name: 'fr\\nt'; use letters");
+        assert!(!Error::input("a.toml", "x\r\ny\u{1b}")
+            .to_string()
+            .contains(['\n', '\r', '\u{1b}']));
+        assert!(!Error::output("a.png", "two\nlines").to_string().contains('\n'));
     }
 }

@@ -1,0 +1,9 @@
+//! AFL++ target: `cargo afl fuzz -i ../tests/data/fuzz/geotiff -o out/geotiff_heightmap target/debug/geotiff_heightmap`.
+
+fn main() {
+    afl::fuzz!(|data: &[u8]| {
+        alpenglow_fuzz::run(data, "tif", |p| {
+            alpenglow::io::heightmap::load_heightmap(p, &alpenglow::io::heightmap::HeightmapOptions::default())
+        });
+    });
+}
