@@ -237,7 +237,8 @@ pub struct TerrainArgs {
     /// Most texture tiles generated per frame (atlas texturing), 1..=255;
     /// the texel budget is this many 128² tiles. Still renders keep
     /// rendering until every tile is ready.
-    #[arg(long = "tile-budget", default_value_t = 32)]
+    #[arg(long = "tile-budget", default_value_t = 32,
+          value_parser = clap::value_parser!(u32).range(1..=i64::from(alpenglow::texturing::streaming::MAX_TILE_BUDGET)))]
     pub tile_budget: u32,
     /// Spread tile generation by GPU time as well (a quarter of the rest of
     /// the frame, measured): steady frame times for moving cameras. off:
