@@ -241,7 +241,9 @@ fn ground_view_640x360_settles_in_the_default_atlas() {
         "640×360 ground view: {tiles} tiles, settled after {} frames",
         stats.len()
     );
-    assert!(tiles > 400, "the view must need many tiles: {tiles}");
+    // 336 since nodes narrower than a 74 m sample cell no longer split for
+    // the whole cell's height range (issue 15; more than 400 before).
+    assert!(tiles > 300, "the view must need many tiles: {tiles}");
     assert_eq!(last.coarsened, 0, "the default atlas holds the view");
     assert!(
         stats.len() <= 2 * tiles.div_ceil(streaming.budget.tiles),

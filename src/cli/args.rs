@@ -311,7 +311,13 @@ pub struct TerrainArgs {
     /// Most texture tiles generated per frame (atlas texturing), 1..=255;
     /// the texel budget is this many 128² tiles. Still renders keep
     /// rendering until every tile is ready.
-    #[arg(long = "tile-budget", default_value_t = 32, value_name = "TILES", help_heading = "Texturing", value_parser = clap::value_parser!(u32).range(0..))]
+    #[arg(
+        long = "tile-budget",
+        default_value_t = 32,
+        value_name = "TILES",
+        help_heading = "Texturing",
+        value_parser = clap::value_parser!(u32).range(1..=i64::from(alpenglow::texturing::streaming::MAX_TILE_BUDGET))
+    )]
     pub tile_budget: u32,
     /// Tile counts only, no pacing of tile generation by measured GPU time
     /// (by default a quarter of the rest of the frame, for steady frame

@@ -20,14 +20,14 @@ pub fn clap_error_line(e: &clap::Error) -> String {
             first = format!("{first} {next}");
         }
     }
-    for (range, words) in [
-        (" is not in 0..", "must be 0 or more"),
-        (" is not in 1..", "must be 1 or more"),
-        (" is not in 2..", "must be 2 or more"),
-    ] {
-        if let Some(at) = first.find(range) {
-            if let Some(colon) = first[..at].rfind("': ") {
-                first = format!("{}': {words}", &first[..colon]);
+    // "-3 is not in 0..=4294967295": a lower bound only, said in words.
+    if let Some(at) = first.find(" is not in ") {
+        let range = &first[at + " is not in ".len()..];
+        let bounds = range.split_once("..=").or_else(|| range.split_once(".."));
+        if let Some((low, high)) = bounds {
+            let open_ended = high.trim().parse::<u64>().is_ok_and(|h| h >= u64::from(u32::MAX));
+            if let (true, Some(colon)) = (open_ended, first[..at].rfind("': ")) {
+                first = format!("{}': must be {low} or more", &first[..colon]);
             }
         }
     }

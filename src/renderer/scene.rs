@@ -147,7 +147,10 @@ impl Scene {
             up: DVec3::Z,
             fov_y_deg: 50.0,
             near: (size * 1e-4).max(0.1),
-            far: size * 10.0,
+            // Ten times the larger of the terrain's size and its height
+            // range: the eye stands above the highest point, and a small
+            // steep field would otherwise lie beyond the far plane.
+            far: size.max(hi - lo) * 10.0,
         }
     }
 }

@@ -17,8 +17,18 @@ use crate::texturing::quadtree::{NodeBounds, NodeId, MAX_PYRAMID_DEPTH};
 /// it refines most visible nodes down to `max_depth`. Callers whose terrain
 /// mesh knows its own per-node error should pass that instead, or set the
 /// error to 0 to refine by texel density alone.
+///
+/// A node narrower than a sample cell still covers a whole cell's samples,
+/// so its range would not shrink as it splits, and on a field of a few
+/// samples every visible node would refine down to `max_depth` (millions of
+/// nodes). Within a cell the surface's slope along an axis is at most the
+/// cell's range over the cell's size, so such a node's error is the range
+/// scaled by its width in cells, `(w_x + w_y)`, where that sum is below 1
+/// ([`HeightBounds::bounds`]).
 #[derive(Clone, Debug)]
 pub struct HeightBounds {
+    /// Width of a level-0 node in sample cells: `(columns − 1, rows − 1)`.
+    cells: (f64, f64),
     columns: u32,
     rows: u32,
     heights: Vec<f32>,
@@ -38,6 +48,7 @@ impl HeightBounds {
             ));
         }
         let mut bounds = HeightBounds {
+            cells: (f64::from(field.columns - 1), f64::from(field.rows - 1)),
             columns: field.columns,
             rows: field.rows,
             heights: field.heights.clone(),
@@ -75,6 +86,9 @@ impl HeightBounds {
     }
 
     /// The bounds of `node`; nodes outside the tree are clamped to its edge.
+    /// The geometric error is `(z_max − z_min)/2`, times `w_x + w_y` (the
+    /// node's width in sample cells along each axis) where that is below 1
+    /// (type documentation).
     pub fn bounds(&self, node: NodeId) -> NodeBounds {
         let side = 1u64.checked_shl(node.level).unwrap_or(0);
         let pyramid = self.pyramid.get(node.level as usize);
@@ -83,10 +97,12 @@ impl HeightBounds {
             Some(level) if inside => level[(u64::from(node.y) * side + u64::from(node.x)) as usize],
             _ => self.sample_range(node),
         };
+        let scale = (-f64::from(node.level)).exp2();
+        let width_in_cells = (self.cells.0 + self.cells.1) * scale;
         NodeBounds {
             z_min,
             z_max,
-            geometric_error: (z_max - z_min) / 2.0,
+            geometric_error: (z_max - z_min) / 2.0 * width_in_cells.min(1.0) as f32,
         }
     }
 
@@ -153,7 +169,11 @@ mod tests {
                     }
                     let got = hb.bounds(node);
                     assert_eq!((got.z_min, got.z_max), want, "{node:?}");
-                    assert_eq!(got.geometric_error, (want.1 - want.0) / 2.0);
+                    // Nodes narrower than a cell (level 5: 12/32 + 8/32
+                    // cells across) scale the error by their width.
+                    let width = (12.0 + 8.0) / f64::from(1u32 << level);
+                    let error = (want.1 - want.0) / 2.0 * width.min(1.0) as f32;
+                    assert_eq!(got.geometric_error, error, "{node:?}");
                 }
             }
         }
@@ -162,5 +182,24 @@ mod tests {
             ..field
         };
         assert!(HeightBounds::new(&bad, 4).is_err());
+    }
+
+    /// A field of 2×2 samples: every node covers all four, yet the error
+    /// halves with every level below the cell, so a steep little field does
+    /// not refine every visible node down to the deepest level.
+    #[test]
+    fn error_shrinks_below_one_sample_cell() {
+        let field = HeightField::from_fn(2, 2, DVec2::splat(100.0), |c, r| (c * 13 + r * 7) as f32);
+        let hb = HeightBounds::new(&field, 12).unwrap();
+        let mut previous = f32::INFINITY;
+        for level in 0..=12 {
+            let b = hb.bounds(NodeId { level, x: 0, y: 0 });
+            assert_eq!((b.z_min, b.z_max), (0.0, 20.0), "level {level}");
+            let want = 10.0 * (2.0 / f64::from(1u32 << level)).min(1.0) as f32;
+            assert_eq!(b.geometric_error, want, "level {level}");
+            assert!(b.geometric_error <= previous);
+            previous = b.geometric_error;
+        }
+        assert!(previous < 0.01, "{previous} m at level 12");
     }
 }

@@ -23,8 +23,14 @@
 
 use std::collections::BTreeMap;
 
+use glam::DVec2;
+
+use crate::error::Result;
 use crate::texturing::atlas::AtlasSettings;
-use crate::texturing::quadtree::{selection_order, NeededTile, NodeId};
+use crate::texturing::generation::PAGE_TABLE_WORDS;
+use crate::texturing::page_table::PageTable;
+use crate::texturing::quadtree::{select_tiles_for_views, selection_order, HeightBounds, NeededTile, NodeId, View};
+use crate::texturing::streaming::TextureStreaming;
 
 /// What fitting did to a selection.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -89,6 +95,30 @@ pub fn fit_to_atlas(needed: &mut Vec<NeededTile>, atlas: &AtlasSettings, max_til
     }
     needed.sort_by(selection_order);
     done
+}
+
+/// What the texture atlas draws from for `views` of a field of `extent`
+/// with `bounds` (on the CPU, each frame before recording): the quadtree's
+/// selection ([`select_tiles_for_views`]) fitted to `streaming`'s atlas and
+/// to the page table's [`PAGE_TABLE_WORDS`] (at most a third of them in
+/// tiles, halved until the table fits).
+pub fn select_to_fit(
+    extent: DVec2,
+    views: &[View],
+    streaming: &TextureStreaming,
+    bounds: &HeightBounds,
+) -> Result<(Vec<NeededTile>, Coarsening)> {
+    let bounds = |n| bounds.bounds(n);
+    let mut needed = select_tiles_for_views(extent, views, &streaming.quadtree, &bounds)?;
+    // Entries take two words, inner nodes one: start at a third.
+    let mut max_tiles = PAGE_TABLE_WORDS / 3;
+    let mut done = fit_to_atlas(&mut needed, &streaming.atlas, max_tiles);
+    while PageTable::words_for(needed.iter().map(|t| t.node)) > PAGE_TABLE_WORDS && max_tiles > 1 {
+        max_tiles /= 2;
+        let more = fit_to_atlas(&mut needed, &streaming.atlas, max_tiles);
+        (done.halved, done.merged) = (done.halved + more.halved, done.merged + more.merged);
+    }
+    Ok((needed, done))
 }
 
 /// Replaces the leaves of the deepest level by their parents; false when

@@ -35,13 +35,13 @@ use crate::profile::FrameProfile;
 #[cfg(doc)]
 use crate::texturing::atlas::GenerationBudget;
 use crate::texturing::atlas::{TileCache, TilePlan};
-use crate::texturing::fit::{fit_to_atlas, Coarsening};
+use crate::texturing::fit::{select_to_fit, Coarsening};
 use crate::texturing::input_maps::InputMaps;
 use crate::texturing::layers::LayerTree;
 use crate::texturing::pacing::{GenerationPacer, GpuTimeBudget};
 use crate::texturing::page_table::PageTable;
 use crate::texturing::passes::{add_atlas_readback, base_push, GenerationPasses};
-use crate::texturing::quadtree::{select_tiles_for_views, HeightBounds, NeededTile, NodeId, View};
+use crate::texturing::quadtree::{HeightBounds, NeededTile, NodeId, View};
 pub use crate::texturing::stats::TextureFrameStats;
 pub use crate::texturing::streaming::{TextureStreaming, MAX_ATLAS_TEXTURES, MAX_VIEWS};
 use crate::view::{frustum_planes, Frame, FrameContext, Technique};
@@ -332,17 +332,7 @@ impl TextureAtlas {
 
     /// The tiles `views` need, coarsened to fit the atlas and the page table.
     fn select(&self, views: &[View]) -> Result<(Vec<NeededTile>, Coarsening)> {
-        let bounds = |n| self.bounds.bounds(n);
-        let mut needed = select_tiles_for_views(self.extent, views, &self.streaming.quadtree, &bounds)?;
-        // Entries take two words, inner nodes one: start at a third.
-        let mut max_tiles = PAGE_TABLE_WORDS / 3;
-        let mut done = fit_to_atlas(&mut needed, &self.streaming.atlas, max_tiles);
-        while PageTable::words_for(needed.iter().map(|t| t.node)) > PAGE_TABLE_WORDS && max_tiles > 1 {
-            max_tiles /= 2;
-            let more = fit_to_atlas(&mut needed, &self.streaming.atlas, max_tiles);
-            (done.halved, done.merged) = (done.halved + more.halved, done.merged + more.merged);
-        }
-        Ok((needed, done))
+        select_to_fit(self.extent, views, &self.streaming, &self.bounds)
     }
 
     /// Selects the tiles `views` need, plans the frame within the budget,

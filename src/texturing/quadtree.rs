@@ -251,9 +251,12 @@ struct Measure {
 /// it, and a leaf gets the largest size any of those views needs and the
 /// smallest distance. So the leaves partition the union of the visible
 /// parts exactly, the finest need wins where views overlap, and no node is
-/// selected twice. Errors on an empty `views`, invalid settings, a
-/// non-finite or non-positive extent, a bad view, or bounds that are not
-/// finite with `z_min ≤ z_max` and `geometric_error ≥ 0`.
+/// selected twice. Nodes split neediest first (the most texels or error
+/// pixels over the thresholds); once a split would exceed [`MAX_SELECTED`]
+/// leaves the rest stay leaves, so a selection's work is bounded whatever
+/// the view and the terrain. Errors on an empty `views`, invalid
+/// settings, a non-finite or non-positive extent, a bad view, or bounds
+/// that are not finite with `z_min ≤ z_max` and `geometric_error ≥ 0`.
 pub fn select_tiles_for_views(
     extent: DVec2,
     views: &[View],
@@ -271,13 +274,89 @@ pub fn select_tiles_for_views(
         return Err(Error::invalid("texture view", "no view to select tiles for"));
     }
     views.iter().try_for_each(check_view)?;
-    let upper = settings.upper_tile();
-    let border2 = 2.0 * f64::from(settings.border);
+    let selector = Selector {
+        extent,
+        views,
+        settings,
+        bounds,
+    };
     let mut leaves = Vec::new();
-    let mut stack = vec![NodeId::ROOT];
-    let mut seen: Vec<Measure> = Vec::with_capacity(views.len());
-    while let Some(node) = stack.pop() {
-        let b = bounds(node);
+    // Nodes to split, the neediest first.
+    let mut split = std::collections::BinaryHeap::new();
+    let visit = |node, leaves: &mut Vec<NeededTile>, split: &mut std::collections::BinaryHeap<Candidate>| {
+        match selector.visit(node)? {
+            Some((tile, Some(need))) => split.push(Candidate { need, tile }),
+            Some((tile, None)) => leaves.push(tile),
+            None => {}
+        }
+        Ok::<(), Error>(())
+    };
+    visit(NodeId::ROOT, &mut leaves, &mut split)?;
+    while let Some(c) = split.pop() {
+        // A split replaces one node by (at most) four.
+        if leaves.len() + split.len() + 4 > MAX_SELECTED {
+            leaves.push(c.tile);
+            leaves.extend(split.drain().map(|c| c.tile));
+            break;
+        }
+        for child in c.tile.node.children() {
+            visit(child, &mut leaves, &mut split)?;
+        }
+    }
+    leaves.sort_by(selection_order);
+    Ok(leaves)
+}
+
+/// A node a view would split, by how much it exceeds the split thresholds.
+struct Candidate {
+    need: f64,
+    tile: NeededTile,
+}
+
+impl PartialEq for Candidate {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other).is_eq()
+    }
+}
+
+impl Eq for Candidate {}
+
+impl PartialOrd for Candidate {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Candidate {
+    /// The larger need first, then the smaller node id.
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.need
+            .total_cmp(&other.need)
+            .then(other.tile.node.cmp(&self.tile.node))
+    }
+}
+
+/// Most leaves [`select_tiles_for_views`] returns: four times what the page
+/// table holds (`crate::texturing::generation::PAGE_TABLE_WORDS`, three
+/// words a tile), which [`crate::texturing::fit`] coarsens further.
+pub const MAX_SELECTED: usize = 1 << 16;
+
+/// One selection's inputs (rules 1–4 of the module documentation).
+struct Selector<'a> {
+    extent: DVec2,
+    views: &'a [View],
+    settings: &'a QuadtreeSettings,
+    bounds: &'a dyn Fn(NodeId) -> NodeBounds,
+}
+
+impl Selector<'_> {
+    /// `None` when every view culls `node`; else its tile as a leaf and,
+    /// when a view would split it, by how much the neediest view exceeds
+    /// the thresholds (the larger of its texels over the aim and its error
+    /// pixels over `pixel_error`).
+    fn visit(&self, node: NodeId) -> Result<Option<(NeededTile, Option<f64>)>> {
+        let (settings, border2) = (self.settings, 2.0 * f64::from(self.settings.border));
+        let b = (self.bounds)(node);
         let error_ok = b.geometric_error.is_finite() && b.geometric_error >= 0.0;
         if !(b.z_min.is_finite() && b.z_max.is_finite() && b.z_min <= b.z_max && error_ok) {
             return Err(Error::invalid(
@@ -285,11 +364,11 @@ pub fn select_tiles_for_views(
                 format!("{b:?} for node {node:?}"),
             ));
         }
-        let (lo, hi) = node.rect(extent);
+        let (lo, hi) = node.rect(self.extent);
         let box_min = lo.extend(f64::from(b.z_min));
         let box_max = hi.extend(f64::from(b.z_max));
-        seen.clear();
-        for view in views {
+        let mut seen: Vec<Measure> = Vec::with_capacity(self.views.len());
+        for view in self.views {
             let outside = |p: &DVec4| box_outside(p, box_min, box_max);
             if view.frustum.is_some_and(|planes| planes.iter().any(outside)) {
                 continue;
@@ -303,17 +382,19 @@ pub fn select_tiles_for_views(
             });
         }
         if seen.is_empty() {
-            continue;
+            return Ok(None);
         }
-        let coarse = seen.iter().any(|m| {
-            m.needed + border2 > f64::from(settings.aim_texels) || m.error_pixels > f64::from(settings.pixel_error)
-        });
-        if node.level < settings.max_depth && coarse {
-            stack.extend(node.children());
-            continue;
-        }
-        let at_max_depth = node.level == settings.max_depth;
-        let largest = if at_max_depth { settings.max_tile } else { upper };
+        let need = seen
+            .iter()
+            .map(|m| {
+                let texels = (m.needed + border2) / f64::from(settings.aim_texels);
+                texels.max(m.error_pixels / f64::from(settings.pixel_error))
+            })
+            .fold(0.0, f64::max);
+        let largest = match node.level == settings.max_depth {
+            true => settings.max_tile,
+            false => settings.upper_tile(),
+        };
         let fit = |w: f64| (w as u32).next_power_of_two().clamp(settings.min_tile, largest);
         let size_for = |m: &Measure| {
             let want = m.needed.ceil() + border2;
@@ -325,10 +406,10 @@ pub fn select_tiles_for_views(
         };
         let size = seen.iter().map(size_for).max().unwrap_or(settings.min_tile);
         let distance = seen.iter().map(|m| m.distance).fold(f64::INFINITY, f64::min);
-        leaves.push(NeededTile { node, size, distance });
+        let tile = NeededTile { node, size, distance };
+        let split = need > 1.0 && node.level < settings.max_depth;
+        Ok(Some((tile, split.then_some(need))))
     }
-    leaves.sort_by(selection_order);
-    Ok(leaves)
 }
 
 /// The order of selected tiles: coarse to fine, then nearest first, then
@@ -347,237 +428,5 @@ fn box_outside(plane: &DVec4, min: DVec3, max: DVec3) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
-    use std::collections::HashSet;
-
-    use super::*;
-
-    const EXTENT: DVec2 = DVec2::new(8000.0, 4000.0);
-
-    fn flat(_: NodeId) -> NodeBounds {
-        NodeBounds {
-            z_min: 0.0,
-            z_max: 100.0,
-            geometric_error: 0.0,
-        }
-    }
-
-    fn view(eye: DVec3) -> View {
-        View {
-            eye,
-            pixel_footprint: View::pixel_footprint_for(1.0, 1080),
-            frustum: None,
-        }
-    }
-
-    fn select(eye: DVec3) -> Vec<NeededTile> {
-        select_tiles(EXTENT, &view(eye), &QuadtreeSettings::default(), &flat).unwrap()
-    }
-
-    #[test]
-    fn leaves_partition_the_rectangle() {
-        let n = 1u32 << 10;
-        for eye in [
-            DVec3::new(100.0, 200.0, 50.0),
-            DVec3::new(7999.0, 3999.0, 10.0),
-            DVec3::new(4000.0, 2000.0, 3e3),
-        ] {
-            let tiles = select(eye);
-            let mut cover = vec![0u8; (n * n) as usize];
-            for t in &tiles {
-                let k = n >> t.node.level;
-                for y in t.node.y * k..(t.node.y + 1) * k {
-                    for x in t.node.x * k..(t.node.x + 1) * k {
-                        cover[(y * n + x) as usize] += 1;
-                    }
-                }
-            }
-            assert!(cover.iter().all(|&c| c == 1), "eye {eye}: {} tiles", tiles.len());
-            assert!(tiles.windows(2).all(|w| selection_order(&w[0], &w[1]).is_lt()));
-        }
-    }
-
-    #[test]
-    fn nearer_nodes_are_finer_and_sizes_in_bounds() {
-        let s = QuadtreeSettings::default();
-        let tiles = select(DVec3::new(100.0, 100.0, 20.0));
-        let near = tiles.iter().min_by(|a, b| a.distance.total_cmp(&b.distance)).unwrap();
-        let far = tiles.iter().max_by(|a, b| a.distance.total_cmp(&b.distance)).unwrap();
-        assert!(near.node.level > far.node.level);
-        assert!(near.node.rect(EXTENT).0.x < 1000.0 && near.node.level == s.max_depth);
-        for t in &tiles {
-            assert!(t.size.is_power_of_two() && (s.min_tile..=s.max_tile).contains(&t.size));
-            assert!(t.node.level == s.max_depth || t.size <= 256, "{t:?}");
-        }
-        // Texels per metre fall off with distance.
-        let density = |t: &NeededTile| f64::from(t.size - 2 * s.border) / (EXTENT.x / f64::from(1u32 << t.node.level));
-        assert!(density(near) > density(far));
-    }
-
-    #[test]
-    fn far_eye_gives_the_root_only() {
-        let tiles = select(DVec3::new(4000.0, 2000.0, 1e7));
-        assert_eq!(tiles.len(), 1);
-        assert_eq!((tiles[0].node, tiles[0].size), (NodeId::ROOT, 16));
-    }
-
-    #[test]
-    fn geometric_error_forces_splits() {
-        let rough = |n: NodeId| NodeBounds {
-            z_min: 0.0,
-            z_max: 100.0,
-            geometric_error: 500.0 / (1u32 << n.level) as f32,
-        };
-        let settings = QuadtreeSettings::default();
-        let v = view(DVec3::new(4000.0, 2000.0, 1e5));
-        assert_eq!(select_tiles(EXTENT, &v, &settings, &flat).unwrap().len(), 1);
-        let tiles = select_tiles(EXTENT, &v, &settings, &rough).unwrap();
-        assert_eq!(tiles.len(), 64, "splits to level 3 where the error is 0.6 px");
-    }
-
-    #[test]
-    fn frustum_drops_nodes_behind_the_camera() {
-        let eye = DVec3::new(4000.0, 2000.0, 50.0);
-        // Looking east: keep x ≥ eye.x (plus five planes that keep everything).
-        let keep = DVec4::new(0.0, 0.0, 0.0, 1.0);
-        let mut v = view(eye);
-        v.frustum = Some([DVec4::new(1.0, 0.0, 0.0, -eye.x), keep, keep, keep, keep, keep]);
-        let all = select(eye);
-        let culled = select_tiles(EXTENT, &v, &QuadtreeSettings::default(), &flat).unwrap();
-        assert!(!culled.is_empty() && culled.len() < all.len());
-        assert!(culled.iter().all(|t| t.node.rect(EXTENT).1.x >= eye.x));
-    }
-
-    /// Texel density (texels per metre) of the leaf over each cell of the
-    /// finest grid (`max_depth` 10), None where no leaf is; panics where
-    /// leaves overlap.
-    fn density_map(tiles: &[NeededTile]) -> Vec<Option<f64>> {
-        const GRID: u32 = 10;
-        let n = 1u32 << GRID;
-        let mut cover = vec![None; (n * n) as usize];
-        for t in tiles {
-            let k = n >> t.node.level;
-            let density = f64::from(t.size - 8) / (EXTENT.x / f64::from(1u32 << t.node.level));
-            for y in t.node.y * k..(t.node.y + 1) * k {
-                for x in t.node.x * k..(t.node.x + 1) * k {
-                    let cell = &mut cover[(y * n + x) as usize];
-                    assert!(cell.is_none(), "{t:?} overlaps another leaf");
-                    *cell = Some(density);
-                }
-            }
-        }
-        cover
-    }
-
-    #[test]
-    fn views_looking_apart_get_the_union_finest_first() {
-        let eye = DVec3::new(4000.0, 2000.0, 50.0);
-        let keep = DVec4::new(0.0, 0.0, 0.0, 1.0);
-        let facing = |sign: f64| View {
-            frustum: Some([DVec4::new(sign, 0.0, 0.0, -sign * eye.x), keep, keep, keep, keep, keep]),
-            ..view(eye)
-        };
-        // East looks from the eye, west from 500 m west of it: different needs.
-        let (east, west) = (
-            facing(1.0),
-            View {
-                eye: eye - DVec3::new(500.0, 0.0, 0.0),
-                ..facing(-1.0)
-            },
-        );
-        let s = QuadtreeSettings::default();
-        let one = |v: &View| select_tiles(EXTENT, v, &s, &flat).unwrap();
-        let (a, b) = (density_map(&one(&east)), density_map(&one(&west)));
-        let both = select_tiles_for_views(EXTENT, &[east, west], &s, &flat).unwrap();
-        let union = density_map(&both);
-        let keys: HashSet<NodeId> = both.iter().map(|t| t.node).collect();
-        assert_eq!(keys.len(), both.len(), "a node selected twice");
-        let (mut only_a, mut only_b) = (0, 0);
-        for ((u, a), b) in union.iter().zip(&a).zip(&b) {
-            assert_eq!(u.is_some(), a.is_some() || b.is_some(), "cover is not the union");
-            only_a += usize::from(a.is_some() && b.is_none());
-            only_b += usize::from(b.is_some() && a.is_none());
-        }
-        assert!(
-            only_a > 0 && only_b > 0,
-            "the views must each see something the other does not"
-        );
-        // Every leaf has the texels each view that sees it needs (rule 2),
-        // unless clamped to the largest size.
-        for t in &both {
-            let (lo, hi) = t.node.rect(EXTENT);
-            let (min, max) = (lo.extend(0.0), hi.extend(100.0));
-            for v in [&east, &west] {
-                if v.frustum.unwrap().iter().any(|p| box_outside(p, min, max)) {
-                    continue;
-                }
-                let distance = v.eye.clamp(min, max).distance(v.eye).max(MIN_DISTANCE);
-                let needed = (hi - lo).max_element() / (v.pixel_footprint * distance);
-                let inner = f64::from(t.size - 2 * s.border);
-                assert!(inner >= needed || t.size == s.max_tile, "{t:?}: {needed} texels needed");
-            }
-        }
-        assert!(both.len() > one(&east).len().max(one(&west).len()));
-    }
-
-    #[test]
-    fn overlapping_views_do_not_duplicate_tiles() {
-        let s = QuadtreeSettings::default();
-        let v = view(DVec3::new(1000.0, 1000.0, 300.0));
-        let single = select_tiles(EXTENT, &v, &s, &flat).unwrap();
-        let twice = select_tiles_for_views(EXTENT, &[v, v], &s, &flat).unwrap();
-        assert_eq!(single, twice);
-        // A view a little to the side shares most of the tiles.
-        let near = View {
-            eye: v.eye + DVec3::new(50.0, 0.0, 0.0),
-            ..v
-        };
-        let pair = select_tiles_for_views(EXTENT, &[v, near], &s, &flat).unwrap();
-        density_map(&pair);
-        assert!(pair.len() < single.len() * 3 / 2, "{} vs {}", pair.len(), single.len());
-        assert!(select_tiles_for_views(EXTENT, &[], &s, &flat).is_err());
-    }
-
-    #[test]
-    fn invalid_settings_and_inputs_are_errors() {
-        let d = QuadtreeSettings::default();
-        let bad = [
-            QuadtreeSettings { min_tile: 24, ..d },
-            QuadtreeSettings { min_tile: 1024, ..d },
-            QuadtreeSettings { border: 8, ..d },
-            QuadtreeSettings { max_depth: 16, ..d },
-            QuadtreeSettings { aim_texels: 4, ..d },
-            QuadtreeSettings {
-                pixel_error: f32::NAN,
-                ..d
-            },
-        ];
-        for s in bad {
-            assert!(s.validate().is_err(), "{s:?}");
-            assert!(select_tiles(EXTENT, &view(DVec3::ZERO), &s, &flat).is_err());
-        }
-        let v = View {
-            pixel_footprint: 0.0,
-            ..view(DVec3::ZERO)
-        };
-        assert!(select_tiles(EXTENT, &v, &d, &flat).is_err());
-        assert!(select_tiles(DVec2::new(0.0, 1.0), &view(DVec3::ZERO), &d, &flat).is_err());
-        let nan = |_: NodeId| NodeBounds {
-            z_min: f32::NAN,
-            z_max: 0.0,
-            geometric_error: 0.0,
-        };
-        assert!(select_tiles(EXTENT, &view(DVec3::ZERO), &d, &nan).is_err());
-    }
-
-    #[test]
-    fn node_ids_relate() {
-        let n = NodeId { level: 3, x: 5, y: 2 };
-        assert_eq!(n.parent(), Some(NodeId { level: 2, x: 2, y: 1 }));
-        assert_eq!(NodeId::ROOT.parent(), None);
-        assert!(n.children().iter().all(|c| c.parent() == Some(n) && n.contains(c)));
-        assert!(NodeId::ROOT.contains(&n) && n.contains(&n) && !n.contains(&NodeId::ROOT));
-        assert!(!NodeId { level: 2, x: 1, y: 1 }.contains(&n));
-        assert_eq!(n.rect(EXTENT), (DVec2::new(5000.0, 1000.0), DVec2::new(6000.0, 1500.0)));
-    }
-}
+#[path = "quadtree_tests.rs"]
+mod tests;

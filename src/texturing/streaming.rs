@@ -38,6 +38,10 @@ pub const SLOTS_PER_SIZE: [(u32, u64, u64); 5] = [
     (128, 96, 1150),
     (256, 10, 17700),
 ];
+/// The largest tile budget of [`TextureStreaming::for_views`]'s quadtree
+/// (aim 128²): [`TextureStreaming::max_tile_budget`], for argument parsers
+/// that check the range before anything starts.
+pub const MAX_TILE_BUDGET: u32 = (MAX_DISPATCH_TEXELS / (128 * 128)) as u32;
 /// Default share of the frame's other GPU time tile generation may add.
 pub const DEFAULT_FRAME_SHARE: f32 = 0.25;
 
@@ -312,6 +316,7 @@ mod tests {
         assert_eq!(tight.atlas_bytes(), min);
         let s = TextureStreaming::for_image(640, 360);
         assert_eq!(s.max_tile_budget(), 255);
+        assert_eq!(MAX_TILE_BUDGET, s.max_tile_budget());
         for tiles in [1, 2, 32, 128, 254, 255] {
             let b = s.with_tile_budget(tiles).unwrap();
             b.validate().unwrap();
