@@ -4,7 +4,8 @@
 //! [`vulkan`] (the only `unsafe` code) → [`graph`] (render graph: passes
 //! declare reads and writes; baking derives barriers) → [`view`] (cameras,
 //! views, the frame's shared targets and uploads) → the techniques
-//! ([`terrain`], [`texturing`], [`lighting`], [`points`], [`post`]) →
+//! ([`terrain`], [`synthesis`], [`texturing`], [`lighting`],
+//! [`points`], [`post`]) →
 //! [`renderer`] (composition: scenes, frames, outputs) → the CLI (binary
 //! only). [`io`], [`profile`], [`random`], [`shaders`] and [`error`] are
 //! leaves every layer may use.
@@ -31,6 +32,8 @@ pub mod random;
 pub mod renderer;
 #[forbid(unsafe_code)]
 pub mod shaders;
+#[forbid(unsafe_code)]
+pub mod synthesis;
 #[forbid(unsafe_code)]
 pub mod terrain;
 #[forbid(unsafe_code)]
