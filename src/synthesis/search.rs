@@ -7,11 +7,18 @@
 //! compute passes in `glsl/synthesis/`):
 //!
 //! ```text
-//! d(c)   = Σ_t w_t·[(h_t − h'_t)² + λ·((hx_t − hx'_t)² + (hy_t − hy'_t)²)] / Σ_t w_t
-//! best   = min_c d(c)
-//! accept = { c : d(c) ≤ (1 + ε)·best }
+//! s(c)   = Σ_t w_t·[(h_t − h'_t)² + λ·((hx_t − hx'_t)² + (hy_t − hy'_t)²)]
+//! d(c)   = s(c) / Σ_t w_t
+//! best   = min_c s(c)
+//! accept = { c : s(c) ≤ (1 + ε)·best }
 //! choice = the accepted c with the smallest (hash(seed, pixel, c), c)
 //! ```
+//!
+//! The decision compares the weighted sums s(c): Σ_t w_t is the same for
+//! every candidate of a query, so this is the text's rule on d, and it needs
+//! only additions and multiplications, which Vulkan rounds correctly, so a
+//! GPU that keeps the sum's order and contracts nothing (`precise`) agrees
+//! with the CPU bit for bit. The division gives the reported distances only.
 //!
 //! `t` runs over the window's taps row by row (dy outer, dx inner, from
 //! −(n−1)/2), `w_t = G·v` is the query's weight of tap `t` (0 where the
@@ -64,7 +71,7 @@ pub struct Query {
 pub struct Choice {
     /// Index into [`Exemplar::candidates`].
     pub candidate: u32,
-    /// d of the chosen candidate.
+    /// d of the chosen candidate (the normalised s).
     pub distance: f32,
     /// The smallest d over all candidates.
     pub best: f32,
@@ -144,14 +151,20 @@ pub fn check(exemplar: &Exemplar, config: &SearchConfig, queries: &[Query]) -> R
     Ok(())
 }
 
-/// d(c) of the module docs for the window centred at texel `centre`.
-pub fn distance(exemplar: &Exemplar, config: &SearchConfig, query: &Query, centre: u32) -> f32 {
+/// Σ_t w_t of a query (module docs).
+pub fn total_weight(query: &Query) -> f32 {
+    query.taps.iter().map(|t| t[3]).sum()
+}
+
+/// s(c) of the module docs for the window centred at texel `centre`: taps
+/// in order, each term `w·(dh² + λ·(dhx² + dhy²))` added to the running sum
+/// (the GPU keeps exactly this order and rounding).
+pub fn weighted_mismatch(exemplar: &Exemplar, config: &SearchConfig, query: &Query, centre: u32) -> f32 {
     let n = config.window as i64;
     let r = n / 2;
     let width = exemplar.width as i64;
     let (cx, cy) = (centre as i64 % width, centre as i64 / width);
     let mut sum = 0.0f32;
-    let mut weight = 0.0f32;
     for dy in -r..=r {
         for dx in -r..=r {
             let tap = query.taps[((dy + r) * n + dx + r) as usize];
@@ -163,23 +176,19 @@ pub fn distance(exemplar: &Exemplar, config: &SearchConfig, query: &Query, centr
             let dhx = tap[1] - texel[1];
             let dhy = tap[2] - texel[2];
             sum += tap[3] * (dh * dh + config.lambda * (dhx * dhx + dhy * dhy));
-            weight += tap[3];
         }
     }
-    if weight > 0.0 {
-        sum / weight
-    } else {
-        0.0
-    }
+    sum
 }
 
-/// The rule's choice for one query given all candidates' distances.
-pub fn choose_from(distances: &[f32], config: &SearchConfig, pixel: u32) -> Choice {
-    let best = distances.iter().copied().fold(f32::INFINITY, f32::min);
+/// The rule's choice for one query given every candidate's s(c) and the
+/// query's Σ w (module docs).
+pub fn choose_from(sums: &[f32], total_weight: f32, config: &SearchConfig, pixel: u32) -> Choice {
+    let best = sums.iter().copied().fold(f32::INFINITY, f32::min);
     let threshold = (1.0 + config.epsilon) * best;
     let mut pick: Option<(u32, u32)> = None;
-    for (c, &d) in distances.iter().enumerate() {
-        if d <= threshold {
+    for (c, &s) in sums.iter().enumerate() {
+        if s <= threshold {
             let key = (choice_hash(config.seed, pixel, c as u32), c as u32);
             if pick.map_or(true, |p| key < p) {
                 pick = Some(key);
@@ -187,10 +196,11 @@ pub fn choose_from(distances: &[f32], config: &SearchConfig, pixel: u32) -> Choi
         }
     }
     let candidate = pick.map_or(0, |(_, c)| c);
+    let normalise = |s: f32| if total_weight > 0.0 { s / total_weight } else { 0.0 };
     Choice {
         candidate,
-        distance: distances.get(candidate as usize).copied().unwrap_or(best),
-        best,
+        distance: normalise(sums.get(candidate as usize).copied().unwrap_or(best)),
+        best: normalise(best),
     }
 }
 
@@ -215,13 +225,13 @@ impl NeighbourhoodSearch for CpuSearch {
                 .chunks(chunk)
                 .map(|part| {
                     scope.spawn(move || {
-                        let mut distances = vec![0.0f32; exemplar.candidates.len()];
+                        let mut sums = vec![0.0f32; exemplar.candidates.len()];
                         part.iter()
                             .map(|q| {
-                                for (d, &c) in distances.iter_mut().zip(&exemplar.candidates) {
-                                    *d = distance(exemplar, config, q, c);
+                                for (s, &c) in sums.iter_mut().zip(&exemplar.candidates) {
+                                    *s = weighted_mismatch(exemplar, config, q, c);
                                 }
-                                choose_from(&distances, config, q.pixel)
+                                choose_from(&sums, total_weight(q), config, q.pixel)
                             })
                             .collect::<Vec<_>>()
                     })
