@@ -22,6 +22,7 @@
 //! * [`streaming`]: quadtree, atlas and budget settings, sized from the
 //!   frame's views;
 //! * [`stats`]: streaming statistics per frame and over a run;
+//! * [`from_image`]: surface layers estimated from a real image (§8.3);
 //! * [`reference`]: the CPU twin of the shaders' evaluation, for tests;
 //! * [`dominant`]: the dominant layer of a point (the class AOV).
 
@@ -30,6 +31,7 @@ pub mod atlas_settings;
 pub mod bounds;
 pub mod dominant;
 pub mod fit;
+pub mod from_image;
 pub mod generation;
 pub mod gpu_layout;
 pub mod input_maps;

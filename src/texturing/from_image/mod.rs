@@ -1,0 +1,229 @@
+//! Surface layers from a real image (dissertation §8.3; `ALGORITHMS.md` §5):
+//! a true-colour satellite or aerial image registered to the height field
+//! is classified into surface types, and for each type the conditions
+//! under which it appears (altitude, slope, the extra input maps) are
+//! estimated as sampled functions; a layer tree with one layer per type
+//! then reproduces the image's surface from the height field alone.
+//!
+//! The steps, in the text's order (each module documents its decisions):
+//!
+//! 1. [`shading`]: the image's baked-in light, modelled from the height
+//!    field for the image's sun (self and cast shadow) — §8.3 leaves
+//!    shading to the colour space; here it is modelled so that shadowed
+//!    walls are neither rock nor water;
+//! 2. [`classify`]: HSV + RGB per pixel, near-grey pixels into reserved
+//!    classes, dark pixels in modelled shadow set aside;
+//! 3. [`kmeans`]: the chromatic pixels clustered in the hue–saturation
+//!    histogram (k fixed or chosen by the silhouette);
+//! 4. [`distributions`]: per class and input quantity the histogram where
+//!    the class occurs, scaled to mean 0.5 and clamped (snow below a
+//!    minimum altitude is cloud and not counted);
+//! 5. [`tree`]: root = the most common class, one level-1 child per other
+//!    class with its mean colour (linear albedo), written as TOML.
+//!
+//! # Registration
+//! The image covers the height field's area pixel for pixel: its size is
+//! the field's `columns × rows` times an integer factor `s` (1, 2, …), and
+//! image pixel `(i, j)` lies inside field cell `(i / s, j / s)` (pixels are
+//! areas whose outer edges coincide with those of the field's cells, as in
+//! a GeoTIFF with `AREA_OR_POINT=Area`). Its centre is at field column
+//! `(i + ½)/s − ½` and image row `(j + ½)/s − ½`, clamped onto the field;
+//! image rows run north to south ([`RowOrder::NorthUp`], the usual raster
+//! order) or south to north like the field's rows.
+
+pub mod classify;
+pub mod distributions;
+pub mod kmeans;
+pub mod shading;
+pub mod tree;
+
+use glam::DVec2;
+use image::RgbImage;
+
+use crate::error::{Error, Result};
+use crate::io::heightmap::{HeightField, RowOrder};
+
+pub use classify::{ClassKind, PixelStatus};
+pub use tree::GeneratedLayers;
+
+/// Most classes k-means may find (`--classes`).
+pub const MAX_CLASSES: usize = 8;
+/// Classes tried by the automatic choice.
+pub const AUTO_CLASSES: std::ops::RangeInclusive<usize> = 2..=6;
+
+/// How many chromatic classes k-means finds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ClassCount {
+    /// Exactly k (1..=[`MAX_CLASSES`]).
+    Fixed(usize),
+    /// The k of [`AUTO_CLASSES`] with the largest silhouette ([`kmeans`]).
+    Auto,
+}
+
+/// Options of [`build_layers`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct FromImageOptions {
+    /// Chromatic classes (the reserved grey classes come on top).
+    pub classes: ClassCount,
+    /// Where the image's row 0 lies.
+    pub image_rows: RowOrder,
+    /// The image's sun: azimuth clockwise from north and elevation, degrees.
+    pub sun_azimuth_deg: f64,
+    pub sun_elevation_deg: f64,
+    /// Whether dark pixels in modelled shadow are set aside ([`classify`]);
+    /// off only to show what they would become.
+    pub shade_handling: bool,
+    /// Snow below this altitude (metres) is cloud; `None`: 60 % of the way
+    /// from the field's lowest to its highest sample.
+    pub snow_min_altitude: Option<f32>,
+    /// Samples of each distribution function (1..=64).
+    pub bins: usize,
+    /// Seed of k-means' initialisation.
+    pub seed: u64,
+    /// Weight of the shade-normalised value in the clustering space
+    /// ([`kmeans`]); 0: hue and saturation alone.
+    pub value_weight: f64,
+}
+
+impl Default for FromImageOptions {
+    fn default() -> Self {
+        FromImageOptions {
+            classes: ClassCount::Auto,
+            image_rows: RowOrder::NorthUp,
+            sun_azimuth_deg: 150.0,
+            sun_elevation_deg: 30.0,
+            shade_handling: true,
+            snow_min_altitude: None,
+            bins: 16,
+            seed: 1,
+            value_weight: 0.5,
+        }
+    }
+}
+
+impl FromImageOptions {
+    fn validate(&self) -> Result<()> {
+        if let ClassCount::Fixed(k) = self.classes {
+            if !(1..=MAX_CLASSES).contains(&k) {
+                return Err(Error::invalid(
+                    "classes",
+                    format!("{k} is out of range 1..={MAX_CLASSES}"),
+                ));
+            }
+        }
+        if !(self.sun_azimuth_deg.is_finite() && (-360.0..=360.0).contains(&self.sun_azimuth_deg)) {
+            return Err(Error::invalid("sun_azimuth_deg", "must be within ±360 degrees"));
+        }
+        if !(self.sun_elevation_deg > 0.0 && self.sun_elevation_deg <= 90.0) {
+            return Err(Error::invalid("sun_elevation_deg", "must be in (0, 90] degrees"));
+        }
+        if !(0.0..=4.0).contains(&self.value_weight) {
+            return Err(Error::invalid(
+                "value_weight",
+                format!("{} is out of range 0..=4", self.value_weight),
+            ));
+        }
+        if self.snow_min_altitude.is_some_and(|a| !a.is_finite()) {
+            return Err(Error::invalid("snow_min_altitude", "must be finite"));
+        }
+        if !(1..=distributions::MAX_SAMPLES).contains(&self.bins) {
+            return Err(Error::invalid(
+                "bins",
+                format!("{} is out of range 1..={}", self.bins, distributions::MAX_SAMPLES),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Where the image's pixels lie on the height field (module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Registration {
+    pub width: u32,
+    pub height: u32,
+    /// Image pixels per field cell along each axis.
+    pub factor: u32,
+    columns: u32,
+    rows: u32,
+    spacing: DVec2,
+    north_up: bool,
+}
+
+impl Registration {
+    /// The registration of a `width × height` image on `field`; an error
+    /// unless the image is an integer multiple of the field's grid.
+    pub fn new(width: u32, height: u32, field: &HeightField, rows: RowOrder) -> Result<Registration> {
+        let (c, r) = (field.columns, field.rows);
+        let factor = width.checked_div(c).unwrap_or(0);
+        if c < 2 || r < 2 || factor == 0 || width != factor * c || height != factor * r {
+            return Err(Error::invalid(
+                "image",
+                format!("{width}×{height} pixels is not an integer multiple of the height field's {c}×{r} grid"),
+            ));
+        }
+        Ok(Registration {
+            width,
+            height,
+            factor,
+            columns: c,
+            rows: r,
+            spacing: field.spacing,
+            north_up: rows == RowOrder::NorthUp,
+        })
+    }
+
+    /// World xy (metres) of the centre of pixel `(i, j)`.
+    pub fn world(&self, i: u32, j: u32) -> DVec2 {
+        let s = f64::from(self.factor);
+        let last = DVec2::new(f64::from(self.columns - 1), f64::from(self.rows - 1));
+        let u = ((f64::from(i) + 0.5) / s - 0.5).clamp(0.0, last.x);
+        let v = ((f64::from(j) + 0.5) / s - 0.5).clamp(0.0, last.y);
+        let row = if self.north_up { last.y - v } else { v };
+        DVec2::new(u, row) * self.spacing
+    }
+
+    /// Pixels of the image.
+    pub fn pixels(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// World xy of every pixel, row-major from image row 0.
+    pub fn world_positions(&self) -> Vec<DVec2> {
+        (0..self.height)
+            .flat_map(|j| (0..self.width).map(move |i| (i, j)))
+            .map(|(i, j)| self.world(i, j))
+            .collect()
+    }
+}
+
+/// Surface layers estimated from `image` over `field` (module docs): the
+/// layer tree as TOML with the classification behind it. `maps` are the
+/// extra input maps ([`crate::texturing::layers::INPUT_NAMES`] order),
+/// each spanning the field corner to corner; every present map becomes a
+/// constraint of every child layer.
+pub fn build_layers(
+    image: &RgbImage,
+    field: &HeightField,
+    maps: &[Option<HeightField>; 3],
+    options: &FromImageOptions,
+) -> Result<GeneratedLayers> {
+    options.validate()?;
+    field.validate(std::path::Path::new("height field"))?;
+    let registration = Registration::new(image.width(), image.height(), field, options.image_rows)?;
+    let positions = registration.world_positions();
+    let samples = distributions::Samples::at(field, maps, &positions)?;
+    let light = shading::relative_illumination(field, &positions, options.sun_azimuth_deg, options.sun_elevation_deg);
+    let (lo, hi) = field.min_max();
+    let snow_min = options.snow_min_altitude.unwrap_or(lo + 0.6 * (hi - lo));
+    let classification = classify::classify(image, &registration, &light, &samples.altitude, snow_min, options)?;
+    let functions = distributions::estimate(&classification, &samples, options.bins);
+    Ok(tree::build(
+        &classification,
+        &functions,
+        &tree::Provenance {
+            options: options.clone(),
+            snow_min_altitude: snow_min,
+            spacing: field.spacing,
+        },
+    ))
+}
