@@ -236,6 +236,41 @@ fn ties_are_broken_by_the_same_hash() {
 }
 
 #[test]
+fn degenerate_sums_are_handled_like_the_cpu() {
+    let (ctx, report) = validated_context();
+    let mut rng = SplitMix64(4);
+    let exemplar = Arc::new(random_exemplar(&mut rng, 14, 12, 3));
+    let query = |pixel: u32, tap: [f32; 4]| Query {
+        pixel,
+        taps: vec![tap; 9],
+    };
+    let queries = vec![
+        // Nothing known: every s is 0, every candidate accepted, d = 0.
+        query(1, [f32::NAN, 0.0, 0.0, 0.0]),
+        // A NaN weight: every s is NaN, nothing accepted, candidate 0.
+        query(2, [1.0, 0.0, 0.0, f32::NAN]),
+        // Overflow: every s is +∞, all accepted (∞ ≤ ∞).
+        query(3, [3e38, 0.0, 0.0, 1.0]),
+        // Negative heights, known.
+        query(4, [-5.0, 1.0, -1.0, 0.5]),
+    ];
+    for epsilon in [0.0, 1.0] {
+        let config = SearchConfig {
+            window: 3,
+            lambda: 0.5,
+            epsilon,
+            seed: 8,
+        };
+        let (gpu, cpu) = both(&ctx, &exemplar, config, GpuSearchLimits::default(), &queries);
+        assert_same(&gpu, &cpu, &format!("degenerate, ε {epsilon}"));
+        assert_eq!(cpu[1].candidate, 0, "nothing accepted");
+        assert_eq!(cpu[2].best, f32::INFINITY);
+    }
+    drop(ctx);
+    assert_validation_clean(&report);
+}
+
+#[test]
 fn passes_are_named_and_timed_and_an_empty_list_is_no_work() {
     let (ctx, report) = validated_context();
     let mut rng = SplitMix64(1);

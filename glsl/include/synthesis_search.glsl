@@ -62,12 +62,12 @@ float key_float(uint k) {
 // The key a per-query minimum starts from: +∞ (every s is below or equal).
 const uint SYNTHESIS_KEY_INFINITY = 0xff800000u;
 
-// Whether s(c) is within the tolerance: s ≤ (1 + ε)·best, the product
-// rounded once as on the CPU.
-bool synthesis_accepted(float s, uint results_handle, uint q) {
+// The tolerance of query q: a candidate is accepted when s(c) ≤ (1 + ε)·best,
+// the product rounded once as on the CPU.
+float synthesis_threshold(uint results_handle, uint q) {
     float best = key_float(g_synthesis_results[results_handle].r[q].x);
     precise float threshold = uintBitsToFloat(pc.rule.z) * best;
-    return s <= threshold;
+    return threshold;
 }
 
 #endif

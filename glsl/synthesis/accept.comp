@@ -14,10 +14,11 @@ void main() {
     uint candidates = pc.sizes.y;
     uint blocks = (candidates + 255u) / 256u;
     uint pixel = g_synthesis_uints[pc.inputs.w].u[q];
+    float threshold = synthesis_threshold(pc.outputs.y, q);
     uint hash = SYNTHESIS_NONE;
     for (uint block = gl_WorkGroupID.x; block < blocks; block += gl_NumWorkGroups.x) {
         uint c = block * 256u + gl_LocalInvocationID.x;
-        if (c < candidates && synthesis_accepted(g_synthesis_sums[pc.outputs.x].s[q * candidates + c], pc.outputs.y, q)) {
+        if (c < candidates && g_synthesis_sums[pc.outputs.x].s[q * candidates + c] <= threshold) {
             hash = min(hash, choice_hash(pc.rule.x, pixel, c));
         }
     }
