@@ -118,7 +118,7 @@ fn gpu_choices_equal_the_cpu_twins() {
             // Several batches: neither the batch nor the s buffer holds all queries.
             let limits = GpuSearchLimits {
                 distance_bytes: 9 * exemplar.candidates.len() as u64 * 4,
-                batch_queries: 4096,
+                ..GpuSearchLimits::default()
             };
             let (gpu, cpu) = both(&ctx, &exemplar, config, limits, &queries);
             let what = format!("window {window}, λ {lambda}, ε {epsilon}");
@@ -153,10 +153,17 @@ fn splitting_into_batches_changes_nothing() {
     let mut whole = GpuSearch::new(&ctx, exemplar.clone(), config).expect("GPU search");
     assert!(whole.batch_queries() as usize >= queries.len());
     let reference = whole.choose(&queries).expect("one batch");
-    for (distance_bytes, batch_queries, batch) in [(5 * row + 3, 4096, 5), (u64::MAX, 4, 4), (row, 4096, 1)] {
+    // The s buffer, the batch and the workgroups along the candidates limited.
+    for (distance_bytes, batch_queries, candidate_workgroups, batch) in [
+        (5 * row + 3, 4096, u32::MAX, 5),
+        (u64::MAX, 4, u32::MAX, 4),
+        (row, 4096, u32::MAX, 1),
+        (u64::MAX, 4096, 1, 4096),
+    ] {
         let limits = GpuSearchLimits {
             distance_bytes,
             batch_queries,
+            candidate_workgroups,
         };
         let mut split = GpuSearch::with_limits(&ctx, exemplar.clone(), config, limits).expect("GPU search");
         assert_eq!(split.batch_queries(), batch, "{limits:?}");
@@ -345,7 +352,7 @@ fn bad_input_is_a_one_line_error() {
     // Not even one query's s fits the batch.
     let tiny = GpuSearchLimits {
         distance_bytes: 8,
-        batch_queries: 16,
+        ..GpuSearchLimits::default()
     };
     one_line(
         error(GpuSearch::with_limits(&ctx, exemplar.clone(), config, tiny)),

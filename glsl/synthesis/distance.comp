@@ -6,6 +6,7 @@
 // query's taps pass through shared memory 256 at a time; each invocation
 // adds its terms tap by tap in the CPU twin's order, every operation
 // `precise` (no contraction), so s is bit for bit `weighted_mismatch`.
+#extension GL_EXT_control_flow_attributes : require
 #include "../include/synthesis_search.glsl"
 
 #define GROUP 64u
@@ -16,6 +17,8 @@
 layout(local_size_x = 64) in;
 
 shared vec4 s_taps[TAP_CHUNK];
+// Per tap of the chunk: its texel offset from the window centre.
+shared int s_offsets[TAP_CHUNK];
 shared uint s_best;
 
 void main() {
@@ -34,7 +37,7 @@ void main() {
         }
         int centre[PER_INVOCATION];
         float sum[PER_INVOCATION];
-        for (uint k = 0u; k < PER_INVOCATION; ++k) {
+        [[unroll]] for (uint k = 0u; k < PER_INVOCATION; ++k) {
             uint c = block * BLOCK + k * GROUP + lane;
             centre[k] = c < candidates ? int(g_synthesis_uints[pc.inputs.y].u[c]) : -1;
             sum[k] = 0.0;
@@ -44,6 +47,7 @@ void main() {
             barrier();
             for (uint t = lane; t < count; t += GROUP) {
                 s_taps[t] = g_synthesis_taps[pc.inputs.z].t[q * taps + first + t];
+                s_offsets[t] = (int((first + t) / n) - r) * width + int((first + t) % n) - r;
             }
             barrier();
             for (uint i = 0u; i < count; ++i) {
@@ -51,9 +55,8 @@ void main() {
                 if (tap.w == 0.0) {
                     continue;
                 }
-                uint t = first + i;
-                int offset = (int(t / n) - r) * width + int(t % n) - r;
-                for (uint k = 0u; k < PER_INVOCATION; ++k) {
+                int offset = s_offsets[i];
+                [[unroll]] for (uint k = 0u; k < PER_INVOCATION; ++k) {
                     if (centre[k] < 0) {
                         continue;
                     }
@@ -69,7 +72,7 @@ void main() {
             }
         }
         uint best = SYNTHESIS_KEY_INFINITY;
-        for (uint k = 0u; k < PER_INVOCATION; ++k) {
+        [[unroll]] for (uint k = 0u; k < PER_INVOCATION; ++k) {
             uint c = block * BLOCK + k * GROUP + lane;
             if (centre[k] >= 0) {
                 g_synthesis_sums[pc.outputs.x].s[q * candidates + c] = sum[k];

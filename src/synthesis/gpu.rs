@@ -49,15 +49,20 @@ pub struct GpuSearchLimits {
     pub distance_bytes: u64,
     /// The most queries per batch.
     pub batch_queries: u32,
+    /// The most workgroups a pass dispatches along the candidates (also
+    /// bounded by the device's limit); each workgroup loops over the blocks
+    /// of candidates beyond them.
+    pub candidate_workgroups: u32,
 }
 
 impl Default for GpuSearchLimits {
-    /// 64 MiB of s (16 M query–candidate pairs, plenty to fill a GPU) and
-    /// 4096 queries per batch.
+    /// 64 MiB of s (16 M query–candidate pairs, plenty to fill a GPU),
+    /// 4096 queries per batch, the device's workgroup count.
     fn default() -> Self {
         GpuSearchLimits {
             distance_bytes: 64 << 20,
             batch_queries: 4096,
+            candidate_workgroups: u32::MAX,
         }
     }
 }
@@ -223,7 +228,10 @@ impl GpuSearch {
             shape: [candidates, config.window, exemplar.width],
             rule: [config.seed, config.lambda.to_bits(), (1.0 + config.epsilon).to_bits()],
         };
-        for spec in pass_specs(ctx, &bindings, candidates) {
+        let workgroups = limits
+            .candidate_workgroups
+            .clamp(1, ctx.shared.limits.max_compute_work_group_count[0]);
+        for spec in pass_specs(&bindings, candidates, workgroups) {
             declare(ctx, &mut graph, &bindings, spec)?;
         }
         graph.read_back(bindings.readback);
@@ -383,8 +391,7 @@ fn plan_batch(ctx: &Context, exemplar: &Exemplar, config: &SearchConfig, limits:
 }
 
 /// The passes of the module docs, in order.
-fn pass_specs(ctx: &Context, b: &Bindings, candidates: u32) -> Vec<PassSpec> {
-    let max_x = ctx.shared.limits.max_compute_work_group_count[0];
+fn pass_specs(b: &Bindings, candidates: u32, max_x: u32) -> Vec<PassSpec> {
     let per_query = move |block: u32| candidates.div_ceil(block).min(max_x);
     let write = BufferAccess::StorageWrite(Stage::Compute);
     let read_write = BufferAccess::StorageReadWrite(Stage::Compute);
