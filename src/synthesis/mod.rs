@@ -4,6 +4,7 @@
 //! between terrains of different procedural models.
 //!
 //! [`search`] is the neighbourhood search, the step that dominates the cost:
-//! a CPU twin and GPU compute passes implement the same rule.
+//! a CPU twin and GPU compute passes ([`gpu`]) implement the same rule.
 
+pub mod gpu;
 pub mod search;
