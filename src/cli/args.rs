@@ -40,6 +40,9 @@ pub enum Command {
     Spt(SptCommand),
     /// Print the Vulkan device, driver and the features in use.
     Info(DeviceArgs),
+    /// Surface-layer trees: `layers from-image` (§8.3).
+    #[command(subcommand)]
+    Layers(super::layers::LayersCommand),
 }
 
 #[derive(Args, Debug, Clone)]
@@ -490,7 +493,7 @@ fn parse_vec3(s: &str) -> Result<DVec3, String> {
     }
 }
 
-fn parse_spacing(s: &str) -> Result<(f64, f64), String> {
+pub(crate) fn parse_spacing(s: &str) -> Result<(f64, f64), String> {
     let v = parse_numbers(s, "DX[,DY]")?;
     let (dx, dy) = match v.as_slice() {
         [d] => (*d, *d),
@@ -502,7 +505,7 @@ fn parse_spacing(s: &str) -> Result<(f64, f64), String> {
 }
 
 /// `NAME=FILE` of `--input-map`.
-fn parse_input_map(s: &str) -> Result<(usize, PathBuf), String> {
+pub(crate) fn parse_input_map(s: &str) -> Result<(usize, PathBuf), String> {
     let names = alpenglow::texturing::layers::INPUT_NAMES;
     let (name, file) = s.split_once('=').ok_or_else(|| format!("'{s}': expected NAME=FILE"))?;
     let k = (names.iter().position(|n| *n == name))

@@ -4,6 +4,7 @@ mod args;
 mod errors;
 mod exr;
 mod fly;
+mod layers;
 mod lighting;
 mod orbit;
 mod outputs;
@@ -78,6 +79,7 @@ pub fn run() -> Result<ExitCode> {
         Command::Fly(args) => fly::fly(args),
         Command::Spt(args::SptCommand::Build(args)) => spt::build(args),
         Command::Info(args) => info(args),
+        Command::Layers(command) => layers::run(command),
     }
 }
 

@@ -26,11 +26,8 @@ use super::classify::{Classification, PixelStatus};
 use crate::error::Result;
 use crate::io::heightmap::HeightField;
 use crate::terrain::bspline::{sample_bspline, sample_bspline_gradient};
-use crate::texturing::layers::{LayerTree, INPUT_NAMES};
+use crate::texturing::layers::{LayerTree, SampledFunction, INPUT_NAMES};
 use crate::texturing::reference::ReferenceSurface;
-
-/// Most samples of a sampled function (the layer format's limit).
-pub const MAX_SAMPLES: usize = 64;
 
 /// The input quantities at every pixel.
 #[derive(Clone, Debug, PartialEq)]
@@ -69,31 +66,6 @@ impl Samples {
             maps,
             altitude_range: field.min_max(),
         })
-    }
-}
-
-/// A sampled function over [min, max].
-#[derive(Clone, Debug, PartialEq)]
-pub struct SampledFunction {
-    pub samples: Vec<f32>,
-    pub min: f32,
-    pub max: f32,
-}
-
-impl SampledFunction {
-    /// The function's value at `x` as the layer format defines it: linear
-    /// between the bin centres, the end samples in the outer half-bins, 0
-    /// outside [min, max].
-    pub fn eval(&self, x: f32) -> f32 {
-        let n = self.samples.len();
-        if n == 0 || !(x >= self.min && x <= self.max) {
-            return 0.0;
-        }
-        let t = (x - self.min) / (self.max - self.min).max(f32::MIN_POSITIVE) * n as f32 - 0.5;
-        let i = t.floor().clamp(0.0, (n - 1) as f32) as usize;
-        let j = (i + 1).min(n - 1);
-        let f = (t - i as f32).clamp(0.0, 1.0);
-        self.samples[i] * (1.0 - f) + self.samples[j] * f
     }
 }
 
@@ -223,12 +195,7 @@ mod tests {
         let values = [0.5, 1.2, 1.5, 1.9, 3.5];
         let f = distribution(&values, |i| i < 4, Domain { min: 0.0, max: 4.0 }, 4);
         assert_eq!(f.samples, vec![0.5, 1.0, 0.0, 0.0]);
-        // Evaluation: end values in the outer half-bins, linear between centres, 0 outside.
-        assert_eq!(f.eval(0.2), 0.5);
-        assert_eq!(f.eval(1.0), 0.75);
-        assert_eq!(f.eval(4.0), 0.0);
-        assert_eq!(f.eval(4.1), 0.0);
-        assert_eq!(f.eval(-0.1), 0.0);
+        assert_eq!((f.min, f.max), (0.0, 4.0));
         // Nothing taken: all zero.
         assert!(distribution(&values, |_| false, Domain { min: 0.0, max: 4.0 }, 4)
             .samples

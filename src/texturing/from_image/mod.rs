@@ -31,6 +31,7 @@
 //! image rows run north to south ([`RowOrder::NorthUp`], the usual raster
 //! order) or south to north like the field's rows.
 
+pub mod calibrate;
 pub mod classify;
 pub mod distributions;
 pub mod kmeans;
@@ -80,6 +81,9 @@ pub struct FromImageOptions {
     pub bins: usize,
     /// Seed of k-means' initialisation.
     pub seed: u64,
+    /// Whether the layers' noise bias is calibrated to the class fractions
+    /// ([`calibrate`]).
+    pub calibrate: bool,
     /// Weight of the shade-normalised value in the clustering space
     /// ([`kmeans`]); 0: hue and saturation alone.
     pub value_weight: f64,
@@ -94,8 +98,9 @@ impl Default for FromImageOptions {
             sun_elevation_deg: 30.0,
             shade_handling: true,
             snow_min_altitude: None,
-            bins: 16,
+            bins: 48,
             seed: 1,
+            calibrate: true,
             value_weight: 0.5,
         }
     }
@@ -126,10 +131,14 @@ impl FromImageOptions {
         if self.snow_min_altitude.is_some_and(|a| !a.is_finite()) {
             return Err(Error::invalid("snow_min_altitude", "must be finite"));
         }
-        if !(1..=distributions::MAX_SAMPLES).contains(&self.bins) {
+        if !(1..=crate::texturing::layers::MAX_SAMPLES).contains(&self.bins) {
             return Err(Error::invalid(
                 "bins",
-                format!("{} is out of range 1..={}", self.bins, distributions::MAX_SAMPLES),
+                format!(
+                    "{} is out of range 1..={}",
+                    self.bins,
+                    crate::texturing::layers::MAX_SAMPLES
+                ),
             ));
         }
         Ok(())
@@ -196,6 +205,24 @@ impl Registration {
     }
 }
 
+/// Reads a colour image (PNG or JPEG, 8-bit; grey is taken as RGB, alpha
+/// dropped) within `limits`: the declared size is checked before decoding.
+pub fn load_rgb_image(path: &std::path::Path, limits: &crate::io::limits::InputLimits) -> Result<RgbImage> {
+    let bytes = crate::io::read_input_limited(path, limits.max_file_bytes)?;
+    let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
+        .with_guessed_format()
+        .map_err(|e| Error::input(path, e))?;
+    if reader.format().is_none() {
+        return Err(Error::input(path, "not a PNG or JPEG image"));
+    }
+    let (w, h) = reader.into_dimensions().map_err(|e| Error::input(path, e))?;
+    limits
+        .check_image(u64::from(w), u64::from(h), 4)
+        .map_err(|m| Error::input(path, m))?;
+    let image = image::load_from_memory(&bytes).map_err(|e| Error::input(path, e.to_string().replace('\n', " ")))?;
+    Ok(image.to_rgb8())
+}
+
 /// Surface layers estimated from `image` over `field` (module docs): the
 /// layer tree as TOML with the classification behind it. `maps` are the
 /// extra input maps ([`crate::texturing::layers::INPUT_NAMES`] order),
@@ -217,13 +244,26 @@ pub fn build_layers(
     let snow_min = options.snow_min_altitude.unwrap_or(lo + 0.6 * (hi - lo));
     let classification = classify::classify(image, &registration, &light, &samples.altitude, snow_min, options)?;
     let functions = distributions::estimate(&classification, &samples, options.bins);
-    Ok(tree::build(
-        &classification,
-        &functions,
-        &tree::Provenance {
-            options: options.clone(),
-            snow_min_altitude: snow_min,
-            spacing: field.spacing,
-        },
-    ))
+    let provenance = tree::Provenance {
+        options: options.clone(),
+        snow_min_altitude: snow_min,
+        spacing: field.spacing,
+    };
+    let mut generated = tree::build(&classification, &functions, &provenance);
+    if options.calibrate {
+        let fractions = classification.fractions();
+        let targets: Vec<f64> = generated.layers.iter().map(|l| fractions[l.class]).collect();
+        let points = calibrate::sample_positions(&positions, registration.width as usize);
+        generated.predicted =
+            calibrate::calibrate(&mut generated.layers, &targets, tree::layer_tree, field, maps, &points)?;
+        let shares: Vec<String> = (generated.layers.iter())
+            .zip(&generated.predicted)
+            .map(|(l, f)| format!("{} {:.1} %", l.name, 100.0 * f))
+            .collect();
+        generated.header.push(format!(
+            "Noise bias calibrated to the class areas; predicted dominant-layer areas: {}.",
+            shares.join(", ")
+        ));
+    }
+    Ok(generated)
 }

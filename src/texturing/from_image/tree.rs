@@ -23,8 +23,9 @@ use std::fmt::Write as _;
 use glam::{DVec2, Vec3};
 
 use super::classify::Classification;
-use super::distributions::{map_name, Distributions, SampledFunction};
+use super::distributions::{map_name, Distributions};
 use super::{ClassCount, FromImageOptions};
+use crate::texturing::layers::{LayerTree, SampledFunction};
 
 /// c_S of every level-1 layer.
 pub const NOISE_BIAS: f32 = 1.0;
@@ -65,6 +66,9 @@ pub struct GeneratedLayers {
     pub layers: Vec<GeneratedLayer>,
     /// Comment lines of the file's header (without `# `).
     pub header: Vec<String>,
+    /// Share of the terrain each layer is predicted to dominate in a render
+    /// ([`super::calibrate`]; empty without calibration).
+    pub predicted: Vec<f64>,
 }
 
 /// The layer tree of `classification` with `distributions` (module docs).
@@ -110,6 +114,7 @@ pub fn build(
         classification: classification.clone(),
         distributions: distributions.clone(),
         layers,
+        predicted: Vec::new(),
     }
 }
 
@@ -154,8 +159,9 @@ fn header(classification: &Classification, provenance: &Provenance) -> Vec<Strin
     vec![
         "Surface layers estimated from a real image (alpenglow layers from-image; dissertation §8.3).".into(),
         format!(
-            "Classes: k-means in the hue-saturation histogram, {choice}; near-grey pixels (saturation <= {GREY_SATURATION}) \
-             in reserved classes rock and snow (by shade-normalised value)."
+            "Classes: k-means in the hue-saturation(-value, weight {}) histogram, {choice}; near-grey pixels \
+             (saturation <= {GREY_SATURATION}) in reserved classes rock and snow (by shade-normalised value).",
+            o.value_weight
         ),
         format!("Shade: {shade}."),
         format!(
@@ -203,7 +209,27 @@ fn write_layer(out: &mut String, layer: &GeneratedLayer) {
     let _ = writeln!(out, "noise_wavelength = {}", float(layer.noise_wavelength));
 }
 
+/// `layers` (root first) as TOML tables.
+pub fn layers_toml(layers: &[GeneratedLayer]) -> String {
+    let mut out = String::new();
+    for (i, layer) in layers.iter().enumerate() {
+        out.push_str(if i == 0 { "\n[root]\n" } else { "\n[[root.children]]\n" });
+        write_layer(&mut out, layer);
+    }
+    out
+}
+
+/// `layers` (root first) as a tree.
+pub fn layer_tree(layers: &[GeneratedLayer]) -> crate::error::Result<LayerTree> {
+    LayerTree::parse(&layers_toml(layers), "generated layers")
+}
+
 impl GeneratedLayers {
+    /// The tree ([`GeneratedLayers::to_toml`] parsed).
+    pub fn tree(&self) -> crate::error::Result<LayerTree> {
+        layer_tree(&self.layers)
+    }
+
     /// The tree as TOML: `sources` (e.g. the input files) and the header
     /// as comments, then `[root]` and its `[[root.children]]`.
     pub fn to_toml(&self, sources: &[String]) -> String {
@@ -211,11 +237,7 @@ impl GeneratedLayers {
         for line in sources.iter().chain(&self.header) {
             let _ = writeln!(out, "# {}", line.replace('\n', " "));
         }
-        for (i, layer) in self.layers.iter().enumerate() {
-            out.push_str(if i == 0 { "\n[root]\n" } else { "\n[[root.children]]\n" });
-            write_layer(&mut out, layer);
-        }
-        out
+        out + &layers_toml(&self.layers)
     }
 }
 
