@@ -24,9 +24,9 @@ use crate::texturing::layers::{LayerTree, MAX_NOISE_TERM};
 use crate::texturing::reference::ReferenceSurface;
 
 /// Image pixels between the points the calibration evaluates, each way.
-pub const STRIDE: usize = 4;
+pub const STRIDE: usize = 8;
 /// Fixed-point steps of the calibration.
-pub const STEPS: usize = 16;
+pub const STEPS: usize = 12;
 /// Range of c_S the calibration keeps to.
 const BIAS_RANGE: (f32, f32) = (0.02, 8.0);
 
