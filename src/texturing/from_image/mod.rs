@@ -267,3 +267,63 @@ pub fn build_layers(
     }
     Ok(generated)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random::SplitMix64;
+
+    #[test]
+    fn pixels_register_area_to_area() {
+        let field = HeightField::from_fn(2, 2, DVec2::splat(10.0), |_, _| 0.0);
+        let north = Registration::new(4, 4, &field, RowOrder::NorthUp).unwrap();
+        assert_eq!(north.factor, 2);
+        // Outer half-pixels clamp onto the field's edge samples.
+        assert_eq!(north.world(0, 0), DVec2::new(0.0, 10.0));
+        assert_eq!(north.world(3, 3), DVec2::new(10.0, 0.0));
+        // Pixel centres a quarter cell inside: column 0.25, image row 0.75.
+        assert_eq!(north.world(1, 2), DVec2::new(2.5, 2.5));
+        let south = Registration::new(4, 4, &field, RowOrder::SouthUp).unwrap();
+        assert_eq!(south.world(1, 2), DVec2::new(2.5, 7.5));
+        assert!(Registration::new(5, 4, &field, RowOrder::NorthUp).is_err());
+        assert!(Registration::new(4, 6, &field, RowOrder::NorthUp).is_err());
+    }
+
+    /// Forest low, bare ground high on a slope rising to the north: two
+    /// classes, the bare layer constrained to the upper altitudes, and the
+    /// calibrated tree predicted to cover the image's shares.
+    #[test]
+    fn a_two_class_slope_gives_two_layers_with_the_image_areas() {
+        let field = HeightField::from_fn(32, 24, DVec2::splat(100.0), |_, r| 1000.0 + 50.0 * r as f32);
+        let mut rng = SplitMix64(5);
+        let image = RgbImage::from_fn(64, 48, |_, j| {
+            let base: [f64; 3] = if j < 18 {
+                [170.0, 150.0, 120.0]
+            } else {
+                [60.0, 80.0, 40.0]
+            };
+            image::Rgb(base.map(|c| (c + 12.0 * (rng.next_f64() - 0.5)) as u8))
+        });
+        let options = FromImageOptions {
+            classes: ClassCount::Fixed(2),
+            ..Default::default()
+        };
+        let generated = build_layers(&image, &field, &[None, None, None], &options).unwrap();
+        let c = &generated.classification;
+        assert_eq!(c.classes.len(), 2);
+        assert_eq!(c.classes[usize::from(c.labels[5 * 64 + 10])].name, "bare");
+        assert_eq!(c.classes[usize::from(c.labels[40 * 64 + 10])].name, "forest");
+        assert!((c.fractions()[usize::from(c.labels[5 * 64 + 10])] - 0.375).abs() < 1e-9);
+        let tree = generated.tree().unwrap();
+        assert_eq!(tree.layers[0].layer.name, "forest");
+        let bare = &tree.layers[1].layer;
+        let altitude = bare.altitude.as_ref().unwrap();
+        let (lo, hi) = field.min_max();
+        assert!(altitude.eval(hi - 10.0) > 0.9 && altitude.eval(lo + 10.0) == 0.0);
+        assert!(
+            (generated.predicted[1] - 0.375).abs() < 0.05,
+            "{:?}",
+            generated.predicted
+        );
+    }
+}
