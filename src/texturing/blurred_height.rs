@@ -46,13 +46,13 @@ fn convolve(values: &[f64], columns: usize, rows: usize, taps: &[f64], along_x: 
 }
 
 /// `field` blurred with a Gaussian of standard deviation `radius` metres
-/// (module docs); an error when that is more than [`MAX_BLUR_SAMPLES`]
-/// samples along an axis.
-pub fn blurred_height(field: &HeightField, radius: f32) -> Result<HeightField> {
+/// (module docs); an error naming `what` when that is more than
+/// [`MAX_BLUR_SAMPLES`] samples along an axis.
+pub fn blurred_height(field: &HeightField, radius: f32, what: &str) -> Result<HeightField> {
     let sigma = field.spacing.map(|s| f64::from(radius) / s);
     if !(sigma.x > 0.0 && sigma.y > 0.0) || sigma.max_element() > MAX_BLUR_SAMPLES {
         return Err(Error::invalid(
-            "height_blur",
+            what,
             format!(
                 "{radius} m is {:.1} × {:.1} samples of the height field; at most {MAX_BLUR_SAMPLES} per axis",
                 sigma.x, sigma.y
@@ -101,14 +101,14 @@ mod tests {
     fn blur_keeps_planes_and_spreads_a_spike_as_a_gaussian() {
         // A plane stays a plane away from the border (a symmetric kernel).
         let plane = field(41, 31, 10.0, |c, r| 3.0 * c - 2.0 * r + 100.0);
-        let blurred = blurred_height(&plane, 20.0).unwrap();
+        let blurred = blurred_height(&plane, 20.0, "plane").unwrap();
         for (c, r) in [(20, 15), (10, 8), (30, 20)] {
             assert!((blurred.height(c, r) - plane.height(c, r)).abs() < 1e-3);
         }
         // A spike of volume 1 at the centre: the blurred height at distance
         // d is the sampled Gaussian of σ = 2 samples (20 m / 10 m).
         let spike = field(41, 41, 10.0, |c, r| if c == 20.0 && r == 20.0 { 1.0 } else { 0.0 });
-        let blurred = blurred_height(&spike, 20.0).unwrap();
+        let blurred = blurred_height(&spike, 20.0, "spike").unwrap();
         let taps = gaussian_taps(2.0);
         for (dc, dr) in [(0, 0), (1, 0), (2, 3), (6, 6)] {
             let expected = taps[6 + dc] * taps[6 + dr];
@@ -123,11 +123,13 @@ mod tests {
     #[test]
     fn radii_beyond_the_kernel_limit_are_errors() {
         let flat = field(8, 8, 10.0, |_, _| 0.0);
-        let message = blurred_height(&flat, 641.0).unwrap_err().to_string();
+        let message = blurred_height(&flat, 641.0, "layer 'snow': height_blur")
+            .unwrap_err()
+            .to_string();
         assert!(
             message.contains("height_blur") && message.contains("at most 64"),
             "{message}"
         );
-        assert!(blurred_height(&flat, 640.0).is_ok());
+        assert!(blurred_height(&flat, 640.0, "flat").is_ok());
     }
 }

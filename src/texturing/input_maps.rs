@@ -76,7 +76,9 @@ impl InputMaps {
             out.maps[k] = Some(upload(ctx, graph, format!("input map {name}"), map)?);
         }
         for (k, radius) in tree.blur_radii().into_iter().enumerate().take(MAX_BLUR_RADII) {
-            let blurred = blurred_height(field, radius)?;
+            let layer = (tree.layers.iter()).find(|l| l.layer.height_blur == Some(radius));
+            let what = format!("layer '{}': height_blur", layer.map_or("", |l| l.layer.name.as_str()));
+            let blurred = blurred_height(field, radius, &what)?;
             let (image, handle) = upload(ctx, graph, format!("height blurred by {radius} m"), &blurred)?;
             out.blurred[k] = Some((radius, image, handle));
         }

@@ -53,7 +53,7 @@ impl<'a> ReferenceSurface<'a> {
             maps,
             tile: noise_tile(noise_seed, NOISE_TILE)?,
             blurred: (tree.blur_radii().into_iter().take(MAX_BLUR_RADII))
-                .map(|r| blurred_height(field, r))
+                .map(|r| blurred_height(field, r, "height_blur"))
                 .collect::<Result<_>>()?,
         })
     }
