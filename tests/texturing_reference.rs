@@ -12,9 +12,11 @@ mod common;
 
 use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
 use alpenglow::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
+use alpenglow::terrain::geometry_image::TerrainSettings;
 use alpenglow::texturing::generation::TextureStreaming;
 use alpenglow::texturing::gpu_layout::TexturingMode;
 use alpenglow::texturing::layers::LayerTree;
+use alpenglow::texturing::reference::ReferenceSurface;
 use common::atlas::check_texels_against_cpu;
 use common::{assert_validation_clean, data, dump_pngs, jacksboro_field, mean_flip, validated_context};
 use glam::DVec2;
@@ -169,7 +171,7 @@ fn peak_camera(scene: &Scene) -> Camera {
 
 /// `height_blur` (§8.2.3, snow in furrows): examples/layers/snow_in_furrows.toml
 /// plus a second radius (a lower "firn" layer) evaluate alike on the CPU,
-/// in the atlas and per pixel, and the blur changes the picture.
+/// in the atlas and per pixel, and the blur changes the layers.
 #[test]
 fn blurred_heights_match_the_cpu_reference_in_atlas_and_direct_mode() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/layers/snow_in_furrows.toml");
@@ -187,12 +189,29 @@ fn blurred_heights_match_the_cpu_reference_in_atlas_and_direct_mode() {
         .position(|l| l.layer.name == "snow")
         .expect("snow") as u32;
     let camera = peak_camera(&scene);
-    let blurred = check_atlas_direct_and_cpu("blurred", &scene, &camera, &[0, snow, snow + 1]);
-    scene.layers = LayerTree::load(&path).expect("example");
-    scene.layers.layers.iter_mut().for_each(|l| l.layer.height_blur = None);
-    let sharp = render("sharp", &scene, &camera, TexturingMode::Atlas, false);
-    dump_pngs(&[("sharp-atlas", &sharp.rgba8)], WIDTH, HEIGHT);
-    let (mean, _) = mean_flip(&sharp.rgba8, &blurred.rgba8, WIDTH, HEIGHT);
-    eprintln!("blurred: mean FLIP against the tree without height_blur {mean:.4}");
-    assert!(mean > 0.01, "height_blur changed little: mean FLIP {mean:.4}");
+    check_atlas_direct_and_cpu("blurred", &scene, &camera, &[0, snow, snow + 1]);
+    // The blur matters: on the CPU twin, the snow and firn coverage of the
+    // same tree without height_blur differs on a 24 × 24 grid of points
+    // over the 6 km around the peak.
+    let mut sharp = scene.layers.clone();
+    sharp.layers.iter_mut().for_each(|l| l.layer.height_blur = None);
+    let seed = TerrainSettings::default().noise_seed;
+    let reference = |tree| ReferenceSurface::new(&scene.heights, tree, &scene.input_maps, seed).expect("cpu");
+    let (with, without) = (reference(&scene.layers), reference(&sharp));
+    let peak = camera.target.truncate();
+    let (mut changed, mut covered) = (0, 0);
+    for j in 0..24 {
+        for i in 0..24 {
+            let xy = peak + (DVec2::new(f64::from(i), f64::from(j)) / 23.0 - 0.5) * 6000.0;
+            let snow_and_firn = |r: &ReferenceSurface| {
+                let c = r.evaluate(xy, 10.0).coverage;
+                c[snow as usize] + c[snow as usize + 1]
+            };
+            let (a, b) = (snow_and_firn(&with), snow_and_firn(&without));
+            changed += usize::from((a - b).abs() > 0.1);
+            covered += usize::from(a.max(b) > 0.1);
+        }
+    }
+    eprintln!("blurred: snow or firn at {covered} of 576 points, changed by height_blur at {changed}");
+    assert!(changed * 5 > covered && covered > 50, "{changed} of {covered}");
 }
