@@ -285,6 +285,36 @@ pub fn encode_exr_samples(
     Ok(bytes.into_inner())
 }
 
+/// Encodes a one-channel OpenEXR height map in memory: 32-bit float
+/// channel `Y` (the channel the height-map loader reads first), `values`
+/// row-major, row 0 at the top, ZIP compression (lossless).
+pub fn encode_exr_height(values: &[f32], width: u32, height: u32) -> Result<Vec<u8>> {
+    use exr::prelude::{Encoding, Image, Layer, LayerAttributes, SpecificChannels, WritableImage};
+    let pixels = pixel_count("EXR image size", width, height)?;
+    if values.len() != pixels {
+        return Err(Error::invalid(
+            "EXR height data",
+            format!("{} values for a {width}×{height} image", values.len()),
+        ));
+    }
+    let w = width as usize;
+    let channels = SpecificChannels::build()
+        .with_channel("Y")
+        .with_pixel_fn(|p: exr::math::Vec2<usize>| (values[p.y() * w + p.x()],));
+    let layer = Layer::new(
+        (w, height as usize),
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        channels,
+    );
+    let mut bytes = Cursor::new(Vec::new());
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(|e| Error::invalid("EXR encoding", one_line(e)))?;
+    Ok(bytes.into_inner())
+}
+
 /// Channels of an EXR image as `(width, height, [(name, samples)])`, samples
 /// row-major from the top, converted to `f32`, channels in file
 /// (alphabetical) order. Reads the first valid layer at full resolution,
