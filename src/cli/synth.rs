@@ -15,7 +15,7 @@ use alpenglow::io::heightmap::{load_heightmap, load_heightmap_with_voids, Height
 use alpenglow::io::image_out::{encode_exr_height, encode_png_gray16};
 use alpenglow::synthesis::fill::{plan_hole_fill, FillParams, Growth};
 use alpenglow::synthesis::search::{CpuSearch, NeighbourhoodSearch};
-use alpenglow::synthesis::transition::{blur_band, plan_transition, Axis, TransitionParams};
+use alpenglow::synthesis::transition::{plan_transition, Axis, TransitionParams};
 
 use crate::cli::args::{parse_spacing, RowsArg};
 use crate::cli::outputs::Outputs;
@@ -268,10 +268,11 @@ fn transition(args: TransitionArgs) -> Result<ExitCode> {
         },
         blur_radius: args.blur,
     };
-    let (growth, band) = plan_transition(&a, &b, &params)?;
+    let (growth, transition) = plan_transition(&a, &b, &params)?;
+    let band = transition.band;
     let started = Instant::now();
-    let grown = grow_with(growth, args.grow.search)?;
-    let joined = blur_band(&grown, &band, params.blur_radius);
+    let residual = grow_with(growth, args.grow.search)?;
+    let joined = transition.finish(&residual, params.blur_radius);
     let seconds = started.elapsed().as_secs_f64();
     outputs.stage(Some(&args.out), || encode_field(&args.out, &joined, &args.heights))?;
     outputs.commit()?;

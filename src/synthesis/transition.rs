@@ -20,6 +20,10 @@
 //! samples (σ = R/2, weights normalised, edges clamped), `R = 2` by
 //! default, written to band samples only — `A`'s and `B`'s samples stay
 //! exactly as given.
+//!
+//! One departure from the text: the band grows on the residual over a
+//! smooth base ([`plan_transition`]), so that fields at different heights
+//! meet without a cliff.
 
 use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
@@ -148,24 +152,93 @@ pub fn compose(a: &HeightField, b: &HeightField, params: &TransitionParams) -> R
     Ok((composed, unknown, band))
 }
 
-/// Prepares growing the transition between `a` and `b`: the growth of the
-/// composed field's band and the band.
-pub fn plan_transition(a: &HeightField, b: &HeightField, params: &TransitionParams) -> Result<(Growth, Band)> {
-    let (composed, unknown, band) = compose(a, b, params)?;
-    Ok((plan_hole_fill(&composed, &unknown, &params.grow)?, band))
+/// A prepared transition: the band, the composed field (A, B and a
+/// linear ramp across the band) and its smooth base (module docs).
+pub struct Transition {
+    pub band: Band,
+    composed: HeightField,
+    base: Vec<f64>,
 }
 
-/// Blurs the band of a grown field (module docs); other samples unchanged.
-pub fn blur_band(grown: &HeightField, band: &Band, radius: u32) -> HeightField {
+impl Transition {
+    /// The joined field from the grown residual: band samples `base +
+    /// residual`, blurred with radius `blur`; A's and B's samples exactly
+    /// as given.
+    pub fn finish(&self, residual: &HeightField, blur: u32) -> HeightField {
+        let mut out = self.composed.clone();
+        for r in 0..out.rows {
+            for c in 0..out.columns {
+                if self.band.contains(c, r) {
+                    let i = (r * out.columns + c) as usize;
+                    out.heights[i] = (self.base[i] + f64::from(residual.heights[i])) as f32;
+                }
+            }
+        }
+        blur_band(&out, &self.band, blur)
+    }
+}
+
+/// Prepares growing the transition between `a` and `b`: the growth of the
+/// residual's band and the [`Transition`] that turns the grown residual
+/// into the joined field.
+///
+/// The band is grown on the residual over a smooth base, not on absolute
+/// heights: the base is the composed field with each line across the band
+/// a linear ramp between the band's two edge samples, blurred with a
+/// Gaussian of radius n (the window side; σ = n/2); the residual, height
+/// minus base, of A's and B's samples is the exemplar and the grown band's
+/// height is base + residual. Copying absolute heights, as the text does,
+/// leaves a cliff in the band where the fronts from A and from B meet
+/// whenever the two fields lie at different heights.
+pub fn plan_transition(a: &HeightField, b: &HeightField, params: &TransitionParams) -> Result<(Growth, Transition)> {
+    let (mut composed, unknown, band) = compose(a, b, params)?;
+    let (w, h) = (composed.columns, composed.rows);
+    let across = if band.axis == Axis::X { h } else { w };
+    for line in 0..across {
+        let index = |along: u32| {
+            let (c, r) = if band.axis == Axis::X {
+                (along, line)
+            } else {
+                (line, along)
+            };
+            (r * w + c) as usize
+        };
+        let (lo, hi) = (band.start - 1, band.start + band.width);
+        let (h_lo, h_hi) = (
+            f64::from(composed.heights[index(lo)]),
+            f64::from(composed.heights[index(hi)]),
+        );
+        for along in band.start..hi {
+            let t = f64::from(along - lo) / f64::from(hi - lo);
+            composed.heights[index(along)] = (h_lo + t * (h_hi - h_lo)) as f32;
+        }
+    }
+    let base = gaussian_blur(&composed, params.grow.window);
+    let mut residual = composed.clone();
+    for (i, v) in residual.heights.iter_mut().enumerate() {
+        *v = if unknown[i] {
+            0.0
+        } else {
+            (f64::from(*v) - base[i]) as f32
+        };
+    }
+    let growth = plan_hole_fill(&residual, &unknown, &params.grow)?;
+    Ok((growth, Transition { band, composed, base }))
+}
+
+/// A separable Gaussian blur of `field` with radius `radius` samples (σ =
+/// radius/2, weights normalised, edges clamped).
+fn gaussian_blur(field: &HeightField, radius: u32) -> Vec<f64> {
+    let heights: Vec<f64> = field.heights.iter().map(|&v| f64::from(v)).collect();
     if radius == 0 {
-        return grown.clone();
+        return heights;
     }
     let sigma = f64::from(radius) / 2.0;
     let kernel: Vec<f64> = (-(radius as i64)..=radius as i64)
         .map(|x| (-(x * x) as f64 / (2.0 * sigma * sigma)).exp())
         .collect();
     let total: f64 = kernel.iter().sum();
-    let (w, h) = (grown.columns as i64, grown.rows as i64);
+    let (w, h) = (field.columns as i64, field.rows as i64);
     let pass = |values: &[f64], along_x: bool| -> Vec<f64> {
         let mut out = vec![0.0; values.len()];
         for r in 0..h {
@@ -185,8 +258,12 @@ pub fn blur_band(grown: &HeightField, band: &Band, radius: u32) -> HeightField {
         }
         out
     };
-    let heights: Vec<f64> = grown.heights.iter().map(|&v| f64::from(v)).collect();
-    let blurred = pass(&pass(&heights, true), false);
+    pass(&pass(&heights, true), false)
+}
+
+/// Blurs the band of a grown field (module docs); other samples unchanged.
+pub fn blur_band(grown: &HeightField, band: &Band, radius: u32) -> HeightField {
+    let blurred = gaussian_blur(grown, radius);
     let mut out = grown.clone();
     for r in 0..grown.rows {
         for c in 0..grown.columns {
@@ -209,9 +286,9 @@ pub fn grow_transition(
     search: &mut dyn NeighbourhoodSearch,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<HeightField> {
-    let (growth, band) = plan_transition(a, b, params)?;
-    let grown = growth.grow(search, progress)?;
-    Ok(blur_band(&grown, &band, params.blur_radius))
+    let (growth, transition) = plan_transition(a, b, params)?;
+    let residual = growth.grow(search, progress)?;
+    Ok(transition.finish(&residual, params.blur_radius))
 }
 
 /// [`grow_transition`] with the CPU search.
@@ -221,13 +298,13 @@ pub fn grow_transition_cpu(
     params: &TransitionParams,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<HeightField> {
-    let (growth, band) = plan_transition(a, b, params)?;
+    let (growth, transition) = plan_transition(a, b, params)?;
     let mut search = CpuSearch {
         exemplar: growth.exemplar().clone(),
         config: growth.search_config(),
     };
-    let grown = growth.grow(&mut search, progress)?;
-    Ok(blur_band(&grown, &band, params.blur_radius))
+    let residual = growth.grow(&mut search, progress)?;
+    Ok(transition.finish(&residual, params.blur_radius))
 }
 
 #[cfg(test)]
