@@ -50,25 +50,22 @@ pub struct Normalisation {
 }
 
 impl Normalisation {
-    /// The statistics of the known samples of `fields` (each with its
-    /// unknown mask and slopes, as [`slopes`] gives them).
-    pub fn of(fields: &[(&HeightField, &[bool], &[[f32; 2]])]) -> Normalisation {
+    /// The statistics of the known samples of `field` (with its unknown
+    /// mask and slopes, as [`slopes`] gives them).
+    pub fn of(field: &HeightField, unknown: &[bool], slopes: &[[f32; 2]]) -> Normalisation {
         let (mut count, mut sum, mut slope_sq) = (0.0f64, 0.0f64, 0.0f64);
-        for (field, unknown, slopes) in fields {
-            for ((&h, &u), s) in field.heights.iter().zip(unknown.iter()).zip(slopes.iter()) {
-                if !u {
-                    let h = f64::from(h);
-                    count += 1.0;
-                    sum += h;
-                    slope_sq += f64::from(s[0]).powi(2) + f64::from(s[1]).powi(2);
-                }
+        for ((&h, &u), s) in field.heights.iter().zip(unknown).zip(slopes) {
+            if !u {
+                count += 1.0;
+                sum += f64::from(h);
+                slope_sq += f64::from(s[0]).powi(2) + f64::from(s[1]).powi(2);
             }
         }
         let count = count.max(1.0);
         let mean = sum / count;
         let positive_or_one = |v: f64| if v > 0.0 && v.is_finite() { v } else { 1.0 };
         let slope_scale = positive_or_one((slope_sq / (2.0 * count)).sqrt());
-        let spacing = fields.first().map_or(1.0, |f| (f.0.spacing.x + f.0.spacing.y) / 2.0);
+        let spacing = (field.spacing.x + field.spacing.y) / 2.0;
         Normalisation {
             height_mean: mean,
             height_scale: positive_or_one(slope_scale * spacing),

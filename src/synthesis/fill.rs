@@ -357,7 +357,7 @@ pub fn plan_hole_fill(field: &HeightField, unknown: &[bool], params: &FillParams
         ));
     }
     let slopes = slopes(field, unknown);
-    let norm = Normalisation::of(&[(field, unknown, &slopes)]);
+    let norm = Normalisation::of(field, unknown, &slopes);
     let texels = texels(field, unknown, &slopes, &norm);
     let distance = distance_to_unknown(field.columns, field.rows, unknown);
     let ranked = known_windows(field.columns, field.rows, unknown, params.window)
