@@ -88,3 +88,13 @@ pub const POST_RESOLVE: SpirV = spirv!("post/resolve.comp");
 pub const POST_DISTORTION: SpirV = spirv!("post/distortion.comp");
 /// post.motion_blur: velocity-based motion blur (§3.3).
 pub const POST_MOTION_BLUR: SpirV = spirv!("post/motion_blur.comp");
+/// synthesis.clear: the per-query results of a search batch reset (§7.3).
+pub const SYNTHESIS_CLEAR: SpirV = spirv!("synthesis/clear.comp");
+/// synthesis.distance: s(c) of every (query, candidate) and the best per query (§7.3).
+pub const SYNTHESIS_DISTANCE: SpirV = spirv!("synthesis/distance.comp");
+/// synthesis.accept: the smallest choice hash among the accepted candidates (§7.3).
+pub const SYNTHESIS_ACCEPT: SpirV = spirv!("synthesis/accept.comp");
+/// synthesis.pick: the smallest accepted candidate with that hash (§7.3).
+pub const SYNTHESIS_PICK: SpirV = spirv!("synthesis/pick.comp");
+/// synthesis.resolve: the pick, its s and the best s into the readback buffer (§7.3).
+pub const SYNTHESIS_RESOLVE: SpirV = spirv!("synthesis/resolve.comp");

@@ -1,5 +1,6 @@
 // The surface-layer tree (dissertation §8.2, Table 8.1; ALGORITHMS.md §4),
-// evaluated at a point of the base surface: hat-function constraints,
+// evaluated at a point of the base surface: hat-function and sampled-function
+// (§8.3) constraints,
 // coverage with noise, depth-first colour blending, displacement feeding
 // the next layers' altitude and the normal. Same rules as the CPU reference
 // src/texturing/layers.rs (`evaluate`); layout as src/texturing/gpu_layout.rs.
@@ -12,18 +13,39 @@
 struct SurfaceLayer {
     vec4 color_roughness;  // linear colour, roughness B_S (metres)
     vec4 noise;            // c_S, n_S, coverage-noise wavelength, displacement-noise wavelength
-    vec4 hats[6];          // (min, max, fuzz, used): altitude, elevation, slope, rainfall, radiation, temperature
+    vec4 hats[6];          // constraints (see `constraint`): altitude, elevation, slope, rainfall, radiation, temperature
     uvec4 tree;            // parent (0xffffffff: root), level
 };
 
 layout(set = 0, binding = 2, std430) readonly buffer SurfaceLayers { SurfaceLayer l[]; } g_surface_layers[];
+// The same buffer as floats: the sampled functions' samples follow the layers.
+layout(set = 0, binding = 2, std430) readonly buffer SurfaceLayerFloats { float v[]; } g_surface_layer_floats[];
 
 #define MAX_SURFACE_LAYERS 32
 
-// F(a) of a hat (min, max, fuzz, used); 1 when unused.
-float hat(vec4 h, float a) {
+// F(a) of a constraint h of the layers buffer `layers` (src/texturing/gpu_layout.rs
+// `pack_constraint`): w = 0 unused (1); w = 1 a hat (min, max, fuzz); w = 1 + n a
+// sampled function of n samples over [min, max] starting at float z of the
+// buffer: linear between the bin centres, the end values in the outer
+// half-bins, 0 outside [min, max] (src/texturing/layers/constraint.rs).
+float constraint(uint layers, vec4 h, float a) {
     if (h.w == 0.0) {
         return 1.0;
+    }
+    if (h.w >= 2.0) {
+        if (!(a >= h.x && a <= h.y)) {
+            return 0.0;
+        }
+        uint n = uint(h.w) - 1u;
+        float last = float(n - 1u);
+        float t = clamp((a - h.x) / (h.y - h.x) * float(n) - 0.5, 0.0, last);
+        float i = floor(t);
+        float u = t - i;
+        uint k = min(uint(i), n - 1u);
+        uint first = uint(h.z);
+        float lo = g_surface_layer_floats[layers].v[first + k];
+        float hi = g_surface_layer_floats[layers].v[first + min(k + 1u, n - 1u)];
+        return lo * (1.0 - u) + hi * u;
     }
     if (h.z <= 0.0) {
         return (a >= h.x && a <= h.y) ? 1.0 : 0.0;
@@ -64,8 +86,8 @@ float layer_noise(uint tile, vec2 xy, float wavelength, vec2 offset, float footp
 // The extra input maps (rainfall, radiation, temperature) at uv (0..1 over
 // the terrain rectangle): bilinear in R32F textures whose corner samples
 // sit on the rectangle's corners; `maps` holds the sampled handles and in w
-// bit k when map k is present. An absent map reads −3e38, which every hat
-// rejects (the CPU checks that no layer uses an absent map).
+// bit k when map k is present. An absent map reads −3e38, which every
+// constraint rejects (the CPU checks that no layer uses an absent map).
 vec3 input_maps(uvec4 maps, vec2 uv) {
     vec3 values = vec3(-3.0e38);
     for (uint k = 0u; k < 3u; ++k) {
@@ -96,7 +118,7 @@ LayerState layer_state(float h, vec2 grad) {
 }
 
 // Layer i of the flat depth-first tree applied at world xy: coverage from
-// the hats (altitude and elevation of the modified height, base slope,
+// the constraints (altitude and elevation of the modified height, base slope,
 // input maps `maps`), noise and the parent's coverage; colour blend;
 // displacement. `range`: the height field's lowest and highest sample.
 void apply_layer(uint layers, uint i, uint tile, vec2 xy, float footprint, vec2 range, vec3 maps, inout LayerState s) {
@@ -105,12 +127,13 @@ void apply_layer(uint layers, uint i, uint tile, vec2 xy, float footprint, vec2 
     vec4 noise = g_surface_layers[layers].l[i].noise;
     float c_s = 1.0;
     if (level > 0u) {
-        float product = hat(g_surface_layers[layers].l[i].hats[0], s.h) *
-                        hat(g_surface_layers[layers].l[i].hats[1], (s.h - range.x) / max(range.y - range.x, 1e-6)) *
-                        hat(g_surface_layers[layers].l[i].hats[2], s.slope) *
-                        hat(g_surface_layers[layers].l[i].hats[3], maps.x) *
-                        hat(g_surface_layers[layers].l[i].hats[4], maps.y) *
-                        hat(g_surface_layers[layers].l[i].hats[5], maps.z);
+        float product =
+            constraint(layers, g_surface_layers[layers].l[i].hats[0], s.h) *
+            constraint(layers, g_surface_layers[layers].l[i].hats[1], (s.h - range.x) / max(range.y - range.x, 1e-6)) *
+            constraint(layers, g_surface_layers[layers].l[i].hats[2], s.slope) *
+            constraint(layers, g_surface_layers[layers].l[i].hats[3], maps.x) *
+            constraint(layers, g_surface_layers[layers].l[i].hats[4], maps.y) *
+            constraint(layers, g_surface_layers[layers].l[i].hats[5], maps.z);
         // In depth-first order the last layer seen one level up is the parent.
         float parent = s.coverage[min(level - 1u, 3u)];
         if (product > 0.0 && parent > 0.0) {

@@ -1,7 +1,7 @@
 #version 460
 // texturing.layer.<name> (dissertation §8.2, Table 8.1; ALGORITHMS.md §4):
 // one layer of the surface-layer tree, in depth-first order, over every
-// texel of every dirty tile at once: coverage from hats, noise and the
+// texel of every dirty tile at once: coverage from constraints, noise and the
 // parent level's coverage, colour blend, displacement passed on to the next
 // layer (surface_layers.glsl, the same code terrain.draw runs per pixel in
 // --texturing direct).
@@ -19,7 +19,7 @@ void main() {
     }
     uint texel = gl_GlobalInvocationID.x;
     LayerState s = unpack_state(g_texel_states[pc.handles.y].t[texel]);
-    // Sample the input maps only for a layer with hats on them.
+    // Sample the input maps only for a layer constrained by them.
     uvec4 maps_used = pc.maps;
     for (uint k = 0u; k < 3u; ++k) {
         if (g_surface_layers[pc.handles.z].l[pc.counts.z].hats[3u + k].w == 0.0) {

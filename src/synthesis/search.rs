@@ -44,6 +44,21 @@ pub struct Exemplar {
     pub candidates: Vec<u32>,
 }
 
+impl Exemplar {
+    /// The texel indices of a `width`×`height` grid whose `window`-wide
+    /// window lies inside it, row-major (candidates before any filtering
+    /// for known texels).
+    pub fn inside_centres(width: u32, height: u32, window: u32) -> Vec<u32> {
+        let r = window / 2;
+        (0..width * height)
+            .filter(|i| {
+                let (x, y) = (i % width, i / width);
+                x >= r && y >= r && x + r < width && y + r < height
+            })
+            .collect()
+    }
+}
+
 /// The search's parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SearchConfig {
@@ -196,10 +211,21 @@ pub fn choose_from(sums: &[f32], total_weight: f32, config: &SearchConfig, pixel
         }
     }
     let candidate = pick.map_or(0, |(_, c)| c);
+    normalised_choice(
+        candidate,
+        sums.get(candidate as usize).copied().unwrap_or(best),
+        best,
+        total_weight,
+    )
+}
+
+/// The [`Choice`] of `candidate` from its s and the best s: both divided by
+/// the query's Σ w (0 when no tap is known), as every search reports it.
+pub fn normalised_choice(candidate: u32, chosen_sum: f32, best: f32, total_weight: f32) -> Choice {
     let normalise = |s: f32| if total_weight > 0.0 { s / total_weight } else { 0.0 };
     Choice {
         candidate,
-        distance: normalise(sums.get(candidate as usize).copied().unwrap_or(best)),
+        distance: normalise(chosen_sum),
         best: normalise(best),
     }
 }
@@ -256,17 +282,11 @@ mod tests {
 
     fn ramp(width: u32, height: u32) -> Exemplar {
         let texels = (0..width * height).map(|i| [(i % width) as f32, 1.0, 0.0]).collect();
-        let candidates = (0..width * height)
-            .filter(|i| {
-                let (x, y) = (i % width, i / width);
-                x >= 1 && y >= 1 && x + 1 < width && y + 1 < height
-            })
-            .collect();
         Exemplar {
             width,
             height,
             texels,
-            candidates,
+            candidates: Exemplar::inside_centres(width, height, 3),
         }
     }
 

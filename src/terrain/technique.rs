@@ -108,7 +108,7 @@ impl Terrain {
             ctx,
             "surface layers",
             BufferUsageFlags::STORAGE_BUFFER,
-            bytemuck::cast_slice(&pack_layers(texturing.layers)),
+            &pack_layers(texturing.layers).bytes(),
         )?);
         let sampled = |image: &Image, what| heap_handle(image.sampled_handle(), what);
         let handles = [

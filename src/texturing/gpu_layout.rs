@@ -3,7 +3,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use super::layers::{Hat, LayerTree};
+use super::layers::{Constraint, LayerTree};
 
 /// How the terrain is coloured.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -37,37 +37,73 @@ pub struct GpuLayer {
     pub color_roughness: [f32; 4],
     /// c_S, n_S, coverage-noise wavelength, displacement-noise wavelength.
     pub noise: [f32; 4],
-    /// Hats (min, max, fuzz, 1 = used): altitude, elevation, slope, rainfall, radiation, temperature.
+    /// Constraints ([`pack_constraint`]): altitude, elevation, slope,
+    /// rainfall, radiation, temperature.
     pub hats: [[f32; 4]; 6],
     /// Parent index (u32::MAX: root), level, 0, 0.
     pub tree: [u32; 4],
 }
 
-fn hat(h: Option<Hat>) -> [f32; 4] {
-    h.map_or([0.0; 4], |h| [h.min, h.max, h.fuzz, 1.0])
+/// The layers buffer: the layers in evaluation order, then the samples of
+/// their sampled functions (floats).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PackedLayers {
+    pub layers: Vec<GpuLayer>,
+    pub samples: Vec<f32>,
 }
 
-/// The tree in evaluation order.
-pub fn pack_layers(tree: &LayerTree) -> Vec<GpuLayer> {
-    tree.layers
-        .iter()
+impl PackedLayers {
+    /// The buffer's contents.
+    pub fn bytes(&self) -> Vec<u8> {
+        let mut bytes = bytemuck::cast_slice::<GpuLayer, u8>(&self.layers).to_vec();
+        bytes.extend_from_slice(bytemuck::cast_slice(&self.samples));
+        bytes
+    }
+}
+
+/// Floats per [`GpuLayer`].
+const LAYER_FLOATS: usize = std::mem::size_of::<GpuLayer>() / 4;
+
+/// A constraint as the shader reads it: unused (0, 0, 0, 0); a hat
+/// (min, max, fuzz, 1); a sampled function of n samples (min, max, index of
+/// its first sample among the buffer's floats, 1 + n), its samples appended
+/// to `samples` (which follow `layer_count` layers in the buffer).
+pub fn pack_constraint(c: Option<&Constraint>, layer_count: usize, samples: &mut Vec<f32>) -> [f32; 4] {
+    match c {
+        None => [0.0; 4],
+        Some(Constraint::Hat(h)) => [h.min, h.max, h.fuzz, 1.0],
+        Some(Constraint::Sampled(s)) => {
+            let first = layer_count * LAYER_FLOATS + samples.len();
+            samples.extend_from_slice(&s.samples);
+            [s.min, s.max, first as f32, 1.0 + s.samples.len() as f32]
+        }
+    }
+}
+
+/// The tree in evaluation order, with the samples of its sampled functions.
+pub fn pack_layers(tree: &LayerTree) -> PackedLayers {
+    let count = tree.layers.len();
+    let mut samples = Vec::new();
+    let layers = (tree.layers.iter())
         .map(|flat| {
             let l = &flat.layer;
+            let constraints = [
+                l.altitude.as_ref(),
+                l.elevation.as_ref(),
+                l.slope.as_ref(),
+                l.inputs[0].as_ref(),
+                l.inputs[1].as_ref(),
+                l.inputs[2].as_ref(),
+            ];
             GpuLayer {
                 color_roughness: l.color.extend(l.roughness).to_array(),
                 noise: [l.noise_bias, l.noise_scale, l.noise_wavelength, l.roughness_wavelength],
-                hats: [
-                    hat(l.altitude),
-                    hat(l.elevation),
-                    hat(l.slope),
-                    hat(l.inputs[0]),
-                    hat(l.inputs[1]),
-                    hat(l.inputs[2]),
-                ],
+                hats: constraints.map(|c| pack_constraint(c, count, &mut samples)),
                 tree: [flat.parent.map_or(u32::MAX, |p| p as u32), flat.level as u32, 0, 0],
             }
         })
-        .collect()
+        .collect();
+    PackedLayers { layers, samples }
 }
 
 /// Per-frame constants of terrain texturing (`TerrainTexturing`).

@@ -8,7 +8,9 @@
 //! (0) and highest (1) sample, so one tree suits any terrain), slope and
 //! optional extra input maps registered to the height
 //! field (rainfall, radiation, temperature), each a hat function with range
-//! [min, max] and fuzziness f:
+//! [min, max] and fuzziness f, or a sampled function (§8.3; [`constraint`]
+//! has the formula: samples at the centres of equal bins over [min, max],
+//! linear in between, 0 outside), which replaces the hat in the product:
 //!
 //! ```text
 //! f1(a) = (a − (min − f)) / (2f),  f2(a) = ((max + f) − a) / (2f)
@@ -62,47 +64,9 @@ pub const INPUT_NAMES: [&str; 3] = ["rainfall", "radiation", "temperature"];
 /// The built-in tree: rock root; grass with dark, dry and light grass; sand; snow.
 pub const DEFAULT_LAYERS: &str = include_str!("default_layers.toml");
 
-/// A hat function over an attribute (§8.2): 1 inside [min, max], ramps of
-/// half-width `fuzz` around the ends.
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Hat {
-    pub min: f32,
-    pub max: f32,
-    #[serde(default)]
-    pub fuzz: f32,
-}
-
-impl Hat {
-    /// F(a) (module docs); 0 for NaN (an absent input).
-    pub fn eval(&self, a: f32) -> f32 {
-        if a.is_nan() {
-            return 0.0;
-        }
-        if self.fuzz <= 0.0 {
-            return if a >= self.min && a <= self.max { 1.0 } else { 0.0 };
-        }
-        let f1 = (a - (self.min - self.fuzz)) / (2.0 * self.fuzz);
-        let f2 = ((self.max + self.fuzz) - a) / (2.0 * self.fuzz);
-        f1.min(f2).clamp(0.0, 1.0)
-    }
-
-    fn validate(&self) -> std::result::Result<(), String> {
-        if !(self.min.is_finite() && self.max.is_finite() && self.fuzz.is_finite()) {
-            return Err("range and fuzz must be finite".into());
-        }
-        if [self.min, self.max, self.fuzz].iter().any(|v| v.abs() > MAX_HAT_VALUE) {
-            return Err(format!("range and fuzz must lie within ±{MAX_HAT_VALUE}"));
-        }
-        if self.min > self.max {
-            return Err(format!("min {} is above max {}", self.min, self.max));
-        }
-        if self.fuzz < 0.0 {
-            return Err(format!("fuzz {} is negative", self.fuzz));
-        }
-        Ok(())
-    }
-}
+pub mod constraint;
+use constraint::ConstraintFile;
+pub use constraint::{Constraint, Hat, SampledFunction, MAX_HAT_VALUE, MAX_SAMPLES};
 
 /// One layer (Table 8.1).
 #[derive(Clone, Debug, PartialEq)]
@@ -121,13 +85,13 @@ pub struct Layer {
     /// Wavelength of the coverage noise N (metres).
     pub noise_wavelength: f32,
     /// Altitude constraint (metres).
-    pub altitude: Option<Hat>,
+    pub altitude: Option<Constraint>,
     /// Elevation constraint: altitude relative to the height field's range (0 lowest, 1 highest).
-    pub elevation: Option<Hat>,
+    pub elevation: Option<Constraint>,
     /// Slope constraint (degrees).
-    pub slope: Option<Hat>,
+    pub slope: Option<Constraint>,
     /// Constraints on the extra inputs, in [`INPUT_NAMES`] order.
-    pub inputs: [Option<Hat>; 3],
+    pub inputs: [Option<Constraint>; 3],
 }
 
 /// A layer in depth-first order with its place in the tree.
@@ -167,12 +131,12 @@ struct LayerFile {
     noise_scale: f32,
     #[serde(default = "default_wavelength")]
     noise_wavelength: f32,
-    altitude: Option<Hat>,
-    elevation: Option<Hat>,
-    slope: Option<Hat>,
-    rainfall: Option<Hat>,
-    radiation: Option<Hat>,
-    temperature: Option<Hat>,
+    altitude: Option<ConstraintFile>,
+    elevation: Option<ConstraintFile>,
+    slope: Option<ConstraintFile>,
+    rainfall: Option<ConstraintFile>,
+    radiation: Option<ConstraintFile>,
+    temperature: Option<ConstraintFile>,
     #[serde(default)]
     children: Vec<toml::Spanned<LayerFile>>,
 }
@@ -191,9 +155,6 @@ pub const MAX_ROUGHNESS: f32 = 1e4;
 pub const WAVELENGTH_RANGE: std::ops::RangeInclusive<f32> = 1e-3..=1e6;
 /// Largest magnitude of the noise bias c_S and scale n_S.
 pub const MAX_NOISE_TERM: f32 = 1e3;
-/// Largest magnitude of a constraint's min, max and fuzz (metres for
-/// altitude, degrees for slope, the maps' own units).
-pub const MAX_HAT_VALUE: f32 = 1e7;
 
 /// Checks a layer's numbers against the documented ranges.
 fn check_numbers(f: &LayerFile) -> std::result::Result<(), String> {
@@ -298,22 +259,28 @@ fn flatten(
         return Err(bad(format!("color {color:?} is not linear albedo in [0, 1]")));
     }
     check_numbers(&f).map_err(bad)?;
-    let hats = [
-        ("altitude", f.altitude),
-        ("elevation", f.elevation),
-        ("slope", f.slope),
-        ("rainfall", f.rainfall),
-        ("radiation", f.radiation),
-        ("temperature", f.temperature),
+    let constrained = [
+        &f.altitude,
+        &f.elevation,
+        &f.slope,
+        &f.rainfall,
+        &f.radiation,
+        &f.temperature,
     ];
-    for (what, hat) in &hats {
-        if let Some(h) = hat {
-            h.validate().map_err(|why| bad(format!("{what}: {why}")))?;
-        }
-    }
-    if level == 0 && hats.iter().any(|(_, h)| h.is_some()) {
+    if level == 0 && constrained.iter().any(|c| c.is_some()) {
         return Err(bad("the root is the base material and takes no constraints".into()));
     }
+    let parse = |what: &str, file: Option<ConstraintFile>| {
+        (file.map(|c| c.into_constraint(what)).transpose()).map_err(|why| bad(format!("{what}: {why}")))
+    };
+    let altitude = parse("altitude", f.altitude)?;
+    let elevation = parse("elevation", f.elevation)?;
+    let slope = parse("slope", f.slope)?;
+    let inputs = [
+        parse("rainfall", f.rainfall)?,
+        parse("radiation", f.radiation)?,
+        parse("temperature", f.temperature)?,
+    ];
     let index = out.len();
     out.push(FlatLayer {
         layer: Layer {
@@ -324,10 +291,10 @@ fn flatten(
             noise_bias: f.noise_bias,
             noise_scale: f.noise_scale,
             noise_wavelength: f.noise_wavelength,
-            altitude: f.altitude,
-            elevation: f.elevation,
-            slope: f.slope,
-            inputs: [f.rainfall, f.radiation, f.temperature],
+            altitude,
+            elevation,
+            slope,
+            inputs,
         },
         level,
         parent,
@@ -354,13 +321,13 @@ pub struct LayerInputs {
 /// C of a layer (module docs) for coverage noise value `noise` ∈ [−1, 1].
 pub fn coverage(layer: &Layer, inputs: &LayerInputs, noise: f32) -> f32 {
     let mut product = 1.0;
-    if let Some(h) = layer.altitude {
+    if let Some(h) = &layer.altitude {
         product *= h.eval(inputs.altitude);
     }
-    if let Some(h) = layer.elevation {
+    if let Some(h) = &layer.elevation {
         product *= h.eval(inputs.elevation);
     }
-    if let Some(h) = layer.slope {
+    if let Some(h) = &layer.slope {
         product *= h.eval(inputs.slope);
     }
     for (hat, value) in layer.inputs.iter().zip(inputs.maps) {

@@ -2,8 +2,14 @@
 
 use super::*;
 
+mod sampled;
+
 fn hat(min: f32, max: f32, fuzz: f32) -> Hat {
     Hat { min, max, fuzz }
+}
+
+fn hat_constraint(min: f32, max: f32, fuzz: f32) -> Option<Constraint> {
+    Some(Constraint::Hat(hat(min, max, fuzz)))
 }
 
 #[test]
@@ -40,15 +46,15 @@ fn leaf(name: &str, color: [f32; 3]) -> Layer {
         altitude: None,
         elevation: None,
         slope: None,
-        inputs: [None; 3],
+        inputs: [None, None, None],
     }
 }
 
 #[test]
 fn coverage_multiplies_constraints_and_clamps_noise() {
     let mut l = leaf("snow", [1.0; 3]);
-    l.altitude = Some(hat(1000.0, 5000.0, 100.0));
-    l.slope = Some(hat(0.0, 30.0, 5.0));
+    l.altitude = hat_constraint(1000.0, 5000.0, 100.0);
+    l.slope = hat_constraint(0.0, 30.0, 5.0);
     l.noise_bias = 0.5;
     l.noise_scale = 1.0;
     let at = |altitude, slope| LayerInputs {
@@ -66,7 +72,7 @@ fn coverage_multiplies_constraints_and_clamps_noise() {
     assert_eq!(coverage(&l, &at(1000.0, 30.0), 0.5), 0.25);
     assert_eq!(coverage(&l, &at(500.0, 10.0), 1.0), 0.0);
     // Input maps: an absent map (NaN) fails its constraint.
-    l.inputs[0] = Some(hat(0.0, 1.0, 0.5));
+    l.inputs[0] = hat_constraint(0.0, 1.0, 0.5);
     assert_eq!(coverage(&l, &at(2000.0, 10.0), 0.5), 0.0);
     let mut with_map = at(2000.0, 10.0);
     with_map.maps[0] = 0.5;
