@@ -14,7 +14,9 @@ use std::path::Path;
 use std::time::Instant;
 
 use alpenglow::io::heightmap::{load_heightmap, HeightField, HeightmapOptions};
-use alpenglow::synthesis::fill::{fill_holes_cpu, FillParams};
+use alpenglow::synthesis::fill::{fill_holes_cpu, plan_hole_fill, FillParams};
+use alpenglow::synthesis::gpu::GpuSearch;
+use alpenglow::vulkan::{Context, ContextOptions};
 use glam::DVec2;
 
 const SIDE: u32 = 1025;
@@ -70,15 +72,23 @@ fn main() -> alpenglow::Result<()> {
             }
         }
     }
-    if search != "cpu" {
-        eprintln!("--search {search}: GPU search not built yet; use --search cpu");
+    if search != "cpu" && search != "gpu" {
+        eprintln!("--search {search}: use cpu or gpu");
         std::process::exit(2);
     }
+    let ctx = if search == "gpu" {
+        Some(Context::new(&ContextOptions::default())?)
+    } else {
+        None
+    };
     let field = dem()?;
     let params = FillParams::default();
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let device = ctx
+        .as_ref()
+        .map_or(format!("{threads} threads"), |c| c.info().name.clone());
     println!(
-        "synth_bench: {SIDE}² DEM, window {}, {} candidates, batch {}, {search} search ({threads} threads)",
+        "synth_bench: {SIDE}² DEM, window {}, {} candidates, batch {}, {search} search ({device})",
         params.window, params.candidates, params.batch
     );
     println!("{:>6} {:>8} {:>10} {:>12}", "hole", "samples", "seconds", "µs/sample");
@@ -100,7 +110,16 @@ fn main() -> alpenglow::Result<()> {
             .map(|i| (lo..lo + size).contains(&(i % SIDE)) && (lo..lo + size).contains(&(i / SIDE)))
             .collect();
         let started = Instant::now();
-        fill_holes_cpu(&field, &unknown, &params, &mut |_, _| {})?;
+        match &ctx {
+            Some(ctx) => {
+                let growth = plan_hole_fill(&field, &unknown, &params)?;
+                let mut gpu = GpuSearch::new(ctx, growth.exemplar().clone(), growth.search_config())?;
+                growth.grow(&mut gpu, &mut |_, _| {})?;
+            }
+            None => {
+                fill_holes_cpu(&field, &unknown, &params, &mut |_, _| {})?;
+            }
+        }
         let seconds = started.elapsed().as_secs_f64();
         rate = Some(seconds / samples as f64);
         println!(

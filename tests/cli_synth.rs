@@ -209,11 +209,6 @@ fn bad_inputs_are_one_line_errors_and_write_nothing() {
             vec!["--window", "larger"],
         ),
         (
-            "gpu",
-            fill(&["--spacing", "1"], &mask, &out),
-            vec!["GPU search not built yet"],
-        ),
-        (
             "extension",
             fill(&FAST, &mask, &outputs.join("o.txt").display().to_string()),
             vec!["--out", ".png"],

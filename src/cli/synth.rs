@@ -14,7 +14,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use alpenglow::io::heightmap::{load_heightmap, load_heightmap_with_voids, HeightField, HeightmapOptions, RowOrder};
 use alpenglow::io::image_out::{encode_exr_height, encode_png_gray16};
 use alpenglow::synthesis::fill::{plan_hole_fill, FillParams, Growth};
-use alpenglow::synthesis::search::{CpuSearch, NeighbourhoodSearch};
+use alpenglow::synthesis::gpu::GpuSearch;
+use alpenglow::synthesis::search::CpuSearch;
 use alpenglow::synthesis::transition::{plan_transition, Axis, TransitionParams};
 
 use crate::cli::args::{parse_spacing, RowsArg};
@@ -89,6 +90,8 @@ pub struct GrowArgs {
     /// Neighbourhood search.
     #[arg(long, value_enum, default_value = "gpu", value_name = "DEVICE")]
     pub search: SearchArg,
+    #[command(flatten)]
+    pub device: crate::cli::args::DeviceArgs,
 }
 
 impl GrowArgs {
@@ -232,7 +235,7 @@ fn fill(args: FillArgs) -> Result<ExitCode> {
         );
     }
     let started = Instant::now();
-    let filled = grow_with(growth, args.grow.search)?;
+    let filled = grow_with(growth, &args.grow)?;
     let seconds = started.elapsed().as_secs_f64();
     outputs.stage(Some(&args.out), || encode_field(&args.out, &filled, &args.heights))?;
     outputs.commit()?;
@@ -271,7 +274,7 @@ fn transition(args: TransitionArgs) -> Result<ExitCode> {
     let (growth, transition) = plan_transition(&a, &b, &params)?;
     let band = transition.band;
     let started = Instant::now();
-    let residual = grow_with(growth, args.grow.search)?;
+    let residual = grow_with(growth, &args.grow)?;
     let joined = transition.finish(&residual, params.blur_radius);
     let seconds = started.elapsed().as_secs_f64();
     outputs.stage(Some(&args.out), || encode_field(&args.out, &joined, &args.heights))?;
@@ -287,22 +290,36 @@ fn transition(args: TransitionArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Grows `growth` with the search of `--search`, with a progress bar on
+/// Grows `growth` with the search of `--search` (on the GPU: the device
+/// of `--device`, validated with `--validation`), with a progress bar on
 /// stderr when it is a terminal.
-fn grow_with(growth: Growth, search: SearchArg) -> Result<HeightField> {
-    let mut search: Box<dyn NeighbourhoodSearch> = match search {
-        SearchArg::Gpu => bail!("--search gpu: GPU search not built yet; use --search cpu"),
-        SearchArg::Cpu => Box::new(CpuSearch {
-            exemplar: growth.exemplar().clone(),
-            config: growth.search_config(),
-        }),
-    };
+fn grow_with(growth: Growth, args: &GrowArgs) -> Result<HeightField> {
     let bar = ProgressBar::new(growth.unknown_count() as u64);
     bar.set_style(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} samples grown (eta {eta})")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let grown = growth.grow(search.as_mut(), &mut |done, _| bar.set_position(done as u64))?;
+    let mut progress = |done: usize, _| bar.set_position(done as u64);
+    let grown = match args.search {
+        SearchArg::Cpu => {
+            let mut search = CpuSearch {
+                exemplar: growth.exemplar().clone(),
+                config: growth.search_config(),
+            };
+            growth.grow(&mut search, &mut progress)?
+        }
+        SearchArg::Gpu => {
+            let ctx = super::context(&args.device)?;
+            let report = ctx.validation_report();
+            let grown = {
+                let mut search = GpuSearch::new(&ctx, growth.exemplar().clone(), growth.search_config())?;
+                growth.grow(&mut search, &mut progress)?
+            };
+            drop(ctx);
+            super::check_validation(report)?;
+            grown
+        }
+    };
     bar.finish_and_clear();
     Ok(grown)
 }
