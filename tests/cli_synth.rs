@@ -241,3 +241,31 @@ fn bad_inputs_are_one_line_errors_and_write_nothing() {
     assert_one_line_error("transition sizes", &t, &["same size"]);
     assert_no_files_left("errors", &outputs);
 }
+
+#[test]
+fn the_gpu_search_gives_the_cpu_twins_output_under_validation() {
+    let dir = fresh_dir("synth-gpu");
+    let outputs: Vec<Vec<u8>> = [&["--validation"][..], &["--search", "cpu"][..]]
+        .iter()
+        .enumerate()
+        .map(|(k, search)| {
+            let out = dir.join(format!("joined-{k}.exr")).display().to_string();
+            let mut a = vec![
+                "synth",
+                "transition",
+                "procedural:ridged,size=24,spacing=20",
+                "procedural:fbm,size=24,spacing=20",
+                "--band",
+                "80",
+                "--window",
+                "5",
+                "--out",
+                &out,
+            ];
+            a.extend_from_slice(search);
+            assert_success("transition", &run(&a));
+            std::fs::read(&out).unwrap()
+        })
+        .collect();
+    assert_eq!(outputs[0], outputs[1], "GPU and CPU searches differ");
+}
