@@ -40,6 +40,9 @@ pub enum Command {
     Spt(SptCommand),
     /// Print the Vulkan device, driver and the features in use.
     Info(DeviceArgs),
+    /// Height-field synthesis (§7.3): `synth fill`, `synth transition`.
+    #[command(subcommand)]
+    Synth(super::synth::SynthCommand),
 }
 
 #[derive(Args, Debug, Clone)]
@@ -490,7 +493,7 @@ fn parse_vec3(s: &str) -> Result<DVec3, String> {
     }
 }
 
-fn parse_spacing(s: &str) -> Result<(f64, f64), String> {
+pub(super) fn parse_spacing(s: &str) -> Result<(f64, f64), String> {
     let v = parse_numbers(s, "DX[,DY]")?;
     let (dx, dy) = match v.as_slice() {
         [d] => (*d, *d),

@@ -10,6 +10,7 @@ mod outputs;
 mod points;
 mod rig;
 mod spt;
+mod synth;
 mod terrain_spec;
 
 use std::path::PathBuf;
@@ -78,6 +79,7 @@ pub fn run() -> Result<ExitCode> {
         Command::Fly(args) => fly::fly(args),
         Command::Spt(args::SptCommand::Build(args)) => spt::build(args),
         Command::Info(args) => info(args),
+        Command::Synth(command) => synth::synth(command),
     }
 }
 
