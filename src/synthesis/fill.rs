@@ -10,9 +10,17 @@
 //! `v = 0` for unknown or outside samples. The search
 //! ([`crate::synthesis::search`]) picks one of the candidate windows within
 //! `(1+ε)` of the best match, and `p` takes all three channels of that
-//! window's centre texel; its height is the centre's height, copied
-//! exactly. Filled samples then count as known for later queries;
-//! candidates always come from the original known samples.
+//! window's centre texel. Its height is the centre's height raised by the
+//! offset that fits the window best: the `G·v`-weighted mean of
+//! `h_q − h'_q` over the known taps `q` (state minus candidate window).
+//! The text copies the height as it is; the match is on absolute heights,
+//! so the chosen window is usually close, but the small remaining offset
+//! is what showed as speckle and as a scar where two fronts meet. On the
+//! test DEM the offset raised the share of boundary gradients within the
+//! field's 99th percentile from 95.8 % to 97.6 % and lowered the curvature
+//! KS statistic from 0.122 to 0.103 (`tests/synthesis_fill.rs`). Filled
+//! samples then count as known for later queries; candidates always come
+//! from the original known samples.
 //!
 //! # Order and waves
 //!
@@ -131,6 +139,8 @@ pub struct Growth {
     exemplar: Arc<Exemplar>,
     exemplar_heights: Vec<f32>,
     params: FillParams,
+    /// Metres per unit of the height channel, for pasting with an offset.
+    height_scale: f32,
 }
 
 impl Growth {
@@ -169,6 +179,7 @@ impl Growth {
             exemplar: Arc::new(exemplar),
             exemplar_heights,
             params,
+            height_scale: 0.0,
         })
     }
 
@@ -210,8 +221,14 @@ impl Growth {
                     wave.len()
                 )));
             }
-            for (&p, choice) in wave.iter().zip(&choices) {
-                self.copy_candidate(p, choice)?;
+            // Offsets read the state before the wave, like the queries.
+            let offsets = wave
+                .iter()
+                .zip(&choices)
+                .map(|(&p, choice)| Ok(self.offset(p, self.centre(choice)?, &weights)))
+                .collect::<Result<Vec<f32>>>()?;
+            for ((&p, choice), offset) in wave.iter().zip(&choices).zip(offsets) {
+                self.copy_candidate(p, choice, offset)?;
             }
             order.mark_known(&wave, &self.unknown);
             done += wave.len();
@@ -242,17 +259,65 @@ impl Growth {
         Query { pixel: p, taps }
     }
 
-    /// Writes the chosen candidate's centre texel and height at `p`.
-    fn copy_candidate(&mut self, p: u32, choice: &Choice) -> Result<()> {
-        let centre = self
-            .exemplar
+    /// Pastes heights with the offset that fits the known taps best
+    /// (module docs); `height_scale`: metres per unit of the height channel.
+    pub fn paste_with_offset(mut self, height_scale: f32) -> Growth {
+        self.height_scale = height_scale;
+        self
+    }
+
+    /// Weighted mean of (state − candidate window) heights over the known
+    /// taps of `p`'s window, in metres.
+    fn offset(&self, p: u32, centre: u32, weights: &[f32]) -> f32 {
+        if self.height_scale <= 0.0 {
+            return 0.0;
+        }
+        let w = self.field.columns as i64;
+        let h = self.field.rows as i64;
+        let r = i64::from(self.params.window / 2);
+        let (x, y) = (i64::from(p) % w, i64::from(p) / w);
+        let ew = self.exemplar.width as i64;
+        let (cx, cy) = (i64::from(centre) % ew, i64::from(centre) / ew);
+        let (mut sum, mut weight) = (0.0f64, 0.0f64);
+        let mut t = 0;
+        for dy in -r..=r {
+            for dx in -r..=r {
+                let (qx, qy) = (x + dx, y + dy);
+                if qx >= 0 && qy >= 0 && qx < w && qy < h && !self.unknown[(qy * w + qx) as usize] {
+                    let e = self.exemplar_heights[((cy + dy) * ew + cx + dx) as usize];
+                    let q = self.field.heights[(qy * w + qx) as usize];
+                    sum += f64::from(weights[t]) * f64::from(q - e);
+                    weight += f64::from(weights[t]);
+                }
+                t += 1;
+            }
+        }
+        if weight > 0.0 {
+            (sum / weight) as f32
+        } else {
+            0.0
+        }
+    }
+
+    /// The exemplar texel at the centre of the chosen window.
+    fn centre(&self, choice: &Choice) -> Result<u32> {
+        self.exemplar
             .candidates
             .get(choice.candidate as usize)
             .copied()
-            .ok_or_else(|| Error::Graph(format!("the search chose candidate {} of none", choice.candidate)))?;
+            .ok_or_else(|| Error::Graph(format!("the search chose candidate {} of none", choice.candidate)))
+    }
+
+    /// Writes the chosen candidate's centre texel and height, raised by
+    /// `offset` metres, at `p`.
+    fn copy_candidate(&mut self, p: u32, choice: &Choice, offset: f32) -> Result<()> {
+        let centre = self.centre(choice)?;
         let p = p as usize;
         self.texels[p] = self.exemplar.texels[centre as usize];
-        self.field.heights[p] = self.exemplar_heights[centre as usize];
+        self.field.heights[p] = self.exemplar_heights[centre as usize] + offset;
+        if self.height_scale > 0.0 {
+            self.texels[p][0] += offset / self.height_scale;
+        }
         self.unknown[p] = false;
         Ok(())
     }
@@ -376,14 +441,15 @@ pub fn plan_hole_fill(field: &HeightField, unknown: &[bool], params: &FillParams
             *h = 0.0;
         }
     }
-    Growth::new(
+    Ok(Growth::new(
         state,
         unknown.to_vec(),
         texels,
         exemplar,
         field.heights.clone(),
         *params,
-    )
+    )?
+    .paste_with_offset(norm.height_scale as f32))
 }
 
 /// Fills the `unknown` samples of `field` with `search`, which must hold
