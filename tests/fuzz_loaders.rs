@@ -10,7 +10,7 @@ use std::path::Path;
 use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
 use alpenglow::points::build::input::{load_points_file, PointInput};
 use alpenglow::points::build::spt_file::{read_spt, write_spt};
-use alpenglow::texturing::layers::LayerTree;
+use alpenglow::texturing::layers::{Constraint, LayerTree, MAX_BLUR_RADII, MAX_HEIGHT_BLUR, MAX_SAMPLES};
 use alpenglow::view::camera_path::load_keyframes;
 use alpenglow::view::rig::Rig;
 use fuzz::mutate::{fix_png_crcs, reseal_spt, Kind};
@@ -68,14 +68,36 @@ fn spt(path: &Path) -> Outcome {
 
 fn layers(path: &Path) -> Outcome {
     let tree = LayerTree::load(path)?;
+    let sampled_ok = |c: &Option<Constraint>| match c {
+        Some(Constraint::Sampled(s)) => {
+            s.min < s.max
+                && (1..=MAX_SAMPLES).contains(&s.samples.len())
+                && s.samples.iter().all(|v| (0.0..=1.0).contains(v))
+        }
+        _ => true,
+    };
     let ok = !tree.layers.is_empty()
+        && tree.blur_radii().len() <= MAX_BLUR_RADII
         && tree.layers.iter().all(|l| {
-            l.layer.color.is_finite() && l.layer.color.min_element() >= 0.0 && l.layer.color.max_element() <= 1.0
+            let l = &l.layer;
+            let constraints = [
+                &l.altitude,
+                &l.elevation,
+                &l.slope,
+                &l.inputs[0],
+                &l.inputs[1],
+                &l.inputs[2],
+            ];
+            l.color.is_finite()
+                && l.color.min_element() >= 0.0
+                && l.color.max_element() <= 1.0
+                && constraints.into_iter().all(sampled_ok)
+                && l.height_blur.map_or(true, |r| r > 0.0 && r <= MAX_HEIGHT_BLUR)
         });
     Ok(if ok {
         Ok(())
     } else {
-        Err("empty tree or a colour out of range".into())
+        Err("empty tree, a colour, sampled function or height_blur out of range".into())
     })
 }
 

@@ -11,23 +11,26 @@
 mod common;
 
 use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
-use alpenglow::renderer::{FrameImages, RenderSettings, Renderer, Scene};
+use alpenglow::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
+use alpenglow::terrain::geometry_image::TerrainSettings;
 use alpenglow::texturing::generation::TextureStreaming;
 use alpenglow::texturing::gpu_layout::TexturingMode;
 use alpenglow::texturing::layers::LayerTree;
+use alpenglow::texturing::reference::ReferenceSurface;
 use common::atlas::check_texels_against_cpu;
 use common::{assert_validation_clean, data, dump_pngs, jacksboro_field, mean_flip, validated_context};
+use glam::DVec2;
 
 const WIDTH: u32 = 160;
 const HEIGHT: u32 = 90;
 /// Mean FLIP of the atlas frame against the direct frame (as tests/texturing_atlas.rs).
 const MAX_MEAN_FLIP: f32 = 0.05;
 
-/// A settled frame of the default camera in `mode`, under validation.
+/// A settled frame of `camera` in `mode`, under validation.
 /// `readback` (atlas mode): also the atlas, read back, with the frame's page
 /// table and the atlas size, compared with the CPU twin on a 6×6 grid of
 /// inner texels of every tile the frame draws from.
-fn render(name: &str, scene: &Scene, mode: TexturingMode, readback: bool) -> FrameImages {
+fn render(name: &str, scene: &Scene, camera: &Camera, mode: TexturingMode, readback: bool) -> FrameImages {
     let (ctx, report) = validated_context();
     let (images, atlas) = {
         let streaming = TextureStreaming {
@@ -45,7 +48,7 @@ fn render(name: &str, scene: &Scene, mode: TexturingMode, readback: bool) -> Fra
             ..RenderSettings::new(WIDTH, HEIGHT)
         };
         let mut renderer = Renderer::new(&ctx, scene, settings).expect("renderer");
-        let frame = renderer.render_settled(&scene.default_camera(), 16).expect("frame");
+        let frame = renderer.render_settled(camera, 16).expect("frame");
         let atlas = readback.then(|| {
             assert!(renderer.pass_names().iter().any(|p| p == "texturing.readback"));
             let atlas = renderer.read_texture_atlas(&frame).expect("atlas readback");
@@ -66,7 +69,7 @@ fn render(name: &str, scene: &Scene, mode: TexturingMode, readback: bool) -> Fra
 }
 
 fn check_atlas_against_cpu(name: &str, scene: &Scene) {
-    render(name, scene, TexturingMode::Atlas, true);
+    render(name, scene, &scene.default_camera(), TexturingMode::Atlas, true);
 }
 
 #[test]
@@ -118,27 +121,97 @@ fn sampled_tree(lo: f32, hi: f32) -> LayerTree {
     LayerTree::parse(&text, "sampled tree").expect("sampled tree")
 }
 
+/// Atlas texels against the CPU twin, and the atlas frame against the
+/// direct frame; every layer in `layers` dominates more than 1 % of both
+/// frames (classes: 10 + layer). Returns the atlas frame.
+fn check_atlas_direct_and_cpu(name: &str, scene: &Scene, camera: &Camera, layers: &[u32]) -> FrameImages {
+    let atlas = render(name, scene, camera, TexturingMode::Atlas, true);
+    let direct = render(name, scene, camera, TexturingMode::Direct, false);
+    let names = (format!("{name}-atlas"), format!("{name}-direct"));
+    dump_pngs(&[(&names.0, &atlas.rgba8), (&names.1, &direct.rgba8)], WIDTH, HEIGHT);
+    let (mean, _) = mean_flip(&direct.rgba8, &atlas.rgba8, WIDTH, HEIGHT);
+    eprintln!("{name}: mean FLIP atlas vs direct {mean:.4}");
+    assert!(mean <= MAX_MEAN_FLIP, "{name}: mean FLIP {mean:.4} > {MAX_MEAN_FLIP}");
+    for (mode, frame) in [("atlas", &atlas), ("direct", &direct)] {
+        for &layer in layers {
+            let share = frame.class.iter().filter(|&&c| c == 10 + layer).count() as f64 / frame.class.len() as f64;
+            assert!(
+                share > 0.01,
+                "{name} {mode}: layer {layer} dominates {share:.4} of the frame"
+            );
+        }
+    }
+    atlas
+}
+
 #[test]
 fn sampled_functions_match_the_cpu_reference_in_atlas_and_direct_mode() {
     let mut scene = Scene::new(jacksboro_field());
     let (lo, hi) = scene.heights.min_max();
     scene.layers = sampled_tree(lo, hi);
     scene.input_maps[0] = Some(load_heightmap(&data("rainfall.png"), &HeightmapOptions::default()).expect("map"));
-    let atlas = render("sampled tree", &scene, TexturingMode::Atlas, true);
-    let direct = render("sampled tree", &scene, TexturingMode::Direct, false);
-    dump_pngs(
-        &[("sampled-atlas", &atlas.rgba8), ("sampled-direct", &direct.rgba8)],
-        WIDTH,
-        HEIGHT,
-    );
-    let (mean, _) = mean_flip(&direct.rgba8, &atlas.rgba8, WIDTH, HEIGHT);
-    eprintln!("sampled tree: mean FLIP atlas vs direct {mean:.4}");
-    assert!(mean <= MAX_MEAN_FLIP, "mean FLIP {mean:.4} > {MAX_MEAN_FLIP}");
-    // Every layer dominates somewhere in both frames (classes: 10 + layer).
-    for (mode, frame) in [("atlas", &atlas), ("direct", &direct)] {
-        for layer in 0..4u32 {
-            let share = frame.class.iter().filter(|&&c| c == 10 + layer).count() as f64 / frame.class.len() as f64;
-            assert!(share > 0.01, "{mode}: layer {layer} dominates {share:.4} of the frame");
+    check_atlas_direct_and_cpu("sampled tree", &scene, &scene.default_camera(), &[0, 1, 2, 3]);
+}
+
+/// 3 km from the height field's highest sample towards the terrain's
+/// centre, 800 m above it, looking at it (where the snow is).
+fn peak_camera(scene: &Scene) -> Camera {
+    let field = &scene.heights;
+    let (peak, top) =
+        (field.heights.iter().enumerate()).fold((0, f32::MIN), |best, (i, &h)| if h > best.1 { (i, h) } else { best });
+    let columns = field.columns as usize;
+    let at = DVec2::new((peak % columns) as f64, (peak / columns) as f64) * field.spacing;
+    let eye = at + (field.extent() * 0.5 - at).normalize_or_zero() * 3000.0;
+    Camera {
+        eye: eye.extend(f64::from(top) + 800.0),
+        target: at.extend(f64::from(top) - 200.0),
+        ..scene.default_camera()
+    }
+}
+
+/// `height_blur` (§8.2.3, snow in furrows): examples/layers/snow_in_furrows.toml
+/// plus a second radius (a lower "firn" layer) evaluate alike on the CPU,
+/// in the atlas and per pixel, and the blur changes the layers.
+#[test]
+fn blurred_heights_match_the_cpu_reference_in_atlas_and_direct_mode() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/layers/snow_in_furrows.toml");
+    let text = std::fs::read_to_string(&path).expect("example");
+    let firn = "\n[[root.children]]\nname = \"firn\"\ncolor = [0.70, 0.72, 0.78]\nheight_blur = 400.0\n\
+                elevation = { samples = [0.0, 0.3, 1.0, 1.0], min = 0.55, max = 0.8 }\n\
+                slope = { samples = [1.0, 1.0, 0.2, 0.0], max = 40.0 }\n";
+    let mut scene = Scene::new(jacksboro_field());
+    scene.layers = LayerTree::parse(&format!("{text}{firn}"), "snow and firn").expect("layers");
+    assert_eq!(scene.layers.blur_radii(), [100.0, 400.0]);
+    let snow = scene
+        .layers
+        .layers
+        .iter()
+        .position(|l| l.layer.name == "snow")
+        .expect("snow") as u32;
+    let camera = peak_camera(&scene);
+    check_atlas_direct_and_cpu("blurred", &scene, &camera, &[0, snow, snow + 1]);
+    // The blur matters: on the CPU twin, the snow and firn coverage of the
+    // same tree without height_blur differs on a 24 × 24 grid of points
+    // over the 6 km around the peak.
+    let mut sharp = scene.layers.clone();
+    sharp.layers.iter_mut().for_each(|l| l.layer.height_blur = None);
+    let seed = TerrainSettings::default().noise_seed;
+    let reference = |tree| ReferenceSurface::new(&scene.heights, tree, &scene.input_maps, seed).expect("cpu");
+    let (with, without) = (reference(&scene.layers), reference(&sharp));
+    let peak = camera.target.truncate();
+    let (mut changed, mut covered) = (0, 0);
+    for j in 0..24 {
+        for i in 0..24 {
+            let xy = peak + (DVec2::new(f64::from(i), f64::from(j)) / 23.0 - 0.5) * 6000.0;
+            let snow_and_firn = |r: &ReferenceSurface| {
+                let c = r.evaluate(xy, 10.0).coverage;
+                c[snow as usize] + c[snow as usize + 1]
+            };
+            let (a, b) = (snow_and_firn(&with), snow_and_firn(&without));
+            changed += usize::from((a - b).abs() > 0.1);
+            covered += usize::from(a.max(b) > 0.1);
         }
     }
+    eprintln!("blurred: snow or firn at {covered} of 576 points, changed by height_blur at {changed}");
+    assert!(changed * 5 > covered && covered > 50, "{changed} of {covered}");
 }

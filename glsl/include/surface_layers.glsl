@@ -4,17 +4,28 @@
 // coverage with noise, depth-first colour blending, displacement feeding
 // the next layers' altitude and the normal. Same rules as the CPU reference
 // src/texturing/layers.rs (`evaluate`); layout as src/texturing/gpu_layout.rs.
+// A `height_blur` layer's altitude, elevation and slope read a blurred
+// height field instead (§8.2.3, snow in furrows; src/texturing/blurred_height.rs).
 // Needs terrain_detail.glsl (wavelet noise) included first.
 #ifndef ALPENGLOW_SURFACE_LAYERS_GLSL
 #define ALPENGLOW_SURFACE_LAYERS_GLSL
 
 #include "heap.glsl"
+#include "bspline_height.glsl"
 
 struct SurfaceLayer {
     vec4 color_roughness;  // linear colour, roughness B_S (metres)
     vec4 noise;            // c_S, n_S, coverage-noise wavelength, displacement-noise wavelength
     vec4 hats[6];          // constraints (see `constraint`): altitude, elevation, slope, rainfall, radiation, temperature
-    uvec4 tree;            // parent (0xffffffff: root), level
+    uvec4 tree;            // parent (0xffffffff: root), level, blurred height field (sampled), 1: height_blur
+};
+
+// The height field's texture (sampled handle), columns × rows and sample
+// spacing (metres): what a `height_blur` layer needs besides its blurred field.
+struct BaseField {
+    uint heights;
+    uvec2 dims;
+    vec2 spacing;
 };
 
 layout(set = 0, binding = 2, std430) readonly buffer SurfaceLayers { SurfaceLayer l[]; } g_surface_layers[];
@@ -120,17 +131,30 @@ LayerState layer_state(float h, vec2 grad) {
 // Layer i of the flat depth-first tree applied at world xy: coverage from
 // the constraints (altitude and elevation of the modified height, base slope,
 // input maps `maps`), noise and the parent's coverage; colour blend;
-// displacement. `range`: the height field's lowest and highest sample.
-void apply_layer(uint layers, uint i, uint tile, vec2 xy, float footprint, vec2 range, vec3 maps, inout LayerState s) {
-    uint level = g_surface_layers[layers].l[i].tree.y;
+// displacement. `range`: the height field's lowest and highest sample;
+// `field`: the base height field (read by `height_blur` layers).
+void apply_layer(uint layers, uint i, uint tile, vec2 xy, float footprint, vec2 range, vec3 maps, BaseField field,
+                 inout LayerState s) {
+    uvec4 tree = g_surface_layers[layers].l[i].tree;
+    uint level = tree.y;
     vec4 color_roughness = g_surface_layers[layers].l[i].color_roughness;
     vec4 noise = g_surface_layers[layers].l[i].noise;
     float c_s = 1.0;
     if (level > 0u) {
+        float altitude = s.h;
+        float slope = s.slope;
+        if (tree.w != 0u) {
+            // The blurred surface plus what the layers before added.
+            vec2 base_grad, blurred_grad;
+            float base = bspline_height(field.heights, field.dims, field.spacing, xy, base_grad);
+            float blurred = bspline_height(tree.z, field.dims, field.spacing, xy, blurred_grad);
+            altitude = blurred + (s.h - base);
+            slope = degrees(atan(length(blurred_grad)));
+        }
         float product =
-            constraint(layers, g_surface_layers[layers].l[i].hats[0], s.h) *
-            constraint(layers, g_surface_layers[layers].l[i].hats[1], (s.h - range.x) / max(range.y - range.x, 1e-6)) *
-            constraint(layers, g_surface_layers[layers].l[i].hats[2], s.slope) *
+            constraint(layers, g_surface_layers[layers].l[i].hats[0], altitude) *
+            constraint(layers, g_surface_layers[layers].l[i].hats[1], (altitude - range.x) / max(range.y - range.x, 1e-6)) *
+            constraint(layers, g_surface_layers[layers].l[i].hats[2], slope) *
             constraint(layers, g_surface_layers[layers].l[i].hats[3], maps.x) *
             constraint(layers, g_surface_layers[layers].l[i].hats[4], maps.y) *
             constraint(layers, g_surface_layers[layers].l[i].hats[5], maps.z);
@@ -167,10 +191,10 @@ void apply_layer(uint layers, uint i, uint tile, vec2 xy, float footprint, vec2 
 // The whole tree at world xy of the base surface (height h, gradient grad):
 // colour, the displacement gradient in `extra` and the dominant layer.
 vec3 evaluate_layers(uint layers, uint count, uint tile, vec2 xy, float footprint, float h, vec2 grad, vec2 range,
-                     vec3 maps, out vec2 extra, out uint dominant) {
+                     vec3 maps, BaseField field, out vec2 extra, out uint dominant) {
     LayerState s = layer_state(h, grad);
     for (uint i = 0u; i < count && i < MAX_SURFACE_LAYERS; ++i) {
-        apply_layer(layers, i, tile, xy, footprint, range, maps, s);
+        apply_layer(layers, i, tile, xy, footprint, range, maps, field, s);
     }
     extra = s.extra;
     dominant = s.dominant;

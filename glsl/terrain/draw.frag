@@ -124,8 +124,9 @@ void main() {
             float h = bspline_height(th.y, g_texturing[texturing].grid.xy, sr.xy, in_world.xy, base_grad);
             float footprint = max(depth, 1e-3) * pc.forward.w;
             vec3 maps = input_maps(g_texturing[texturing].maps, in_world.xy / g_texturing[texturing].extent.xy);
+            BaseField field = BaseField(th.y, g_texturing[texturing].grid.xy, sr.xy);
             a = evaluate_layers(th.x, g_texturing[texturing].grid.z, th.z, in_world.xy, footprint, h, base_grad, sr.zw,
-                                maps, extra, layer);
+                                maps, field, extra, layer);
             // The layers' displacement bumps the normal on top of the mesh's.
             n = normalize(n + vec3(-extra, 0.0) * n.z);
             semantic = CLASS_LAYER_BASE + layer;

@@ -27,6 +27,7 @@ void main() {
         }
     }
     vec3 maps = input_maps(maps_used, xy / pc.extent.xy);
-    apply_layer(pc.handles.z, pc.counts.z, pc.handles.w, xy, texel_footprint(job), pc.spacing_range.zw, maps, s);
+    BaseField field = BaseField(pc.counts.w, pc.grid.xy, pc.spacing_range.xy);
+    apply_layer(pc.handles.z, pc.counts.z, pc.handles.w, xy, texel_footprint(job), pc.spacing_range.zw, maps, field, s);
     g_texel_states[pc.handles.y].t[texel] = pack_state(s);
 }

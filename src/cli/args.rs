@@ -43,6 +43,9 @@ pub enum Command {
     /// Surface-layer trees: `layers from-image` (§8.3).
     #[command(subcommand)]
     Layers(super::layers::LayersCommand),
+    /// Height-field synthesis (§7.3): `synth fill`, `synth transition`.
+    #[command(subcommand)]
+    Synth(super::synth::SynthCommand),
 }
 
 #[derive(Args, Debug, Clone)]
@@ -493,7 +496,7 @@ fn parse_vec3(s: &str) -> Result<DVec3, String> {
     }
 }
 
-pub(crate) fn parse_spacing(s: &str) -> Result<(f64, f64), String> {
+pub(super) fn parse_spacing(s: &str) -> Result<(f64, f64), String> {
     let v = parse_numbers(s, "DX[,DY]")?;
     let (dx, dy) = match v.as_slice() {
         [d] => (*d, *d),
@@ -505,7 +508,7 @@ pub(crate) fn parse_spacing(s: &str) -> Result<(f64, f64), String> {
 }
 
 /// `NAME=FILE` of `--input-map`.
-pub(crate) fn parse_input_map(s: &str) -> Result<(usize, PathBuf), String> {
+pub(super) fn parse_input_map(s: &str) -> Result<(usize, PathBuf), String> {
     let names = alpenglow::texturing::layers::INPUT_NAMES;
     let (name, file) = s.split_once('=').ok_or_else(|| format!("'{s}': expected NAME=FILE"))?;
     let k = (names.iter().position(|n| *n == name))

@@ -11,6 +11,7 @@ mod outputs;
 mod points;
 mod rig;
 mod spt;
+mod synth;
 mod terrain_spec;
 
 use std::path::PathBuf;
@@ -80,6 +81,7 @@ pub fn run() -> Result<ExitCode> {
         Command::Spt(args::SptCommand::Build(args)) => spt::build(args),
         Command::Info(args) => info(args),
         Command::Layers(command) => layers::run(command),
+        Command::Synth(command) => synth::synth(command),
     }
 }
 

@@ -46,8 +46,9 @@ pub fn is_tiff(bytes: &[u8]) -> bool {
 const TAG_BYTES: usize = 1 << 20;
 
 /// Decodes a greyscale (Geo)TIFF into raw values with the spacing and row
-/// order of its georeferencing.
-pub(crate) fn decode_geotiff(path: &Path, bytes: &[u8], limits: &InputLimits) -> Result<RawGrid> {
+/// order of its georeferencing. No-data samples are an error, or NaN with
+/// `voids` (the unknown samples of [`crate::io::heightmap::load_heightmap_with_voids`]).
+pub(crate) fn decode_geotiff(path: &Path, bytes: &[u8], limits: &InputLimits, voids: bool) -> Result<RawGrid> {
     let bad = |e: tiff::TiffError| Error::input(path, format!("invalid TIFF: {}", one_line(e)));
     let mut decoder = Decoder::new(Cursor::new(bytes)).map_err(bad)?;
     let (w, h) = decoder.dimensions().map_err(bad)?;
@@ -81,12 +82,16 @@ pub(crate) fn decode_geotiff(path: &Path, bytes: &[u8], limits: &InputLimits) ->
         .unwrap_or(usize::MAX)
         .max(TAG_BYTES);
     let mut decoder = decoder.with_limits(image_limits);
-    let values = samples(decoder.read_image().map_err(bad)?);
+    let mut values = samples(decoder.read_image().map_err(bad)?);
     if values.len() as u64 != u64::from(w) * u64::from(h) {
         return Err(Error::input(
             path,
             format!("{} samples for a {w}×{h} image", values.len()),
         ));
+    }
+    let is_nodata = |v: f32| nodata.is_some_and(|n| f64::from(v) == n as f32 as f64);
+    if voids {
+        values.iter_mut().filter(|v| is_nodata(**v)).for_each(|v| *v = f32::NAN);
     }
     if let Some(nodata) = nodata {
         if let Some(i) = values.iter().position(|&v| f64::from(v) == nodata as f32 as f64) {

@@ -252,6 +252,21 @@ const EXR_MAGIC: &[u8] = &[0x76, 0x2f, 0x31, 0x01];
 /// smaller than 2×2 samples, and NaN, infinite or out-of-range heights (the
 /// first bad sample's column and row are named).
 pub fn load_heightmap(path: &Path, opts: &HeightmapOptions) -> Result<HeightField> {
+    load(path, opts, false).map(|(field, _)| field)
+}
+
+/// [`load_heightmap`] that accepts voids: NaN or infinite samples of PNG,
+/// EXR and TIFF files, a GeoTIFF's `GDAL_NODATA` samples and an SRTM
+/// `.hgt` file's voids (−32768). Returns the field, with height 0 m
+/// (`0·scale + offset`) at each void, and the void mask (row-major like the
+/// heights; `true`: unknown). The unknown samples of hole filling
+/// (`crate::synthesis::fill`, §7.3).
+pub fn load_heightmap_with_voids(path: &Path, opts: &HeightmapOptions) -> Result<(HeightField, Vec<bool>)> {
+    load(path, opts, true)
+}
+
+/// [`load_heightmap`], with `voids`: [`load_heightmap_with_voids`].
+fn load(path: &Path, opts: &HeightmapOptions, voids: bool) -> Result<(HeightField, Vec<bool>)> {
     check_options(path, opts)?;
     let bytes = crate::io::read_input_limited(path, opts.limits.max_file_bytes)?;
     if bytes.is_empty() {
@@ -264,9 +279,9 @@ pub fn load_heightmap(path: &Path, opts: &HeightmapOptions) -> Result<HeightFiel
     } else if bytes.starts_with(EXR_MAGIC) {
         decode_exr(path, &bytes, &opts.limits)?
     } else if crate::io::geotiff::is_tiff(&bytes) {
-        crate::io::geotiff::decode_geotiff(path, &bytes, &opts.limits)?
+        crate::io::geotiff::decode_geotiff(path, &bytes, &opts.limits, voids)?
     } else if ext.as_deref() == Some("hgt") {
-        crate::io::hgt::decode_hgt(path, &bytes)?
+        crate::io::hgt::decode_hgt(path, &bytes, voids)?
     } else {
         let msg = match ext.as_deref() {
             Some("png") => "not a PNG file (bad signature)",
@@ -277,7 +292,7 @@ pub fn load_heightmap(path: &Path, opts: &HeightmapOptions) -> Result<HeightFiel
         return Err(Error::input(path, msg));
     };
     drop(bytes);
-    field_from_grid(path, grid, opts)
+    field_from_grid(path, grid, opts, voids)
 }
 
 /// Checks scale, offset and spacing before the file is read.
@@ -315,8 +330,14 @@ impl RawGrid {
 }
 
 /// Checks, orients and scales a decoded grid (in place: no second copy of
-/// the samples).
-fn field_from_grid(path: &Path, grid: RawGrid, opts: &HeightmapOptions) -> Result<HeightField> {
+/// the samples); with `voids`, non-finite samples become 0 and `true` in
+/// the returned mask (else they are an error and the mask is empty).
+fn field_from_grid(
+    path: &Path,
+    grid: RawGrid,
+    opts: &HeightmapOptions,
+    voids: bool,
+) -> Result<(HeightField, Vec<bool>)> {
     let RawGrid {
         columns,
         rows,
@@ -333,6 +354,11 @@ fn field_from_grid(path: &Path, grid: RawGrid, opts: &HeightmapOptions) -> Resul
             format!("image is {columns}×{rows}; a height field needs at least 2×2 samples"),
         ));
     }
+    let mut unknown = Vec::new();
+    if voids {
+        unknown = raw.iter().map(|v| !v.is_finite()).collect();
+        raw.iter_mut().filter(|v| !v.is_finite()).for_each(|v| *v = 0.0);
+    }
     if let Some(i) = raw.iter().position(|v| !v.is_finite()) {
         let (c, r) = (i % columns as usize, i / columns as usize);
         return Err(Error::input(
@@ -342,6 +368,7 @@ fn field_from_grid(path: &Path, grid: RawGrid, opts: &HeightmapOptions) -> Resul
     }
     if north_up.unwrap_or(opts.rows == RowOrder::NorthUp) {
         flip_rows(&mut raw, columns as usize);
+        flip_rows(&mut unknown, columns as usize);
     }
     for v in &mut raw {
         *v = *v * opts.scale + opts.offset;
@@ -368,11 +395,11 @@ fn field_from_grid(path: &Path, grid: RawGrid, opts: &HeightmapOptions) -> Resul
     };
     // Catches overflow of value·scale + offset, among others.
     field.validate(path)?;
-    Ok(field)
+    Ok((field, unknown))
 }
 
 /// Reverses the order of the rows of `values` (`columns` per row) in place.
-fn flip_rows(values: &mut [f32], columns: usize) {
+fn flip_rows<T>(values: &mut [T], columns: usize) {
     let rows = values.len() / columns.max(1);
     for r in 0..rows / 2 {
         let (top, bottom) = values.split_at_mut((rows - 1 - r) * columns);

@@ -44,8 +44,9 @@ pub fn latitude_from_name(path: &Path) -> Option<f64> {
 }
 
 /// Decodes an SRTM `.hgt` file: its size gives the resolution, its name the
-/// latitude (for the spacing).
-pub(crate) fn decode_hgt(path: &Path, bytes: &[u8]) -> Result<RawGrid> {
+/// latitude (for the spacing). Voids are an error, or NaN samples with
+/// `voids` (the unknown samples of [`crate::io::heightmap::load_heightmap_with_voids`]).
+pub(crate) fn decode_hgt(path: &Path, bytes: &[u8], voids: bool) -> Result<RawGrid> {
     let (side, arc_seconds) = match bytes.len() {
         n if n == 1201 * 1201 * 2 => (1201u32, 3.0),
         n if n == 3601 * 3601 * 2 => (3601u32, 1.0),
@@ -67,6 +68,10 @@ pub(crate) fn decode_hgt(path: &Path, bytes: &[u8]) -> Result<RawGrid> {
     let mut values = Vec::with_capacity(bytes.len() / 2);
     for (i, b) in bytes.chunks_exact(2).enumerate() {
         let v = i16::from_be_bytes([b[0], b[1]]);
+        if v == VOID && voids {
+            values.push(f32::NAN);
+            continue;
+        }
         if v == VOID {
             let (c, r) = (i % side as usize, i / side as usize);
             return Err(Error::input(
@@ -112,17 +117,18 @@ mod tests {
     #[test]
     fn voids_and_sizes_are_errors() {
         let p = Path::new("N10E010.hgt");
-        let e = decode_hgt(p, &[0u8; 100]).unwrap_err().to_string();
+        let e = decode_hgt(p, &[0u8; 100], false).unwrap_err().to_string();
         assert!(e.contains("100 bytes"), "{e}");
         let mut bytes = vec![0u8; 1201 * 1201 * 2];
         bytes[2 * 1205..2 * 1205 + 2].copy_from_slice(&VOID.to_be_bytes());
-        let e = decode_hgt(p, &bytes).unwrap_err().to_string();
+        assert!(decode_hgt(p, &bytes, true).unwrap().values[1205].is_nan());
+        let e = decode_hgt(p, &bytes, false).unwrap_err().to_string();
         assert!(e.contains("column 4, row 1"), "{e}");
         bytes[2 * 1205..2 * 1205 + 2].copy_from_slice(&(-5i16).to_be_bytes());
-        let g = decode_hgt(p, &bytes).unwrap();
+        let g = decode_hgt(p, &bytes, false).unwrap();
         assert_eq!((g.columns, g.rows, g.values[1205]), (1201, 1201, -5.0));
         let s = g.spacing.unwrap();
         assert!((s.y - 92.18).abs() < 0.01 && (s.x - 91.22).abs() < 0.01, "{s}");
-        assert!(decode_hgt(Path::new("dem.hgt"), &bytes).is_err());
+        assert!(decode_hgt(Path::new("dem.hgt"), &bytes, false).is_err());
     }
 }

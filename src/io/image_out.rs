@@ -73,6 +73,27 @@ pub fn encode_png_rgba8(rgba: &[u8], width: u32, height: u32) -> Result<Vec<u8>>
     Ok(bytes)
 }
 
+/// Encodes a 16-bit greyscale PNG in memory (a height map the loaders
+/// read back exactly): `values` row-major, row 0 at the top.
+pub fn encode_png_gray16(values: &[u16], width: u32, height: u32) -> Result<Vec<u8>> {
+    let pixels = pixel_count("PNG image size", width, height)?;
+    if values.len() != pixels {
+        return Err(Error::invalid(
+            "PNG pixel data",
+            format!("{} values for a {width}×{height} image", values.len()),
+        ));
+    }
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    use image::{ExtendedColorType, ImageEncoder};
+    // The encoder takes native-endian samples and writes them big-endian.
+    let native: Vec<u8> = values.iter().flat_map(|v| v.to_ne_bytes()).collect();
+    let mut bytes = Vec::new();
+    PngEncoder::new_with_quality(&mut bytes, CompressionType::Default, FilterType::Adaptive)
+        .write_image(&native, width, height, ExtendedColorType::L16)
+        .map_err(|e| Error::invalid("PNG encoding", one_line(e)))?;
+    Ok(bytes)
+}
+
 /// Writes an 8-bit RGBA PNG.
 ///
 /// `rgba` holds 4 bytes per pixel, row-major, row 0 at the top, already
@@ -258,6 +279,36 @@ pub fn encode_exr_samples(
 
     let mut bytes = Cursor::new(Vec::new());
     image
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(|e| Error::invalid("EXR encoding", one_line(e)))?;
+    Ok(bytes.into_inner())
+}
+
+/// Encodes a one-channel OpenEXR height map in memory: 32-bit float
+/// channel `Y` (the channel the height-map loader reads first), `values`
+/// row-major, row 0 at the top, ZIP compression (lossless).
+pub fn encode_exr_height(values: &[f32], width: u32, height: u32) -> Result<Vec<u8>> {
+    use exr::prelude::{Encoding, Image, Layer, LayerAttributes, SpecificChannels, WritableImage};
+    let pixels = pixel_count("EXR image size", width, height)?;
+    if values.len() != pixels {
+        return Err(Error::invalid(
+            "EXR height data",
+            format!("{} values for a {width}×{height} image", values.len()),
+        ));
+    }
+    let w = width as usize;
+    let channels = SpecificChannels::build()
+        .with_channel("Y")
+        .with_pixel_fn(|p: exr::math::Vec2<usize>| (values[p.y() * w + p.x()],));
+    let layer = Layer::new(
+        (w, height as usize),
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        channels,
+    );
+    let mut bytes = Cursor::new(Vec::new());
+    Image::from_layer(layer)
         .write()
         .to_buffered(&mut bytes)
         .map_err(|e| Error::invalid("EXR encoding", one_line(e)))?;

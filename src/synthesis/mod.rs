@@ -5,6 +5,12 @@
 //!
 //! [`search`] is the neighbourhood search, the step that dominates the cost:
 //! a CPU twin and GPU compute passes ([`gpu`]) implement the same rule.
+//! [`exemplar`] builds the three channels and the candidate windows,
+//! [`fill`] grows the unknown samples in waves, [`transition`] joins two
+//! height fields across a grown band.
 
+pub mod exemplar;
+pub mod fill;
 pub mod gpu;
 pub mod search;
+pub mod transition;

@@ -99,7 +99,7 @@ impl Terrain {
         texturing: &TerrainTexturing,
     ) -> Result<Terrain> {
         let geometry = GeometryImage::new(ctx, field, settings)?;
-        let maps = InputMaps::import(ctx, graph, texturing.layers, texturing.input_maps)?;
+        let maps = InputMaps::import(ctx, graph, texturing.layers, texturing.input_maps, &geometry.field)?;
         let layer_count = texturing.layers.layers.len() as u32;
         if layer_count == 0 {
             return Err(Error::invalid("surface layers", "the tree has no layer"));
@@ -108,7 +108,7 @@ impl Terrain {
             ctx,
             "surface layers",
             BufferUsageFlags::STORAGE_BUFFER,
-            &pack_layers(texturing.layers).bytes(),
+            &pack_layers(texturing.layers, &maps.blurred_handles()).bytes(),
         )?);
         let sampled = |image: &Image, what| heap_handle(image.sampled_handle(), what);
         let handles = [

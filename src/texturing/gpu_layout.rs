@@ -40,7 +40,8 @@ pub struct GpuLayer {
     /// Constraints ([`pack_constraint`]): altitude, elevation, slope,
     /// rainfall, radiation, temperature.
     pub hats: [[f32; 4]; 6],
-    /// Parent index (u32::MAX: root), level, 0, 0.
+    /// Parent index (u32::MAX: root), level, and for a `height_blur` layer
+    /// the sampled handle of its blurred height field and 1 (else 0, 0).
     pub tree: [u32; 4],
 }
 
@@ -80,13 +81,16 @@ pub fn pack_constraint(c: Option<&Constraint>, layer_count: usize, samples: &mut
     }
 }
 
-/// The tree in evaluation order, with the samples of its sampled functions.
-pub fn pack_layers(tree: &LayerTree) -> PackedLayers {
+/// The tree in evaluation order, with the samples of its sampled functions;
+/// `blurred`: the sampled handle of the blurred height field of each
+/// `height_blur` radius ([`crate::texturing::input_maps::InputMaps::blurred_handles`]).
+pub fn pack_layers(tree: &LayerTree, blurred: &[(f32, u32)]) -> PackedLayers {
     let count = tree.layers.len();
     let mut samples = Vec::new();
     let layers = (tree.layers.iter())
         .map(|flat| {
             let l = &flat.layer;
+            let blur = (l.height_blur).and_then(|r| blurred.iter().find(|(radius, _)| *radius == r));
             let constraints = [
                 l.altitude.as_ref(),
                 l.elevation.as_ref(),
@@ -99,7 +103,12 @@ pub fn pack_layers(tree: &LayerTree) -> PackedLayers {
                 color_roughness: l.color.extend(l.roughness).to_array(),
                 noise: [l.noise_bias, l.noise_scale, l.noise_wavelength, l.roughness_wavelength],
                 hats: constraints.map(|c| pack_constraint(c, count, &mut samples)),
-                tree: [flat.parent.map_or(u32::MAX, |p| p as u32), flat.level as u32, 0, 0],
+                tree: [
+                    flat.parent.map_or(u32::MAX, |p| p as u32),
+                    flat.level as u32,
+                    blur.map_or(0, |(_, handle)| *handle),
+                    u32::from(blur.is_some()),
+                ],
             }
         })
         .collect();

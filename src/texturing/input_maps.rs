@@ -3,6 +3,9 @@
 //! field: each map's grid spans the terrain rectangle corner to corner at
 //! any resolution. Uploaded once as R32F textures; the layer shaders sample
 //! them bilinearly (`input_maps` in `glsl/include/surface_layers.glsl`).
+//! Also the blurred height fields of `height_blur` layers
+//! ([`crate::texturing::blurred_height`]), R32F as well, which the shaders
+//! sample with the base height's cubic B-spline.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -10,24 +13,52 @@ use std::sync::Arc;
 use crate::error::{Error, Result};
 use crate::graph::{ImageId, RenderGraph};
 use crate::io::heightmap::HeightField;
-use crate::texturing::layers::{LayerTree, INPUT_NAMES};
+use crate::texturing::blurred_height::blurred_height;
+use crate::texturing::layers::{LayerTree, INPUT_NAMES, MAX_BLUR_RADII};
 use crate::vulkan::{Context, Format, Image, ImageDesc, ImageUsageFlags};
 
 /// The input maps as graph resources with their sampled heap handles
-/// (`None`: absent).
+/// (`None`: absent), and the blurred height fields with their radius.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct InputMaps {
     pub maps: [Option<(ImageId, u32)>; 3],
+    pub blurred: [Option<(f32, ImageId, u32)>; MAX_BLUR_RADII],
+}
+
+/// Uploads `map`'s samples as an R32F texture `name` and imports it.
+fn upload<P: 'static>(
+    ctx: &Context,
+    graph: &mut RenderGraph<P>,
+    name: String,
+    map: &HeightField,
+) -> Result<(ImageId, u32)> {
+    let image = Image::with_data(
+        ctx,
+        ImageDesc {
+            name: name.clone(),
+            width: map.columns,
+            height: map.rows,
+            format: Format::R32_SFLOAT,
+            usage: ImageUsageFlags::SAMPLED,
+        },
+        bytemuck::cast_slice(&map.heights),
+    )?;
+    let handle = image
+        .sampled_handle()
+        .ok_or_else(|| Error::Graph(format!("{name} has no sampled handle")))?;
+    Ok((graph.import_image(Arc::new(image)), handle))
 }
 
 impl InputMaps {
     /// Checks that every input `tree` uses is present and valid, uploads
-    /// the present maps and imports them into `graph`.
+    /// the present maps and `field` blurred for each of the tree's
+    /// `height_blur` radii, and imports them into `graph`.
     pub fn import<P: 'static>(
         ctx: &Context,
         graph: &mut RenderGraph<P>,
         tree: &LayerTree,
         maps: &[Option<HeightField>; 3],
+        field: &HeightField,
     ) -> Result<InputMaps> {
         let mut out = InputMaps::default();
         for (k, map) in maps.iter().enumerate() {
@@ -42,28 +73,27 @@ impl InputMaps {
                 continue;
             };
             map.validate(Path::new(&format!("input map '{name}'")))?;
-            let image = Image::with_data(
-                ctx,
-                ImageDesc {
-                    name: format!("input map {name}"),
-                    width: map.columns,
-                    height: map.rows,
-                    format: Format::R32_SFLOAT,
-                    usage: ImageUsageFlags::SAMPLED,
-                },
-                bytemuck::cast_slice(&map.heights),
-            )?;
-            let handle = image
-                .sampled_handle()
-                .ok_or_else(|| Error::Graph(format!("input map '{name}' has no sampled handle")))?;
-            out.maps[k] = Some((graph.import_image(Arc::new(image)), handle));
+            out.maps[k] = Some(upload(ctx, graph, format!("input map {name}"), map)?);
+        }
+        for (k, radius) in tree.blur_radii().into_iter().enumerate().take(MAX_BLUR_RADII) {
+            let layer = (tree.layers.iter()).find(|l| l.layer.height_blur == Some(radius));
+            let what = format!("layer '{}': height_blur", layer.map_or("", |l| l.layer.name.as_str()));
+            let blurred = blurred_height(field, radius, &what)?;
+            let (image, handle) = upload(ctx, graph, format!("height blurred by {radius} m"), &blurred)?;
+            out.blurred[k] = Some((radius, image, handle));
         }
         Ok(out)
     }
 
-    /// The present maps.
+    /// The present maps and blurred height fields.
     pub fn present(&self) -> impl Iterator<Item = ImageId> + '_ {
-        self.maps.iter().flatten().map(|(id, _)| *id)
+        let blurred = self.blurred.iter().flatten().map(|(_, id, _)| *id);
+        self.maps.iter().flatten().map(|(id, _)| *id).chain(blurred)
+    }
+
+    /// Radii and sampled handles of the blurred height fields.
+    pub fn blurred_handles(&self) -> Vec<(f32, u32)> {
+        self.blurred.iter().flatten().map(|&(r, _, h)| (r, h)).collect()
     }
 
     /// `maps` of the shaders: sampled handles, and in w bit k when map k is

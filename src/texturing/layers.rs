@@ -38,6 +38,17 @@
 //! * **Noise**: N and D_S are fractional Brownian motion of the project's
 //!   wavelet noise (three octaves, lacunarity 2, gain 0.5, normalised to
 //!   about [−1, 1]) at the layer's wavelengths, decorrelated per layer.
+//! * **`height_blur = R`** (metres, (0, [`MAX_HEIGHT_BLUR`]], at most
+//!   [`MAX_BLUR_RADII`] distinct radii per tree; not on the root): §8.2.3
+//!   simulates snow "deposited in furrows by wind ... when a blurred
+//!   elevation data serves as input for the slope constraint evaluation".
+//!   Such a layer's constraints read the height field blurred with a
+//!   Gaussian of σ = R ([`crate::texturing::blurred_height`]), upsampled
+//!   with the same cubic B-spline as the base: its slope is that of the
+//!   blurred surface (as the text says), and its altitude and elevation are
+//!   the blurred height plus the displacement the layers before added
+//!   (h − H + H_R), so snow fills furrows — high on the smoothed surface and
+//!   gentle there — and thins on narrow ridges. Other layers are unchanged.
 //! * Colours are linear albedo in [0, 1], exactly 3 components.
 //! * Ranges (errors otherwise): roughness in [0, [`MAX_ROUGHNESS`]] m,
 //!   wavelengths in [`WAVELENGTH_RANGE`] m, noise bias and scale within
@@ -92,6 +103,10 @@ pub struct Layer {
     pub slope: Option<Constraint>,
     /// Constraints on the extra inputs, in [`INPUT_NAMES`] order.
     pub inputs: [Option<Constraint>; 3],
+    /// `height_blur` (metres, module docs): the altitude, elevation and
+    /// slope constraints read the height field blurred with a Gaussian of
+    /// this standard deviation.
+    pub height_blur: Option<f32>,
 }
 
 /// A layer in depth-first order with its place in the tree.
@@ -137,6 +152,7 @@ struct LayerFile {
     rainfall: Option<ConstraintFile>,
     radiation: Option<ConstraintFile>,
     temperature: Option<ConstraintFile>,
+    height_blur: Option<f32>,
     #[serde(default)]
     children: Vec<toml::Spanned<LayerFile>>,
 }
@@ -153,6 +169,10 @@ fn one() -> f32 {
 pub const MAX_ROUGHNESS: f32 = 1e4;
 /// Wavelengths of the noises (metres) lie in this range.
 pub const WAVELENGTH_RANGE: std::ops::RangeInclusive<f32> = 1e-3..=1e6;
+/// Largest `height_blur` (metres).
+pub const MAX_HEIGHT_BLUR: f32 = 1e5;
+/// Most distinct `height_blur` radii in a tree (one blurred height field each).
+pub const MAX_BLUR_RADII: usize = 2;
 /// Largest magnitude of the noise bias c_S and scale n_S.
 pub const MAX_NOISE_TERM: f32 = 1e3;
 
@@ -176,6 +196,11 @@ fn check_numbers(f: &LayerFile) -> std::result::Result<(), String> {
                 WAVELENGTH_RANGE.start(),
                 WAVELENGTH_RANGE.end()
             ));
+        }
+    }
+    if let Some(r) = f.height_blur {
+        if !(r > 0.0 && r <= MAX_HEIGHT_BLUR) {
+            return Err(format!("height_blur {r} is not in (0, {MAX_HEIGHT_BLUR}] m"));
         }
     }
     Ok(())
@@ -212,12 +237,35 @@ impl LayerTree {
         })?;
         let mut layers = Vec::new();
         flatten(text, origin, file.root, 0, None, &mut layers)?;
-        Ok(LayerTree { layers })
+        let tree = LayerTree { layers };
+        if tree.blur_radii().len() > MAX_BLUR_RADII {
+            let radii = tree.blur_radii();
+            return Err(Error::invalid(
+                origin,
+                format!(
+                    "{} distinct height_blur radii {radii:?}; a tree has at most {MAX_BLUR_RADII}",
+                    radii.len()
+                ),
+            ));
+        }
+        Ok(tree)
     }
 
     /// The root layer.
     pub fn root(&self) -> Option<&Layer> {
         self.layers.first().map(|l| &l.layer)
+    }
+
+    /// The distinct `height_blur` radii (metres), in depth-first order of
+    /// first use: index k is the blurred height field k.
+    pub fn blur_radii(&self) -> Vec<f32> {
+        let mut radii: Vec<f32> = Vec::new();
+        for r in self.layers.iter().filter_map(|l| l.layer.height_blur) {
+            if !radii.contains(&r) {
+                radii.push(r);
+            }
+        }
+        radii
     }
 
     /// Whether any layer is constrained by input map `k` ([`INPUT_NAMES`]).
@@ -267,7 +315,7 @@ fn flatten(
         &f.radiation,
         &f.temperature,
     ];
-    if level == 0 && constrained.iter().any(|c| c.is_some()) {
+    if level == 0 && (constrained.iter().any(|c| c.is_some()) || f.height_blur.is_some()) {
         return Err(bad("the root is the base material and takes no constraints".into()));
     }
     let parse = |what: &str, file: Option<ConstraintFile>| {
@@ -295,6 +343,7 @@ fn flatten(
             elevation,
             slope,
             inputs,
+            height_blur: f.height_blur,
         },
         level,
         parent,
@@ -375,22 +424,20 @@ pub struct BasePoint {
     pub range: (f32, f32),
     /// Extra inputs ([`INPUT_NAMES`]); NaN where a map is absent.
     pub maps: [f32; 3],
+    /// Height and gradient of the blurred height fields, in
+    /// [`LayerTree::blur_radii`] order (unused entries: anything).
+    pub blurred: [(f32, DVec2); MAX_BLUR_RADII],
 }
 
 /// CPU reference of the tree at `base`.
 pub fn evaluate(tree: &LayerTree, base: &BasePoint, noise: &LayerNoise) -> Surface {
-    let BasePoint {
-        xy,
-        height,
-        gradient,
-        range: (lo, hi),
-        maps,
-    } = *base;
-    let slope = gradient.length().atan().to_degrees() as f32;
+    let (lo, hi) = base.range;
+    let slope = base.gradient.length().atan().to_degrees() as f32;
+    let radii = tree.blur_radii();
     let mut surface = Surface {
         color: Vec3::ZERO,
-        height,
-        gradient,
+        height: base.height,
+        gradient: base.gradient,
         coverage: Vec::with_capacity(tree.layers.len()),
     };
     for (i, flat) in tree.layers.iter().enumerate() {
@@ -398,20 +445,29 @@ pub fn evaluate(tree: &LayerTree, base: &BasePoint, noise: &LayerNoise) -> Surfa
         let c_s = match flat.parent {
             None => 1.0,
             Some(p) => {
-                let inputs = LayerInputs {
+                let mut inputs = LayerInputs {
                     altitude: surface.height,
-                    elevation: (surface.height - lo) / (hi - lo).max(1e-6),
+                    elevation: 0.0,
                     slope,
-                    maps,
+                    maps: base.maps,
                 };
-                let (n, _) = noise(i, true, xy, layer.noise_wavelength);
+                let blurred = (layer.height_blur)
+                    .and_then(|r| radii.iter().position(|&q| q == r))
+                    .and_then(|k| base.blurred.get(k));
+                if let Some(&(height, gradient)) = blurred {
+                    // The blurred surface plus what the layers before added.
+                    inputs.altitude = height + (surface.height - base.height);
+                    inputs.slope = gradient.length().atan().to_degrees() as f32;
+                }
+                inputs.elevation = (inputs.altitude - lo) / (hi - lo).max(1e-6);
+                let (n, _) = noise(i, true, base.xy, layer.noise_wavelength);
                 coverage(layer, &inputs, n) * surface.coverage[p]
             }
         };
         surface.coverage.push(c_s);
         surface.color = surface.color * (1.0 - c_s) + layer.color * c_s;
         if layer.roughness > 0.0 && c_s > 0.0 {
-            let (d, grad) = noise(i, false, xy, layer.roughness_wavelength);
+            let (d, grad) = noise(i, false, base.xy, layer.roughness_wavelength);
             let amplitude = c_s * layer.roughness;
             surface.height += amplitude * d;
             surface.gradient += f64::from(amplitude) * grad;

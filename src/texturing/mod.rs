@@ -6,7 +6,8 @@
 //! * [`layers`]: the surface-layer tree (TOML file, built-in default), hat
 //!   functions and coverage, the CPU reference evaluation;
 //! * [`input_maps`]: rainfall, radiation and temperature maps registered
-//!   to the height field;
+//!   to the height field; [`blurred_height`]: the blurred height fields
+//!   `height_blur` layers read (snow in furrows);
 //! * [`quadtree`]: per frame, the nodes the views need and their tile
 //!   sizes, one partition for all views; [`bounds`]: the height field's
 //!   per-node bounds it measures;
@@ -28,6 +29,7 @@
 
 pub mod atlas;
 pub mod atlas_settings;
+pub mod blurred_height;
 pub mod bounds;
 pub mod dominant;
 pub mod fit;

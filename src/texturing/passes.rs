@@ -25,7 +25,8 @@ pub(crate) struct TileGenerationPush {
     /// Tile jobs, texel states (storage buffers), layers (storage buffer),
     /// noise tile (sampled).
     handles: [u32; 4],
-    /// Jobs, texels, layer index, height field (sampled).
+    /// Jobs, texels, layer index, height field (sampled; in the layer
+    /// passes only for `height_blur` layers).
     counts: [u32; 4],
     /// Height-field columns, rows.
     grid: [u32; 4],
@@ -89,7 +90,7 @@ impl GenerationPasses {
     ) -> Result<()> {
         let layer_pipeline = Arc::new(ComputePipeline::new(ctx, shaders::TEXTURING_LAYER)?);
         let (jobs, scratch, base_push) = (self.jobs, self.scratch, self.base_push);
-        let (layers, noise, maps) = (inputs.layers, inputs.noise, inputs.maps);
+        let (layers, noise, maps, heights) = (inputs.layers, inputs.noise, inputs.maps, inputs.heights);
         for (i, flat) in inputs.tree.layers.iter().enumerate() {
             let name = format!(
                 "texturing.layer{i}.{}",
@@ -104,6 +105,11 @@ impl GenerationPasses {
             for map in maps.present() {
                 pass = pass.read(map, ImageAccess::Sampled(Stage::Compute));
             }
+            // A height_blur layer reads the base height beside its blurred one.
+            let blurred = flat.layer.height_blur.is_some();
+            if blurred {
+                pass = pass.read(heights, ImageAccess::Sampled(Stage::Compute));
+            }
             pass.write(scratch, BufferAccess::StorageReadWrite(Stage::Compute))
                 .record(move |pass, frame| {
                     let tiles = frame.prepared::<TextureFrame>()?;
@@ -114,7 +120,12 @@ impl GenerationPasses {
                             pass.storage_buffer(layers)?,
                             pass.sampled(noise)?,
                         ],
-                        counts: [tiles.jobs, tiles.texels as u32, i as u32, 0],
+                        counts: [
+                            tiles.jobs,
+                            tiles.texels as u32,
+                            i as u32,
+                            if blurred { pass.sampled(heights)? } else { 0 },
+                        ],
                         maps: maps.handles(),
                         ..base_push
                     };

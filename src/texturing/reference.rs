@@ -2,8 +2,10 @@
 //! tree of [`crate::texturing::layers`] evaluated with the same base
 //! surface (the height field's cubic B-spline), the same band-limited
 //! wavelet-noise fBm, the same per-layer noise offsets and the same input
-//! map sampling as `glsl/include/surface_layers.glsl`, in f64. Tests compare
-//! the atlas's texels with it.
+//! map sampling as `glsl/include/surface_layers.glsl`, in f64, and the same
+//! blurred height fields for `height_blur` layers
+//! ([`crate::texturing::blurred_height`]). Tests compare the atlas's texels
+//! with it.
 
 use glam::{DVec2, Vec3};
 
@@ -12,7 +14,8 @@ use crate::io::heightmap::HeightField;
 use crate::terrain::bspline::{sample_bspline, sample_bspline_gradient};
 use crate::terrain::geometry_image::NOISE_TILE;
 use crate::terrain::wavelet_noise::{evaluate_gradient, noise_tile};
-use crate::texturing::layers::{evaluate, BasePoint, LayerTree, Surface};
+use crate::texturing::blurred_height::blurred_height;
+use crate::texturing::layers::{evaluate, BasePoint, LayerTree, Surface, MAX_BLUR_RADII};
 
 /// Offsets of the coverage noise N and the displacement noise D of layer
 /// `i`, per octave `k` multiplied by `k + 1` (as in the shader).
@@ -31,6 +34,8 @@ pub struct ReferenceSurface<'a> {
     pub tree: &'a LayerTree,
     pub maps: &'a [Option<HeightField>; 3],
     tile: Vec<f32>,
+    /// The height field blurred for each of the tree's `height_blur` radii.
+    blurred: Vec<HeightField>,
 }
 
 impl<'a> ReferenceSurface<'a> {
@@ -47,6 +52,9 @@ impl<'a> ReferenceSurface<'a> {
             tree,
             maps,
             tile: noise_tile(noise_seed, NOISE_TILE)?,
+            blurred: (tree.blur_radii().into_iter().take(MAX_BLUR_RADII))
+                .map(|r| blurred_height(field, r, "height_blur"))
+                .collect::<Result<_>>()?,
         })
     }
 
@@ -107,6 +115,13 @@ impl<'a> ReferenceSurface<'a> {
             gradient: sample_bspline_gradient(self.field, xy.x, xy.y),
             range: self.field.min_max(),
             maps: [0, 1, 2].map(|k| self.input_map(k, xy)),
+            blurred: std::array::from_fn(|k| match self.blurred.get(k) {
+                Some(b) => (
+                    sample_bspline(b, xy.x, xy.y) as f32,
+                    sample_bspline_gradient(b, xy.x, xy.y),
+                ),
+                None => (0.0, DVec2::ZERO),
+            }),
         };
         let noise = |i: usize, coverage: bool, p: DVec2, wavelength: f32| {
             let (v, g) = self.layer_noise(p, f64::from(wavelength), noise_offset(i, coverage), footprint);

@@ -2,7 +2,24 @@
 
 use super::*;
 
+mod height_blur;
 mod sampled;
+
+/// A root and one child "c" (at line 5) with `extra` from line 8 on.
+fn tree_with(extra: &str) -> String {
+    format!("[root]\nname = \"r\"\ncolor = [0.1, 0.1, 0.1]\n\n[[root.children]]\nname = \"c\"\ncolor = [0.5, 0.5, 0.5]\n{extra}\n")
+}
+
+/// Parsing `text` fails with one line naming `origin` and containing `needle`.
+fn assert_error(text: &str, origin: &str, needle: &str) -> String {
+    let message = LayerTree::parse(text, origin).unwrap_err().to_string();
+    assert!(
+        message.contains(origin) && message.contains(needle),
+        "{text}: {message:?} lacks {needle:?}"
+    );
+    assert!(!message.contains('\n'), "one line: {message:?}");
+    message
+}
 
 fn hat(min: f32, max: f32, fuzz: f32) -> Hat {
     Hat { min, max, fuzz }
@@ -47,6 +64,7 @@ fn leaf(name: &str, color: [f32; 3]) -> Layer {
         elevation: None,
         slope: None,
         inputs: [None, None, None],
+        height_blur: None,
     }
 }
 
@@ -113,6 +131,7 @@ fn evaluation_blends_depth_first_and_coverage_feeds_children_only() {
         gradient: DVec2::ZERO,
         range: (0.0, 200.0),
         maps: [f32::NAN; 3],
+        blurred: [(0.0, DVec2::ZERO); MAX_BLUR_RADII],
     };
     let s = evaluate(&tree, &at(100.5), &noise);
     assert_eq!(s.coverage, vec![1.0, 0.5, 0.25, 1.0]);
@@ -193,12 +212,7 @@ fn colour_components_and_numeric_ranges_are_checked() {
         ("color = [0.5, 0.5, 0.5]\nglow = 1", "unknown field"),
     ];
     for (extra, expected) in bad {
-        let message = LayerTree::parse(&layer(extra), "l.toml").unwrap_err().to_string();
-        assert!(
-            message.contains("l.toml") && message.contains(expected),
-            "{extra}: {message}"
-        );
-        assert!(!message.contains('\n'), "{message:?}");
+        assert_error(&layer(extra), "l.toml", expected);
     }
     let child = "[root]\nname = \"rock\"\ncolor = [0.5, 0.5, 0.5]\n[[root.children]]\nname = \"snow\"\n\
                  color = [1, 1, 1]\naltitude = { min = 0, max = 1e30 }\n";

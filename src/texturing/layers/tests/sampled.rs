@@ -3,11 +3,6 @@
 use super::*;
 use crate::texturing::gpu_layout::{pack_layers, GpuLayer};
 
-/// A root and one child "c" (at line 5) with `constraint` on line 8.
-fn tree_with(constraint: &str) -> String {
-    format!("[root]\nname = \"r\"\ncolor = [0.1, 0.1, 0.1]\n\n[[root.children]]\nname = \"c\"\ncolor = [0.5, 0.5, 0.5]\n{constraint}\n")
-}
-
 fn sampled(min: f32, max: f32, samples: &[f32]) -> SampledFunction {
     SampledFunction {
         min,
@@ -92,12 +87,7 @@ fn bad_sampled_functions_are_one_line_errors_naming_file_line_layer_and_key() {
         ("slope = { max = 5 }", "slope: a hat needs min and max"),
     ];
     for (constraint, needle) in cases {
-        let message = LayerTree::parse(&tree_with(constraint), "s.toml")
-            .unwrap_err()
-            .to_string();
-        assert!(message.contains("s.toml"), "{constraint}: {message}");
-        assert!(message.contains(needle), "{constraint}: {message:?} lacks {needle:?}");
-        assert!(!message.contains('\n'), "{constraint}: {message:?}");
+        let message = assert_error(&tree_with(constraint), "s.toml", needle);
         if !needle.starts_with("line") && !needle.starts_with("unknown") {
             assert!(message.contains("line 5: layer 'c': "), "{constraint}: {message}");
         }
@@ -156,7 +146,7 @@ fn packed_constraints_point_at_their_samples_after_the_layers() {
          temperature = { samples = [0.25, 0.75], min = -10, max = 30 }",
     );
     let tree = LayerTree::parse(&text, "s.toml").unwrap();
-    let packed = pack_layers(&tree);
+    let packed = pack_layers(&tree, &[]);
     assert_eq!(packed.layers.len(), 2);
     assert_eq!(packed.samples, [0.2, 0.9, 1.0, 0.4, 0.25, 0.75]);
     let floats = (2 * std::mem::size_of::<GpuLayer>() / 4) as f32;
@@ -171,6 +161,6 @@ fn packed_constraints_point_at_their_samples_after_the_layers() {
     let as_floats: &[f32] = bytemuck::cast_slice(&bytes);
     assert_eq!(as_floats[hats[5][2] as usize + 1], 0.75);
     // Hat-only trees pack exactly as before: no samples.
-    let packed = pack_layers(&LayerTree::default_tree());
+    let packed = pack_layers(&LayerTree::default_tree(), &[]);
     assert!(packed.samples.is_empty() && packed.bytes().len() == packed.layers.len() * 144);
 }

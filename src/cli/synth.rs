@@ -1,0 +1,363 @@
+//! `alpenglow synth fill` and `alpenglow synth transition`: height-field
+//! synthesis by non-parametric sampling (dissertation §7.3;
+//! `alpenglow::synthesis`).
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{bail, Result};
+use clap::{Args, Subcommand, ValueEnum};
+use glam::DVec2;
+use indicatif::{ProgressBar, ProgressStyle};
+
+use alpenglow::io::heightmap::{load_heightmap, load_heightmap_with_voids, HeightField, HeightmapOptions, RowOrder};
+use alpenglow::io::image_out::{encode_exr_height, encode_png_gray16};
+use alpenglow::synthesis::fill::{plan_hole_fill, FillParams, Growth};
+use alpenglow::synthesis::gpu::GpuSearch;
+use alpenglow::synthesis::search::CpuSearch;
+use alpenglow::synthesis::transition::{plan_transition, Axis, TransitionParams};
+
+use crate::cli::args::{parse_spacing, RowsArg};
+use crate::cli::outputs::Outputs;
+use crate::cli::terrain_spec::{TerrainSpec, PREFIX};
+
+#[derive(Subcommand, Debug)]
+pub enum SynthCommand {
+    /// Fill holes of a DEM by pixel growing (§7.3): the samples marked by
+    /// --mask, or without it the voids of the input (NaN, no-data).
+    Fill(FillArgs),
+    /// Join two height fields of the same size across a grown band (§7.3.3).
+    Transition(TransitionArgs),
+}
+
+/// How height-map files are read (and PNG outputs written).
+#[derive(Args, Debug)]
+#[command(next_help_heading = "Height maps")]
+pub struct HeightArgs {
+    /// Metres between height samples: DX, or DX,DY (default: a GeoTIFF's or
+    /// .hgt's georeferencing, else 1 with a warning).
+    #[arg(long, value_parser = parse_spacing, value_name = "DX[,DY]")]
+    pub spacing: Option<(f64, f64)>,
+    /// Multiplier of height-map values (to metres); a PNG or EXR output is
+    /// written back with the same mapping.
+    #[arg(long = "height-scale", default_value_t = 1.0, value_name = "FACTOR")]
+    pub height_scale: f32,
+    /// Added to height-map values after scaling, in metres (also used for
+    /// the output).
+    #[arg(long = "height-offset", default_value_t = 0.0, value_name = "METRES")]
+    pub height_offset: f32,
+    /// Where a PNG, EXR or plain TIFF's first row lies (south-up: rows
+    /// kept; north-up: flipped); the output keeps the input's orientation.
+    #[arg(long, value_enum, default_value = "south-up", value_name = "ORDER")]
+    pub rows: RowsArg,
+    /// Largest input file in MiB.
+    #[arg(long = "max-input-mb", default_value_t = 2048, value_name = "MIB", value_parser = clap::value_parser!(u64).range(1..))]
+    pub max_input_mb: u64,
+}
+
+/// The neighbourhood search.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SearchArg {
+    /// Compute passes on the Vulkan device.
+    Gpu,
+    /// The CPU twin (same rule, same result).
+    Cpu,
+}
+
+/// Parameters of pixel growing.
+#[derive(Args, Debug)]
+#[command(next_help_heading = "Synthesis")]
+pub struct GrowArgs {
+    /// Window side n in samples, odd (default: fill 7, transition 11).
+    #[arg(long, value_name = "SAMPLES")]
+    pub window: Option<u32>,
+    /// Weight λ of the slope channels against the height channel (both normalised).
+    #[arg(long, default_value_t = 0.25, value_name = "WEIGHT")]
+    pub lambda: f32,
+    /// Tolerance ε: candidates within (1+ε) of the best match (default: fill 0.1, transition 0.5).
+    #[arg(long, value_name = "TOLERANCE")]
+    pub epsilon: Option<f32>,
+    /// Seed of the candidate subsample and the random choice.
+    #[arg(long, default_value_t = 1, value_name = "SEED")]
+    pub seed: u32,
+    /// Most samples searched together in one wave (1: the text's sequential order).
+    #[arg(long, default_value_t = 256, value_name = "SAMPLES")]
+    pub batch: usize,
+    /// Most candidate windows (those nearest the unknown samples first).
+    #[arg(long, default_value_t = 16384, value_name = "COUNT")]
+    pub candidates: usize,
+    /// Neighbourhood search.
+    #[arg(long, value_enum, default_value = "gpu", value_name = "DEVICE")]
+    pub search: SearchArg,
+    #[command(flatten)]
+    pub device: crate::cli::args::DeviceArgs,
+}
+
+impl GrowArgs {
+    fn params(&self, defaults: FillParams) -> FillParams {
+        FillParams {
+            window: self.window.unwrap_or(defaults.window),
+            lambda: self.lambda,
+            epsilon: self.epsilon.unwrap_or(defaults.epsilon),
+            seed: self.seed,
+            batch: self.batch,
+            candidates: self.candidates,
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct FillArgs {
+    /// The DEM: PNG, EXR, GeoTIFF or SRTM .hgt.
+    #[arg(long, value_name = "FILE")]
+    pub input: PathBuf,
+    /// Greyscale PNG (or any height map) of the input's size: non-zero
+    /// samples are unknown (besides the input's voids).
+    #[arg(long, value_name = "FILE")]
+    pub mask: Option<PathBuf>,
+    /// The filled DEM: .png (16-bit, the input's scale and offset) or .exr (float).
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub grow: GrowArgs,
+    #[command(flatten)]
+    pub heights: HeightArgs,
+}
+
+/// The axis of `--axis`.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AxisArg {
+    /// A west, B east, a band of columns.
+    X,
+    /// A south, B north, a band of rows.
+    Y,
+}
+
+#[derive(Args, Debug)]
+pub struct TransitionArgs {
+    /// Height field A (a file or procedural:MODEL[,KEY=VALUE...]).
+    #[arg(value_name = "A")]
+    pub a: String,
+    /// Height field B, the same size and spacing as A.
+    #[arg(value_name = "B")]
+    pub b: String,
+    /// The joined field: .png (16-bit, --height-scale and --height-offset) or .exr (float).
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Width of the grown band in metres, centred between A and B.
+    #[arg(long, value_name = "METRES")]
+    pub band: f64,
+    /// Axis across which A and B are joined.
+    #[arg(long, value_enum, default_value = "x", value_name = "AXIS")]
+    pub axis: AxisArg,
+    /// Radius in samples of the Gaussian blur of the grown band (σ = R/2; 0: none).
+    #[arg(long, default_value_t = 2, value_name = "SAMPLES")]
+    pub blur: u32,
+    #[command(flatten)]
+    pub grow: GrowArgs,
+    #[command(flatten)]
+    pub heights: HeightArgs,
+}
+
+/// Runs `synth fill` or `synth transition`.
+pub fn synth(command: SynthCommand) -> Result<ExitCode> {
+    match command {
+        SynthCommand::Fill(args) => fill(args),
+        SynthCommand::Transition(args) => transition(args),
+    }
+}
+
+fn heightmap_options(args: &HeightArgs) -> HeightmapOptions {
+    HeightmapOptions {
+        scale: args.height_scale,
+        offset: args.height_offset,
+        spacing: args.spacing.map(|(dx, dy)| DVec2::new(dx, dy)),
+        rows: match args.rows {
+            RowsArg::NorthUp => RowOrder::NorthUp,
+            RowsArg::SouthUp => RowOrder::SouthUp,
+        },
+        limits: alpenglow::io::limits::InputLimits::with_max_file_mib(args.max_input_mb),
+    }
+}
+
+/// Reserves `out` after checking its extension.
+fn reserve_output(out: &Path) -> Result<Outputs> {
+    let ext = out.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if !matches!(ext.as_deref(), Some("png" | "exr")) {
+        bail!("--out {}: the output must end in .png (16-bit) or .exr", out.display());
+    }
+    let mut outputs = Outputs::default();
+    outputs.add(Some(out), "--out")?;
+    Ok(outputs)
+}
+
+/// The unknown samples of `fill`: the input's voids and the mask's non-zero samples.
+fn load_fill_input(args: &FillArgs) -> Result<(HeightField, Vec<bool>)> {
+    let opts = heightmap_options(&args.heights);
+    let (field, mut unknown) = load_heightmap_with_voids(&args.input, &opts)?;
+    if let Some(path) = &args.mask {
+        let mask_opts = HeightmapOptions {
+            scale: 1.0,
+            offset: 0.0,
+            spacing: Some(DVec2::ONE),
+            ..opts
+        };
+        let mask = load_heightmap(path, &mask_opts)?;
+        if (mask.columns, mask.rows) != (field.columns, field.rows) {
+            bail!(
+                "--mask {}: the mask is {}×{} samples, the input {} is {}×{}",
+                path.display(),
+                mask.columns,
+                mask.rows,
+                args.input.display(),
+                field.columns,
+                field.rows
+            );
+        }
+        for (u, &m) in unknown.iter_mut().zip(&mask.heights) {
+            *u |= m != 0.0;
+        }
+    }
+    Ok((field, unknown))
+}
+
+fn fill(args: FillArgs) -> Result<ExitCode> {
+    let mut outputs = reserve_output(&args.out)?;
+    let (field, unknown) = load_fill_input(&args)?;
+    let params = args.grow.params(FillParams::default());
+    let growth = plan_hole_fill(&field, &unknown, &params)?;
+    let total = growth.unknown_count();
+    if total == 0 {
+        log::warn!(
+            "{}: no sample is unknown (no --mask and no voids, or an empty mask); writing the input unchanged",
+            args.input.display()
+        );
+    }
+    let started = Instant::now();
+    let filled = grow_with(growth, &args.grow)?;
+    let seconds = started.elapsed().as_secs_f64();
+    outputs.stage(Some(&args.out), || encode_field(&args.out, &filled, &args.heights))?;
+    outputs.commit()?;
+    println!(
+        "{}: filled {total} of {}×{} samples in {seconds:.1} s → {}",
+        args.input.display(),
+        field.columns,
+        field.rows,
+        args.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Loads A or B of `transition`: a procedural spec or a height-map file.
+fn load_field(source: &str, args: &HeightArgs) -> Result<HeightField> {
+    if source.starts_with(PREFIX) {
+        let spec: TerrainSpec = source.parse().map_err(|e: String| anyhow::anyhow!(e))?;
+        return Ok(spec.generate()?);
+    }
+    Ok(load_heightmap(Path::new(source), &heightmap_options(args))?)
+}
+
+fn transition(args: TransitionArgs) -> Result<ExitCode> {
+    let mut outputs = reserve_output(&args.out)?;
+    let a = load_field(&args.a, &args.heights)?;
+    let b = load_field(&args.b, &args.heights)?;
+    let params = TransitionParams {
+        grow: args.grow.params(TransitionParams::default().grow),
+        band_metres: args.band,
+        axis: match args.axis {
+            AxisArg::X => Axis::X,
+            AxisArg::Y => Axis::Y,
+        },
+        blur_radius: args.blur,
+    };
+    let (growth, transition) = plan_transition(&a, &b, &params)?;
+    let band = transition.band;
+    let started = Instant::now();
+    let residual = grow_with(growth, &args.grow)?;
+    let joined = transition.finish(&residual, params.blur_radius);
+    let seconds = started.elapsed().as_secs_f64();
+    outputs.stage(Some(&args.out), || encode_field(&args.out, &joined, &args.heights))?;
+    outputs.commit()?;
+    println!(
+        "transition {}×{}: a band of {} samples from {} grown in {seconds:.1} s → {}",
+        a.columns,
+        a.rows,
+        band.width,
+        band.start,
+        args.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Grows `growth` with the search of `--search` (on the GPU: the device
+/// of `--device`, validated with `--validation`), with a progress bar on
+/// stderr when it is a terminal.
+fn grow_with(growth: Growth, args: &GrowArgs) -> Result<HeightField> {
+    let bar = ProgressBar::new(growth.unknown_count() as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} samples grown (eta {eta})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let mut progress = |done: usize, _| bar.set_position(done as u64);
+    let grown = match args.search {
+        SearchArg::Cpu => {
+            let mut search = CpuSearch {
+                exemplar: growth.exemplar().clone(),
+                config: growth.search_config(),
+            };
+            growth.grow(&mut search, &mut progress)?
+        }
+        SearchArg::Gpu => {
+            let ctx = super::context(&args.device)?;
+            let report = ctx.validation_report();
+            let grown = {
+                let mut search = GpuSearch::new(&ctx, growth.exemplar().clone(), growth.search_config())?;
+                growth.grow(&mut search, &mut progress)?
+            };
+            drop(ctx);
+            super::check_validation(report)?;
+            grown
+        }
+    };
+    bar.finish_and_clear();
+    Ok(grown)
+}
+
+/// The bytes of `field` written to `out` (by extension) with the height
+/// mapping and row order of `args`.
+fn encode_field(out: &Path, field: &HeightField, args: &HeightArgs) -> alpenglow::Result<Vec<u8>> {
+    use alpenglow::error::Error;
+    let (w, h) = (field.columns as usize, field.rows as usize);
+    let (scale, offset) = (f64::from(args.height_scale), f64::from(args.height_offset));
+    let flip = args.rows == RowsArg::NorthUp;
+    // Image row i shows field row i (south-up) or h−1−i (north-up).
+    let raw_at = |i: usize| {
+        let (c, r) = (i % w, i / w);
+        let row = if flip { h - 1 - r } else { r };
+        (c, row, (f64::from(field.heights[row * w + c]) - offset) / scale)
+    };
+    let is_png = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !is_png {
+        let values: Vec<f32> = (0..w * h).map(|i| raw_at(i).2 as f32).collect();
+        return encode_exr_height(&values, field.columns, field.rows);
+    }
+    let mut values = Vec::with_capacity(w * h);
+    for i in 0..w * h {
+        let (c, r, raw) = raw_at(i);
+        let rounded = raw.round();
+        if !(0.0..=65535.0).contains(&rounded) {
+            return Err(Error::output(
+                out,
+                format!(
+                    "height {} m at column {c}, row {r} is outside the 16-bit PNG range {offset}..={} m \
+                     (set --height-scale and --height-offset, or write .exr)",
+                    field.heights[r * w + c],
+                    offset + 65535.0 * scale
+                ),
+            ));
+        }
+        values.push(rounded as u16);
+    }
+    encode_png_gray16(&values, field.columns, field.rows)
+}

@@ -1,0 +1,271 @@
+//! End-to-end tests of `alpenglow synth fill` and `alpenglow synth
+//! transition` (§7.3) with the CPU search: outputs that keep the known
+//! samples exactly, voids of an EXR as the unknown samples, one-line
+//! errors that leave no file behind.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
+use alpenglow::io::image_out::{encode_exr_height, encode_png_gray16};
+use common::cli::*;
+
+const SIDE: u32 = 40;
+
+/// A 40×40 crop of the Jacksboro DEM at column `x0`, row `y0` as raw
+/// 16-bit values (metres).
+fn crop(x0: u32, y0: u32) -> Vec<u16> {
+    let full = load_heightmap(
+        Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/jacksboro-fault.png")),
+        &HeightmapOptions {
+            spacing: Some(glam::DVec2::ONE),
+            ..HeightmapOptions::default()
+        },
+    )
+    .unwrap();
+    (0..SIDE * SIDE)
+        .map(|i| full.height(x0 + i % SIDE, y0 + i / SIDE) as u16)
+        .collect()
+}
+
+fn write_png(path: &Path, values: &[u16], width: u32, height: u32) {
+    std::fs::write(path, encode_png_gray16(values, width, height).unwrap()).unwrap();
+}
+
+/// Raw values of a greyscale PNG or the heights of an EXR.
+fn read(path: &Path) -> Vec<f32> {
+    let opts = HeightmapOptions {
+        spacing: Some(glam::DVec2::ONE),
+        ..HeightmapOptions::default()
+    };
+    load_heightmap(path, &opts).unwrap().heights
+}
+
+/// An 8×6 hole at column 12, row 20 (`true`: unknown).
+fn hole() -> Vec<bool> {
+    (0..SIDE * SIDE)
+        .map(|i| (12..20).contains(&(i % SIDE)) && (20..26).contains(&(i / SIDE)))
+        .collect()
+}
+
+/// Input and mask files in `dir`.
+fn fixture(dir: &Path) -> (PathBuf, PathBuf, Vec<u16>) {
+    let input = dir.join("dem.png");
+    let mask = dir.join("mask.png");
+    let values = crop(60, 150);
+    write_png(&input, &values, SIDE, SIDE);
+    let mask_values: Vec<u16> = hole().iter().map(|&u| if u { 255 } else { 0 }).collect();
+    write_png(&mask, &mask_values, SIDE, SIDE);
+    (input, mask, values)
+}
+
+const FAST: [&str; 6] = ["--search", "cpu", "--candidates", "256", "--spacing", "74.4,92.6"];
+
+fn args<'a>(head: &[&'a str], paths: &'a [String]) -> Vec<&'a str> {
+    let mut all: Vec<&str> = vec!["synth"];
+    all.extend_from_slice(head);
+    all.extend(paths.iter().map(String::as_str));
+    all.extend_from_slice(&FAST);
+    all
+}
+
+#[test]
+fn fill_keeps_known_samples_and_fills_the_mask() {
+    let dir = fresh_dir("synth-fill");
+    let (input, mask, values) = fixture(&dir);
+    let hole = hole();
+    for name in ["out.png", "out.exr"] {
+        let out = dir.join(name);
+        let paths = [
+            "--input".into(),
+            input.display().to_string(),
+            "--mask".into(),
+            mask.display().to_string(),
+            "--out".into(),
+            out.display().to_string(),
+        ];
+        let run_out = run(&args(&["fill"], &paths));
+        assert_success(name, &run_out);
+        assert!(
+            text(&run_out.stdout).contains("filled 48 of 40×40 samples"),
+            "{}",
+            text(&run_out.stdout)
+        );
+        let filled = read(&out);
+        let (lo, hi) = (
+            *values.iter().min().unwrap() as f32,
+            *values.iter().max().unwrap() as f32,
+        );
+        for (i, (&v, &f)) in values.iter().zip(&filled).enumerate() {
+            if hole[i] {
+                assert!((lo..=hi).contains(&f), "{name}: filled sample {i} = {f}");
+            } else {
+                assert_eq!(f, f32::from(v), "{name}: known sample {i}");
+            }
+        }
+    }
+}
+
+#[test]
+fn fill_takes_the_voids_of_an_exr_without_a_mask() {
+    let dir = fresh_dir("synth-voids");
+    let values = crop(200, 40);
+    let hole = hole();
+    let heights: Vec<f32> = values
+        .iter()
+        .zip(&hole)
+        .map(|(&v, &u)| if u { f32::NAN } else { f32::from(v) })
+        .collect();
+    let input = dir.join("voids.exr");
+    std::fs::write(&input, encode_exr_height(&heights, SIDE, SIDE).unwrap()).unwrap();
+    let out = dir.join("filled.exr");
+    let paths = [
+        "--input".into(),
+        input.display().to_string(),
+        "--out".into(),
+        out.display().to_string(),
+    ];
+    let run_out = run(&args(&["fill"], &paths));
+    assert_success("voids", &run_out);
+    let filled = read(&out);
+    assert!(filled.iter().all(|h| h.is_finite()));
+    for i in (0..heights.len()).filter(|&i| !hole[i]) {
+        assert_eq!(filled[i].to_bits(), heights[i].to_bits());
+    }
+}
+
+#[test]
+fn transition_keeps_a_and_b_on_their_sides() {
+    let dir = fresh_dir("synth-transition");
+    let (a, b) = (dir.join("a.png"), dir.join("b.png"));
+    let (va, vb) = (crop(60, 150), crop(250, 20));
+    write_png(&a, &va, SIDE, SIDE);
+    write_png(&b, &vb, SIDE, SIDE);
+    let out = dir.join("joined.png");
+    // 10 samples of 74.4 m: columns 15..25.
+    let paths = [
+        a.display().to_string(),
+        b.display().to_string(),
+        "--out".into(),
+        out.display().to_string(),
+    ];
+    let run_out = run(&args(&["transition", "--band", "744", "--window", "7"], &paths));
+    assert_success("transition", &run_out);
+    let joined = read(&out);
+    for (i, &h) in joined.iter().enumerate() {
+        let c = i as u32 % SIDE;
+        if c < 15 {
+            assert_eq!(h, f32::from(va[i]), "A at {i}");
+        } else if c >= 25 {
+            assert_eq!(h, f32::from(vb[i]), "B at {i}");
+        }
+    }
+    // A procedural A against a file B of the same grid.
+    let exr = dir.join("procedural.exr");
+    let paths = [
+        "procedural:ridged,size=40,spacing=74.4:92.6".to_string(),
+        b.display().to_string(),
+        "--out".into(),
+        exr.display().to_string(),
+    ];
+    let run_out = run(&args(&["transition", "--band", "744", "--window", "7"], &paths));
+    assert_success("procedural transition", &run_out);
+    assert_eq!(read(&exr).len(), (SIDE * SIDE) as usize);
+}
+
+#[test]
+fn bad_inputs_are_one_line_errors_and_write_nothing() {
+    let dir = fresh_dir("synth-errors");
+    let (input, mask, _) = fixture(&dir);
+    let small_mask = dir.join("small-mask.png");
+    write_png(&small_mask, &[0; 12], 4, 3);
+    let outputs = fresh_dir("synth-errors-out");
+    let out = outputs.join("o.png").display().to_string();
+    let (input, mask, small_mask) = (
+        input.display().to_string(),
+        mask.display().to_string(),
+        small_mask.display().to_string(),
+    );
+    let fill = |extra: &[&str], mask: &str, out: &str| {
+        let mut a = vec!["synth", "fill", "--input", &input, "--mask", mask, "--out", out];
+        a.extend_from_slice(extra);
+        run(&a)
+    };
+    let cases: Vec<(&str, std::process::Output, Vec<&str>)> = vec![
+        (
+            "mask size",
+            fill(&FAST, &small_mask, &out),
+            vec!["--mask", "small-mask.png", "4×3"],
+        ),
+        (
+            "even window",
+            fill(&[&FAST[..], &["--window", "4"]].concat(), &mask, &out),
+            vec!["--window", "odd"],
+        ),
+        (
+            "huge window",
+            fill(&[&FAST[..], &["--window", "41"]].concat(), &mask, &out),
+            vec!["--window", "larger"],
+        ),
+        (
+            "extension",
+            fill(&FAST, &mask, &outputs.join("o.txt").display().to_string()),
+            vec!["--out", ".png"],
+        ),
+        (
+            "missing mask",
+            fill(&FAST, "no-such-mask.png", &out),
+            vec!["no-such-mask.png", "not found"],
+        ),
+    ];
+    for (what, output, needles) in &cases {
+        assert_one_line_error(what, output, needles);
+    }
+    let b = dir.join("b.png");
+    write_png(&b, &[500; 100], 10, 10);
+    let t = run(&[
+        "synth",
+        "transition",
+        &input,
+        &b.display().to_string(),
+        "--out",
+        &out,
+        "--band",
+        "100",
+        "--search",
+        "cpu",
+        "--spacing",
+        "1",
+    ]);
+    assert_one_line_error("transition sizes", &t, &["same size"]);
+    assert_no_files_left("errors", &outputs);
+}
+
+#[test]
+fn the_gpu_search_gives_the_cpu_twins_output_under_validation() {
+    let dir = fresh_dir("synth-gpu");
+    let outputs: Vec<Vec<u8>> = [&["--validation"][..], &["--search", "cpu"][..]]
+        .iter()
+        .enumerate()
+        .map(|(k, search)| {
+            let out = dir.join(format!("joined-{k}.exr")).display().to_string();
+            let mut a = vec![
+                "synth",
+                "transition",
+                "procedural:ridged,size=24,spacing=20",
+                "procedural:fbm,size=24,spacing=20",
+                "--band",
+                "80",
+                "--window",
+                "5",
+                "--out",
+                &out,
+            ];
+            a.extend_from_slice(search);
+            assert_success("transition", &run(&a));
+            std::fs::read(&out).unwrap()
+        })
+        .collect();
+    assert_eq!(outputs[0], outputs[1], "GPU and CPU searches differ");
+}
