@@ -289,6 +289,32 @@ mod tests {
         assert!(Registration::new(4, 6, &field, RowOrder::NorthUp).is_err());
     }
 
+    /// A given input map becomes a sampled constraint of every child over
+    /// the map's range, high where the class lies.
+    #[test]
+    fn input_maps_become_constraints() {
+        let field = HeightField::from_fn(16, 12, DVec2::splat(100.0), |_, _| 500.0);
+        // Rainfall rising to the north on its own 2×2 grid (corner to corner).
+        let rain = HeightField::from_fn(2, 2, DVec2::ONE, |_, r| 100.0 * r as f32);
+        let image = RgbImage::from_fn(16, 12, |_, j| {
+            image::Rgb(if j < 4 { [170, 150, 120] } else { [60, 80, 40] })
+        });
+        let options = FromImageOptions {
+            classes: ClassCount::Fixed(2),
+            calibrate: false,
+            ..Default::default()
+        };
+        let generated = build_layers(&image, &field, &[Some(rain), None, None], &options).unwrap();
+        let tree = generated.tree().unwrap();
+        assert!(tree.uses_input(0) && !tree.uses_input(1));
+        let Some(crate::texturing::layers::Constraint::Sampled(f)) = &tree.layers[1].layer.inputs[0] else {
+            panic!("no sampled rainfall constraint");
+        };
+        assert_eq!((f.min, f.max), (0.0, 100.0));
+        assert!(f.eval(100.0) > 0.9 && f.eval(5.0) == 0.0, "{f:?}");
+        assert!(f.samples[..24].iter().all(|&s| s == 0.0), "{f:?}");
+    }
+
     /// Forest low, bare ground high on a slope rising to the north: two
     /// classes, the bare layer constrained to the upper altitudes, and the
     /// calibrated tree predicted to cover the image's shares.
