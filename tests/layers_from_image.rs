@@ -193,28 +193,28 @@ fn bad_inputs_are_one_line_errors() {
                 classes: ClassCount::Fixed(9),
                 ..Default::default()
             },
-            "classes",
+            "from_image.classes",
         ),
         (
             FromImageOptions {
                 classes: ClassCount::Fixed(0),
                 ..Default::default()
             },
-            "classes",
+            "from_image.classes",
         ),
         (
             FromImageOptions {
                 bins: 0,
                 ..Default::default()
             },
-            "bins",
+            "from_image.bins",
         ),
         (
             FromImageOptions {
                 sun_elevation_deg: 0.0,
                 ..Default::default()
             },
-            "sun_elevation_deg",
+            "from_image.sun_elevation_deg",
         ),
     ] {
         let e = build_layers(image, field, &maps, &options).unwrap_err();
@@ -425,7 +425,7 @@ fn the_command_writes_a_tree_and_refuses_bad_input_in_one_line() {
     assert_eq!(LayerTree::parse(&text, "written").expect("parses").layers.len(), 5);
     for (image, extra, expected) in [
         ("real-world/rmnp-rgb.png", &["--classes", "9"][..], "--classes"),
-        ("real-world/rmnp-rgb.png", &["--bins", "65"][..], "bins"),
+        ("real-world/rmnp-rgb.png", &["--bins", "65"][..], "invalid --bins"),
         ("tiny-ramp.png", &[][..], "integer multiple"),
     ] {
         let bad = run(image, extra);

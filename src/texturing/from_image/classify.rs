@@ -241,7 +241,7 @@ fn fill_set_aside(labels: &mut [u8], width: usize) -> Result<()> {
     let mut queue: VecDeque<usize> = (0..labels.len()).filter(|&i| labels[i] != u8::MAX).collect();
     if queue.is_empty() {
         return Err(Error::invalid(
-            "image",
+            "from_image.image",
             "no pixel could be classified (all in shade or cloud)",
         ));
     }

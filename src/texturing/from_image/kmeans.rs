@@ -243,7 +243,7 @@ pub fn cluster(histogram: &ColourHistogram, count: ClassCount, seed: u64) -> Res
         _ if distinct == 0 => (Vec::new(), Vec::new()),
         ClassCount::Fixed(k) if k > distinct => {
             return Err(Error::invalid(
-                "classes",
+                "from_image.classes",
                 format!("{k} classes but the image's colours fill only {distinct} hue–saturation bins"),
             ))
         }

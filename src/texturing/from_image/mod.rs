@@ -111,29 +111,35 @@ impl FromImageOptions {
         if let ClassCount::Fixed(k) = self.classes {
             if !(1..=MAX_CLASSES).contains(&k) {
                 return Err(Error::invalid(
-                    "classes",
+                    "from_image.classes",
                     format!("{k} is out of range 1..={MAX_CLASSES}"),
                 ));
             }
         }
         if !(self.sun_azimuth_deg.is_finite() && (-360.0..=360.0).contains(&self.sun_azimuth_deg)) {
-            return Err(Error::invalid("sun_azimuth_deg", "must be within ±360 degrees"));
+            return Err(Error::invalid(
+                "from_image.sun_azimuth_deg",
+                "must be within ±360 degrees",
+            ));
         }
         if !(self.sun_elevation_deg > 0.0 && self.sun_elevation_deg <= 90.0) {
-            return Err(Error::invalid("sun_elevation_deg", "must be in (0, 90] degrees"));
+            return Err(Error::invalid(
+                "from_image.sun_elevation_deg",
+                "must be in (0, 90] degrees",
+            ));
         }
         if !(0.0..=4.0).contains(&self.value_weight) {
             return Err(Error::invalid(
-                "value_weight",
+                "from_image.value_weight",
                 format!("{} is out of range 0..=4", self.value_weight),
             ));
         }
         if self.snow_min_altitude.is_some_and(|a| !a.is_finite()) {
-            return Err(Error::invalid("snow_min_altitude", "must be finite"));
+            return Err(Error::invalid("from_image.snow_min_altitude", "must be finite"));
         }
         if !(1..=crate::texturing::layers::MAX_SAMPLES).contains(&self.bins) {
             return Err(Error::invalid(
-                "bins",
+                "from_image.bins",
                 format!(
                     "{} is out of range 1..={}",
                     self.bins,
@@ -166,7 +172,7 @@ impl Registration {
         let factor = width.checked_div(c).unwrap_or(0);
         if c < 2 || r < 2 || factor == 0 || width != factor * c || height != factor * r {
             return Err(Error::invalid(
-                "image",
+                "from_image.image",
                 format!("{width}×{height} pixels is not an integer multiple of the height field's {c}×{r} grid"),
             ));
         }
