@@ -9,7 +9,8 @@
 //!   central differences of the samples) are water at most 3 % of the time;
 //!   without the shade rule more than 10 % of them are.
 //! * The rendered region (top-down, class AOV: the dominant layer) covers
-//!   each class's share of the image within 0.08, and its hue–saturation
+//!   each class's share of the image within 0.08, shows the image's class
+//!   at the same place on more pixels than chance + 0.10, and its hue–saturation
 //!   histogram is nearer the image's than that of the built-in layers;
 //!   an oblique view shows every class; all under validation.
 
@@ -305,6 +306,49 @@ fn rendered_fractions(frame: &FrameImages, generated: &GeneratedLayers) -> Vec<f
     counts.iter().map(|&c| c as f64 / terrain as f64).collect()
 }
 
+/// Share of the terrain pixels of the top-down `frame` whose dominant
+/// layer's class is the image's class at the same place (the surface point
+/// from the pixel's ray and `distance`, mapped back through the
+/// registration), and the share expected by chance (Σ image share ×
+/// render share over the classes).
+fn place_agreement(frame: &FrameImages, camera: &Camera, generated: &GeneratedLayers) -> (f64, f64) {
+    let (image, field) = rmnp();
+    let (w, h) = TOP;
+    let tan = (camera.fov_y_deg.to_radians() * 0.5).tan();
+    let aspect = f64::from(w) / f64::from(h);
+    let s = f64::from(image.width() / field.columns);
+    let labels = &generated.classification.labels;
+    let (mut agree, mut terrain) = (0usize, 0usize);
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let Some(layer) = frame.class[i].checked_sub(CLASS_LAYER_BASE) else {
+                continue;
+            };
+            let ndc = DVec2::new(
+                (f64::from(x) + 0.5) / f64::from(w) * 2.0 - 1.0,
+                1.0 - (f64::from(y) + 0.5) / f64::from(h) * 2.0,
+            );
+            let ray = camera.forward() + camera.right() * (ndc.x * tan * aspect) + camera.image_up() * (ndc.y * tan);
+            let p = camera.eye + ray.normalize() * f64::from(frame.distance[i]);
+            let column = ((p.x / SPACING.x + 0.5) * s)
+                .floor()
+                .clamp(0.0, f64::from(image.width() - 1));
+            let row = ((f64::from(field.rows - 1) - p.y / SPACING.y + 0.5) * s)
+                .floor()
+                .clamp(0.0, f64::from(image.height() - 1));
+            let label = labels[row as usize * image.width() as usize + column as usize];
+            terrain += 1;
+            agree += usize::from(generated.layers[layer as usize].class == usize::from(label));
+        }
+    }
+    let chance = (generated.classification.fractions().iter())
+        .zip(rendered_fractions(frame, generated))
+        .map(|(a, b)| a * b)
+        .sum();
+    (agree as f64 / terrain.max(1) as f64, chance)
+}
+
 /// Normalised hue–saturation histogram (12 hues of 30°, 5 saturations of 0.2).
 fn hs_histogram(pixels: impl Iterator<Item = [u8; 3]>) -> Vec<f64> {
     let mut h = vec![0.0; 60];
@@ -380,6 +424,10 @@ fn the_rendered_region_covers_each_class_like_the_image() {
         oblique_classes.iter().filter(|&&f| f > 0.0).count() >= 4,
         "{oblique_classes:?}"
     );
+
+    let (agreement, chance) = place_agreement(top, &top_down(field), g);
+    eprintln!("same class at the same place: {agreement:.4} of the terrain pixels (chance {chance:.4})");
+    assert!(agreement > chance + 0.1, "agreement {agreement}, chance {chance}");
 
     let reference = hs_histogram(image.pixels().map(|p| p.0));
     let ours = chi_square(&reference, &hs_histogram(rgb_pixels(top)));
