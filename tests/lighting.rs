@@ -196,13 +196,16 @@ fn sun_visibility_agrees_with_a_cpu_ray_cast_on_the_real_dem() {
 
 #[test]
 fn aerial_perspective_matches_its_cpu_twin() {
-    use alpenglow::lighting::aerial::{aerial_perspective, distant_radiance, AerialCoefficients};
+    use alpenglow::lighting::aerial::{
+        aerial_perspective, distant_radiance, optical_depth, AerialCoefficients, SCALE_HEIGHTS_M,
+    };
     use alpenglow::lighting::preetham::PreethamSky;
     use alpenglow::view::{Exposure, ShadowMode, SkyLightMode};
 
     let (ctx, report) = validated_context();
     {
         let scene = Scene::new(common::jacksboro_field());
+        let ground = f64::from(scene.height_range().0);
         let camera = common::jacksboro_valley_camera();
         let size = (96, 60);
         let lighting = Lighting {
@@ -244,7 +247,14 @@ fn aerial_perspective_matches_its_cpu_twin() {
                     sun,
                     sky.sun_irradiance(),
                 );
-                let expected = aerial_perspective(l0, distance, l_inf, coefficients.extinction());
+                let tau = optical_depth(
+                    &coefficients,
+                    distance,
+                    (camera.eye.z - ground) as f32,
+                    (world.z - ground) as f32,
+                    SCALE_HEIGHTS_M,
+                );
+                let expected = aerial_perspective(l0, tau, l_inf);
                 let got = glam::Vec3::from_slice(&on.hdr[i * 4..i * 4 + 3]);
                 let error = ((got - expected).abs() / expected.max(glam::Vec3::splat(1.0))).max_element();
                 assert!(

@@ -1,5 +1,6 @@
-//! Aerial perspective with a constant-density atmosphere near the ground
-//! (§6.3 "Aerial Perspective", eq. 6.16, 6.17; §9.1; `ALGORITHMS.md` §6).
+//! Aerial perspective (§6.3 "Aerial Perspective", eq. 6.16, 6.17; §9.1;
+//! `ALGORITHMS.md` §6): the text's homogeneous medium, with the density of
+//! each component graded along the ray (below).
 //! GPU twin: `glsl/include/aerial_perspective.glsl`.
 //!
 //! Along a view ray of length s through a homogeneous medium of extinction
@@ -24,6 +25,17 @@
 //! scattering form is the fallback (the Preetham sky never does: it keeps a
 //! twilight floor, see `preetham`).
 //!
+//! The text's medium is homogeneous, which holds for views near the ground
+//! but fogs a view from above: looking down from 12 km, β at the ground
+//! over 10 km of air gives a transmittance of about 0.4 at 550 nm, and the
+//! ground all but vanishes. So the extinction is graded: `τ = (β_R·ρ_R +
+//! β_M·ρ_M)·s`, where ρ is the mean relative density along the straight ray
+//! of an exponential profile with the atmosphere's scale heights (8 km
+//! Rayleigh, 1.2 km Mie; `LightingFrame.planet.zw`) above the terrain's
+//! ground (`mie.w`): [`mean_density`], [`optical_depth`]. The same view
+//! then keeps a transmittance of about 0.85. Rays near the ground are
+//! nearly unchanged (ρ ≈ e^(−z/H)).
+//!
 //! Coefficients at the ground: Rayleigh from the molecular formula (§6.3
 //! eq. 6.5, Preetham 1999 appendix) at the channel wavelengths 680, 550,
 //! 440 nm, ≈ (5.8, 13.6, 33.1)·10⁻⁶/m, ∝ λ⁻⁴; Mie from the turbidity through
@@ -47,6 +59,12 @@ pub const WAVELENGTHS_NM: [f32; 3] = [680.0, 550.0, 440.0];
 pub const MIE_G: f32 = 0.76;
 /// Optical length of the aerosols at the zenith (m), §6.3 Fig. 6.7.
 pub const AEROSOL_OPTICAL_LENGTH_M: f32 = 1250.0;
+/// Scale heights (m) of the density of molecules and aerosols with these
+/// coefficients: the molecules' optical length at the zenith (8.4 km, which
+/// the Rayleigh coefficients give with the standard atmosphere's optical
+/// depth) and [`AEROSOL_OPTICAL_LENGTH_M`], so that the graded columns
+/// integrate to the same optical depths the coefficients were made from.
+pub const SCALE_HEIGHTS_M: (f32, f32) = (8_400.0, AEROSOL_OPTICAL_LENGTH_M);
 /// `sin` of the top of the horizon band (10°) the distant radiance is read
 /// from; the bottom is `preetham::COS_THETA_MIN` (≈ 0.57°).
 pub const HORIZON_BAND_SIN: f32 = 0.173_648_18;
@@ -114,20 +132,51 @@ impl AerialCoefficients {
         e_sun * angular / self.extinction()
     }
 
-    /// Writes `rayleigh` (rgb β_R, w g) and `mie.rgb` (β_M); `mie.w` (the
-    /// ground altitude) is left alone.
+    /// Writes `rayleigh` (rgb β_R, w g), `mie.rgb` (β_M) and the scale
+    /// heights `planet.zw` ([`SCALE_HEIGHTS_M`]); `mie.w` (the ground
+    /// altitude) and the radii `planet.xy` are left alone.
     pub fn fill(&self, frame: &mut LightingFrame) {
         frame.rayleigh = self.rayleigh.extend(self.g).to_array();
         frame.mie[..3].copy_from_slice(&self.mie.to_array());
+        frame.planet[2] = SCALE_HEIGHTS_M.0;
+        frame.planet[3] = SCALE_HEIGHTS_M.1;
     }
 }
 
-/// `L = L₀·e^(−βs) + (1 − e^(−βs))·L_∞`: radiance `l0` seen through `s`
-/// metres of air of extinction `beta` whose infinitely long ray has
+/// `L = L₀·e^(−τ) + (1 − e^(−τ))·L_∞`: radiance `l0` seen through air of
+/// optical depth `tau` ([`optical_depth`]) whose infinitely long ray has
 /// radiance `l_inf`. CPU twin of the GLSL `aerial_perspective`.
-pub fn aerial_perspective(l0: Vec3, s: f32, l_inf: Vec3, beta: Vec3) -> Vec3 {
-    let t = (-beta * s.max(0.0)).exp();
+pub fn aerial_perspective(l0: Vec3, tau: Vec3, l_inf: Vec3) -> Vec3 {
+    let t = (-tau.max(Vec3::ZERO)).exp();
     l0 * t + (Vec3::ONE - t) * l_inf
+}
+
+/// Mean density along a straight ray between heights `z0` and `z1` (m)
+/// above the ground, relative to the ground's, for an exponential profile
+/// of scale height `h` (m): `(e^(−z0/h) − e^(−z1/h)) / ((z1 − z0)/h)`, and
+/// `e^(−z̄/h)` for a level ray. Heights below the ground count as the
+/// ground; `h ≤ 0` means constant density (1). Twin of
+/// `aerial_mean_density`.
+pub fn mean_density(z0: f32, z1: f32, h: f32) -> f32 {
+    if h.is_nan() || h <= 0.0 {
+        return 1.0;
+    }
+    let (a, b) = (z0.max(0.0) / h, z1.max(0.0) / h);
+    let d = b - a;
+    if d.abs() < 1e-3 {
+        (-0.5 * (a + b)).exp()
+    } else {
+        ((-a).exp() - (-b).exp()) / d
+    }
+}
+
+/// Optical depth τ (per channel) of `s` metres of air between heights
+/// `z0` and `z1` above the ground: the ground coefficients scaled by the
+/// mean density of their components (`scale_heights`: Rayleigh, Mie, m).
+pub fn optical_depth(coefficients: &AerialCoefficients, s: f32, z0: f32, z1: f32, scale_heights: (f32, f32)) -> Vec3 {
+    let rho_r = mean_density(z0, z1, scale_heights.0);
+    let rho_m = mean_density(z0, z1, scale_heights.1);
+    (coefficients.rayleigh * rho_r + coefficients.mie * rho_m) * s.max(0.0)
 }
 
 /// The direction the distant radiance is read from: `d` (any length) with
@@ -198,15 +247,45 @@ mod tests {
         let (l0, l_inf) = (Vec3::new(100.0, 200.0, 50.0), Vec3::new(3000.0, 4000.0, 6000.0));
         let beta = AerialCoefficients::for_turbidity(3.0).unwrap().extinction();
         for d in [0.0f32, 100.0, 1e3, 1e4, 5e4] {
-            let got = aerial_perspective(l0, d, l_inf, beta);
+            let got = aerial_perspective(l0, beta * d, l_inf);
             for c in 0..3 {
                 let t = (-(beta[c] as f64) * d as f64).exp();
                 let want = l0[c] as f64 * t + (1.0 - t) * l_inf[c] as f64;
                 assert!((got[c] as f64 / want - 1.0).abs() < 1e-5, "{d} {c}");
             }
         }
-        assert_eq!(aerial_perspective(l0, 0.0, l_inf, beta), l0);
-        assert!((aerial_perspective(l0, 1e7, l_inf, beta) - l_inf).length() < 1e-3);
+        assert_eq!(aerial_perspective(l0, Vec3::ZERO, l_inf), l0);
+        assert!((aerial_perspective(l0, beta * 1e7, l_inf) - l_inf).length() < 1e-3);
+    }
+
+    /// The mean density against a numerical integral of e^(−z/h) along
+    /// the ray, level rays, rays into the ground and the constant case.
+    #[test]
+    fn mean_density_integrates_the_exponential_profile() {
+        for (z0, z1, h) in [
+            (0.0f32, 10_000.0f32, 8_000.0f32),
+            (12_000.0, 2_000.0, 1_200.0),
+            (500.0, 500.4, 1_200.0),
+            (0.0, 300.0, 1_200.0),
+        ] {
+            let n = 100_000;
+            let numeric: f64 = (0..n)
+                .map(|i| {
+                    let z = z0 as f64 + (z1 - z0) as f64 * (i as f64 + 0.5) / n as f64;
+                    (-z / h as f64).exp()
+                })
+                .sum::<f64>()
+                / n as f64;
+            let got = mean_density(z0, z1, h) as f64;
+            assert!(
+                (got / numeric - 1.0).abs() < 1e-3,
+                "{z0}..{z1} h {h}: {got} vs {numeric}"
+            );
+        }
+        assert_eq!(mean_density(-50.0, -10.0, 8_000.0), 1.0);
+        assert_eq!(mean_density(100.0, 9_000.0, 0.0), 1.0);
+        // Looking down from 10 km through a 1.2 km Mie layer: about an eighth.
+        assert!((mean_density(10_000.0, 0.0, 1_200.0) - 0.12).abs() < 0.01);
     }
 
     #[test]
