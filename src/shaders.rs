@@ -40,6 +40,14 @@ pub const SPLAT_ACCUMULATE_FRAG: SpirV = spirv!("points/accumulate.frag");
 pub const SPLAT_OPAQUE_FRAG: SpirV = spirv!("points/opaque.frag");
 /// points.normalize: divide by the weight and shade (full-screen fragment stage).
 pub const SPLAT_NORMALIZE_FRAG: SpirV = spirv!("points/normalize.frag");
+/// points.*, object-space primitives (§10.3): quads in the tangent plane, the interval test.
+pub const OBJECT_SPLAT_VERT: SpirV = spirv!("points/object_splat.vert");
+/// points.visibility, object-space primitives: the pushed-back quad's depth inside the kernel's disk.
+pub const OBJECT_VISIBILITY_FRAG: SpirV = spirv!("points/object_visibility.frag");
+/// points.accumulate, object-space primitives: the kernel texel as weight, additively blended.
+pub const OBJECT_ACCUMULATE_FRAG: SpirV = spirv!("points/object_accumulate.frag");
+/// points.opaque, object-space primitives: the kernel's disk opaque, shaded directly.
+pub const OBJECT_OPAQUE_FRAG: SpirV = spirv!("points/object_opaque.frag");
 /// points.*, hybrid triangles (§10.1.8): vertex pulling and the test r < s/ε.
 pub const HYBRID_VERT: SpirV = spirv!("points/hybrid.vert");
 /// points.visibility, hybrid triangles: depth pushed back by the surfels' offset.

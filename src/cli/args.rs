@@ -148,6 +148,10 @@ pub enum SplatPrimitiveArg {
     Quad,
     /// Instanced quads.
     Instanced,
+    /// The text's quadruplicated object-space quads, kernel in a texture (§10.3).
+    ObjectQuad,
+    /// The text's instanced object-space quads, kernel in a texture (§10.3).
+    ObjectInstanced,
 }
 
 #[derive(Args, Debug, Clone)]

@@ -57,6 +57,8 @@ pub fn splat_settings(args: &PointArgs, fov_y_deg: f64, rows: u32) -> Result<Spl
             SplatPrimitiveArg::Point => SplatPrimitive::Point,
             SplatPrimitiveArg::Quad => SplatPrimitive::Quad,
             SplatPrimitiveArg::Instanced => SplatPrimitive::Instanced,
+            SplatPrimitiveArg::ObjectQuad => SplatPrimitive::ObjectQuad,
+            SplatPrimitiveArg::ObjectInstanced => SplatPrimitive::ObjectInstanced,
         },
         shaded: !args.no_shading,
         two_sided: args.two_sided,

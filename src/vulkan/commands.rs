@@ -295,6 +295,17 @@ impl CommandRecorder {
         unsafe { self.device().cmd_draw_indexed(self.cmd, indices, instances, 0, 0, 0) };
     }
 
+    /// Draws `indices` indices from `first_index` of the bound index buffer,
+    /// `instances` instances from `first_instance` (per-instance attributes
+    /// start at that instance).
+    pub fn draw_indexed_range(&mut self, indices: u32, first_index: u32, instances: u32, first_instance: u32) {
+        // SAFETY: as in `draw_indexed`.
+        unsafe {
+            self.device()
+                .cmd_draw_indexed(self.cmd, indices, instances, first_index, 0, first_instance)
+        };
+    }
+
     /// Copies `size` bytes from the start of `src` to the start of `dst`.
     pub fn copy_buffer(&mut self, src: &Buffer, dst: &Buffer, size: u64) {
         let region = vk::BufferCopy {

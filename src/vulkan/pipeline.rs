@@ -169,6 +169,16 @@ pub struct GraphicsPipeline {
 impl GraphicsPipeline {
     /// Builds a graphics pipeline.
     pub fn new(ctx: &Context, desc: &GraphicsPipelineDesc) -> Result<Self> {
+        Self::with_input_rate(ctx, desc, vk::VertexInputRate::VERTEX)
+    }
+
+    /// Builds a graphics pipeline whose vertex buffer binding 0 advances
+    /// once per instance (per-instance attributes, e.g. instanced splat quads).
+    pub fn new_per_instance(ctx: &Context, desc: &GraphicsPipelineDesc) -> Result<Self> {
+        Self::with_input_rate(ctx, desc, vk::VertexInputRate::INSTANCE)
+    }
+
+    fn with_input_rate(ctx: &Context, desc: &GraphicsPipelineDesc, input_rate: vk::VertexInputRate) -> Result<Self> {
         let vertex = create_module(ctx, &desc.vertex)?;
         let fragment = match create_module(ctx, &desc.fragment) {
             Ok(m) => m,
@@ -190,7 +200,7 @@ impl GraphicsPipeline {
         let bindings = [vk::VertexInputBindingDescription {
             binding: 0,
             stride: desc.vertex_stride,
-            input_rate: vk::VertexInputRate::VERTEX,
+            input_rate,
         }];
         let attributes: Vec<_> = desc
             .vertex_attributes

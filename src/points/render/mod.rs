@@ -10,9 +10,14 @@
 //! | `points.normalize` | ewa | full screen: divide by w, shade, write radiance, view depth, W, world normal and ids (the winner's, else the last surfel's) |
 //! | `points.opaque` | opaque | opaque discs with ray–plane depth, shaded directly, with normal and ids |
 //!
+//! The primitives `object-quad` and `object-instanced` ([`object_space`],
+//! §10.3) draw the same passes with object-space quads and the kernel in a
+//! texture instead of the screen-space EWA set-up.
+//!
 //! The graph derives every barrier between them. Shaders: `glsl/points/`.
 
 pub mod gpu_layout;
+pub mod object_space;
 mod passes;
 pub mod selection;
 pub mod shadow;
@@ -47,6 +52,14 @@ pub enum SplatPrimitive {
     Quad,
     /// Instanced quads: one instance of six vertices per splat.
     Instanced,
+    /// The text's quadruplication (§10.3, Table 10.3): object-space quads in
+    /// the splat's tangent plane with the kernel in a texture, the splat data
+    /// duplicated into 4 vertices per splat, 6 indices (no EWA set-up).
+    ObjectQuad,
+    /// The text's instancing (§10.3, Table 10.3): one 4-vertex object-space
+    /// quad instanced per splat with per-instance splat attributes, the
+    /// kernel in a texture (no EWA set-up).
+    ObjectInstanced,
 }
 
 impl SplatMode {
@@ -61,14 +74,32 @@ impl SplatMode {
 }
 
 impl SplatPrimitive {
-    pub const ALL: [SplatPrimitive; 3] = [SplatPrimitive::Point, SplatPrimitive::Quad, SplatPrimitive::Instanced];
+    pub const ALL: [SplatPrimitive; 5] = [
+        SplatPrimitive::Point,
+        SplatPrimitive::Quad,
+        SplatPrimitive::Instanced,
+        SplatPrimitive::ObjectQuad,
+        SplatPrimitive::ObjectInstanced,
+    ];
+    /// alpenglow's primitives: the screen-space EWA set-up in the vertex stage (§10.2.2).
+    pub const SCREEN_SPACE: [SplatPrimitive; 3] =
+        [SplatPrimitive::Point, SplatPrimitive::Quad, SplatPrimitive::Instanced];
+    /// The text's object-space quads with the kernel in a texture (§10.3).
+    pub const OBJECT_SPACE: [SplatPrimitive; 2] = [SplatPrimitive::ObjectQuad, SplatPrimitive::ObjectInstanced];
 
     pub fn name(self) -> &'static str {
         match self {
             SplatPrimitive::Point => "point",
             SplatPrimitive::Quad => "quad",
             SplatPrimitive::Instanced => "instanced",
+            SplatPrimitive::ObjectQuad => "object-quad",
+            SplatPrimitive::ObjectInstanced => "object-instanced",
         }
+    }
+
+    /// Whether the splat is an object-space quad with the kernel in a texture (§10.3).
+    pub fn is_object_space(self) -> bool {
+        Self::OBJECT_SPACE.contains(&self)
     }
 }
 

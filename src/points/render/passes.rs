@@ -7,6 +7,7 @@ use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 
+use super::object_space::{self, ObjectSpaceBuffers};
 use super::selection::FramePlan;
 use super::triangles::draw_triangles;
 use super::{PointsFrame, SplatPrimitive};
@@ -15,7 +16,7 @@ use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, PassBuilder, Re
 use crate::shaders;
 use crate::view::{Frame, SceneTargets, ViewIndex};
 use crate::vulkan::{
-    Blend, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp,
+    Blend, Buffer, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp,
     PrimitiveTopology, SpirV,
 };
 
@@ -44,7 +45,7 @@ pub(super) struct SplatPush {
     pub frame: u32,
     /// Drawn-splat counter, storage ([`NO_HANDLE`]: do not count).
     pub counter: u32,
-    /// Gaussian table, storage.
+    /// Gaussian table, storage (object-space primitives: the kernel texture, sampled).
     pub table: u32,
     /// `PASS_*`.
     pub pass: u32,
@@ -83,6 +84,8 @@ pub(super) struct PointBuffers {
     /// Hybrid triangles (§10.1.8), when the scene has any.
     pub triangles: Option<BufferId>,
     pub primitive: SplatPrimitive,
+    /// Vertices, indices and kernel texture of the object-space primitives (§10.3).
+    pub object: Option<ObjectSpaceBuffers>,
 }
 
 /// One view's points passes: its index, frame region and targets.
@@ -118,7 +121,10 @@ impl PointBuffers {
         if let Some(t) = self.triangles {
             builder = builder.read(t, BufferAccess::StorageRead(Stage::Vertex));
         }
-        builder
+        match &self.object {
+            Some(object) => object.read_by(builder),
+            None => builder,
+        }
     }
 
     /// The push constants of `pass` (counting the drawn splats when `count`).
@@ -136,7 +142,10 @@ impl PointBuffers {
                 (true, Some(c)) => ctx.storage_buffer(c)?,
                 _ => NO_HANDLE,
             },
-            table: ctx.storage_buffer(self.table)?,
+            table: match &self.object {
+                Some(object) => ctx.sampled(object.kernel)?,
+                None => ctx.storage_buffer(self.table)?,
+            },
             pass,
             primitive: PRIMITIVE_QUAD,
             size_class: SIZE_ANY,
@@ -148,6 +157,13 @@ impl PointBuffers {
     fn triangle_handle(&self, ctx: &crate::graph::PassContext<'_>) -> Result<Option<u32>> {
         self.triangles.map(|t| ctx.storage_buffer(t)).transpose()
     }
+
+    /// The vertex and index buffers of the object-space primitives in a pass.
+    fn object_buffers<'a>(&self, ctx: &crate::graph::PassContext<'a>) -> Result<Option<(&'a Buffer, &'a Buffer)>> {
+        self.object
+            .map(|o| Ok((ctx.buffer(o.vertices)?, ctx.buffer(o.indices)?)))
+            .transpose()
+    }
 }
 
 /// The plan of view `index` in `frame`.
@@ -156,12 +172,12 @@ fn plan_of(frame: &Frame, index: ViewIndex) -> Result<&FramePlan> {
 }
 
 /// A splat or hybrid-triangle pipeline of one pass.
-struct PipelineSpec {
-    name: &'static str,
-    shaders: (SpirV, SpirV),
-    color_formats: Vec<Format>,
-    blend: Blend,
-    depth: (bool, CompareOp),
+pub(super) struct PipelineSpec {
+    pub name: &'static str,
+    pub shaders: (SpirV, SpirV),
+    pub color_formats: Vec<Format>,
+    pub blend: Blend,
+    pub depth: (bool, CompareOp),
 }
 
 impl PipelineSpec {
@@ -192,8 +208,9 @@ impl PipelineSpec {
     }
 }
 
-/// A pass's pipelines: splats as triangles, as points (point primitive),
-/// and hybrid triangles (when the scene has any).
+/// A pass's pipelines: splats as triangles (screen-space quads, or the
+/// object-space quads of §10.3), as points (point primitive), and hybrid
+/// triangles (when the scene has any).
 pub(super) struct PassPipelines {
     triangles: GraphicsPipeline,
     points: Option<GraphicsPipeline>,
@@ -205,7 +222,7 @@ impl PassPipelines {
         ctx: &Context,
         targets: &SceneTargets,
         buffers: &PointBuffers,
-        splats: PipelineSpec,
+        (splats, object_fragment): (PipelineSpec, SpirV),
         hybrid: PipelineSpec,
     ) -> Result<Self> {
         let depth = targets.formats.depth;
@@ -220,19 +237,24 @@ impl PassPipelines {
         } else {
             None
         };
+        let triangles = match buffers.primitive.is_object_space() {
+            true => splats.build_object_space(ctx, depth, buffers.primitive, object_fragment)?,
+            false => splats.build(ctx, depth, false)?,
+        };
         Ok(PassPipelines {
-            triangles: splats.build(ctx, depth, false)?,
+            triangles,
             points,
             hybrid: buffers.triangles.map(|_| hybrid.build(ctx, depth, false)).transpose()?,
         })
     }
 
-    /// Records one draw per planned instance.
+    /// Records one draw per planned instance (`object`: the vertex and index
+    /// buffers of the object-space primitives).
     fn draw(
         &self,
         cmd: &mut CommandRecorder,
         plan: &FramePlan,
-        primitive: SplatPrimitive,
+        (primitive, object): (SplatPrimitive, Option<(&Buffer, &Buffer)>),
         mut push: SplatPush,
     ) -> Result<()> {
         let six = |n: u32| {
@@ -250,6 +272,11 @@ impl PassPipelines {
             Ok::<(), Error>(())
         };
         match (primitive, &self.points) {
+            (SplatPrimitive::ObjectQuad | SplatPrimitive::ObjectInstanced, _) => {
+                let object = object
+                    .ok_or_else(|| Error::Graph("points: the object-space primitives' buffers are missing".into()))?;
+                object_space::draw(cmd, &self.triangles, plan, (primitive, push), object)?;
+            }
             (SplatPrimitive::Point, Some(points)) => {
                 cmd.bind_graphics(points);
                 (push.primitive, push.size_class) = (PRIMITIVE_POINT, SIZE_POINT);
@@ -310,7 +337,10 @@ pub(super) fn declare_opaque(
         ctx,
         targets,
         &buffers,
-        spec("points.opaque", shaders::SPLAT_OPAQUE_FRAG),
+        (
+            spec("points.opaque", shaders::SPLAT_OPAQUE_FRAG),
+            shaders::OBJECT_OPAQUE_FRAG,
+        ),
         PipelineSpec {
             shaders: (shaders::HYBRID_VERT, shaders::HYBRID_OPAQUE_FRAG),
             ..spec("points.opaque.triangles", shaders::HYBRID_OPAQUE_FRAG)
@@ -331,6 +361,7 @@ pub(super) fn declare_opaque(
             let plan = plan_of(frame, view.index)?;
             let push = buffers.push(pass, view.frame, PASS_OPAQUE, true)?;
             let triangles = buffers.triangle_handle(pass)?;
+            let object = buffers.object_buffers(pass)?;
             let (radiance, view_depth) = (pass.image(view.radiance)?, pass.image(view.view_depth)?);
             let (weight, depth) = (pass.image(view.weight)?, pass.image(view.depth)?);
             let (visibility, normal, ids) = (
@@ -350,7 +381,7 @@ pub(super) fn declare_opaque(
                 ],
                 Some((depth, view.clear_depth.then_some(1.0))),
             );
-            pipelines.draw(cmd, plan, buffers.primitive, push)?;
+            pipelines.draw(cmd, plan, (buffers.primitive, object), push)?;
             pipelines.draw_hybrid(cmd, plan, push, triangles)?;
             cmd.end_rendering();
             Ok(())
@@ -414,9 +445,12 @@ fn declare_visibility(
         ctx,
         targets,
         &buffers,
-        spec(
-            "points.visibility",
-            (shaders::SPLAT_VERT, shaders::SPLAT_VISIBILITY_FRAG),
+        (
+            spec(
+                "points.visibility",
+                (shaders::SPLAT_VERT, shaders::SPLAT_VISIBILITY_FRAG),
+            ),
+            shaders::OBJECT_VISIBILITY_FRAG,
         ),
         spec(
             "points.visibility.triangles",
@@ -431,12 +465,13 @@ fn declare_visibility(
             let plan = plan_of(frame, view.index)?;
             let push = buffers.push(pass, view.frame, PASS_VISIBILITY, true)?;
             let triangles = buffers.triangle_handle(pass)?;
+            let object = buffers.object_buffers(pass)?;
             let (ids, depth) = (pass.image(ids)?, pass.image(view.depth)?);
             let cmd = pass.cmd();
             let clear = view.clear_depth.then_some(1.0);
             cmd.begin_rendering(&[(ids, LoadOp::Clear([0.0; 4]))], Some((depth, clear)));
             pipelines.draw_hybrid(cmd, plan, push, triangles)?;
-            pipelines.draw(cmd, plan, buffers.primitive, push)?;
+            pipelines.draw(cmd, plan, (buffers.primitive, object), push)?;
             cmd.end_rendering();
             Ok(())
         });
@@ -469,9 +504,12 @@ fn declare_accumulate(
         ctx,
         targets,
         &buffers,
-        spec(
-            "points.accumulate",
-            (shaders::SPLAT_VERT, shaders::SPLAT_ACCUMULATE_FRAG),
+        (
+            spec(
+                "points.accumulate",
+                (shaders::SPLAT_VERT, shaders::SPLAT_ACCUMULATE_FRAG),
+            ),
+            shaders::OBJECT_ACCUMULATE_FRAG,
         ),
         spec(
             "points.accumulate.triangles",
@@ -488,6 +526,7 @@ fn declare_accumulate(
             let plan = plan_of(frame, view.index)?;
             let push = buffers.push(pass, view.frame, PASS_ACCUMULATE, false)?;
             let triangles = buffers.triangle_handle(pass)?;
+            let object = buffers.object_buffers(pass)?;
             let (cw, nd) = (
                 pass.image(accumulation.color_weight)?,
                 pass.image(accumulation.normal_depth)?,
@@ -496,7 +535,7 @@ fn declare_accumulate(
             let clear = LoadOp::Clear([0.0; 4]);
             let cmd = pass.cmd();
             cmd.begin_rendering(&[(cw, clear), (nd, clear), (ids, clear)], Some((depth, None)));
-            pipelines.draw(cmd, plan, buffers.primitive, push)?;
+            pipelines.draw(cmd, plan, (buffers.primitive, object), push)?;
             pipelines.draw_hybrid(cmd, plan, push, triangles)?;
             cmd.end_rendering();
             Ok(())

@@ -7,11 +7,12 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::gpu_layout::{frame_header, gaussian_table, pack_nodes, HEADER_BYTES, INSTANCE_BYTES};
+use super::object_space::ObjectSpaceResources;
 use super::passes::{declare_ewa, declare_opaque, PointBuffers, PointView};
 use super::selection::{plan_frame, FramePlan, ObjectLayout};
 use super::stats::{PointFrameStats, StatsLog};
 use super::triangles::TriangleBuffer;
-use super::{SplatMode, SplatSettings};
+use super::{SplatMode, SplatPrimitive, SplatSettings};
 use crate::error::{Error, Result};
 use crate::graph::RenderGraph;
 use crate::points::build::clusters::{cluster_normals, CLUSTER_COUNT};
@@ -49,6 +50,8 @@ struct PointResources {
     counters: Option<Vec<Arc<Buffer>>>,
     /// Hybrid triangles (§10.1.8), when the scene has any.
     triangles: Option<TriangleBuffer>,
+    /// Kernel texture, vertices and indices of the object-space primitives (§10.3).
+    object: Option<ObjectSpaceResources>,
 }
 
 /// The point objects of a scene: splat lists uploaded once, the points
@@ -102,12 +105,18 @@ impl PointRenderer {
             ));
         }
         let storage = BufferUsageFlags::STORAGE_BUFFER;
+        // object-instanced reads the list as its per-instance vertex buffer.
+        let splat_usage = match settings.primitive {
+            SplatPrimitive::ObjectInstanced => storage | BufferUsageFlags::VERTEX_BUFFER,
+            _ => storage,
+        };
         let splat_buffer = Arc::new(Buffer::with_data(
             ctx,
             "splats",
-            storage,
+            splat_usage,
             bytemuck::cast_slice(&splats),
         )?);
+        let object = ObjectSpaceResources::upload(ctx, settings.primitive, &splats, settings.cutoff)?;
         let table = gaussian_table(settings.cutoff);
         let table = Arc::new(Buffer::with_data(
             ctx,
@@ -136,6 +145,7 @@ impl PointRenderer {
                 table,
                 counters,
                 triangles,
+                object,
             },
             buffers: None,
             views: Vec::new(),
@@ -172,9 +182,12 @@ impl PointRenderer {
                 table,
                 counters,
                 triangles,
+                object,
             } = &self.resources;
+            let splats = graph.import_buffer(splats.clone());
             PointBuffers {
-                splats: graph.import_buffer(splats.clone()),
+                object: object.as_ref().map(|o| o.import(graph, splats)),
+                splats,
                 table: graph.import_buffer(table.clone()),
                 counter: counters.as_ref().map(|c| graph.import_buffers_per_frame(c.clone())),
                 triangles: triangles.as_ref().map(|t| graph.import_buffer(t.buffer.clone())),
