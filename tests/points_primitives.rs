@@ -21,8 +21,8 @@ use alpenglow::points::render::{PointFrameStats, SplatMode, SplatPrimitive, Spla
 use alpenglow::points::scene::{PointScene, PointTransform};
 use alpenglow::renderer::{Camera, FrameImages, Scene};
 use common::points::{
-    analytic_plane, bunny_camera, bunny_object, grazing_camera, holes, plane_flip, plane_scene, point_sampled_flip,
-    render_points, unlit, FAR_FIELD_Y, PLANE_HEIGHT, PLANE_WIDTH, SPACING,
+    analytic_plane, bunny_camera, bunny_object, grazing_camera, holes, pixels_differing, plane_flip, plane_scene,
+    point_sampled_flip, render_points, unlit, FAR_FIELD_Y, PLANE_HEIGHT, PLANE_WIDTH, SPACING,
 };
 use common::{dump_pngs, flip_errors, linear_to_srgb8};
 
@@ -162,12 +162,7 @@ fn object_space_quads_draw_the_bunny_like_ewa_quads() {
             "object-quad alone covers {quad_only} pixels"
         );
         // Quadruplication and instancing rasterise the same quads.
-        let differing = quad
-            .rgba8
-            .chunks_exact(4)
-            .zip(instanced.rgba8.chunks_exact(4))
-            .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| x.abs_diff(*y) > 1))
-            .count();
+        let differing = pixels_differing(&quad, &instanced, 1);
         assert!(
             differing * 1000 <= pixels,
             "{differing} pixels differ between object-quad and object-instanced"

@@ -19,8 +19,8 @@ use alpenglow::points::render::{PointFrameStats, SplatMode, SplatPrimitive, Spla
 use alpenglow::points::scene::{PointObject, PointScene, PointTransform};
 use alpenglow::renderer::{Camera, FrameImages, Scene};
 use common::points::{
-    analytic_plane, bunny_camera, bunny_object, grazing_camera, holes, plane_flip, plane_scene, point_sampled_flip,
-    render_points, unlit, FAR_FIELD_Y, PLANE_HEIGHT as HEIGHT, PLANE_WIDTH as WIDTH, SPACING,
+    analytic_plane, bunny_camera, bunny_object, grazing_camera, holes, pixels_differing, plane_flip, plane_scene,
+    point_sampled_flip, render_points, unlit, FAR_FIELD_Y, PLANE_HEIGHT as HEIGHT, PLANE_WIDTH as WIDTH, SPACING,
 };
 /// Mean FLIP of EWA splats against the supersampled reference over the far
 /// plane. Measured 0.138 on lavapipe (what remains is the reconstruction's
@@ -148,12 +148,7 @@ fn the_three_screen_space_primitives_draw_the_same_splats() {
         .collect();
     let quad = &images[1].1;
     for (primitive, frame) in &images {
-        let differing = frame
-            .rgba8
-            .chunks_exact(4)
-            .zip(quad.rgba8.chunks_exact(4))
-            .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| x.abs_diff(*y) > 2))
-            .count();
+        let differing = pixels_differing(frame, quad, 2);
         eprintln!("{}: {differing} pixels differ from quads", primitive.name());
         assert!(
             differing * 1000 <= (WIDTH * HEIGHT) as usize,
@@ -193,12 +188,7 @@ fn normal_clusters_skip_back_faces_without_changing_the_image() {
         stats.drawn_splats, plain_stats.drawn_splats,
         "the same front-facing splats are drawn"
     );
-    let differing = plain
-        .rgba8
-        .chunks_exact(4)
-        .zip(clustered.rgba8.chunks_exact(4))
-        .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| x.abs_diff(*y) > 2))
-        .count();
+    let differing = pixels_differing(&plain, &clustered, 2);
     assert!(
         differing * 1000 <= (WIDTH * HEIGHT) as usize,
         "{differing} pixels differ"

@@ -39,6 +39,13 @@ pub fn render_points(
     out
 }
 
+/// Pixels of two frames whose sRGB8 differs by more than `tolerance` in a channel.
+pub fn pixels_differing(a: &FrameImages, b: &FrameImages, tolerance: u8) -> usize {
+    (a.rgba8.chunks_exact(4).zip(b.rgba8.chunks_exact(4)))
+        .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| x.abs_diff(*y) > tolerance))
+        .count()
+}
+
 /// The Stanford bunny sampled into 20 000 surfels (y-up: stand it up with
 /// the transform `r=90,0,0`); `hybrid` keeps its triangles (§10.1.8).
 pub fn bunny_object(hybrid: bool) -> PointObject {

@@ -133,21 +133,17 @@ impl ObjectSpaceResources {
             },
             &kernel_texels(cutoff),
         )?;
+        let upload = |name: &str, usage, bytes: &[u8]| Buffer::with_data(ctx, name, usage, bytes).map(Arc::new);
         let (vertices, indices) = match primitive {
             SplatPrimitive::ObjectQuad => {
                 let (vertices, indices) = quadruplicate(splats);
-                let vertices = Buffer::with_data(
-                    ctx,
-                    "quadruplicated splats",
-                    BufferUsageFlags::VERTEX_BUFFER,
-                    bytemuck::cast_slice(&vertices),
-                )?;
-                (Some(Arc::new(vertices)), indices)
+                let usage = BufferUsageFlags::VERTEX_BUFFER;
+                let vertices = upload("quadruplicated splats", usage, bytemuck::cast_slice(&vertices))?;
+                (Some(vertices), indices)
             }
             _ => (None, QUAD_INDICES.to_vec()),
         };
-        let indices = Buffer::with_data(
-            ctx,
+        let indices = upload(
             "splat quad indices",
             BufferUsageFlags::INDEX_BUFFER,
             bytemuck::cast_slice(&indices),
@@ -155,7 +151,7 @@ impl ObjectSpaceResources {
         Ok(Some(ObjectSpaceResources {
             kernel: Arc::new(kernel),
             vertices,
-            indices: Arc::new(indices),
+            indices,
         }))
     }
 
@@ -209,7 +205,6 @@ impl PipelineSpec {
             offset: 16 * location,
         };
         let desc = GraphicsPipelineDesc {
-            name: self.name,
             vertex: shaders::OBJECT_SPLAT_VERT,
             fragment,
             vertex_stride: SPLAT_BYTES as u32,
@@ -219,15 +214,7 @@ impl PipelineSpec {
                 attribute(2, Format::R32G32B32A32_UINT),
                 attribute(3, Format::R32G32B32A32_SFLOAT),
             ],
-            topology: PrimitiveTopology::TRIANGLE_LIST,
-            cull_back_faces: false,
-            wireframe: false,
-            color_formats: self.color_formats.clone(),
-            blend: self.blend,
-            depth_format: Some(depth_format),
-            depth_test: true,
-            depth_write: self.depth.0,
-            depth_compare: self.depth.1,
+            ..self.desc(depth_format, PrimitiveTopology::TRIANGLE_LIST)
         };
         match primitive {
             SplatPrimitive::ObjectInstanced => GraphicsPipeline::new_per_instance(ctx, &desc),

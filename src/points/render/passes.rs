@@ -181,30 +181,32 @@ pub(super) struct PipelineSpec {
 }
 
 impl PipelineSpec {
+    /// The pipeline's description without vertex input.
+    pub(super) fn desc(&self, depth_format: Format, topology: PrimitiveTopology) -> GraphicsPipelineDesc {
+        GraphicsPipelineDesc {
+            name: self.name,
+            vertex: self.shaders.0,
+            fragment: self.shaders.1,
+            vertex_stride: 0,
+            vertex_attributes: Vec::new(),
+            topology,
+            cull_back_faces: false,
+            wireframe: false,
+            color_formats: self.color_formats.clone(),
+            blend: self.blend,
+            depth_format: Some(depth_format),
+            depth_test: true,
+            depth_write: self.depth.0,
+            depth_compare: self.depth.1,
+        }
+    }
+
     fn build(&self, ctx: &Context, depth_format: Format, points: bool) -> Result<GraphicsPipeline> {
-        GraphicsPipeline::new(
-            ctx,
-            &GraphicsPipelineDesc {
-                name: self.name,
-                vertex: self.shaders.0,
-                fragment: self.shaders.1,
-                vertex_stride: 0,
-                vertex_attributes: Vec::new(),
-                topology: if points {
-                    PrimitiveTopology::POINT_LIST
-                } else {
-                    PrimitiveTopology::TRIANGLE_LIST
-                },
-                cull_back_faces: false,
-                wireframe: false,
-                color_formats: self.color_formats.clone(),
-                blend: self.blend,
-                depth_format: Some(depth_format),
-                depth_test: true,
-                depth_write: self.depth.0,
-                depth_compare: self.depth.1,
-            },
-        )
+        let topology = match points {
+            true => PrimitiveTopology::POINT_LIST,
+            false => PrimitiveTopology::TRIANGLE_LIST,
+        };
+        GraphicsPipeline::new(ctx, &self.desc(depth_format, topology))
     }
 }
 
