@@ -109,7 +109,7 @@ fn bunny_render_args(dir: &std::path::Path, extra: &[&str]) -> Vec<String> {
     args
 }
 
-/// Both splat modes and all three primitives render the bunny under
+/// Both splat modes and all five primitives render the bunny under
 /// validation; the EXR carries W (positive on the bunny, 0 on the sky), and
 /// the statistics line reports the GPU's interval test (and, with
 /// `--hybrid`, the triangles drawn up close).
@@ -123,6 +123,7 @@ fn renders_points_in_every_mode_and_primitive_with_w_in_the_exr() {
         ("ewa", "point", false),
         ("opaque", "quad", false),
         ("opaque", "point", false),
+        ("ewa", "object-quad", false),
         ("ewa", "quad", true),
         ("opaque", "quad", true),
     ] {
