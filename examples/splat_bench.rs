@@ -1,12 +1,19 @@
 //! Benchmark of point rendering (dissertation §10.1.7, §10.2, §10.3):
 //! `cargo run --release --example splat_bench [-- --quick]`.
 //!
-//! 1. Splats per second of each splat mode (opaque, three-pass EWA) and
-//!    primitive (point, quad by vertex pulling, instanced quad), as in
-//!    Table 10.3: the bunny sampled into ~100k surfels, every leaf drawn
-//!    (a flat list: no level of detail), framed in a 512² window.
+//! 1. Table 10.3: frames and splats per second of each primitive in the
+//!    three passes of EWA splatting (and in the opaque mode), the text's set
+//!    (point primitives with the EWA set-up, quadruplicated and instanced
+//!    object-space quads with the kernel in a texture) beside alpenglow's own
+//!    (EWA quads by vertex pulling, instanced EWA quads, EWA points), with
+//!    the text's fps: the bunny sampled into N ≈ 101 685 surfels like the
+//!    text's, every leaf drawn (a flat list: no level of detail), a close
+//!    view covering a 512² window.
 //! 2. The sequential point tree against drawing every leaf, at several
-//!    distances: splats in the prefix, splats drawn, GPU time.
+//!    distances: splats in the prefix, splats drawn, GPU time; and the SPT
+//!    rate (splats sent and drawn per second) of a field of 64 bunnies at
+//!    1–5 m, opaque points as in the text (§10.1.7: ~60 M points/s on a
+//!    Radeon 9700, ~80 M on a GeForce 6800 GT) and EWA quads.
 //! 3. CPU time of the per-frame selection per object instance: the default
 //!    scene's 300 rock instances.
 //! 4. Hybrid point–polygon rendering (§10.1.8) against points only, at
@@ -17,14 +24,29 @@
 //! frames; splats/s = splats drawn (the vertex stage's count) / that time.
 
 use alpenglow::points::build::spt::{epsilon_from_pixels, SequentialPointTree, ROOT_R_MAX};
+use alpenglow::points::render::object_space::QUADRUPLICATION_EXTRA_BYTES_PER_SPLAT;
 use alpenglow::points::render::{SplatMode, SplatPrimitive, SplatSettings};
-use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointObject, PointScene, PointTransform};
+use alpenglow::points::scene::{
+    load_point_object, PointInstance, PointLoadOptions, PointObject, PointScene, PointTransform,
+};
 use alpenglow::profile::median;
 use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
 use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
 use glam::DVec3;
 
 const SIDE: u32 = 512;
+/// Surfels sampled from the bunny mesh: 101 684 leaves, the text's N = 101 685.
+const MESH_SAMPLES: usize = 102_480;
+/// Table 10.3 (GeForce 6800 GT, N = 101 685, 512²): fps of the text's primitives.
+const TEXT_FPS: [(SplatPrimitive, &str, f64); 3] = [
+    (
+        SplatPrimitive::Point,
+        "Perspective Accurate Splatting (point primitives)",
+        50.0,
+    ),
+    (SplatPrimitive::ObjectQuad, "Quadruplication", 97.8),
+    (SplatPrimitive::ObjectInstanced, "Instancing", 29.7),
+];
 
 struct Measured {
     gpu_ms: f64,
@@ -107,7 +129,7 @@ fn main() {
         ..Default::default()
     };
     let options = PointLoadOptions {
-        mesh_samples: 100_000,
+        mesh_samples: MESH_SAMPLES,
         spt,
         ..PointLoadOptions::default()
     };
@@ -121,32 +143,7 @@ fn main() {
     let flat = single(leaves);
     let close = camera_at(0.25);
 
-    println!(
-        "\n1. {} leaves as a flat list, {SIDE}² window, two-sided (every splat drawn):",
-        flat.points.total_splats()
-    );
-    println!("| mode | primitive | splats drawn | GPU ms (points passes) | M splats/s |");
-    println!("|---|---|---|---|---|");
-    for mode in SplatMode::ALL {
-        for primitive in SplatPrimitive::ALL {
-            let settings = SplatSettings {
-                mode,
-                primitive,
-                two_sided: true,
-                ..SplatSettings::default()
-            };
-            let m = measure(&ctx, &flat, &close, settings, frames);
-            println!(
-                "| {} | {} | {} | {:.1} | {:.2} |",
-                mode.name(),
-                primitive.name(),
-                m.drawn,
-                m.gpu_ms,
-                m.drawn as f64 / m.gpu_ms / 1e3
-            );
-        }
-    }
-
+    table_10_3(&ctx, &flat, &close, frames);
     println!(
         "\n2. Sequential point tree ({} nodes) against every leaf, EWA quads:",
         bunny.tree.nodes.len()
@@ -165,6 +162,8 @@ fn main() {
         );
     }
 
+    spt_rate(&ctx, &tree_scene.points.objects[0], frames);
+
     println!("\n3. CPU selection per frame, default scene (300 rock instances):");
     let scene = Scene::default_procedural().expect("default scene");
     let m = measure(&ctx, &scene, &scene.default_camera(), SplatSettings::default(), frames);
@@ -174,6 +173,103 @@ fn main() {
         m.cpu_ms * 1e3 / scene.points.instances.len() as f64
     );
     hybrid_against_points(&ctx, &options, &models, frames);
+}
+
+/// Part 1: Table 10.3, the text's primitive set and alpenglow's, in both modes.
+fn table_10_3(ctx: &Context, flat: &Scene, close: &Camera, frames: usize) {
+    let n = flat.points.total_splats();
+    println!("\n1. Table 10.3: {n} leaves as a flat list, {SIDE}² window, two-sided (every splat drawn):");
+    println!("| mode | set | primitive | splats drawn | GPU ms (points passes) | fps (points passes) | M splats/s | text fps (GeForce 6800 GT) |");
+    println!("|---|---|---|---|---|---|---|---|");
+    let rows = [
+        ("text", SplatPrimitive::Point),
+        ("text", SplatPrimitive::ObjectQuad),
+        ("text", SplatPrimitive::ObjectInstanced),
+        ("alpenglow", SplatPrimitive::Quad),
+        ("alpenglow", SplatPrimitive::Instanced),
+    ];
+    for mode in SplatMode::ALL {
+        for (set, primitive) in rows {
+            let settings = SplatSettings {
+                mode,
+                primitive,
+                two_sided: true,
+                ..SplatSettings::default()
+            };
+            let m = measure(ctx, flat, close, settings, frames);
+            let text = TEXT_FPS
+                .iter()
+                .find(|(p, _, _)| *p == primitive && mode == SplatMode::Ewa && set == "text")
+                .map_or("–".to_string(), |(_, name, fps)| format!("{fps} ({name})"));
+            println!(
+                "| {} | {set} | {} | {} | {:.1} | {:.2} | {:.2} | {text} |",
+                mode.name(),
+                primitive.name(),
+                m.drawn,
+                m.gpu_ms,
+                1e3 / m.gpu_ms,
+                m.drawn as f64 / m.gpu_ms / 1e3
+            );
+        }
+    }
+    println!(
+        "quadruplication: {QUADRUPLICATION_EXTRA_BYTES_PER_SPLAT} bytes per splat on top of the 64-byte splat record ({:.1} MB for {n} splats)",
+        (QUADRUPLICATION_EXTRA_BYTES_PER_SPLAT * n as u64) as f64 / 1e6
+    );
+}
+
+/// Part 2b: the SPT rate of a field of 8×8 bunnies 0.5 m apart seen from
+/// 1 m before its front row (the text's set-up: opaque point primitives,
+/// §10.1.7; and EWA quads): splats sent (prefixes) and drawn per second.
+fn spt_rate(ctx: &Context, bunny: &PointObject, frames: usize) {
+    let standing = PointTransform::parse("r=90,0,0").unwrap();
+    let mut points = PointScene {
+        objects: vec![bunny.clone()],
+        ..PointScene::default()
+    };
+    for j in 0..8 {
+        for i in 0..8 {
+            let translation = DVec3::new(0.5 * (i as f64 - 3.5), 0.5 * j as f64, 0.0);
+            let transform = PointTransform {
+                translation,
+                ..standing
+            };
+            points.instances.push(PointInstance { object: 0, transform });
+        }
+    }
+    let scene = Scene::points_only(points);
+    let camera = Camera {
+        eye: DVec3::new(0.0, -1.0, 0.6),
+        target: DVec3::new(0.0, 2.0, 0.0),
+        ..camera_at(1.0)
+    };
+    println!("\nSPT rate: 64 bunny instances at 1–5 m, {SIDE}² window, back faces culled:");
+    println!(
+        "| mode | primitive | splats sent (prefixes) | splats drawn | GPU ms | M splats/s sent | M splats/s drawn |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for (mode, primitive) in [
+        (SplatMode::Opaque, SplatPrimitive::Point),
+        (SplatMode::Ewa, SplatPrimitive::Quad),
+        (SplatMode::Ewa, SplatPrimitive::ObjectQuad),
+    ] {
+        let settings = SplatSettings {
+            mode,
+            primitive,
+            ..SplatSettings::default()
+        };
+        let m = measure(ctx, &scene, &camera, settings, frames);
+        println!(
+            "| {} | {} | {} | {} | {:.1} | {:.2} | {:.2} |",
+            mode.name(),
+            primitive.name(),
+            m.prefix,
+            m.drawn,
+            m.gpu_ms,
+            m.prefix as f64 / m.gpu_ms / 1e3,
+            m.drawn as f64 / m.gpu_ms / 1e3
+        );
+    }
 }
 
 /// Part 4: each model with and without its triangles (EWA quads).
