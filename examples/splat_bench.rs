@@ -20,6 +20,8 @@
 //!    several distances: splats and triangles drawn, GPU time
 //!    (`-- --hybrid` runs only this part).
 //!
+//! `-- --primitives` runs only part 1 and the SPT rate.
+//!
 //! GPU times are the medians of the points passes' timestamps over the timed
 //! frames; splats/s = splats drawn (the vertex stage's count) / that time.
 
@@ -117,6 +119,7 @@ fn camera_at(distance: f64) -> Camera {
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
     let hybrid_only = std::env::args().any(|a| a == "--hybrid");
+    let primitives_only = std::env::args().any(|a| a == "--primitives");
     let frames = if quick { 3 } else { 10 };
     let ctx = Context::new(&ContextOptions {
         validation: false,
@@ -144,6 +147,10 @@ fn main() {
     let close = camera_at(0.25);
 
     table_10_3(&ctx, &flat, &close, frames);
+    if primitives_only {
+        spt_rate(&ctx, &bunny, frames);
+        return;
+    }
     println!(
         "\n2. Sequential point tree ({} nodes) against every leaf, EWA quads:",
         bunny.tree.nodes.len()
