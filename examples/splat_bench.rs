@@ -39,8 +39,8 @@ use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
 use glam::DVec3;
 
 const SIDE: u32 = 512;
-/// Surfels sampled from the bunny mesh: 101 684 leaves, the text's N = 101 685.
-const MESH_SAMPLES: usize = 102_480;
+/// Surfels sampled from the bunny mesh (each a leaf): the text's N = 101 685.
+const MESH_SAMPLES: usize = 101_685;
 /// Table 10.3 (GeForce 6800 GT, N = 101 685, 512²): fps of the text's primitives.
 const TEXT_FPS: [(SplatPrimitive, &str, f64); 3] = [
     (
@@ -255,24 +255,28 @@ fn spt_rate(ctx: &Context, bunny: &PointObject, frames: usize) {
     };
     println!("\nSPT rate: 64 bunny instances at 2.7–6.5 m, {SIDE}² window, back faces culled:");
     println!(
-        "| mode | primitive | splats sent (prefixes) | splats drawn | GPU ms | M splats/s sent | M splats/s drawn |"
+        "| mode | primitive | shaded | splats sent (prefixes) | splats drawn | GPU ms | M splats/s sent | M splats/s drawn |"
     );
-    println!("|---|---|---|---|---|---|---|");
-    for (mode, primitive) in [
-        (SplatMode::Opaque, SplatPrimitive::Point),
-        (SplatMode::Ewa, SplatPrimitive::Quad),
-        (SplatMode::Ewa, SplatPrimitive::ObjectQuad),
+    println!("|---|---|---|---|---|---|---|---|");
+    // Opaque unlit points are the text's "single-colored point primitives".
+    for (mode, primitive, shaded) in [
+        (SplatMode::Opaque, SplatPrimitive::Point, false),
+        (SplatMode::Opaque, SplatPrimitive::Point, true),
+        (SplatMode::Ewa, SplatPrimitive::Quad, true),
+        (SplatMode::Ewa, SplatPrimitive::ObjectQuad, true),
     ] {
         let settings = SplatSettings {
             mode,
             primitive,
+            shaded,
             ..SplatSettings::default()
         };
         let m = measure(ctx, &scene, &camera, settings, frames);
         println!(
-            "| {} | {} | {} | {} | {:.1} | {:.2} | {:.2} |",
+            "| {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.2} |",
             mode.name(),
             primitive.name(),
+            if shaded { "yes" } else { "no" },
             m.prefix,
             m.drawn,
             m.gpu_ms,
