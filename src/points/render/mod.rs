@@ -19,6 +19,7 @@
 pub mod gpu_layout;
 pub mod object_space;
 mod passes;
+mod pipeline_spec;
 pub mod selection;
 pub mod shadow;
 pub mod stats;

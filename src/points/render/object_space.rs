@@ -23,7 +23,8 @@
 use std::sync::Arc;
 
 use super::gpu_layout::GpuSplat;
-use super::passes::{PipelineSpec, SplatPush};
+use super::passes::SplatPush;
+use super::pipeline_spec::PipelineSpec;
 use super::selection::FramePlan;
 use super::SplatPrimitive;
 use crate::error::{Error, Result};

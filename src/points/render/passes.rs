@@ -8,6 +8,7 @@ use std::sync::Arc;
 use bytemuck::{Pod, Zeroable};
 
 use super::object_space::{self, ObjectSpaceBuffers};
+use super::pipeline_spec::PipelineSpec;
 use super::selection::FramePlan;
 use super::triangles::draw_triangles;
 use super::{PointsFrame, SplatPrimitive};
@@ -16,8 +17,7 @@ use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, PassBuilder, Re
 use crate::shaders;
 use crate::view::{Frame, SceneTargets, ViewIndex};
 use crate::vulkan::{
-    Blend, Buffer, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp,
-    PrimitiveTopology, SpirV,
+    Blend, Buffer, CommandRecorder, CompareOp, Context, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, SpirV,
 };
 
 /// `SplatPush.pass`: which pass the shaders run in.
@@ -169,45 +169,6 @@ impl PointBuffers {
 /// The plan of view `index` in `frame`.
 fn plan_of(frame: &Frame, index: ViewIndex) -> Result<&FramePlan> {
     Ok(&frame.prepared::<PointsFrame>()?.view(index)?.plan)
-}
-
-/// A splat or hybrid-triangle pipeline of one pass.
-pub(super) struct PipelineSpec {
-    pub name: &'static str,
-    pub shaders: (SpirV, SpirV),
-    pub color_formats: Vec<Format>,
-    pub blend: Blend,
-    pub depth: (bool, CompareOp),
-}
-
-impl PipelineSpec {
-    /// The pipeline's description without vertex input.
-    pub(super) fn desc(&self, depth_format: Format, topology: PrimitiveTopology) -> GraphicsPipelineDesc {
-        GraphicsPipelineDesc {
-            name: self.name,
-            vertex: self.shaders.0,
-            fragment: self.shaders.1,
-            vertex_stride: 0,
-            vertex_attributes: Vec::new(),
-            topology,
-            cull_back_faces: false,
-            wireframe: false,
-            color_formats: self.color_formats.clone(),
-            blend: self.blend,
-            depth_format: Some(depth_format),
-            depth_test: true,
-            depth_write: self.depth.0,
-            depth_compare: self.depth.1,
-        }
-    }
-
-    fn build(&self, ctx: &Context, depth_format: Format, points: bool) -> Result<GraphicsPipeline> {
-        let topology = match points {
-            true => PrimitiveTopology::POINT_LIST,
-            false => PrimitiveTopology::TRIANGLE_LIST,
-        };
-        GraphicsPipeline::new(ctx, &self.desc(depth_format, topology))
-    }
 }
 
 /// A pass's pipelines: splats as triangles (screen-space quads, or the
