@@ -136,7 +136,8 @@ void main() {
         s_large_count = 0u;
     }
     barrier();
-    uint index = gl_GlobalInvocationID.x;
+    // Dispatches wider than the 65535-workgroup limit use rows of workgroups.
+    uint index = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * WORKGROUP_SIZE + gl_LocalInvocationIndex;
     SplatSetup v;
     uint setup = index < pc.single.w ? splat_setup(index, v) : SPLAT_SETUP_OUTSIDE_INTERVAL;
     if (pc.handles.z != NO_HANDLE && setup != SPLAT_SETUP_OUTSIDE_INTERVAL) {

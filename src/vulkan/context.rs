@@ -307,8 +307,8 @@ impl Context {
             .vertex_pipeline_stores_and_atomics(optional.vertex_pipeline_stores_and_atomics)
             .shader_int64(optional.shader_buffer_int64_atomics);
         v12 = v12.shader_buffer_int64_atomics(optional.shader_buffer_int64_atomics);
-        let mut interlock = vk::PhysicalDeviceFragmentShaderInterlockFeaturesEXT::default()
-            .fragment_shader_pixel_interlock(true);
+        let mut interlock =
+            vk::PhysicalDeviceFragmentShaderInterlockFeaturesEXT::default().fragment_shader_pixel_interlock(true);
         let extensions = [ash::ext::fragment_shader_interlock::NAME.as_ptr()];
         let mut device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)

@@ -22,9 +22,9 @@ use crate::vulkan::{
 /// `SplatPush.pass`: which pass the shaders run in.
 const PASS_VISIBILITY: u32 = 0;
 const PASS_ACCUMULATE: u32 = 1;
-const PASS_OPAQUE: u32 = 2;
+pub(super) const PASS_OPAQUE: u32 = 2;
 /// `SplatPush.primitive`.
-const PRIMITIVE_QUAD: u32 = 0;
+pub(super) const PRIMITIVE_QUAD: u32 = 0;
 const PRIMITIVE_INSTANCED: u32 = 1;
 const PRIMITIVE_POINT: u32 = 2;
 /// `SplatPush.size_class`: every splat, only those a point can cover, only larger ones.
@@ -122,7 +122,7 @@ impl PointBuffers {
     }
 
     /// The push constants of `pass` (counting the drawn splats when `count`).
-    fn push(
+    pub(super) fn push(
         &self,
         ctx: &crate::graph::PassContext<'_>,
         frame: UploadRegion,
@@ -145,27 +145,27 @@ impl PointBuffers {
     }
 
     /// The triangle buffer's handle in a pass.
-    fn triangle_handle(&self, ctx: &crate::graph::PassContext<'_>) -> Result<Option<u32>> {
+    pub(super) fn triangle_handle(&self, ctx: &crate::graph::PassContext<'_>) -> Result<Option<u32>> {
         self.triangles.map(|t| ctx.storage_buffer(t)).transpose()
     }
 }
 
 /// The plan of view `index` in `frame`.
-fn plan_of(frame: &Frame, index: ViewIndex) -> Result<&FramePlan> {
+pub(super) fn plan_of(frame: &Frame, index: ViewIndex) -> Result<&FramePlan> {
     Ok(&frame.prepared::<PointsFrame>()?.view(index)?.plan)
 }
 
 /// A splat or hybrid-triangle pipeline of one pass.
-struct PipelineSpec {
-    name: &'static str,
-    shaders: (SpirV, SpirV),
-    color_formats: Vec<Format>,
-    blend: Blend,
-    depth: (bool, CompareOp),
+pub(super) struct PipelineSpec {
+    pub name: &'static str,
+    pub shaders: (SpirV, SpirV),
+    pub color_formats: Vec<Format>,
+    pub blend: Blend,
+    pub depth: (bool, CompareOp),
 }
 
 impl PipelineSpec {
-    fn build(&self, ctx: &Context, depth_format: Format, points: bool) -> Result<GraphicsPipeline> {
+    pub(super) fn build(&self, ctx: &Context, depth_format: Format, points: bool) -> Result<GraphicsPipeline> {
         GraphicsPipeline::new(
             ctx,
             &GraphicsPipelineDesc {
