@@ -15,7 +15,7 @@ use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, PassBuilder, Re
 use crate::shaders;
 use crate::view::{Frame, SceneTargets, ViewIndex};
 use crate::vulkan::{
-    Blend, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp,
+    Blend, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, Image, LoadOp,
     PrimitiveTopology, SpirV,
 };
 
@@ -31,7 +31,7 @@ const PRIMITIVE_POINT: u32 = 2;
 const SIZE_ANY: u32 = 0;
 const SIZE_POINT: u32 = 1;
 const SIZE_OVERSIZE: u32 = 2;
-const NO_HANDLE: u32 = u32::MAX;
+pub(super) const NO_HANDLE: u32 = u32::MAX;
 
 /// Push constants of the points passes (`Push` in glsl/include/splat.glsl:
 /// `handles`, then `mode`).
@@ -103,6 +103,41 @@ pub(super) struct PointView {
     pub lighting: UploadRegion,
     /// Clear the depth buffer first (no terrain drew into it).
     pub clear_depth: bool,
+}
+
+impl PointView {
+    /// Declares the writes of a pass that draws the view's shaded outputs
+    /// (radiance, view depth, W with `weight`, visibility, normal, ids).
+    pub(super) fn write_outputs<'g>(
+        &self,
+        builder: PassBuilder<'g, Frame>,
+        weight: ImageAccess,
+    ) -> PassBuilder<'g, Frame> {
+        builder
+            .write(self.radiance, ImageAccess::ColorAttachmentReadWrite)
+            .write(self.view_depth, ImageAccess::ColorAttachmentReadWrite)
+            .write(self.weight, weight)
+            .write(self.visibility, ImageAccess::ColorAttachmentReadWrite)
+            .write(self.normal, ImageAccess::ColorAttachmentReadWrite)
+            .write(self.ids, ImageAccess::ColorAttachmentReadWrite)
+    }
+
+    /// The colour attachments of [`Self::write_outputs`]: every output
+    /// loaded but W, which `weight` loads or clears.
+    pub(super) fn output_attachments<'a>(
+        &self,
+        pass: &crate::graph::PassContext<'a>,
+        weight: LoadOp,
+    ) -> Result<[(&'a Image, LoadOp); 6]> {
+        Ok([
+            (pass.image(self.radiance)?, LoadOp::Load),
+            (pass.image(self.view_depth)?, LoadOp::Load),
+            (pass.image(self.weight)?, weight),
+            (pass.image(self.visibility)?, LoadOp::Load),
+            (pass.image(self.normal)?, LoadOp::Load),
+            (pass.image(self.ids)?, LoadOp::Load),
+        ])
+    }
 }
 
 impl PointBuffers {
@@ -317,39 +352,17 @@ pub(super) fn declare_opaque(
         },
     )?;
     let builder = buffers.read_by(graph.pass(name).graphics(), view.frame, true);
-    targets
-        .lighting
-        .read_in(builder, Stage::Fragment)
-        .write(view.radiance, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.view_depth, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.weight, ImageAccess::ColorAttachmentWrite)
-        .write(view.visibility, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.normal, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.ids, ImageAccess::ColorAttachmentReadWrite)
+    let builder = targets.lighting.read_in(builder, Stage::Fragment);
+    view.write_outputs(builder, ImageAccess::ColorAttachmentWrite)
         .write(view.depth, ImageAccess::DepthAttachmentWrite)
         .record(move |pass, frame| {
             let plan = plan_of(frame, view.index)?;
             let push = buffers.push(pass, view.frame, PASS_OPAQUE, true)?;
             let triangles = buffers.triangle_handle(pass)?;
-            let (radiance, view_depth) = (pass.image(view.radiance)?, pass.image(view.view_depth)?);
-            let (weight, depth) = (pass.image(view.weight)?, pass.image(view.depth)?);
-            let (visibility, normal, ids) = (
-                pass.image(view.visibility)?,
-                pass.image(view.normal)?,
-                pass.image(view.ids)?,
-            );
+            let colors = view.output_attachments(pass, LoadOp::Clear([0.0; 4]))?;
+            let depth = pass.image(view.depth)?;
             let cmd = pass.cmd();
-            cmd.begin_rendering(
-                &[
-                    (radiance, LoadOp::Load),
-                    (view_depth, LoadOp::Load),
-                    (weight, LoadOp::Clear([0.0; 4])),
-                    (visibility, LoadOp::Load),
-                    (normal, LoadOp::Load),
-                    (ids, LoadOp::Load),
-                ],
-                Some((depth, view.clear_depth.then_some(1.0))),
-            );
+            cmd.begin_rendering(&colors, Some((depth, view.clear_depth.then_some(1.0))));
             pipelines.draw(cmd, plan, buffers.primitive, push)?;
             pipelines.draw_hybrid(cmd, plan, push, triangles)?;
             cmd.end_rendering();
@@ -531,21 +544,15 @@ fn declare_normalize(
             ],
         ),
     )?);
-    let builder = graph.pass(name).graphics();
-    targets
+    let builder = targets
         .lighting
-        .read_in(builder, Stage::Fragment)
+        .read_in(graph.pass(name).graphics(), Stage::Fragment)
         .read(accumulation.color_weight, ImageAccess::Sampled(Stage::Fragment))
         .read(accumulation.normal_depth, ImageAccess::Sampled(Stage::Fragment))
         .read(accumulation.nearest_ids, ImageAccess::Sampled(Stage::Fragment))
         .read(accumulation.any_ids, ImageAccess::Sampled(Stage::Fragment))
-        .read(view.frame, BufferAccess::StorageRead(Stage::Fragment))
-        .write(view.radiance, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.view_depth, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.weight, ImageAccess::ColorAttachmentWrite)
-        .write(view.visibility, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.normal, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.ids, ImageAccess::ColorAttachmentReadWrite)
+        .read(view.frame, BufferAccess::StorageRead(Stage::Fragment));
+    view.write_outputs(builder, ImageAccess::ColorAttachmentWrite)
         .record(move |pass, _| {
             let push = NormalizePush {
                 color_weight: pass.sampled(accumulation.color_weight)?,
@@ -555,21 +562,9 @@ fn declare_normalize(
                 any_ids: pass.sampled(accumulation.any_ids)?,
                 ..NormalizePush::zeroed()
             };
-            let (radiance, view_depth) = (pass.image(view.radiance)?, pass.image(view.view_depth)?);
-            let (weight, visibility) = (pass.image(view.weight)?, pass.image(view.visibility)?);
-            let (normal, ids) = (pass.image(view.normal)?, pass.image(view.ids)?);
+            let colors = view.output_attachments(pass, LoadOp::Clear([0.0; 4]))?;
             let cmd = pass.cmd();
-            cmd.begin_rendering(
-                &[
-                    (radiance, LoadOp::Load),
-                    (view_depth, LoadOp::Load),
-                    (weight, LoadOp::Clear([0.0; 4])),
-                    (visibility, LoadOp::Load),
-                    (normal, LoadOp::Load),
-                    (ids, LoadOp::Load),
-                ],
-                None,
-            );
+            cmd.begin_rendering(&colors, None);
             cmd.bind_graphics(&pipeline);
             cmd.push_constants(&push)?;
             cmd.draw(3, 1);

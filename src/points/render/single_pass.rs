@@ -34,7 +34,9 @@ use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 
-use super::passes::{plan_of, PipelineSpec, PointBuffers, PointView, SplatPush, PASS_OPAQUE, PRIMITIVE_QUAD};
+use super::passes::{
+    plan_of, PipelineSpec, PointBuffers, PointView, SplatPush, NO_HANDLE, PASS_OPAQUE, PRIMITIVE_QUAD,
+};
 use super::triangles::draw_triangles;
 use super::SplatBackend;
 use crate::error::{Error, Result};
@@ -54,7 +56,6 @@ const PIXEL_SUM_BYTES: u64 = 48;
 const WORKGROUP_SIZE: u32 = 64;
 /// Most workgroups per dispatch row (the guaranteed `maxComputeWorkGroupCount`).
 const MAX_GROUPS_X: u32 = 65535;
-const NO_HANDLE: u32 = u32::MAX;
 
 /// Push constants of `points.single_pass` (`Push` in glsl/include/splat.glsl
 /// with `SPLAT_SINGLE_PASS`): the splat passes' block, then `single`.
@@ -253,15 +254,8 @@ fn declare_triangles(
     if let Some(t) = buffers.triangles {
         builder = builder.read(t, BufferAccess::StorageRead(Stage::Vertex));
     }
-    targets
-        .lighting
-        .read_in(builder, Stage::Fragment)
-        .write(view.radiance, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.view_depth, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.weight, ImageAccess::ColorAttachmentWrite)
-        .write(view.visibility, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.normal, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.ids, ImageAccess::ColorAttachmentReadWrite)
+    let builder = targets.lighting.read_in(builder, Stage::Fragment);
+    view.write_outputs(builder, ImageAccess::ColorAttachmentWrite)
         .write(view.depth, ImageAccess::DepthAttachmentWrite)
         .record(move |pass, frame| {
             let plan = plan_of(frame, view.index)?;
@@ -276,24 +270,7 @@ fn declare_triangles(
                 record: 0,
             };
             let handle = buffers.triangle_handle(pass)?;
-            let images = [
-                view.radiance,
-                view.view_depth,
-                view.weight,
-                view.visibility,
-                view.normal,
-                view.ids,
-            ];
-            let images = images.map(|i| pass.image(i));
-            let [radiance, view_depth, weight, visibility, normal, ids] = images;
-            let colors = [
-                (radiance?, LoadOp::Load),
-                (view_depth?, LoadOp::Load),
-                (weight?, LoadOp::Clear([0.0; 4])),
-                (visibility?, LoadOp::Load),
-                (normal?, LoadOp::Load),
-                (ids?, LoadOp::Load),
-            ];
+            let colors = view.output_attachments(pass, LoadOp::Clear([0.0; 4]))?;
             let depth = pass.image(view.depth)?;
             let cmd = pass.cmd();
             cmd.begin_rendering(&colors, Some((depth, view.clear_depth.then_some(1.0))));
@@ -462,52 +439,29 @@ fn declare_resolve(
         true => ImageAccess::ColorAttachmentReadWrite,
         false => ImageAccess::ColorAttachmentWrite,
     };
-    let builder = graph.pass(name).graphics();
-    targets
+    let builder = targets
         .lighting
-        .read_in(builder, Stage::Fragment)
+        .read_in(graph.pass(name).graphics(), Stage::Fragment)
         .read(state.sums, BufferAccess::StorageRead(Stage::Fragment))
-        .read(view.frame, BufferAccess::StorageRead(Stage::Fragment))
-        .write(view.radiance, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.view_depth, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.weight, weight_access)
-        .write(view.visibility, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.normal, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.ids, ImageAccess::ColorAttachmentReadWrite)
-        .record(move |pass, _| {
-            let push = StatePush {
-                handles: [pass.storage_buffer(state.sums)?, pass.upload(view.frame)?, 0, 0],
-                mode: [0; 4],
-            };
-            let images = [
-                view.radiance,
-                view.view_depth,
-                view.weight,
-                view.visibility,
-                view.normal,
-                view.ids,
-            ];
-            let [radiance, view_depth, weight, visibility, normal, ids] = images.map(|i| pass.image(i));
-            let weight_load = match weight_written {
-                true => LoadOp::Load,
-                false => LoadOp::Clear([0.0; 4]),
-            };
-            let colors = [
-                (radiance?, LoadOp::Load),
-                (view_depth?, LoadOp::Load),
-                (weight?, weight_load),
-                (visibility?, LoadOp::Load),
-                (normal?, LoadOp::Load),
-                (ids?, LoadOp::Load),
-            ];
-            let cmd = pass.cmd();
-            cmd.begin_rendering(&colors, None);
-            cmd.bind_graphics(&pipeline);
-            cmd.push_constants(&push)?;
-            cmd.draw(3, 1);
-            cmd.end_rendering();
-            Ok(())
-        });
+        .read(view.frame, BufferAccess::StorageRead(Stage::Fragment));
+    view.write_outputs(builder, weight_access).record(move |pass, _| {
+        let push = StatePush {
+            handles: [pass.storage_buffer(state.sums)?, pass.upload(view.frame)?, 0, 0],
+            mode: [0; 4],
+        };
+        let weight_load = match weight_written {
+            true => LoadOp::Load,
+            false => LoadOp::Clear([0.0; 4]),
+        };
+        let colors = view.output_attachments(pass, weight_load)?;
+        let cmd = pass.cmd();
+        cmd.begin_rendering(&colors, None);
+        cmd.bind_graphics(&pipeline);
+        cmd.push_constants(&push)?;
+        cmd.draw(3, 1);
+        cmd.end_rendering();
+        Ok(())
+    });
 }
 
 #[cfg(test)]
