@@ -138,6 +138,25 @@ impl PointView {
             (pass.image(self.ids)?, LoadOp::Load),
         ])
     }
+
+    /// Draws `pipeline` full screen with `push` into the outputs (W loaded
+    /// or cleared by `weight`): the resolve passes.
+    pub(super) fn draw_full_screen<T: Pod>(
+        &self,
+        pass: &mut crate::graph::PassContext<'_>,
+        weight: LoadOp,
+        pipeline: &GraphicsPipeline,
+        push: &T,
+    ) -> Result<()> {
+        let colors = self.output_attachments(pass, weight)?;
+        let cmd = pass.cmd();
+        cmd.begin_rendering(&colors, None);
+        cmd.bind_graphics(pipeline);
+        cmd.push_constants(push)?;
+        cmd.draw(3, 1);
+        cmd.end_rendering();
+        Ok(())
+    }
 }
 
 impl PointBuffers {
@@ -562,14 +581,7 @@ fn declare_normalize(
                 any_ids: pass.sampled(accumulation.any_ids)?,
                 ..NormalizePush::zeroed()
             };
-            let colors = view.output_attachments(pass, LoadOp::Clear([0.0; 4]))?;
-            let cmd = pass.cmd();
-            cmd.begin_rendering(&colors, None);
-            cmd.bind_graphics(&pipeline);
-            cmd.push_constants(&push)?;
-            cmd.draw(3, 1);
-            cmd.end_rendering();
-            Ok(())
+            view.draw_full_screen(pass, LoadOp::Clear([0.0; 4]), &pipeline, &push)
         });
     Ok(())
 }

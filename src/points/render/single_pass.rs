@@ -453,14 +453,7 @@ fn declare_resolve(
             true => LoadOp::Load,
             false => LoadOp::Clear([0.0; 4]),
         };
-        let colors = view.output_attachments(pass, weight_load)?;
-        let cmd = pass.cmd();
-        cmd.begin_rendering(&colors, None);
-        cmd.bind_graphics(&pipeline);
-        cmd.push_constants(&push)?;
-        cmd.draw(3, 1);
-        cmd.end_rendering();
-        Ok(())
+        view.draw_full_screen(pass, weight_load, &pipeline, &push)
     });
 }
 
