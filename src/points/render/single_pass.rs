@@ -254,21 +254,15 @@ fn declare_triangles(
     if let Some(t) = buffers.triangles {
         builder = builder.read(t, BufferAccess::StorageRead(Stage::Vertex));
     }
+    if let Some(c) = buffers.counter {
+        builder = builder.write(c, BufferAccess::StorageReadWrite(Stage::Vertex));
+    }
     let builder = targets.lighting.read_in(builder, Stage::Fragment);
     view.write_outputs(builder, ImageAccess::ColorAttachmentWrite)
         .write(view.depth, ImageAccess::DepthAttachmentWrite)
         .record(move |pass, frame| {
             let plan = plan_of(frame, view.index)?;
-            let push = SplatPush {
-                splats: NO_HANDLE,
-                frame: pass.upload(view.frame)?,
-                counter: NO_HANDLE,
-                table: NO_HANDLE,
-                pass: PASS_OPAQUE,
-                primitive: PRIMITIVE_QUAD,
-                size_class: 0,
-                record: 0,
-            };
+            let push = buffers.push(pass, view.frame, PASS_OPAQUE, true)?;
             let handle = buffers.triangle_handle(pass)?;
             let colors = view.output_attachments(pass, LoadOp::Clear([0.0; 4]))?;
             let depth = pass.image(view.depth)?;
