@@ -12,9 +12,8 @@
 
 layout(pixel_interlock_ordered) in;
 
-// The pass renders into W only to give the rasteriser its area; the
-// resolve pass overwrites it.
-layout(location = 0) out float out_weight;
+// W is the pass's attachment only to give the rasteriser its area: every
+// fragment is discarded after its merge, so W keeps what it held.
 
 void main() {
     SplatSample s;
@@ -29,5 +28,5 @@ void main() {
         }
     }
     endInvocationInterlockARB();
-    out_weight = 0.0;
+    discard;
 }

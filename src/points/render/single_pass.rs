@@ -222,11 +222,11 @@ pub(super) fn declare_single_pass(
     };
     declare_clear(graph, &name("points.single_pass.clear"), state, clear);
     let splat_pass = (name("points.single_pass"), buffers, view);
+    let weight_written = buffers.triangles.is_some();
     match splats {
         SplatPipeline::Compute(p) => declare_compute(graph, splat_pass, state, depth_written, p),
-        SplatPipeline::Interlock(p) => declare_interlock(graph, splat_pass, state, depth_written, p),
+        SplatPipeline::Interlock(p) => declare_interlock(graph, splat_pass, state, (depth_written, weight_written), p),
     }
-    let weight_written = buffers.triangles.is_some();
     declare_resolve(
         graph,
         &name("points.single_pass.resolve"),
@@ -385,24 +385,29 @@ fn declare_compute(
 
 /// `points.single_pass`, interlock backend: the splats as quads whose
 /// fragments merge in a pixel-ordered critical section
-/// (`glsl/points/single_pass_interlock.frag`); W is its nominal target.
+/// (`glsl/points/single_pass_interlock.frag`); W is its nominal target,
+/// never written (loaded when the triangles pass wrote it).
 fn declare_interlock(
     graph: &mut RenderGraph<Frame>,
     (name, buffers, view): (String, PointBuffers, PointView),
     state: PixelState,
-    depth_written: bool,
+    (depth_written, weight_written): (bool, bool),
     pipeline: GraphicsPipeline,
 ) {
     let builder = graph.pass(&name).graphics();
     let stages = (Stage::Vertex, Stage::Fragment);
+    let (weight_access, weight_load) = match weight_written {
+        true => (ImageAccess::ColorAttachmentReadWrite, LoadOp::Load),
+        false => (ImageAccess::ColorAttachmentWrite, LoadOp::DontCare),
+    };
     splat_pass_uses(builder, (buffers, view), state, depth_written, stages)
-        .write(view.weight, ImageAccess::ColorAttachmentWrite)
+        .write(view.weight, weight_access)
         .record(move |pass, frame| {
             let plan = plan_of(frame, view.index)?;
             let mut push = splat_push(pass, (buffers, view), state, depth_written)?;
             let weight = pass.image(view.weight)?;
             let cmd = pass.cmd();
-            cmd.begin_rendering(&[(weight, LoadOp::DontCare)], None);
+            cmd.begin_rendering(&[(weight, weight_load)], None);
             cmd.bind_graphics(&pipeline);
             for d in &plan.draws {
                 let vertices = d
