@@ -10,6 +10,9 @@
 //!   the three-pass mode (the set-up is shared), and the images agree
 //!   within [`BUNNY_FLIP`] (the modes blend the same kernels; they differ
 //!   only where surfaces meet within z_fuzzy, and in the order of merges);
+//! * over the built-in terrain, the bunny sunk into it is hidden where the
+//!   ground is nearer (the depth buffer's test), covering the same pixels
+//!   as in the three-pass mode;
 //! * the interlock backend fails with a one-line error naming
 //!   `fragmentShaderPixelInterlock (VK_EXT_fragment_shader_interlock)` on a
 //!   device without it (lavapipe), and else matches the compute backend.
@@ -164,4 +167,48 @@ fn interlock_backend_needs_the_extension() {
         drop(ctx);
     }
     assert_validation_clean(&report);
+}
+
+/// Over the terrain the splats test against its depth buffer: the bunny,
+/// scaled to a hill and sunk into the built-in terrain, is hidden where the
+/// ground is nearer, as in the three-pass mode.
+#[test]
+fn terrain_hides_single_pass_splats_as_it_hides_three_pass_ones() {
+    let mut scene = Scene::default_procedural().expect("built-in terrain");
+    let transform = PointTransform::parse("t=5120,5120,0;r=90,0,0;s=6000").unwrap();
+    scene.points.add(bunny_object(false), transform);
+    let camera = alpenglow::renderer::Camera {
+        eye: glam::DVec3::new(5120.0, 3900.0, 1700.0),
+        target: glam::DVec3::new(5120.0, 5120.0, 500.0),
+        ..scene.default_camera()
+    };
+    let size = (160, 100);
+    let (three, _) = render_points(&scene, &camera, SplatSettings::default(), size);
+    let settings = SplatSettings {
+        mode: SplatMode::SinglePass,
+        ..SplatSettings::default()
+    };
+    let (single, _) = render_points(&scene, &camera, settings, size);
+    let (a, b) = (covered(&three), covered(&single));
+    let pixels = (size.0 * size.1) as usize;
+    assert!(
+        a > pixels / 10 && a < pixels * 9 / 10,
+        "the bunny covers {a} pixels, partly hidden"
+    );
+    assert!(
+        a.abs_diff(b) * 100 <= a,
+        "covered pixels: three passes {a}, single pass {b}"
+    );
+    let (flip, heat) = mean_flip(&three.rgba8, &single.rgba8, size.0, size.1);
+    dump_pngs(
+        &[
+            ("terrain-three-pass", &three.rgba8),
+            ("terrain-single-pass", &single.rgba8),
+            ("terrain-flip", &heat),
+        ],
+        size.0,
+        size.1,
+    );
+    eprintln!("terrain and bunny: mean FLIP single pass vs three passes {flip:.4}; covered {a} vs {b}");
+    assert!(flip <= BUNNY_FLIP, "FLIP {flip} > {BUNNY_FLIP}");
 }
