@@ -31,12 +31,9 @@
 // The operator is not commutative: the invocation order decides merges at
 // fuzzy boundaries, so results can differ slightly from run to run.
 //
-// Load balance: the workgroup's 64 splats put their set-ups and bounding
-// boxes in shared memory, and the 64 invocations share all their pixels
-// evenly (pixel k of the workgroup's exclusive prefix sum of box areas
-// belongs to the splat found by binary search), so neither a large splat
-// nor a mix of sizes leaves invocations idle while one loops over thousands
-// of pixels.
+// Splats whose bounding box exceeds LARGE_SPLAT_PIXELS pixels are left to the
+// whole workgroup after the small ones: 64 invocations share their pixels,
+// so one invocation does not loop over thousands of pixels alone.
 #ifndef ALPENGLOW_SINGLE_PASS_GLSL
 #define ALPENGLOW_SINGLE_PASS_GLSL
 
@@ -50,15 +47,15 @@ layout(set = 0, binding = 2, std430) coherent buffer PixelWords64 { uint64_t w[]
 #endif
 
 #define WORKGROUP_SIZE 64u
+#define LARGE_SPLAT_PIXELS 256u
 // A safety bound on lock attempts per fragment (never reached unless a
 // driver starves an invocation; the fragment is then dropped, not hung).
 #define MAX_LOCK_ATTEMPTS 1000000u
 
 layout(local_size_x = 64) in;
 
-shared SplatSetup s_setup[WORKGROUP_SIZE];
-shared uvec4 s_box[WORKGROUP_SIZE];            // first pixel x, y, box width, 0
-shared uint s_first[WORKGROUP_SIZE + 1u];      // exclusive prefix sum of box areas
+shared uint s_large[WORKGROUP_SIZE];
+shared uint s_large_count;
 
 #ifdef SINGLE_PASS_INT64
 void merge(SplatFragment frag) {
@@ -123,26 +120,24 @@ void splat_box(SplatSetup v, out uvec2 lo, out uvec2 hi) {
     hi = uvec2(max(last + 1.0, first));
 }
 
-// The splat of the workgroup that pixel `k` of its prefix sum belongs to:
-// the last j with s_first[j] ≤ k.
-uint splat_of(uint k) {
-    uint lo = 0u;
-    uint hi = WORKGROUP_SIZE;
-    while (hi - lo > 1u) {
-        uint mid = (lo + hi) / 2u;
-        if (s_first[mid] <= k) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
+// Pixels `start`, `start` + `stride`, ... of the splat's box.
+void splat_pixels(SplatSetup v, uint start, uint stride) {
+    uvec2 lo, hi;
+    splat_box(v, lo, hi);
+    uint width = hi.x - lo.x;
+    uint count = width * (hi.y - lo.y);
+    for (uint k = start; k < count; k += stride) {
+        splat_pixel(v, lo + uvec2(k % width, k / width));
     }
-    return lo;
 }
 
 void main() {
+    if (gl_LocalInvocationIndex == 0u) {
+        s_large_count = 0u;
+    }
+    barrier();
     // Dispatches wider than the 65535-workgroup limit use rows of workgroups.
-    uint lane = gl_LocalInvocationIndex;
-    uint index = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * WORKGROUP_SIZE + lane;
+    uint index = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * WORKGROUP_SIZE + gl_LocalInvocationIndex;
     SplatSetup v;
     uint setup = index < pc.single.w ? splat_setup(index, v) : SPLAT_SETUP_OUTSIDE_INTERVAL;
     if (pc.handles.z != NO_HANDLE && setup != SPLAT_SETUP_OUTSIDE_INTERVAL) {
@@ -151,27 +146,22 @@ void main() {
             atomicAdd(g_splat_counters[pc.handles.z].drawn, 1u);
         }
     }
-    uvec2 lo = uvec2(0u), hi = uvec2(0u);
     if (setup == SPLAT_SETUP_READY) {
+        uvec2 lo, hi;
         splat_box(v, lo, hi);
-        s_setup[lane] = v;
-    }
-    s_box[lane] = uvec4(lo, hi.x - lo.x, 0u);
-    s_first[lane + 1u] = (hi.x - lo.x) * (hi.y - lo.y);
-    barrier();
-    if (lane == 0u) {
-        s_first[0] = 0u;
-        for (uint j = 1u; j <= WORKGROUP_SIZE; ++j) {
-            s_first[j] += s_first[j - 1u];
+        uvec2 size = hi - lo;
+        if (size.x * size.y > LARGE_SPLAT_PIXELS) {
+            s_large[atomicAdd(s_large_count, 1u)] = index;
+        } else {
+            splat_pixels(v, 0u, 1u);
         }
     }
     barrier();
-    uint total = s_first[WORKGROUP_SIZE];
-    for (uint k = lane; k < total; k += WORKGROUP_SIZE) {
-        uint j = splat_of(k);
-        uint local = k - s_first[j];
-        uvec4 box = s_box[j];
-        splat_pixel(s_setup[j], box.xy + uvec2(local % box.z, local / box.z));
+    uint large = s_large_count;
+    for (uint k = 0u; k < large; ++k) {
+        SplatSetup big;
+        splat_setup(s_large[k], big);
+        splat_pixels(big, gl_LocalInvocationIndex, WORKGROUP_SIZE);
     }
 }
 

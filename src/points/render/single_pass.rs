@@ -20,9 +20,9 @@
 //!    the triangles opaque and shaded, with depth, so splats test against them;
 //! 2. `points.single_pass.clear`: every pixel unlocked, z_d = +inf, no sums;
 //! 3. `points.single_pass`: the splats ([`SplatBackend`]): a compute
-//!    dispatch per planned draw, one invocation per splat for the set-up, the
-//!    pixels of the workgroup's 64 bounding boxes shared evenly by its
-//!    invocations, each merged under a per-pixel spin lock (64-bit word
+//!    dispatch per planned draw, one invocation per splat rasterising its
+//!    bounding box (boxes over 256 pixels shared by the whole workgroup),
+//!    each pixel merged under a per-pixel spin lock (64-bit word
 //!    z_d·2³² + lock with `shaderBufferInt64Atomics`, else 32-bit lock and
 //!    z_d words), or the interlock backend's raster pass;
 //! 4. `points.single_pass.resolve`: full screen, divide and shade.
