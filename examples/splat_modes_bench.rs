@@ -14,13 +14,17 @@
 //! M splats/s, the time of each pass, and the image quality: mean FLIP of the
 //! single-pass image against the three-pass one (same frame, tone-mapped).
 
-use alpenglow::points::build::spt::{epsilon_from_pixels, SequentialPointTree, ROOT_R_MAX};
+#[path = "support/points.rs"]
+mod support;
+
+use alpenglow::points::build::spt::epsilon_from_pixels;
 use alpenglow::points::render::{SplatBackend, SplatMode, SplatSettings};
 use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointObject, PointScene, PointTransform};
 use alpenglow::profile::median;
 use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
 use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
-use glam::DVec3;
+
+use support::{all_leaves, camera_at};
 
 const SIDE: u32 = 512;
 
@@ -80,28 +84,6 @@ fn measure(ctx: &Context, scene: &Scene, camera: &Camera, points: SplatSettings,
         passes,
         drawn: stats.last().and_then(|s| s.drawn_splats).unwrap_or(0),
         rgba8,
-    }
-}
-
-/// The leaves of `tree` as a flat list drawn at every distance.
-fn all_leaves(tree: &SequentialPointTree) -> SequentialPointTree {
-    let mut flat = tree.clone();
-    flat.nodes.retain(|n| n.is_leaf);
-    for n in &mut flat.nodes {
-        n.r_min = 0.0;
-        n.r_max = ROOT_R_MAX;
-    }
-    flat
-}
-
-fn camera_at(distance: f64) -> Camera {
-    Camera {
-        eye: DVec3::new(0.0, -distance, 0.1 + 0.2 * distance),
-        target: DVec3::new(-0.02, 0.0, 0.09),
-        up: DVec3::Z,
-        fov_y_deg: 40.0,
-        near: 0.01,
-        far: 1000.0,
     }
 }
 

@@ -109,6 +109,15 @@ fn bunny_render_args(dir: &std::path::Path, extra: &[&str]) -> Vec<String> {
     args
 }
 
+/// The W channel of the EXR at `path`.
+fn exr_weight(path: &std::path::Path) -> Vec<f32> {
+    let image = exr::prelude::read_all_flat_layers_from_file(path).expect("EXR reads");
+    let w = (image.layer_data[0].channel_data.list.iter())
+        .find(|c| c.name.to_string() == "W")
+        .expect("channel W");
+    w.sample_data.values_as_f32().collect()
+}
+
 /// Both splat modes and all three primitives render the bunny under
 /// validation; the EXR carries W (positive on the bunny, 0 on the sky), and
 /// the statistics line reports the GPU's interval test (and, with
@@ -137,15 +146,7 @@ fn renders_points_in_every_mode_and_primitive_with_w_in_the_exr() {
         let stdout = text(&out.stdout);
         assert!(stdout.contains("pass the interval test"), "{stdout}");
         assert_eq!(stdout.contains("triangles in prefixes drawn"), hybrid, "{stdout}");
-        let image = exr::prelude::read_all_flat_layers_from_file(&exr_path).expect("EXR reads");
-        let layer = &image.layer_data[0];
-        let w = layer
-            .channel_data
-            .list
-            .iter()
-            .find(|c| c.name.to_string() == "W")
-            .expect("channel W");
-        let values: Vec<f32> = w.sample_data.values_as_f32().collect();
+        let values = exr_weight(&exr_path);
         let covered = values.iter().filter(|v| **v > 0.0).count();
         assert!(
             covered > 200 && covered < values.len() / 2,
@@ -221,11 +222,7 @@ fn renders_single_pass_splats_and_names_a_missing_interlock() {
         assert_success(&format!("render {}", extra.join(" ")), &out);
         let stdout = text(&out.stdout);
         assert!(stdout.contains("pass the interval test"), "{stdout}");
-        let image = exr::prelude::read_all_flat_layers_from_file(&exr_path).expect("EXR reads");
-        let w = (image.layer_data[0].channel_data.list.iter())
-            .find(|c| c.name.to_string() == "W")
-            .expect("channel W");
-        let values: Vec<f32> = w.sample_data.values_as_f32().collect();
+        let values = exr_weight(&exr_path);
         let covered = values.iter().filter(|v| **v > 0.0).count();
         assert!(
             covered > 200 && covered < values.len() / 2,

@@ -19,9 +19,9 @@
 
 mod common;
 
-use alpenglow::points::render::{SplatBackend, SplatMode, SplatSettings};
+use alpenglow::points::render::{PointFrameStats, SplatBackend, SplatMode, SplatSettings};
 use alpenglow::points::scene::{PointScene, PointTransform};
-use alpenglow::renderer::{FrameImages, RenderSettings, Renderer, Scene};
+use alpenglow::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
 use common::plane::{analytic_plane, grazing_camera, holes, plane_flip, plane_scene, unlit, FAR_FIELD_Y, SPACING};
 use common::points::{bunny_camera, bunny_object, render_points};
 use common::{assert_validation_clean, dump_pngs, mean_flip, validated_context};
@@ -77,17 +77,39 @@ fn covered(frame: &FrameImages) -> usize {
     frame.weight.as_ref().unwrap().iter().filter(|w| **w > 0.0).count()
 }
 
-#[test]
-fn bunny_single_pass_matches_three_passes() {
-    let scene = bunny_scene();
-    let camera = bunny_camera(0.5);
+/// `scene` in three passes and in a single pass at 160×100; asserts that
+/// both cover the same pixels (within 1 %) and that their mean FLIP stays
+/// within [`BUNNY_FLIP`]; returns both frames and the three-pass coverage.
+fn three_and_single_pass(scene: &Scene, camera: &Camera, label: &str) -> ([(FrameImages, PointFrameStats); 2], usize) {
     let size = (160, 100);
-    let (three, three_stats) = render_points(&scene, &camera, SplatSettings::default(), size);
-    let settings = SplatSettings {
+    let single_pass = SplatSettings {
         mode: SplatMode::SinglePass,
         ..SplatSettings::default()
     };
-    let (single, stats) = render_points(&scene, &camera, settings, size);
+    let frames = [SplatSettings::default(), single_pass].map(|s| render_points(scene, camera, s, size));
+    let [(three, _), (single, _)] = &frames;
+    let (a, b) = (covered(three), covered(single));
+    assert!(
+        a.abs_diff(b) * 100 <= a,
+        "{label}: covered pixels: three passes {a}, single pass {b}"
+    );
+    let (flip, heat) = mean_flip(&three.rgba8, &single.rgba8, size.0, size.1);
+    let names = ["three-pass", "single-pass", "flip"].map(|n| format!("{label}-{n}"));
+    let images = [
+        (names[0].as_str(), &three.rgba8[..]),
+        (names[1].as_str(), &single.rgba8[..]),
+        (names[2].as_str(), &heat[..]),
+    ];
+    dump_pngs(&images, size.0, size.1);
+    eprintln!("{label}: mean FLIP single pass vs three passes {flip:.4}; covered {a} vs {b}");
+    assert!(flip <= BUNNY_FLIP, "{label}: FLIP {flip} > {BUNNY_FLIP}");
+    (frames, a)
+}
+
+#[test]
+fn bunny_single_pass_matches_three_passes() {
+    let ([(_, three_stats), (single, stats)], covered) =
+        three_and_single_pass(&bunny_scene(), &bunny_camera(0.5), "bunny");
     eprintln!(
         "three passes: {}\nsingle pass:  {}",
         three_stats.summary(),
@@ -95,24 +117,7 @@ fn bunny_single_pass_matches_three_passes() {
     );
     assert_eq!(stats.interval_passed, three_stats.interval_passed);
     assert_eq!(stats.drawn_splats, three_stats.drawn_splats);
-    let (a, b) = (covered(&three), covered(&single));
-    assert!(a > 1000, "the bunny covers {a} pixels");
-    assert!(
-        a.abs_diff(b) * 100 <= a,
-        "covered pixels: three passes {a}, single pass {b}"
-    );
-    let (flip, heat) = mean_flip(&three.rgba8, &single.rgba8, size.0, size.1);
-    dump_pngs(
-        &[
-            ("bunny-three-pass", &three.rgba8),
-            ("bunny-single-pass", &single.rgba8),
-            ("bunny-flip", &heat),
-        ],
-        size.0,
-        size.1,
-    );
-    eprintln!("bunny: mean FLIP single pass vs three passes {flip:.4}");
-    assert!(flip <= BUNNY_FLIP, "bunny FLIP {flip} > {BUNNY_FLIP}");
+    assert!(covered > 1000, "the bunny covers {covered} pixels");
     // The AOVs are written where the splats are: class, instance and a unit normal.
     let weight = single.weight.as_ref().unwrap();
     for (i, w) in weight.iter().enumerate() {
@@ -177,38 +182,15 @@ fn terrain_hides_single_pass_splats_as_it_hides_three_pass_ones() {
     let mut scene = Scene::default_procedural().expect("built-in terrain");
     let transform = PointTransform::parse("t=5120,5120,0;r=90,0,0;s=6000").unwrap();
     scene.points.add(bunny_object(false), transform);
-    let camera = alpenglow::renderer::Camera {
+    let camera = Camera {
         eye: glam::DVec3::new(5120.0, 3900.0, 1700.0),
         target: glam::DVec3::new(5120.0, 5120.0, 500.0),
         ..scene.default_camera()
     };
-    let size = (160, 100);
-    let (three, _) = render_points(&scene, &camera, SplatSettings::default(), size);
-    let settings = SplatSettings {
-        mode: SplatMode::SinglePass,
-        ..SplatSettings::default()
-    };
-    let (single, _) = render_points(&scene, &camera, settings, size);
-    let (a, b) = (covered(&three), covered(&single));
-    let pixels = (size.0 * size.1) as usize;
+    let (_, covered) = three_and_single_pass(&scene, &camera, "terrain");
+    let pixels = 160 * 100;
     assert!(
-        a > pixels / 10 && a < pixels * 9 / 10,
-        "the bunny covers {a} pixels, partly hidden"
+        covered > pixels / 10 && covered < pixels * 9 / 10,
+        "the bunny covers {covered} pixels, partly hidden"
     );
-    assert!(
-        a.abs_diff(b) * 100 <= a,
-        "covered pixels: three passes {a}, single pass {b}"
-    );
-    let (flip, heat) = mean_flip(&three.rgba8, &single.rgba8, size.0, size.1);
-    dump_pngs(
-        &[
-            ("terrain-three-pass", &three.rgba8),
-            ("terrain-single-pass", &single.rgba8),
-            ("terrain-flip", &heat),
-        ],
-        size.0,
-        size.1,
-    );
-    eprintln!("terrain and bunny: mean FLIP single pass vs three passes {flip:.4}; covered {a} vs {b}");
-    assert!(flip <= BUNNY_FLIP, "FLIP {flip} > {BUNNY_FLIP}");
 }

@@ -343,13 +343,15 @@ impl PassPipelines {
 }
 
 /// `points.opaque` (the `--splat opaque` baseline): shaded opaque discs
-/// with ray–plane depth, and the hybrid triangles.
+/// with ray–plane depth, and the hybrid triangles; without `draw_splats`
+/// only the triangles (`points.single_pass.triangles`).
 pub(super) fn declare_opaque(
     ctx: &Context,
     graph: &mut RenderGraph<Frame>,
     name: &str,
     (buffers, view): (PointBuffers, PointView),
     targets: &SceneTargets,
+    draw_splats: bool,
 ) -> Result<()> {
     let f = &targets.formats;
     let formats = vec![f.radiance, f.view_depth, f.weight, f.visibility, f.normal, f.ids];
@@ -382,7 +384,9 @@ pub(super) fn declare_opaque(
             let depth = pass.image(view.depth)?;
             let cmd = pass.cmd();
             cmd.begin_rendering(&colors, Some((depth, view.clear_depth.then_some(1.0))));
-            pipelines.draw(cmd, plan, buffers.primitive, push)?;
+            if draw_splats {
+                pipelines.draw(cmd, plan, buffers.primitive, push)?;
+            }
             pipelines.draw_hybrid(cmd, plan, push, triangles)?;
             cmd.end_rendering();
             Ok(())

@@ -36,17 +36,15 @@ use std::sync::Arc;
 use bytemuck::{Pod, Zeroable};
 
 use super::passes::{
-    plan_of, PipelineSpec, PointBuffers, PointView, SplatPush, NO_HANDLE, PASS_OPAQUE, PRIMITIVE_QUAD,
+    declare_opaque, plan_of, PointBuffers, PointView, SplatPush, NO_HANDLE, PASS_OPAQUE, PRIMITIVE_QUAD,
 };
-use super::triangles::draw_triangles;
-use super::SplatBackend;
+use super::{SplatBackend, SplatPrimitive};
 use crate::error::{Error, Result};
 use crate::graph::{BufferAccess, BufferId, BufferInfo, ImageAccess, PassBuilder, RenderGraph, Stage};
 use crate::shaders;
 use crate::view::{Frame, SceneTargets};
 use crate::vulkan::{
-    Blend, CompareOp, ComputePipeline, Context, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, MemoryLocation,
-    PrimitiveTopology,
+    ComputePipeline, Context, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, MemoryLocation, PrimitiveTopology,
 };
 
 /// Bytes of a pixel's lock and z_d (`glsl/include/single_pass_merge.glsl`).
@@ -96,7 +94,6 @@ struct Pipelines {
     clear: ComputePipeline,
     splats: SplatPipeline,
     resolve: GraphicsPipeline,
-    triangles: Option<GraphicsPipeline>,
 }
 
 enum SplatPipeline {
@@ -119,12 +116,7 @@ pub(super) fn check_backend(ctx: &Context, backend: SplatBackend) -> Result<()> 
 }
 
 impl Pipelines {
-    fn new(
-        ctx: &Context,
-        targets: &SceneTargets,
-        buffers: &PointBuffers,
-        (backend, force_32bit_locks): (SplatBackend, bool),
-    ) -> Result<Self> {
+    fn new(ctx: &Context, targets: &SceneTargets, (backend, force_32bit_locks): (SplatBackend, bool)) -> Result<Self> {
         check_backend(ctx, backend)?;
         let f = &targets.formats;
         let outputs = vec![f.radiance, f.view_depth, f.weight, f.visibility, f.normal, f.ids];
@@ -147,19 +139,6 @@ impl Pipelines {
                 },
             )?),
         };
-        let triangles = buffers
-            .triangles
-            .map(|_| {
-                PipelineSpec {
-                    name: "points.single_pass.triangles",
-                    shaders: (shaders::HYBRID_VERT, shaders::HYBRID_OPAQUE_FRAG),
-                    color_formats: outputs.clone(),
-                    blend: Blend::None,
-                    depth: (true, CompareOp::LESS),
-                }
-                .build(ctx, f.depth, false)
-            })
-            .transpose()?;
         Ok(Pipelines {
             clear: ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS_CLEAR)?,
             splats,
@@ -171,7 +150,6 @@ impl Pipelines {
                     outputs,
                 ),
             )?,
-            triangles,
         })
     }
 }
@@ -186,7 +164,7 @@ pub(super) fn declare_single_pass(
     targets: &SceneTargets,
     backend: (SplatBackend, bool),
 ) -> Result<()> {
-    let pipelines = Pipelines::new(ctx, targets, &buffers, backend)?;
+    let pipelines = Pipelines::new(ctx, targets, backend)?;
     let pixels = targets.width * targets.height;
     let buffer = |graph: &mut RenderGraph<Frame>, what, bytes: u64| {
         graph.create_buffer(
@@ -202,21 +180,17 @@ pub(super) fn declare_single_pass(
         sums: buffer(graph, "splat pixel sums", PIXEL_SUM_BYTES),
         pixels,
     };
-    let Pipelines {
-        clear,
-        splats,
-        resolve,
-        triangles,
-    } = pipelines;
-    let depth_written = match triangles {
-        Some(pipeline) => {
-            declare_triangles(
-                graph,
-                &name("points.single_pass.triangles"),
-                (buffers, view),
-                targets,
-                pipeline,
-            );
+    let Pipelines { clear, splats, resolve } = pipelines;
+    // Hybrid triangles (§10.1.8) as opaque shaded triangles with depth, W = 1,
+    // before the splats test against them.
+    let depth_written = match buffers.triangles {
+        Some(_) => {
+            let triangles_only = PointBuffers {
+                primitive: SplatPrimitive::Quad,
+                ..buffers
+            };
+            let name = name("points.single_pass.triangles");
+            declare_opaque(ctx, graph, &name, (triangles_only, view), targets, false)?;
             true
         }
         None => !view.clear_depth,
@@ -237,44 +211,6 @@ pub(super) fn declare_single_pass(
         resolve,
     );
     Ok(())
-}
-
-/// `points.single_pass.triangles`: hybrid triangles (§10.1.8) as opaque,
-/// shaded triangles with depth, before the splats test against them; W = 1.
-fn declare_triangles(
-    graph: &mut RenderGraph<Frame>,
-    name: &str,
-    (buffers, view): (PointBuffers, PointView),
-    targets: &SceneTargets,
-    pipeline: GraphicsPipeline,
-) {
-    let mut builder = graph
-        .pass(name)
-        .graphics()
-        .read(view.frame, BufferAccess::StorageRead(Stage::Graphics));
-    if let Some(t) = buffers.triangles {
-        builder = builder.read(t, BufferAccess::StorageRead(Stage::Vertex));
-    }
-    if let Some(c) = buffers.counter {
-        builder = builder.write(c, BufferAccess::StorageReadWrite(Stage::Vertex));
-    }
-    let builder = targets.lighting.read_in(builder, Stage::Fragment);
-    view.write_outputs(builder, ImageAccess::ColorAttachmentWrite)
-        .write(view.depth, ImageAccess::DepthAttachmentWrite)
-        .record(move |pass, frame| {
-            let plan = plan_of(frame, view.index)?;
-            let push = buffers.push(pass, view.frame, PASS_OPAQUE, true)?;
-            let handle = buffers.triangle_handle(pass)?;
-            let colors = view.output_attachments(pass, LoadOp::Clear([0.0; 4]))?;
-            let depth = pass.image(view.depth)?;
-            let cmd = pass.cmd();
-            cmd.begin_rendering(&colors, Some((depth, view.clear_depth.then_some(1.0))));
-            if let Some(handle) = handle {
-                draw_triangles(cmd, &pipeline, plan, push, handle)?;
-            }
-            cmd.end_rendering();
-            Ok(())
-        });
 }
 
 /// `points.single_pass.clear`: every pixel unlocked, z_d = +inf, sums 0.

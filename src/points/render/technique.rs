@@ -205,7 +205,9 @@ impl PointRenderer {
         };
         let name = |base: &str| pass_name(base, &view.name);
         match self.settings.mode {
-            SplatMode::Opaque => declare_opaque(ctx, graph, &name("points.opaque"), (buffers, point_view), targets)?,
+            SplatMode::Opaque => {
+                declare_opaque(ctx, graph, &name("points.opaque"), (buffers, point_view), targets, true)?
+            }
             SplatMode::Ewa => {
                 let names = [
                     name("points.visibility"),
