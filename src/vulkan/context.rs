@@ -64,6 +64,9 @@ pub struct OptionalFeatures {
     /// `fragmentShaderPixelInterlock` (VK_EXT_fragment_shader_interlock):
     /// the interlock backend of single-pass splatting (§10.4).
     pub fragment_shader_pixel_interlock: bool,
+    /// `fragmentStoresAndAtomics`: fragment shaders write storage buffers
+    /// (the interlock backend's pixel state).
+    pub fragment_stores_and_atomics: bool,
 }
 
 impl OptionalFeatures {
@@ -76,6 +79,7 @@ impl OptionalFeatures {
             ),
             ("shaderBufferInt64Atomics", self.shader_buffer_int64_atomics),
             ("fragmentShaderPixelInterlock", self.fragment_shader_pixel_interlock),
+            ("fragmentStoresAndAtomics", self.fragment_stores_and_atomics),
         ]
         .iter()
         .filter(|(_, on)| *on)
@@ -300,12 +304,14 @@ impl Context {
             vertex_pipeline_stores_and_atomics: offered.vertex_pipeline_stores_and_atomics == vk::TRUE,
             shader_buffer_int64_atomics: offered.shader_int64 == vk::TRUE && int64_atomics,
             fragment_shader_pixel_interlock: pixel_interlock,
+            fragment_stores_and_atomics: offered.fragment_stores_and_atomics == vk::TRUE,
         };
         let base = vk::PhysicalDeviceFeatures::default()
             .independent_blend(true)
             .large_points(optional.large_points)
             .vertex_pipeline_stores_and_atomics(optional.vertex_pipeline_stores_and_atomics)
-            .shader_int64(optional.shader_buffer_int64_atomics);
+            .shader_int64(optional.shader_buffer_int64_atomics)
+            .fragment_stores_and_atomics(optional.fragment_stores_and_atomics);
         v12 = v12.shader_buffer_int64_atomics(optional.shader_buffer_int64_atomics);
         let mut interlock =
             vk::PhysicalDeviceFragmentShaderInterlockFeaturesEXT::default().fragment_shader_pixel_interlock(true);

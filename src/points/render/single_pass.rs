@@ -103,16 +103,31 @@ enum SplatPipeline {
 
 /// Fails with a one-line error when the device cannot run `backend`.
 pub(super) fn check_backend(ctx: &Context, backend: SplatBackend) -> Result<()> {
-    if backend == SplatBackend::Interlock && !ctx.has_feature("fragmentShaderPixelInterlock") {
-        return Err(Error::invalid(
+    if backend != SplatBackend::Interlock {
+        return Ok(());
+    }
+    let missing: Vec<&str> = [
+        (
+            "fragmentShaderPixelInterlock (VK_EXT_fragment_shader_interlock)",
+            "fragmentShaderPixelInterlock",
+        ),
+        ("fragmentStoresAndAtomics", "fragmentStoresAndAtomics"),
+    ]
+    .into_iter()
+    .filter(|(_, feature)| !ctx.has_feature(feature))
+    .map(|(named, _)| named)
+    .collect();
+    match missing.is_empty() {
+        true => Ok(()),
+        false => Err(Error::invalid(
             "splat backend interlock",
             format!(
-                "the device ({}) lacks fragmentShaderPixelInterlock (VK_EXT_fragment_shader_interlock); use the compute backend",
-                ctx.info().name
+                "the device ({}) lacks {}; use the compute backend",
+                ctx.info().name,
+                missing.join(" and ")
             ),
-        ));
+        )),
     }
-    Ok(())
 }
 
 impl Pipelines {
