@@ -10,6 +10,8 @@
 //!   the three-pass mode (the set-up is shared), and the images agree
 //!   within [`BUNNY_FLIP`] (the modes blend the same kernels; they differ
 //!   only where surfaces meet within z_fuzzy, and in the order of merges);
+//! * clip lines (§10.2.4) cut the single-pass splats exactly as the
+//!   three-pass ones (a checkerboard clipped at x = 6 m);
 //! * over the built-in terrain, the bunny sunk into it is hidden where the
 //!   ground is nearer (the depth buffer's test), covering the same pixels
 //!   as in the three-pass mode;
@@ -20,12 +22,16 @@
 
 mod common;
 
+use alpenglow::points::build::clip::{ClipLine, ClipLines};
 use alpenglow::points::render::{PointFrameStats, SplatBackend, SplatMode, SplatSettings};
 use alpenglow::points::scene::{PointScene, PointTransform};
 use alpenglow::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
-use common::plane::{analytic_plane, grazing_camera, holes, plane_flip, plane_scene, unlit, FAR_FIELD_Y, SPACING};
+use common::plane::{
+    analytic_plane, grazing_camera, holes, plane_flip, plane_scene, plane_scene_clipped, unlit, FAR_FIELD_Y, SPACING,
+};
 use common::points::{bunny_camera, bunny_object, render_points};
 use common::{assert_validation_clean, dump_pngs, mean_flip, validated_context};
+use glam::Vec3;
 
 /// Mean FLIP between the single-pass and three-pass bunnies (shaded, 160×100).
 const BUNNY_FLIP: f32 = 0.03;
@@ -66,6 +72,44 @@ fn grazing_checkerboard_single_pass_is_as_good_as_three_passes() {
             "single pass ({lock}): FLIP {flip} > 1.1 × three-pass {three_flip}"
         );
     }
+}
+
+/// Clip lines (§10.2.4) cut the single-pass splats as the three-pass ones:
+/// the checkerboard ends at x = 6 m, the surfels that straddle it clipped
+/// there. Without the clip lines their disks overhang the edge.
+#[test]
+fn clip_lines_cut_single_pass_splats_as_three_pass_ones() {
+    const EDGE: f32 = 6.0;
+    let clipped = |p: Vec3| match p.x < EDGE {
+        true if p.x + SPACING > EDGE => Some(ClipLines([
+            Some(ClipLine {
+                angle: 0.0,
+                offset: EDGE - p.x,
+            }),
+            None,
+        ])),
+        true => Some(ClipLines::NONE),
+        false => None,
+    };
+    let unclipped = |p: Vec3| clipped(p).map(|_| ClipLines::NONE);
+    let camera = grazing_camera();
+    let size = (common::plane::WIDTH, common::plane::HEIGHT);
+    let render = |scene: &Scene, mode| covered(&render_points(scene, &camera, unlit(mode), size).0);
+    let scene = plane_scene_clipped(SPACING, clipped);
+    let (three, single) = (render(&scene, SplatMode::Ewa), render(&scene, SplatMode::SinglePass));
+    let overhanging = render(&plane_scene_clipped(SPACING, unclipped), SplatMode::SinglePass);
+    eprintln!(
+        "covered pixels: clipped three passes {three}, single pass {single}; unclipped single pass {overhanging}"
+    );
+    assert!(
+        three.abs_diff(single) * 1000 <= three,
+        "clipped: three passes {three}, single pass {single}"
+    );
+    assert!(
+        overhanging > single + 100,
+        "the clip lines cut {} pixels",
+        overhanging - single
+    );
 }
 
 fn bunny_scene() -> Scene {

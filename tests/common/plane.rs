@@ -3,6 +3,7 @@
 //! grazing angle, its analytic (supersampled) reference, the mean FLIP of a
 //! render against it, and its holes (W = 0 where the plane is seen).
 
+use alpenglow::points::build::clip::ClipLines;
 use alpenglow::points::build::spt::{build_spt, epsilon_from_pixels, SptOptions};
 use alpenglow::points::render::{SplatMode, SplatSettings};
 use alpenglow::points::scene::{PointObject, PointScene, PointTransform};
@@ -30,18 +31,25 @@ pub fn checker(x: f64, y: f64) -> bool {
 }
 
 pub fn plane_scene(radius: f32) -> Scene {
+    plane_scene_clipped(radius, |_| Some(ClipLines::NONE))
+}
+
+/// The plane with the surfels `clip` keeps (Some) and their clip lines.
+pub fn plane_scene_clipped(radius: f32, clip: impl Fn(Vec3) -> Option<ClipLines>) -> Scene {
     let n = (SIDE / SPACING) as usize;
     let mut surfels = Vec::with_capacity(n * n);
     for j in 0..n {
         for i in 0..n {
             let p = Vec3::new((i as f32 + 0.5) * SPACING, (j as f32 + 0.5) * SPACING, 0.0);
-            surfels.push(Surfel {
-                position: p,
-                normal: Vec3::Z,
-                radius,
-                color: if checker(p.x as f64, p.y as f64) { LIGHT } else { DARK },
-                clip: Default::default(),
-            });
+            if let Some(clip) = clip(p) {
+                surfels.push(Surfel {
+                    position: p,
+                    normal: Vec3::Z,
+                    radius,
+                    color: if checker(p.x as f64, p.y as f64) { LIGHT } else { DARK },
+                    clip,
+                });
+            }
         }
     }
     let options = SptOptions {
