@@ -27,7 +27,10 @@
 //! normalisation, or opaque; not `points.shadow`, the sun's shadow map);
 //! splats/s = splats drawn (the vertex stage's count) / that time.
 
-use alpenglow::points::build::spt::{epsilon_from_pixels, SequentialPointTree, ROOT_R_MAX};
+#[path = "support/points.rs"]
+mod support;
+
+use alpenglow::points::build::spt::epsilon_from_pixels;
 use alpenglow::points::render::object_space::QUADRUPLICATION_EXTRA_BYTES_PER_SPLAT;
 use alpenglow::points::render::{SplatMode, SplatPrimitive, SplatSettings};
 use alpenglow::points::scene::{
@@ -36,7 +39,9 @@ use alpenglow::points::scene::{
 use alpenglow::profile::median;
 use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
 use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
+
 use glam::DVec3;
+use support::{all_leaves, camera_at};
 
 const SIDE: u32 = 512;
 /// Surfels sampled from the bunny mesh (each a leaf): the text's N = 101 685.
@@ -98,32 +103,10 @@ fn measure(ctx: &Context, scene: &Scene, camera: &Camera, points: SplatSettings,
     }
 }
 
-/// The leaves of `tree` as a flat list drawn at every distance.
-fn all_leaves(tree: &SequentialPointTree) -> SequentialPointTree {
-    let mut flat = tree.clone();
-    flat.nodes.retain(|n| n.is_leaf);
-    for n in &mut flat.nodes {
-        n.r_min = 0.0;
-        n.r_max = ROOT_R_MAX;
-    }
-    flat
-}
-
 fn single(object: PointObject) -> Scene {
     let mut points = PointScene::default();
     points.add(object, PointTransform::parse("r=90,0,0").unwrap());
     Scene::points_only(points)
-}
-
-fn camera_at(distance: f64) -> Camera {
-    Camera {
-        eye: DVec3::new(0.0, -distance, 0.1 + 0.2 * distance),
-        target: DVec3::new(-0.02, 0.0, 0.09),
-        up: DVec3::Z,
-        fov_y_deg: 40.0,
-        near: 0.01,
-        far: 1000.0,
-    }
 }
 
 fn main() {

@@ -38,6 +38,16 @@ pub const SPLAT_VISIBILITY_FRAG: SpirV = spirv!("points/visibility.frag");
 pub const SPLAT_ACCUMULATE_FRAG: SpirV = spirv!("points/accumulate.frag");
 /// points.opaque: opaque shaded discs.
 pub const SPLAT_OPAQUE_FRAG: SpirV = spirv!("points/opaque.frag");
+/// points.single_pass (§10.4): the compute backend with 64-bit pixel locks.
+pub const SPLAT_SINGLE_PASS: SpirV = spirv!("points/single_pass.comp");
+/// points.single_pass (§10.4): the compute backend with 32-bit pixel locks.
+pub const SPLAT_SINGLE_PASS_LOCK32: SpirV = spirv!("points/single_pass_lock32.comp");
+/// points.single_pass (§10.4): the interlock backend's fragment stage.
+pub const SPLAT_SINGLE_PASS_INTERLOCK_FRAG: SpirV = spirv!("points/single_pass_interlock.frag");
+/// points.single_pass.clear: every pixel's state reset.
+pub const SPLAT_SINGLE_PASS_CLEAR: SpirV = spirv!("points/single_pass_clear.comp");
+/// points.single_pass.resolve: normalisation and shading of the pixel sums.
+pub const SPLAT_SINGLE_PASS_RESOLVE_FRAG: SpirV = spirv!("points/single_pass_resolve.frag");
 /// points.normalize: divide by the weight and shade (full-screen fragment stage).
 pub const SPLAT_NORMALIZE_FRAG: SpirV = spirv!("points/normalize.frag");
 /// points.*, object-space primitives (§10.3): quads in the tangent plane, the interval test.

@@ -12,7 +12,8 @@
 //!   texturing), and those against the CPU twin of the layer tree; classic
 //!   texturing's four surface types;
 //! * rocks and scans: class 2 and 3 with their instance ids exactly where
-//!   their splats are (W > 0), in both splat modes, over terrain and alone;
+//!   their splats are (W > 0), in every splat mode (opaque, EWA, single
+//!   pass), over terrain and alone;
 //! * normals: unit length and facing the camera on every surface, 0 for sky;
 //! * `Renderer::reset_motion` makes the next frame's motion 0.
 
@@ -378,7 +379,7 @@ fn check_point_ids(name: &str, frame: &FrameImages, expected: &[(u32, u32)]) {
 }
 
 #[test]
-fn rocks_and_scans_have_their_class_and_instance_in_both_splat_modes() {
+fn rocks_and_scans_have_their_class_and_instance_in_every_splat_mode() {
     let (object, scale) = rock(1.0);
     let mut points = PointScene::default();
     place(&mut points, object.clone(), scale, DVec3::new(-0.7, 0.0, 0.0));
@@ -396,7 +397,7 @@ fn rocks_and_scans_have_their_class_and_instance_in_both_splat_modes() {
         near: 0.01,
         far: 100.0,
     };
-    for mode in [SplatMode::Ewa, SplatMode::Opaque] {
+    for mode in [SplatMode::Ewa, SplatMode::Opaque, SplatMode::SinglePass] {
         let settings = RenderSettings {
             points: SplatSettings {
                 mode,

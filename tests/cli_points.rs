@@ -109,6 +109,15 @@ fn bunny_render_args(dir: &std::path::Path, extra: &[&str]) -> Vec<String> {
     args
 }
 
+/// The W channel of the EXR at `path`.
+fn exr_weight(path: &std::path::Path) -> Vec<f32> {
+    let image = exr::prelude::read_all_flat_layers_from_file(path).expect("EXR reads");
+    let w = (image.layer_data[0].channel_data.list.iter())
+        .find(|c| c.name.to_string() == "W")
+        .expect("channel W");
+    w.sample_data.values_as_f32().collect()
+}
+
 /// Both splat modes and all five primitives render the bunny under
 /// validation; the EXR carries W (positive on the bunny, 0 on the sky), and
 /// the statistics line reports the GPU's interval test (and, with
@@ -138,15 +147,7 @@ fn renders_points_in_every_mode_and_primitive_with_w_in_the_exr() {
         let stdout = text(&out.stdout);
         assert!(stdout.contains("pass the interval test"), "{stdout}");
         assert_eq!(stdout.contains("triangles in prefixes drawn"), hybrid, "{stdout}");
-        let image = exr::prelude::read_all_flat_layers_from_file(&exr_path).expect("EXR reads");
-        let layer = &image.layer_data[0];
-        let w = layer
-            .channel_data
-            .list
-            .iter()
-            .find(|c| c.name.to_string() == "W")
-            .expect("channel W");
-        let values: Vec<f32> = w.sample_data.values_as_f32().collect();
+        let values = exr_weight(&exr_path);
         let covered = values.iter().filter(|v| **v > 0.0).count();
         assert!(
             covered > 200 && covered < values.len() / 2,
@@ -201,5 +202,45 @@ fn spt_files_render_and_bad_point_inputs_fail_cleanly() {
     assert_one_line_error("--epsilon 0", &run(&args), &["--epsilon"]);
     std::fs::remove_file(&spt).unwrap();
     assert_no_files_left("bad point inputs", &dir);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `--splat single-pass` (§10.4) renders the bunny under validation with W
+/// in the EXR, alone and with `--hybrid`; `--splat-backend interlock`
+/// renders where the device offers fragment shader interlock and is else a
+/// one-line error naming the feature, with nothing written.
+#[test]
+fn renders_single_pass_splats_and_names_a_missing_interlock() {
+    let dir = fresh_dir("points-single-pass");
+    let exr_path = dir.join("o.exr");
+    let exr = exr_path.display().to_string();
+    for hybrid in [false, true] {
+        let mut extra = vec!["--splat", "single-pass", "--exr", &exr];
+        if hybrid {
+            extra.push("--hybrid");
+        }
+        let out = run(&bunny_render_args(&dir, &extra));
+        assert_success(&format!("render {}", extra.join(" ")), &out);
+        let stdout = text(&out.stdout);
+        assert!(stdout.contains("pass the interval test"), "{stdout}");
+        let values = exr_weight(&exr_path);
+        let covered = values.iter().filter(|v| **v > 0.0).count();
+        assert!(
+            covered > 200 && covered < values.len() / 2,
+            "single-pass (hybrid {hybrid}): W > 0 on {covered} pixels"
+        );
+        std::fs::remove_file(&exr_path).unwrap();
+        std::fs::remove_file(dir.join("o.png")).unwrap();
+    }
+    let args = bunny_render_args(&dir, &["--splat", "single-pass", "--splat-backend", "interlock"]);
+    let out = run(&args);
+    if !out.status.success() {
+        assert_one_line_error(
+            "--splat-backend interlock",
+            &out,
+            &["fragmentShaderPixelInterlock (VK_EXT_fragment_shader_interlock)"],
+        );
+        assert!(!dir.join("o.png").exists(), "nothing written");
+    }
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -20,10 +20,11 @@ mod common;
 use alpenglow::points::render::{PointFrameStats, SplatMode, SplatPrimitive, SplatSettings};
 use alpenglow::points::scene::{PointScene, PointTransform};
 use alpenglow::renderer::{Camera, FrameImages, Scene};
-use common::points::{
-    analytic_plane, bunny_camera, bunny_object, grazing_camera, holes, pixels_differing, plane_flip, plane_scene,
-    point_sampled_flip, render_points, unlit, FAR_FIELD_Y, PLANE_HEIGHT, PLANE_WIDTH, SPACING,
+use common::plane::{
+    analytic_plane, grazing_camera, holes, plane_flip, plane_scene, point_sampled_flip, unlit, FAR_FIELD_Y,
+    HEIGHT as PLANE_HEIGHT, SPACING, WIDTH as PLANE_WIDTH,
 };
+use common::points::{bunny_camera, bunny_object, pixels_differing, render_points};
 use common::{dump_pngs, flip_errors, linear_to_srgb8};
 
 const WIDTH: u32 = 160;

@@ -18,10 +18,11 @@ mod common;
 use alpenglow::points::render::{PointFrameStats, SplatMode, SplatPrimitive, SplatSettings};
 use alpenglow::points::scene::{PointObject, PointScene, PointTransform};
 use alpenglow::renderer::{Camera, FrameImages, Scene};
-use common::points::{
-    analytic_plane, bunny_camera, bunny_object, grazing_camera, holes, pixels_differing, plane_flip, plane_scene,
-    point_sampled_flip, render_points, unlit, FAR_FIELD_Y, PLANE_HEIGHT as HEIGHT, PLANE_WIDTH as WIDTH, SPACING,
+use common::plane::{
+    analytic_plane, grazing_camera, holes, plane_flip, plane_scene, point_sampled_flip, unlit, FAR_FIELD_Y, HEIGHT,
+    SPACING, WIDTH,
 };
+use common::points::{bunny_camera, bunny_object, pixels_differing, render_points};
 /// Mean FLIP of EWA splats against the supersampled reference over the far
 /// plane. Measured 0.138 on lavapipe (what remains is the reconstruction's
 /// blur over one sample spacing and the tree's colour averaging), against

@@ -53,6 +53,9 @@ layout(set = 0, binding = 2, std430) readonly buffer GaussianTable { float g[]; 
 layout(push_constant) uniform Push {
     uvec4 handles;  // splats, point frame, drawn counter (NO_HANDLE: none), Gaussian table
     uvec4 mode;     // pass, primitive, size class, instance index
+#ifdef SPLAT_SINGLE_PASS
+    uvec4 single;   // single-pass (§10.4): pixel words, pixel sums, depth buffer (sampled; NO_HANDLE: cleared), splats of the draw
+#endif
 } pc;
 
 // Orthonormal tangent frame of a unit normal (Duff et al. 2017);

@@ -137,6 +137,17 @@ pub enum SplatArg {
     Opaque,
     /// Perspective-accurate EWA splatting in three passes.
     Ewa,
+    /// EWA splatting in one pass with a fuzzy depth test (§10.4).
+    SinglePass,
+}
+
+/// How single-pass splatting merges each pixel (§10.4).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SplatBackendArg {
+    /// Compute pass with per-pixel locks (64-bit atomics where offered).
+    Compute,
+    /// Fragment shader interlock (needs VK_EXT_fragment_shader_interlock).
+    Interlock,
 }
 
 /// Primitive carrying a splat (§10.3).
@@ -179,6 +190,14 @@ pub struct PointArgs {
         value_name = "PRIMITIVE"
     )]
     pub splat_primitive: SplatPrimitiveArg,
+    /// Backend of --splat single-pass.
+    #[arg(
+        long = "splat-backend",
+        value_enum,
+        default_value = "compute",
+        value_name = "BACKEND"
+    )]
+    pub splat_backend: SplatBackendArg,
     /// SPT error threshold in pixels of this image (r_min = e_g / ε).
     #[arg(long, default_value_t = 1.0, value_name = "PIXELS")]
     pub epsilon: f32,

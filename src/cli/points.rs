@@ -5,11 +5,11 @@
 use anyhow::{bail, Context as _, Result};
 
 use alpenglow::points::build::spt::epsilon_from_pixels;
-use alpenglow::points::render::{SplatMode, SplatPrimitive, SplatSettings};
+use alpenglow::points::render::{SplatBackend, SplatMode, SplatPrimitive, SplatSettings};
 use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointTransform};
 use alpenglow::renderer::Scene;
 
-use super::args::{PointArgs, SplatArg, SplatPrimitiveArg};
+use super::args::{PointArgs, SplatArg, SplatBackendArg, SplatPrimitiveArg};
 
 /// Adds the `--points` objects to `scene` (and, for the built-in terrain,
 /// the `--rocks`); `builtin` says whether the scene is the built-in one.
@@ -52,6 +52,11 @@ pub fn splat_settings(args: &PointArgs, fov_y_deg: f64, rows: u32) -> Result<Spl
         mode: match args.splat {
             SplatArg::Opaque => SplatMode::Opaque,
             SplatArg::Ewa => SplatMode::Ewa,
+            SplatArg::SinglePass => SplatMode::SinglePass,
+        },
+        backend: match args.splat_backend {
+            SplatBackendArg::Compute => SplatBackend::Compute,
+            SplatBackendArg::Interlock => SplatBackend::Interlock,
         },
         primitive: match args.splat_primitive {
             SplatPrimitiveArg::Point => SplatPrimitive::Point,

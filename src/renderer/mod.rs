@@ -15,7 +15,8 @@
 //! vertex buffer, §7.4) → `texturing.*` (compute: the dirty atlas tiles,
 //! §8.2) → `terrain.draw` (graphics, reads the vertex buffer) → the points
 //! passes (`points.visibility` → `points.accumulate` → `points.normalize`
-//! for EWA splats, or `points.opaque`; see [`crate::points::render`]) →
+//! for EWA splats, `points.single_pass.*` for single-pass splats (§10.4), or
+//! `points.opaque`; see [`crate::points::render`]) →
 //! `aovs` (full screen: distance and motion from view depth,
 //! [`crate::post::aovs`]) → `tonemap` (compute) → `readback` (transfer).
 

@@ -58,6 +58,15 @@ pub struct OptionalFeatures {
     pub large_points: bool,
     /// `vertexPipelineStoresAndAtomics`: the vertex stage counts the splats it draws.
     pub vertex_pipeline_stores_and_atomics: bool,
+    /// `shaderInt64` and `shaderBufferInt64Atomics`: single-pass splatting
+    /// (§10.4) packs depth and lock in one 64-bit word (without: a 32-bit fallback).
+    pub shader_buffer_int64_atomics: bool,
+    /// `fragmentShaderPixelInterlock` (VK_EXT_fragment_shader_interlock):
+    /// the interlock backend of single-pass splatting (§10.4).
+    pub fragment_shader_pixel_interlock: bool,
+    /// `fragmentStoresAndAtomics`: fragment shaders write storage buffers
+    /// (the interlock backend's pixel state).
+    pub fragment_stores_and_atomics: bool,
 }
 
 impl OptionalFeatures {
@@ -68,6 +77,9 @@ impl OptionalFeatures {
                 "vertexPipelineStoresAndAtomics",
                 self.vertex_pipeline_stores_and_atomics,
             ),
+            ("shaderBufferInt64Atomics", self.shader_buffer_int64_atomics),
+            ("fragmentShaderPixelInterlock", self.fragment_shader_pixel_interlock),
+            ("fragmentStoresAndAtomics", self.fragment_stores_and_atomics),
         ]
         .iter()
         .filter(|(_, on)| *on)
@@ -107,6 +119,30 @@ impl std::fmt::Debug for Context {
             .field("device", &self.shared.info.name)
             .finish()
     }
+}
+
+/// What the device offers for single-pass splatting (§10.4):
+/// `shaderBufferInt64Atomics`, and `fragmentShaderPixelInterlock` with its
+/// extension VK_EXT_fragment_shader_interlock.
+fn offered_single_pass_features(instance: &ash::Instance, physical: vk::PhysicalDevice) -> (bool, bool) {
+    // SAFETY: plain query on a physical device of this instance.
+    let extensions = unsafe { instance.enumerate_device_extension_properties(physical) }.unwrap_or_default();
+    let has_interlock = extensions
+        .iter()
+        .any(|e| e.extension_name_as_c_str() == Ok(ash::ext::fragment_shader_interlock::NAME));
+    let mut v12 = vk::PhysicalDeviceVulkan12Features::default();
+    let mut interlock = vk::PhysicalDeviceFragmentShaderInterlockFeaturesEXT::default();
+    let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut v12);
+    if has_interlock {
+        features2 = features2.push_next(&mut interlock);
+    }
+    // SAFETY: the device supports Vulkan 1.3 (checked by `inspect`); the
+    // interlock struct is chained only when its extension is offered.
+    unsafe { instance.get_physical_device_features2(physical, &mut features2) };
+    (
+        v12.shader_buffer_int64_atomics == vk::TRUE,
+        has_interlock && interlock.fragment_shader_pixel_interlock == vk::TRUE,
+    )
 }
 
 pub(crate) fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> Error {
@@ -262,19 +298,34 @@ impl Context {
             .maintenance4(true);
         // SAFETY: plain query on a physical device of this instance.
         let offered = unsafe { instance.get_physical_device_features(candidate.physical) };
+        let (int64_atomics, pixel_interlock) = offered_single_pass_features(&instance, candidate.physical);
         let optional = OptionalFeatures {
             large_points: offered.large_points == vk::TRUE,
             vertex_pipeline_stores_and_atomics: offered.vertex_pipeline_stores_and_atomics == vk::TRUE,
+            shader_buffer_int64_atomics: offered.shader_int64 == vk::TRUE && int64_atomics,
+            fragment_shader_pixel_interlock: pixel_interlock,
+            fragment_stores_and_atomics: offered.fragment_stores_and_atomics == vk::TRUE,
         };
         let base = vk::PhysicalDeviceFeatures::default()
             .independent_blend(true)
             .large_points(optional.large_points)
-            .vertex_pipeline_stores_and_atomics(optional.vertex_pipeline_stores_and_atomics);
-        let device_info = vk::DeviceCreateInfo::default()
+            .vertex_pipeline_stores_and_atomics(optional.vertex_pipeline_stores_and_atomics)
+            .shader_int64(optional.shader_buffer_int64_atomics)
+            .fragment_stores_and_atomics(optional.fragment_stores_and_atomics);
+        v12 = v12.shader_buffer_int64_atomics(optional.shader_buffer_int64_atomics);
+        let mut interlock =
+            vk::PhysicalDeviceFragmentShaderInterlockFeaturesEXT::default().fragment_shader_pixel_interlock(true);
+        let extensions = [ash::ext::fragment_shader_interlock::NAME.as_ptr()];
+        let mut device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_features(&base)
             .push_next(&mut v12)
             .push_next(&mut v13);
+        if optional.fragment_shader_pixel_interlock {
+            device_info = device_info
+                .enabled_extension_names(&extensions)
+                .push_next(&mut interlock);
+        }
         // SAFETY: the features were checked as supported by `inspect`; pointers are to locals.
         let device = match unsafe { instance.create_device(candidate.physical, &device_info, None) } {
             Ok(d) => d,

@@ -91,6 +91,7 @@ pub fn mean_flip(reference_rgba: &[u8], test_rgba: &[u8], width: u32, height: u3
 pub mod atlas;
 #[cfg(feature = "cli")]
 pub mod cli;
+pub mod plane;
 pub mod points;
 
 /// With `ALPENGLOW_DUMP=DIR` (an existing folder), writes each named RGBA8

@@ -9,6 +9,10 @@
 //! | `points.accumulate` | ewa | depth test ≤ without writes, additive (w·colour, w), (w·normal, w·depth) into float targets; the ids of the last surfel |
 //! | `points.normalize` | ewa | full screen: divide by w, shade, write radiance, view depth, W, world normal and ids (the winner's, else the last surfel's) |
 //! | `points.opaque` | opaque | opaque discs with ray–plane depth, shaded directly, with normal and ids |
+//! | `points.single_pass.triangles` | single-pass | hybrid triangles as opaque shaded triangles with depth, when the scene has any |
+//! | `points.single_pass.clear` | single-pass | compute: every pixel's state unlocked, z_d = +inf, sums 0 |
+//! | `points.single_pass` | single-pass | compute (or the interlock backend's raster pass): every splat's pixels merged with the fuzzy depth test (§10.4) |
+//! | `points.single_pass.resolve` | single-pass | full screen: as `points.normalize`, from the pixel state |
 //!
 //! The primitives `object-quad` and `object-instanced` ([`object_space`],
 //! §10.3) draw the same passes with object-space quads and the kernel in a
@@ -22,6 +26,7 @@ mod passes;
 mod pipeline_spec;
 pub mod selection;
 pub mod shadow;
+mod single_pass;
 pub mod stats;
 mod technique;
 mod triangles;
@@ -39,6 +44,27 @@ pub enum SplatMode {
     /// Perspective-accurate EWA splatting in three passes (§10.2).
     #[default]
     Ewa,
+    /// The same kernels in one pass with a fuzzy depth test (§10.4): each
+    /// fragment nearer than z_d − z_fuzzy replaces the pixel's splats, one
+    /// within ±z_fuzzy blends by weight, z_fuzzy = `visibility_offset` ×
+    /// the incoming splat's radius; see [`SplatBackend`].
+    SinglePass,
+}
+
+/// How single-pass splatting (§10.4) makes each pixel's read-modify-write atomic.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SplatBackend {
+    /// A compute pass, one invocation per splat, with a per-pixel spin lock:
+    /// one 64-bit word (z_d, lock) with `shaderBufferInt64Atomics`, else a
+    /// 32-bit lock word and a z_d word. Works everywhere (lavapipe too);
+    /// merges at fuzzy boundaries follow the GPU's invocation order, which
+    /// can vary from run to run.
+    #[default]
+    Compute,
+    /// A raster pass whose fragments merge inside a pixel-ordered critical
+    /// section (VK_EXT_fragment_shader_interlock,
+    /// `fragmentShaderPixelInterlock`): merges follow primitive order.
+    Interlock,
 }
 
 /// The primitive that carries a splat (§10.3, Table 10.3).
@@ -64,12 +90,24 @@ pub enum SplatPrimitive {
 }
 
 impl SplatMode {
-    pub const ALL: [SplatMode; 2] = [SplatMode::Opaque, SplatMode::Ewa];
+    pub const ALL: [SplatMode; 3] = [SplatMode::Opaque, SplatMode::Ewa, SplatMode::SinglePass];
 
     pub fn name(self) -> &'static str {
         match self {
             SplatMode::Opaque => "opaque",
             SplatMode::Ewa => "ewa",
+            SplatMode::SinglePass => "single-pass",
+        }
+    }
+}
+
+impl SplatBackend {
+    pub const ALL: [SplatBackend; 2] = [SplatBackend::Compute, SplatBackend::Interlock];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SplatBackend::Compute => "compute",
+            SplatBackend::Interlock => "interlock",
         }
     }
 }
@@ -112,7 +150,8 @@ pub struct SplatSettings {
     /// Kernel cut-off F_G in standard deviations (1 < F_G < 2, §10.2.2); the
     /// cut-off ellipse is the splat's disk.
     pub cutoff: f32,
-    /// Visibility pass offset ε along the view ray, in splat radii (§10.2.3).
+    /// Visibility pass offset ε along the view ray, in splat radii (§10.2.3);
+    /// single-pass mode's z_fuzzy is ε × the incoming splat's radius (§10.4).
     pub visibility_offset: f32,
     /// Shade splats (sun, sky, haze); false writes their albedo (tests, debugging).
     pub shaded: bool,
@@ -125,6 +164,11 @@ pub struct SplatSettings {
     /// Error threshold ε of the trees (as [`crate::points::build::spt::SptOptions::epsilon`]);
     /// None keeps the ε each tree was built with.
     pub epsilon: Option<f32>,
+    /// The single-pass mode's backend (§10.4); ignored by the other modes.
+    pub backend: SplatBackend,
+    /// Single-pass compute backend: use the 32-bit lock even where 64-bit
+    /// buffer atomics exist (tests of the fallback).
+    pub force_32bit_locks: bool,
 }
 
 impl Default for SplatSettings {
@@ -138,6 +182,8 @@ impl Default for SplatSettings {
             two_sided: false,
             normal_clusters: false,
             epsilon: None,
+            backend: SplatBackend::Compute,
+            force_32bit_locks: false,
         }
     }
 }

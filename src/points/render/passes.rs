@@ -17,22 +17,22 @@ use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, PassBuilder, Re
 use crate::shaders;
 use crate::view::{Frame, SceneTargets, ViewIndex};
 use crate::vulkan::{
-    Blend, Buffer, CommandRecorder, CompareOp, Context, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, SpirV,
+    Blend, Buffer, CommandRecorder, CompareOp, Context, GraphicsPipeline, GraphicsPipelineDesc, Image, LoadOp, SpirV,
 };
 
 /// `SplatPush.pass`: which pass the shaders run in.
 const PASS_VISIBILITY: u32 = 0;
 const PASS_ACCUMULATE: u32 = 1;
-const PASS_OPAQUE: u32 = 2;
+pub(super) const PASS_OPAQUE: u32 = 2;
 /// `SplatPush.primitive`.
-const PRIMITIVE_QUAD: u32 = 0;
+pub(super) const PRIMITIVE_QUAD: u32 = 0;
 const PRIMITIVE_INSTANCED: u32 = 1;
 const PRIMITIVE_POINT: u32 = 2;
 /// `SplatPush.size_class`: every splat, only those a point can cover, only larger ones.
 const SIZE_ANY: u32 = 0;
 const SIZE_POINT: u32 = 1;
 const SIZE_OVERSIZE: u32 = 2;
-const NO_HANDLE: u32 = u32::MAX;
+pub(super) const NO_HANDLE: u32 = u32::MAX;
 
 /// Push constants of the points passes (`Push` in glsl/include/splat.glsl:
 /// `handles`, then `mode`).
@@ -108,6 +108,60 @@ pub(super) struct PointView {
     pub clear_depth: bool,
 }
 
+impl PointView {
+    /// Declares the writes of a pass that draws the view's shaded outputs
+    /// (radiance, view depth, W with `weight`, visibility, normal, ids).
+    pub(super) fn write_outputs<'g>(
+        &self,
+        builder: PassBuilder<'g, Frame>,
+        weight: ImageAccess,
+    ) -> PassBuilder<'g, Frame> {
+        builder
+            .write(self.radiance, ImageAccess::ColorAttachmentReadWrite)
+            .write(self.view_depth, ImageAccess::ColorAttachmentReadWrite)
+            .write(self.weight, weight)
+            .write(self.visibility, ImageAccess::ColorAttachmentReadWrite)
+            .write(self.normal, ImageAccess::ColorAttachmentReadWrite)
+            .write(self.ids, ImageAccess::ColorAttachmentReadWrite)
+    }
+
+    /// The colour attachments of [`Self::write_outputs`]: every output
+    /// loaded but W, which `weight` loads or clears.
+    pub(super) fn output_attachments<'a>(
+        &self,
+        pass: &crate::graph::PassContext<'a>,
+        weight: LoadOp,
+    ) -> Result<[(&'a Image, LoadOp); 6]> {
+        Ok([
+            (pass.image(self.radiance)?, LoadOp::Load),
+            (pass.image(self.view_depth)?, LoadOp::Load),
+            (pass.image(self.weight)?, weight),
+            (pass.image(self.visibility)?, LoadOp::Load),
+            (pass.image(self.normal)?, LoadOp::Load),
+            (pass.image(self.ids)?, LoadOp::Load),
+        ])
+    }
+
+    /// Draws `pipeline` full screen with `push` into the outputs (W loaded
+    /// or cleared by `weight`): the resolve passes.
+    pub(super) fn draw_full_screen<T: Pod>(
+        &self,
+        pass: &mut crate::graph::PassContext<'_>,
+        weight: LoadOp,
+        pipeline: &GraphicsPipeline,
+        push: &T,
+    ) -> Result<()> {
+        let colors = self.output_attachments(pass, weight)?;
+        let cmd = pass.cmd();
+        cmd.begin_rendering(&colors, None);
+        cmd.bind_graphics(pipeline);
+        cmd.push_constants(push)?;
+        cmd.draw(3, 1);
+        cmd.end_rendering();
+        Ok(())
+    }
+}
+
 impl PointBuffers {
     /// Declares the reads every splat pass makes (and the counter's write when `count`).
     fn read_by<'g>(&self, builder: PassBuilder<'g, Frame>, frame: UploadRegion, count: bool) -> PassBuilder<'g, Frame> {
@@ -128,7 +182,7 @@ impl PointBuffers {
     }
 
     /// The push constants of `pass` (counting the drawn splats when `count`).
-    fn push(
+    pub(super) fn push(
         &self,
         ctx: &crate::graph::PassContext<'_>,
         frame: UploadRegion,
@@ -154,7 +208,7 @@ impl PointBuffers {
     }
 
     /// The triangle buffer's handle in a pass.
-    fn triangle_handle(&self, ctx: &crate::graph::PassContext<'_>) -> Result<Option<u32>> {
+    pub(super) fn triangle_handle(&self, ctx: &crate::graph::PassContext<'_>) -> Result<Option<u32>> {
         self.triangles.map(|t| ctx.storage_buffer(t)).transpose()
     }
 
@@ -167,7 +221,7 @@ impl PointBuffers {
 }
 
 /// The plan of view `index` in `frame`.
-fn plan_of(frame: &Frame, index: ViewIndex) -> Result<&FramePlan> {
+pub(super) fn plan_of(frame: &Frame, index: ViewIndex) -> Result<&FramePlan> {
     Ok(&frame.prepared::<PointsFrame>()?.view(index)?.plan)
 }
 
@@ -279,13 +333,15 @@ impl PassPipelines {
 }
 
 /// `points.opaque` (the `--splat opaque` baseline): shaded opaque discs
-/// with ray–plane depth, and the hybrid triangles.
+/// with ray–plane depth, and the hybrid triangles; without `draw_splats`
+/// only the triangles (`points.single_pass.triangles`).
 pub(super) fn declare_opaque(
     ctx: &Context,
     graph: &mut RenderGraph<Frame>,
     name: &str,
     (buffers, view): (PointBuffers, PointView),
     targets: &SceneTargets,
+    draw_splats: bool,
 ) -> Result<()> {
     let f = &targets.formats;
     let formats = vec![f.radiance, f.view_depth, f.weight, f.visibility, f.normal, f.ids];
@@ -310,41 +366,21 @@ pub(super) fn declare_opaque(
         },
     )?;
     let builder = buffers.read_by(graph.pass(name).graphics(), view.frame, true);
-    targets
-        .lighting
-        .read_in(builder, Stage::Fragment)
-        .write(view.radiance, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.view_depth, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.weight, ImageAccess::ColorAttachmentWrite)
-        .write(view.visibility, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.normal, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.ids, ImageAccess::ColorAttachmentReadWrite)
+    let builder = targets.lighting.read_in(builder, Stage::Fragment);
+    view.write_outputs(builder, ImageAccess::ColorAttachmentWrite)
         .write(view.depth, ImageAccess::DepthAttachmentWrite)
         .record(move |pass, frame| {
             let plan = plan_of(frame, view.index)?;
             let push = buffers.push(pass, view.frame, PASS_OPAQUE, true)?;
             let triangles = buffers.triangle_handle(pass)?;
             let object = buffers.object_buffers(pass)?;
-            let (radiance, view_depth) = (pass.image(view.radiance)?, pass.image(view.view_depth)?);
-            let (weight, depth) = (pass.image(view.weight)?, pass.image(view.depth)?);
-            let (visibility, normal, ids) = (
-                pass.image(view.visibility)?,
-                pass.image(view.normal)?,
-                pass.image(view.ids)?,
-            );
+            let colors = view.output_attachments(pass, LoadOp::Clear([0.0; 4]))?;
+            let depth = pass.image(view.depth)?;
             let cmd = pass.cmd();
-            cmd.begin_rendering(
-                &[
-                    (radiance, LoadOp::Load),
-                    (view_depth, LoadOp::Load),
-                    (weight, LoadOp::Clear([0.0; 4])),
-                    (visibility, LoadOp::Load),
-                    (normal, LoadOp::Load),
-                    (ids, LoadOp::Load),
-                ],
-                Some((depth, view.clear_depth.then_some(1.0))),
-            );
-            pipelines.draw(cmd, plan, (buffers.primitive, object), push)?;
+            cmd.begin_rendering(&colors, Some((depth, view.clear_depth.then_some(1.0))));
+            if draw_splats {
+                pipelines.draw(cmd, plan, (buffers.primitive, object), push)?;
+            }
             pipelines.draw_hybrid(cmd, plan, push, triangles)?;
             cmd.end_rendering();
             Ok(())
@@ -533,21 +569,15 @@ fn declare_normalize(
             ],
         ),
     )?);
-    let builder = graph.pass(name).graphics();
-    targets
+    let builder = targets
         .lighting
-        .read_in(builder, Stage::Fragment)
+        .read_in(graph.pass(name).graphics(), Stage::Fragment)
         .read(accumulation.color_weight, ImageAccess::Sampled(Stage::Fragment))
         .read(accumulation.normal_depth, ImageAccess::Sampled(Stage::Fragment))
         .read(accumulation.nearest_ids, ImageAccess::Sampled(Stage::Fragment))
         .read(accumulation.any_ids, ImageAccess::Sampled(Stage::Fragment))
-        .read(view.frame, BufferAccess::StorageRead(Stage::Fragment))
-        .write(view.radiance, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.view_depth, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.weight, ImageAccess::ColorAttachmentWrite)
-        .write(view.visibility, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.normal, ImageAccess::ColorAttachmentReadWrite)
-        .write(view.ids, ImageAccess::ColorAttachmentReadWrite)
+        .read(view.frame, BufferAccess::StorageRead(Stage::Fragment));
+    view.write_outputs(builder, ImageAccess::ColorAttachmentWrite)
         .record(move |pass, _| {
             let push = NormalizePush {
                 color_weight: pass.sampled(accumulation.color_weight)?,
@@ -557,26 +587,7 @@ fn declare_normalize(
                 any_ids: pass.sampled(accumulation.any_ids)?,
                 ..NormalizePush::zeroed()
             };
-            let (radiance, view_depth) = (pass.image(view.radiance)?, pass.image(view.view_depth)?);
-            let (weight, visibility) = (pass.image(view.weight)?, pass.image(view.visibility)?);
-            let (normal, ids) = (pass.image(view.normal)?, pass.image(view.ids)?);
-            let cmd = pass.cmd();
-            cmd.begin_rendering(
-                &[
-                    (radiance, LoadOp::Load),
-                    (view_depth, LoadOp::Load),
-                    (weight, LoadOp::Clear([0.0; 4])),
-                    (visibility, LoadOp::Load),
-                    (normal, LoadOp::Load),
-                    (ids, LoadOp::Load),
-                ],
-                None,
-            );
-            cmd.bind_graphics(&pipeline);
-            cmd.push_constants(&push)?;
-            cmd.draw(3, 1);
-            cmd.end_rendering();
-            Ok(())
+            view.draw_full_screen(pass, LoadOp::Clear([0.0; 4]), &pipeline, &push)
         });
     Ok(())
 }

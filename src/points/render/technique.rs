@@ -10,6 +10,7 @@ use super::gpu_layout::{frame_header, gaussian_table, pack_nodes, HEADER_BYTES, 
 use super::object_space::ObjectSpaceResources;
 use super::passes::{declare_ewa, declare_opaque, PointBuffers, PointView};
 use super::selection::{plan_frame, FramePlan, ObjectLayout};
+use super::single_pass::{check_backend, declare_single_pass};
 use super::stats::{PointFrameStats, StatsLog};
 use super::triangles::TriangleBuffer;
 use super::{SplatMode, SplatPrimitive, SplatSettings};
@@ -73,6 +74,9 @@ impl PointRenderer {
     /// `settings.epsilon`, clustered when asked for).
     pub fn new(ctx: &Context, scene: &PointScene, settings: SplatSettings) -> Result<PointRenderer> {
         settings.validate()?;
+        if settings.mode == SplatMode::SinglePass {
+            check_backend(ctx, settings.backend)?;
+        }
         scene.validate()?;
         let mut scene = scene.clone();
         if let Some(epsilon) = settings.epsilon {
@@ -157,7 +161,8 @@ impl PointRenderer {
 
     /// Declares the points passes of view `index` into `targets` (W
     /// required): `points.visibility`, `points.accumulate`,
-    /// `points.normalize` for EWA splats, or `points.opaque`.
+    /// `points.normalize` for EWA splats, `points.single_pass*` for
+    /// single-pass splats (§10.4), or `points.opaque`.
     /// `clear_depth`: no terrain drew into the depth buffer.
     pub fn declare(
         &mut self,
@@ -211,9 +216,11 @@ impl PointRenderer {
             lighting: targets.lighting.constants,
             clear_depth,
         };
-        let name = |base| pass_name(base, &view.name);
+        let name = |base: &str| pass_name(base, &view.name);
         match self.settings.mode {
-            SplatMode::Opaque => declare_opaque(ctx, graph, &name("points.opaque"), (buffers, point_view), targets)?,
+            SplatMode::Opaque => {
+                declare_opaque(ctx, graph, &name("points.opaque"), (buffers, point_view), targets, true)?
+            }
             SplatMode::Ewa => {
                 let names = [
                     name("points.visibility"),
@@ -223,6 +230,14 @@ impl PointRenderer {
                 let names = [names[0].as_str(), names[1].as_str(), names[2].as_str()];
                 declare_ewa(ctx, graph, names, (buffers, point_view), targets)?
             }
+            SplatMode::SinglePass => declare_single_pass(
+                ctx,
+                graph,
+                &name,
+                (buffers, point_view),
+                targets,
+                (self.settings.backend, self.settings.force_32bit_locks),
+            )?,
         }
         self.views.push(point_view);
         Ok(())
