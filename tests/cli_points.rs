@@ -242,5 +242,9 @@ fn renders_single_pass_splats_and_names_a_missing_interlock() {
         );
         assert!(!dir.join("o.png").exists(), "nothing written");
     }
+    // The primitive belongs to the ewa and opaque modes.
+    let args = bunny_render_args(&dir, &["--splat", "single-pass", "--splat-primitive", "point"]);
+    assert_one_line_error("single-pass with a primitive", &run(&args), &["--splat-primitive"]);
+    assert!(!dir.join("o.png").exists(), "nothing written");
     std::fs::remove_dir_all(dir).unwrap();
 }

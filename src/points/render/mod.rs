@@ -191,6 +191,16 @@ impl Default for SplatSettings {
 impl SplatSettings {
     /// Checks the numbers.
     pub fn validate(&self) -> Result<()> {
+        if self.mode == SplatMode::SinglePass && self.primitive != SplatPrimitive::Quad {
+            return Err(Error::invalid(
+                "points.primitive",
+                format!(
+                    "{}: single-pass splatting rasterises its splats itself (compute) or as quads (interlock); \
+                     the primitive applies to the ewa and opaque modes",
+                    self.primitive.name()
+                ),
+            ));
+        }
         if !(self.cutoff > 1.0 && self.cutoff < 2.0) {
             return Err(Error::invalid(
                 "splat cut-off",
