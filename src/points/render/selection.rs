@@ -5,6 +5,17 @@
 //! outside the view frustum are not drawn. The exact interval test runs in
 //! the vertex stage (`glsl/points/splat.vert`).
 //!
+//! Objects marked for thinning (vegetation, `PointObject::thinning`): an
+//! instance whose bounding sphere spans `s` < [`THINNING_SIZE`] error
+//! thresholds ε in the image (about pixels) is drawn with probability
+//! `(s/THINNING_SIZE)²`, decided by a fixed hash of its index
+//! ([`keeps_instance`]). A splat never covers less than the EWA
+//! resampling filter (about three pixels across), so sub-pixel plants
+//! would paint a distant hillside with blobs; thinning keeps their
+//! expected coverage near their true projected area, and their draws few.
+//! Kept instances are a nested set as the camera approaches (each plant
+//! appears at its own distance and stays).
+//!
 //! With normal clusters (§10.1.10) an object's list is cut into 128 sorted
 //! lists by normal direction; clusters whose every splat faces away from the
 //! eye are skipped and the others get their own prefix and draw.
@@ -15,8 +26,29 @@ use glam::{DMat4, DVec3};
 
 use super::gpu_layout::GpuInstance;
 use crate::points::build::clusters::ClusteredTree;
-use crate::points::scene::PointScene;
+use crate::points::scene::{PointObject, PointScene};
+use crate::random::SplitMix64;
 use crate::view::camera::frustum_planes;
+
+/// Image size, in error thresholds ε (about pixels), below which instances
+/// of thinned objects are drawn with falling probability (module docs).
+pub const THINNING_SIZE: f64 = 3.0;
+
+/// Whether instance `index` of `object`, its bounding sphere's centre
+/// `distance` away from the eye (in object units), is drawn (module docs);
+/// always true for objects without thinning.
+pub fn keeps_instance(object: &PointObject, index: usize, distance: f64) -> bool {
+    if !object.thinning {
+        return true;
+    }
+    let epsilon = f64::from(object.tree.epsilon);
+    let size = 2.0 * f64::from(object.tree.bounds_radius) / (distance.max(1e-9) * epsilon);
+    if size >= THINNING_SIZE {
+        return true;
+    }
+    let u = SplitMix64(index as u64 ^ 0x7468_696e_6e69_6e67).next_f64();
+    u < (size / THINNING_SIZE).powi(2)
+}
 
 /// Where an object's splats are in the splat buffer.
 #[derive(Clone, Debug)]
@@ -82,6 +114,9 @@ pub fn plan_frame(
         if planes.iter().any(|p| p.truncate().dot(centre) + p.w < -radius) {
             continue;
         }
+        if !keeps_instance(object, index, (eye - centre).length() / scale) {
+            continue;
+        }
         // r_lo in object units: the tree's intervals are in object units.
         let r_lo = ((((eye - centre).length() - radius) / scale).max(0.0)) as f32;
         let ranges: Vec<(u32, usize)> = match &layout.clusters {
@@ -92,7 +127,7 @@ pub fn plan_frame(
                     .clusters
                     .iter()
                     .enumerate()
-                    .filter(|(_, c)| !c.is_back_facing(eye_object, c.centre, c.radius))
+                    .filter(|(_, c)| object.two_sided || !c.is_back_facing(eye_object, c.centre, c.radius))
                     .map(|(k, c)| (layout.first + c.first, clustered.cluster_prefix_len(k, r_lo)))
                     .collect()
             }
@@ -106,7 +141,7 @@ pub fn plan_frame(
                 f32::from_bits(count as u32),
                 f32::from_bits(layout.first_triangle),
             ],
-            ids: [object.class.id(), index as u32 + 1, 0, 0],
+            ids: [object.class.id(), index as u32 + 1, u32::from(object.two_sided), 0],
         };
         let first_record = plan.records.len() as u32;
         let mut drawn = false;
