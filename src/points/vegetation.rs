@@ -113,9 +113,15 @@ impl VegetationReport {
     }
 }
 
-/// The prototype of `model`, variant `variant` (seeded from `seed`).
+/// The mesh seed of prototype `variant` of `model` (from the options' seed).
+pub fn prototype_seed(model: PlantModel, variant: usize, options: &VegetationOptions) -> u64 {
+    SplitMix64(options.seed ^ ((model as u64) << 32) ^ variant as u64).next_u64()
+}
+
+/// The prototype of `model`, variant `variant`: the plant of
+/// [`prototype_seed`] built into a point tree.
 pub fn plant_prototype(model: PlantModel, variant: usize, options: &VegetationOptions) -> Result<PointObject> {
-    let seed = SplitMix64(options.seed ^ ((model as u64) << 32) ^ variant as u64).next_u64();
+    let seed = prototype_seed(model, variant, options);
     let samples = ((model.default_samples() as f64 * options.samples).round() as usize).max(64);
     let built = build_plant_tree(model, seed, samples, options.hybrid, &options.spt)?;
     Ok(PointObject {
@@ -202,7 +208,7 @@ mod tests {
                 source: 0,
             },
         ];
-        let placed = scatter(&rules, DVec2::new(100.0, 50.0), 4, 1000, &mut |_| Ok(vec![1.0])).unwrap();
+        let placed = scatter(&rules, DVec2::new(100.0, 50.0), 4, 1000, &|_| Ok(vec![1.0])).unwrap();
         let (scene, report) = plant_scene(&rules, &placed, &mut |xy| Ok(xy.x * 0.1), &options).unwrap();
         assert_eq!(scene.objects.len(), 4);
         assert_eq!(report.prototypes, 4);

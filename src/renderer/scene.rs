@@ -97,14 +97,8 @@ impl Scene {
         }
         let terrain = TerrainSettings::default();
         let reference = ReferenceSurface::new(&self.heights, &self.layers, &self.input_maps, terrain.noise_seed)?;
-        let mut shares = |xy| Ok(subtree_shares(&self.layers, &reference.evaluate(xy, 0.0).coverage));
-        let placed = scatter(
-            &rules,
-            self.heights.extent(),
-            options.seed,
-            options.max_plants,
-            &mut shares,
-        )?;
+        let shares = |xy| Ok(subtree_shares(&self.layers, &reference.evaluate(xy, 0.0).coverage));
+        let placed = scatter(&rules, self.heights.extent(), options.seed, options.max_plants, &shares)?;
         if placed.thinned > 0 {
             log::warn!(
                 "vegetation: {} of about {} plants left out (at most {}; lower the density)",

@@ -6,8 +6,8 @@
 //! the vertex stage (`glsl/points/splat.vert`).
 //!
 //! Objects marked for thinning (vegetation, `PointObject::thinning`): an
-//! instance whose bounding sphere spans `s` < [`THINNING_SIZE`] error
-//! thresholds ε in the image (about pixels) is drawn with probability
+//! instance whose bounding sphere spans `s` < [`THINNING_SIZE`] pixels in
+//! the image is drawn with probability
 //! `(s/THINNING_SIZE)²`, decided by a fixed hash of its index
 //! ([`keeps_instance`]). A splat never covers less than the EWA
 //! resampling filter (about three pixels across), so sub-pixel plants
@@ -30,19 +30,19 @@ use crate::points::scene::{PointObject, PointScene};
 use crate::random::SplitMix64;
 use crate::view::camera::frustum_planes;
 
-/// Image size, in error thresholds ε (about pixels), below which instances
-/// of thinned objects are drawn with falling probability (module docs).
+/// Image size in pixels below which instances of thinned objects are drawn
+/// with falling probability (module docs).
 pub const THINNING_SIZE: f64 = 3.0;
 
 /// Whether instance `index` of `object`, its bounding sphere's centre
-/// `distance` away from the eye (in object units), is drawn (module docs);
+/// `distance` away from the eye (in object units), is drawn (module docs)
+/// in a view whose pixels are `pixel` wide at unit distance (1/f_y);
 /// always true for objects without thinning.
-pub fn keeps_instance(object: &PointObject, index: usize, distance: f64) -> bool {
+pub fn keeps_instance(object: &PointObject, index: usize, distance: f64, pixel: f64) -> bool {
     if !object.thinning {
         return true;
     }
-    let epsilon = f64::from(object.tree.epsilon);
-    let size = 2.0 * f64::from(object.tree.bounds_radius) / (distance.max(1e-9) * epsilon);
+    let size = 2.0 * f64::from(object.tree.bounds_radius) / (distance.max(1e-9) * pixel.max(1e-12));
     if size >= THINNING_SIZE {
         return true;
     }
@@ -90,13 +90,14 @@ pub struct FramePlan {
 }
 
 /// Plans a frame: `view` world → camera, `view_proj` world → clip,
+/// `pixel` the width of a pixel at unit distance (1/f_y, for thinning),
 /// `objects[o]` where object o's list is.
 pub fn plan_frame(
     scene: &PointScene,
     objects: &[ObjectLayout],
     eye: DVec3,
-    view: DMat4,
-    view_proj: DMat4,
+    (view, view_proj): (DMat4, DMat4),
+    pixel: f64,
 ) -> FramePlan {
     let planes = frustum_planes(view_proj);
     let mut plan = FramePlan {
@@ -114,7 +115,7 @@ pub fn plan_frame(
         if planes.iter().any(|p| p.truncate().dot(centre) + p.w < -radius) {
             continue;
         }
-        if !keeps_instance(object, index, (eye - centre).length() / scale) {
+        if !keeps_instance(object, index, (eye - centre).length() / scale, pixel) {
             continue;
         }
         // r_lo in object units: the tree's intervals are in object units.

@@ -208,7 +208,8 @@ impl PointShadows {
     }
 
     /// The caster records of one view for `plan`, and its draws.
-    fn plan_view(&self, eye: DVec3, plan: &CascadePlan) -> (Vec<ShadowInstance>, Vec<ShadowDraw>) {
+    /// (`pixel`: the view's pixel width at unit distance, for thinning.)
+    fn plan_view(&self, eye: DVec3, plan: &CascadePlan, pixel: f64) -> (Vec<ShadowInstance>, Vec<ShadowDraw>) {
         let (mut records, mut draws) = (Vec::new(), Vec::new());
         if plan.count() == 0 {
             return (records, draws);
@@ -221,7 +222,8 @@ impl PointShadows {
             let scale = inst.transform.scale;
             let centre = model.transform_point3(tree.bounds_centre.as_dvec3());
             let radius = f64::from(tree.bounds_radius) * scale;
-            if !plan.may_cast(centre, radius) || !keeps_instance(object, index, (eye - centre).length() / scale) {
+            if !plan.may_cast(centre, radius) || !keeps_instance(object, index, (eye - centre).length() / scale, pixel)
+            {
                 continue;
             }
             let r_lo = ((((eye - centre).length() - radius) / scale).max(0.0)) as f32;
@@ -273,7 +275,7 @@ impl Technique for PointShadows {
                     &self.settings,
                     0,
                 )?;
-                self.plan_view(view.camera.eye, &plan)
+                self.plan_view(view.camera.eye, &plan, 1.0 / view.intrinsics().fy)
             } else {
                 (Vec::new(), Vec::new())
             };

@@ -67,9 +67,9 @@ impl PlantModel {
     /// plant a few hundred pixels tall (trees have more surface).
     pub fn default_samples(self) -> usize {
         match self {
-            PlantModel::Conifer => 24_000,
-            PlantModel::Shrub => 9_000,
-            PlantModel::GrassTuft => 3_000,
+            PlantModel::Conifer => 12_000,
+            PlantModel::Shrub => 6_000,
+            PlantModel::GrassTuft => 2_000,
         }
     }
 }

@@ -72,6 +72,54 @@ fn cell_seed(seed: u64, rule: usize, i: u64, j: u64) -> u64 {
     SplitMix64(b ^ j.wrapping_mul(0x1656_67b1_9e37_79f9)).next_u64()
 }
 
+/// The jittered grid of one rule.
+struct Grid {
+    rule: usize,
+    cell: f64,
+    extent: DVec2,
+    seed: u64,
+}
+
+impl Grid {
+    /// The plants of grid rows `rows`, and the candidates evaluated.
+    fn scatter_rows(
+        &self,
+        rule: &ScatterRule,
+        rows: std::ops::Range<u64>,
+        shares: &Shares,
+    ) -> Result<(Vec<Placement>, usize)> {
+        let (cell, extent) = (self.cell, self.extent);
+        let columns = (extent.x / cell).ceil() as u64;
+        let (mut placements, mut candidates) = (Vec::new(), 0);
+        for j in rows {
+            for i in 0..columns {
+                let mut rng = SplitMix64(cell_seed(self.seed, self.rule, i, j));
+                let xy = DVec2::new((i as f64 + rng.next_f64()) * cell, (j as f64 + rng.next_f64()) * cell);
+                let accept = rng.next_f64();
+                let (scale, yaw, variant) = (rng.next_f64(), rng.next_f64(), rng.next_u64());
+                if xy.x >= extent.x || xy.y >= extent.y {
+                    continue;
+                }
+                candidates += 1;
+                let share = shares(xy)?.get(rule.source).copied().unwrap_or(0.0).clamp(0.0, 1.0);
+                if accept < f64::from(share) {
+                    placements.push(Placement {
+                        rule: self.rule,
+                        xy,
+                        scale: rule.scale.0 + (rule.scale.1 - rule.scale.0) * scale,
+                        yaw: yaw * std::f64::consts::TAU,
+                        variant,
+                    });
+                }
+            }
+        }
+        Ok((placements, candidates))
+    }
+}
+
+/// The shares of every source at a point.
+pub type Shares<'a> = dyn Fn(DVec2) -> Result<Vec<f32>> + Sync + 'a;
+
 /// Checks a rule's numbers; `what` names it in errors.
 pub fn check_rule(rule: &ScatterRule, what: &str) -> Result<()> {
     if !(rule.density.is_finite() && rule.density >= 0.0) {
@@ -90,14 +138,9 @@ pub fn check_rule(rule: &ScatterRule, what: &str) -> Result<()> {
 /// Scatters plants by `rules` over the rectangle `[0, extent]` (module
 /// docs), at most `cap` of them. `shares(xy)` gives the share of every
 /// source at a point (values outside [0, 1] are clamped); it is called once
-/// per candidate.
-pub fn scatter(
-    rules: &[ScatterRule],
-    extent: DVec2,
-    seed: u64,
-    cap: usize,
-    shares: &mut dyn FnMut(DVec2) -> Result<Vec<f32>>,
-) -> Result<Scatter> {
+/// per candidate, from as many threads as there are cores (rows of the
+/// grid in bands).
+pub fn scatter(rules: &[ScatterRule], extent: DVec2, seed: u64, cap: usize, shares: &Shares) -> Result<Scatter> {
     for (k, rule) in rules.iter().enumerate() {
         check_rule(rule, &format!("vegetation rule {k}"))?;
     }
@@ -116,29 +159,35 @@ pub fn scatter(
         if density <= 0.0 {
             continue;
         }
-        let cell = density.recip().sqrt();
-        let (nx, ny) = ((extent.x / cell).ceil() as u64, (extent.y / cell).ceil() as u64);
-        for j in 0..ny {
-            for i in 0..nx {
-                let mut rng = SplitMix64(cell_seed(seed, k, i, j));
-                let xy = DVec2::new((i as f64 + rng.next_f64()) * cell, (j as f64 + rng.next_f64()) * cell);
-                let accept = rng.next_f64();
-                let (scale, yaw, variant) = (rng.next_f64(), rng.next_f64(), rng.next_u64());
-                if xy.x >= extent.x || xy.y >= extent.y {
-                    continue;
-                }
-                out.candidates += 1;
-                let share = shares(xy)?.get(rule.source).copied().unwrap_or(0.0).clamp(0.0, 1.0);
-                if accept < f64::from(share) {
-                    out.placements.push(Placement {
-                        rule: k,
-                        xy,
-                        scale: rule.scale.0 + (rule.scale.1 - rule.scale.0) * scale,
-                        yaw: yaw * std::f64::consts::TAU,
-                        variant,
-                    });
-                }
-            }
+        let grid = Grid {
+            rule: k,
+            cell: density.recip().sqrt(),
+            extent,
+            seed,
+        };
+        let rows = (extent.y / grid.cell).ceil() as u64;
+        // Bands of rows on the available cores, joined in order (deterministic).
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(8) as u64;
+        let per_band = rows.div_ceil(threads).max(1);
+        let bands: Vec<Result<(Vec<Placement>, usize)>> = std::thread::scope(|scope| {
+            let handles: Vec<_> = (0..rows)
+                .step_by(per_band as usize)
+                .map(|first| {
+                    let grid = &grid;
+                    scope.spawn(move || grid.scatter_rows(rule, first..(first + per_band).min(rows), shares))
+                })
+                .collect();
+            (handles.into_iter())
+                .map(|h| {
+                    h.join()
+                        .unwrap_or_else(|_| Err(Error::invalid("vegetation", "a scatter thread panicked")))
+                })
+                .collect()
+        });
+        for band in bands {
+            let (placements, candidates) = band?;
+            out.placements.extend(placements);
+            out.candidates += candidates;
         }
     }
     let accepted = out.placements.len();
@@ -169,7 +218,7 @@ mod tests {
         }
     }
 
-    fn constant(shares: Vec<f32>) -> impl FnMut(DVec2) -> Result<Vec<f32>> {
+    fn constant(shares: Vec<f32>) -> impl Fn(DVec2) -> Result<Vec<f32>> + Sync {
         move |_| Ok(shares.clone())
     }
 
@@ -177,11 +226,11 @@ mod tests {
     fn deterministic_per_seed() {
         let rules = [rule(0.01, 0), rule(0.02, 1)];
         let extent = DVec2::new(300.0, 200.0);
-        let run = |seed| scatter(&rules, extent, seed, 10_000, &mut constant(vec![0.5, 0.7])).unwrap();
+        let run = |seed| scatter(&rules, extent, seed, 10_000, &constant(vec![0.5, 0.7])).unwrap();
         assert_eq!(run(1), run(1));
         assert_ne!(run(1).placements, run(2).placements);
         // A rule's plants do not depend on the other rules.
-        let alone = scatter(&rules[..1], extent, 1, 10_000, &mut constant(vec![0.5, 0.7])).unwrap();
+        let alone = scatter(&rules[..1], extent, 1, 10_000, &constant(vec![0.5, 0.7])).unwrap();
         let both = run(1);
         let first: Vec<_> = both.placements.iter().filter(|p| p.rule == 0).copied().collect();
         assert_eq!(alone.placements, first);
@@ -192,7 +241,7 @@ mod tests {
         // Binomial: n cells, p the share; 4.5 standard deviations.
         let extent = DVec2::new(1000.0, 800.0);
         for (density, share) in [(0.01, 1.0f32), (0.01, 0.5), (0.003, 0.25), (0.02, 0.0)] {
-            let out = scatter(&[rule(density, 0)], extent, 9, 1 << 20, &mut constant(vec![share])).unwrap();
+            let out = scatter(&[rule(density, 0)], extent, 9, 1 << 20, &constant(vec![share])).unwrap();
             let n = extent.x * extent.y * density;
             let p = f64::from(share);
             let (mean, sigma) = (n * p, (n * p * (1.0 - p)).sqrt());
@@ -213,8 +262,8 @@ mod tests {
     #[test]
     fn grows_only_where_the_share_is_positive() {
         let extent = DVec2::new(400.0, 400.0);
-        let mut half = |xy: DVec2| Ok(vec![if xy.x < 200.0 { 1.0 } else { 0.0 }]);
-        let out = scatter(&[rule(0.01, 0)], extent, 3, 100_000, &mut half).unwrap();
+        let half = |xy: DVec2| Ok(vec![if xy.x < 200.0 { 1.0 } else { 0.0 }]);
+        let out = scatter(&[rule(0.01, 0)], extent, 3, 100_000, &half).unwrap();
         assert!(out.placements.len() > 700 && out.placements.iter().all(|p| p.xy.x < 200.0));
     }
 
@@ -222,13 +271,13 @@ mod tests {
     fn the_cap_thins_uniformly_and_reports() {
         let extent = DVec2::new(1000.0, 1000.0);
         // 10 000 candidates, cap 1000: the budget (4000) scales densities first.
-        let out = scatter(&[rule(0.01, 0)], extent, 5, 1000, &mut constant(vec![1.0])).unwrap();
+        let out = scatter(&[rule(0.01, 0)], extent, 5, 1000, &constant(vec![1.0])).unwrap();
         assert_eq!(out.placements.len(), 1000);
         assert!(out.candidates <= 4100);
         assert!(out.thinned > 8000 && out.thinned < 9500, "{}", out.thinned);
         // Spread over the whole rectangle, not the first rows.
         assert!(out.placements.iter().any(|p| p.xy.y > 900.0) && out.placements.iter().any(|p| p.xy.y < 100.0));
-        let none = scatter(&[rule(0.01, 0)], extent, 5, 0, &mut constant(vec![1.0])).unwrap();
+        let none = scatter(&[rule(0.01, 0)], extent, 5, 0, &constant(vec![1.0])).unwrap();
         assert!(none.placements.is_empty());
     }
 
@@ -253,11 +302,11 @@ mod tests {
                 ..rule(0.0, 0)
             },
         ] {
-            let e = scatter(&[bad], extent, 1, 10, &mut constant(vec![1.0]))
+            let e = scatter(&[bad], extent, 1, 10, &constant(vec![1.0]))
                 .unwrap_err()
                 .to_string();
             assert!(e.contains("vegetation rule 0") && !e.contains('\n'), "{e}");
         }
-        assert!(scatter(&[], DVec2::ZERO, 1, 10, &mut constant(vec![])).is_err());
+        assert!(scatter(&[], DVec2::ZERO, 1, 10, &constant(vec![])).is_err());
     }
 }
