@@ -1,6 +1,7 @@
 //! Benchmark of vegetation as point trees (dissertation chapter 10, Fig.
 //! 10.12): `cargo run --release --example vegetation_bench [-- --quick]
-//! [-- --png DIR]`.
+//! [--density F] [--png DIR]` (`--density`: the multiplier of the layer
+//! tables' densities, as `--vegetation-density`).
 //!
 //! The default terrain with the built-in layer tree's plants (no rocks), at
 //! 1280×720 (`--quick`: 640×360), from three views: the default camera
@@ -55,12 +56,19 @@ fn main() {
         .position(|a| a == "--png")
         .and_then(|i| args.get(i + 1))
         .cloned();
+    let density: f64 = (args.iter().position(|a| a == "--density"))
+        .and_then(|i| args.get(i + 1))
+        .map_or(1.0, |d| d.parse().expect("--density F"));
     let (width, height) = if quick { (640, 360) } else { (1280, 720) };
     let frames = if quick { 3 } else { 8 };
 
     let started = Instant::now();
     let mut scene = Scene::default_terrain().expect("terrain");
-    let report = scene.add_vegetation(&VegetationOptions::default()).expect("vegetation");
+    let options = VegetationOptions {
+        density,
+        ..VegetationOptions::default()
+    };
+    let report = scene.add_vegetation(&options).expect("vegetation");
     println!(
         "scatter + build: {:.2} s; {} plants ({:?}), {} candidates, {} prototypes with {} splats",
         started.elapsed().as_secs_f64(),
