@@ -1,7 +1,9 @@
 //! End-to-end tests of `--vegetation on|off` and `--vegetation-density`
 //! (dissertation chapter 10, Fig. 10.12): plants of a layer file's
 //! `vegetation` table appear in the image, density 0 is the same image as
-//! off, and bad values and tables are one-line errors.
+//! off, the built-in scene grows plants unless told not to, and bad values
+//! and tables are one-line errors. (These tests run the binary as is:
+//! [`common::cli::run`] turns plants off for the other CLI tests.)
 
 mod common;
 
@@ -41,7 +43,7 @@ fn plants_appear_with_vegetation_on_and_density_zero_is_off() {
     let layers = common::data("layers-vegetation-meadow.toml");
     let image = |name: &str, extra: &[&str]| {
         let out = dir.join(name);
-        let r = run(&render_args(&layers, &out, extra));
+        let r = run_as_is(&render_args(&layers, &out, extra));
         assert_success(name, &r);
         pixels(&out)
     };
@@ -54,6 +56,36 @@ fn plants_appear_with_vegetation_on_and_density_zero_is_off() {
     assert_eq!(zero, off);
     let changed = on.chunks(4).zip(off.chunks(4)).filter(|(a, b)| a != b).count();
     assert!(changed > 48 * 32 / 10, "plants changed only {changed} pixels");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// The instances of the points statistics line (`points: D/N instances, …`).
+fn instances(stdout: &str) -> usize {
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("points: "))
+        .expect("points statistics");
+    let counts = line["points: ".len()..].split(' ').next().expect("D/N");
+    counts.split('/').nth(1).and_then(|n| n.parse().ok()).expect("N")
+}
+
+#[test]
+fn the_built_in_scene_grows_plants_by_default() {
+    let dir = fresh_dir("vegetation-built-in");
+    let out = dir.join("o.png");
+    let count = |extra: &[&str]| {
+        let mut args = vec!["render", "--width", "32", "--height", "20", "--rocks", "0"];
+        args.extend_from_slice(extra);
+        let out_arg = out.to_str().expect("UTF-8 path");
+        args.extend(["--out", out_arg]);
+        let r = run_as_is(&args);
+        assert_success(&args.join(" "), &r);
+        instances(&text(&r.stdout))
+    };
+    let default = count(&[]);
+    assert!(default > 10_000, "{default} plants in the default scene");
+    let half = count(&["--vegetation-density", "0.5"]) as f64 / default as f64;
+    assert!((half - 0.5).abs() < 0.03, "half the density gave {half} of the plants");
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -70,7 +102,7 @@ fn bad_vegetation_values_and_tables_are_one_line_errors() {
         (&["--vegetation-density", "nan"][..], &["--vegetation-density"][..]),
         (&["--vegetation", "maybe"][..], &["--vegetation"][..]),
     ] {
-        let r = run(&render_args(&layers, &out, extra));
+        let r = run_as_is(&render_args(&layers, &out, extra));
         assert_one_line_error(&extra.join(" "), &r, needles);
     }
     for (table, needle) in [
@@ -82,7 +114,7 @@ fn bad_vegetation_values_and_tables_are_one_line_errors() {
         let text =
             format!("[root]\nname = \"m\"\ncolor = [0.1, 0.2, 0.1]\n[[root.vegetation]]\nmodel = \"shrub\"\n{table}\n");
         std::fs::write(&bad, text).unwrap();
-        let r = run(&render_args(&bad, &out, &["--vegetation", "on"]));
+        let r = run_as_is(&render_args(&bad, &out, &["--vegetation", "on"]));
         assert_one_line_error(table, &r, &[needle, "bad.toml"]);
     }
     assert!(!out.exists(), "no output after an error");
