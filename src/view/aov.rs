@@ -33,7 +33,7 @@
 //!
 //! Instance ids: the 1-based index of a point instance in the scene's
 //! `PointScene::instances` (one per `--points`
-//! file; one per boulder), 0 for terrain and sky. Point objects blended by
+//! file; one per boulder; one per plant), 0 for terrain and sky. Point objects blended by
 //! EWA splatting never average ids: they are written by `points.visibility`,
 //! where the nearest surfel wins.
 
