@@ -166,11 +166,27 @@ fn covered_share(a: &[bool], b: &[bool], (w, h): (usize, usize), radius: i64) ->
 
 #[test]
 fn a_plant_point_tree_covers_its_mesh_without_holes() {
+    // Points only, and hybrid (§10.1.8: up close the leaves are triangles).
+    for hybrid in [false, true] {
+        let options = VegetationOptions {
+            hybrid,
+            ..VegetationOptions::default()
+        };
+        for model in [PlantModel::Shrub, PlantModel::GrassTuft] {
+            let coverage = [true, false].map(|two_sided| plant_coverage(model, &options, two_sided));
+            assert!(
+                coverage[1] < coverage[0] - 0.03,
+                "{model:?}, hybrid {hybrid}: culling back faces should open holes: {coverage:?}"
+            );
+        }
+    }
+}
+
+/// Renders variant 0 of `model` (1.7 m tall, 2.6 m away) drawn two-sided
+/// or not, checks it against its rasterised mesh and returns the share of
+/// the mesh's pixels it covers.
+fn plant_coverage(model: PlantModel, options: &VegetationOptions, two_sided: bool) -> f64 {
     let (w, h) = (160u32, 100u32);
-    let options = VegetationOptions {
-        hybrid: false,
-        ..VegetationOptions::default()
-    };
     let camera = Camera {
         eye: DVec3::new(0.0, -2.6, 1.3),
         target: DVec3::new(0.0, 0.0, 0.85),
@@ -179,49 +195,43 @@ fn a_plant_point_tree_covers_its_mesh_without_holes() {
         near: 0.05,
         far: 100.0,
     };
-    let transform = PointTransform::default();
-    for model in [PlantModel::Shrub, PlantModel::GrassTuft] {
-        let scale = f64::from(1.7 / model.nominal_height());
-        let transform = PointTransform { scale, ..transform };
-        let object = plant_prototype(model, 0, &options).expect("prototype");
-        let mesh = generate_plant(model, prototype_seed(model, 0, &options));
-        let reference = rasterise(&mesh, &transform, &View::new(camera, w, h));
-        let mut coverage = Vec::new();
-        for two_sided in [true, false] {
-            let mut points = PointScene::default();
-            points.add(
-                alpenglow::points::scene::PointObject {
-                    two_sided,
-                    ..object.clone()
-                },
-                transform,
-            );
-            let settings = SplatSettings {
-                shaded: false,
-                ..SplatSettings::default()
-            };
-            let (frame, _) = render_points(&Scene::points_only(points), &camera, settings, (w, h));
-            let weight = frame.weight.expect("W");
-            let splats: Vec<bool> = weight.iter().map(|&v| v > 0.0).collect();
-            let size = (w as usize, h as usize);
-            // Mesh pixels with a splat on them (no tolerance: holes count).
-            let recall = covered_share(&reference, &splats, size, 0);
-            common::dump_pngs(&[(&format!("plant-{model:?}-{two_sided}"), &frame.rgba8)], w, h);
-            let precision = covered_share(&splats, &reference, size, 3);
-            println!("{model:?}, two-sided {two_sided}: mesh pixels covered {recall:.3}, splat pixels near the mesh {precision:.3}");
-            coverage.push(recall);
-            if two_sided {
-                assert!(recall >= 0.97, "{model:?}: holes: {recall}");
-                assert!(precision >= 0.9, "{model:?}: splats off the mesh: {precision}");
-                let vegetation = frame.class.iter().filter(|&&c| c == CLASS_VEGETATION).count();
-                assert!(vegetation >= splats.iter().filter(|&&s| s).count() * 9 / 10);
-            }
-        }
+    let transform = PointTransform {
+        scale: f64::from(1.7 / model.nominal_height()),
+        ..PointTransform::default()
+    };
+    let object = plant_prototype(model, 0, options).expect("prototype");
+    let mesh = generate_plant(model, prototype_seed(model, 0, options));
+    let reference = rasterise(&mesh, &transform, &View::new(camera, w, h));
+    let mut points = PointScene::default();
+    points.add(alpenglow::points::scene::PointObject { two_sided, ..object }, transform);
+    let settings = SplatSettings {
+        shaded: false,
+        ..SplatSettings::default()
+    };
+    let (frame, stats) = render_points(&Scene::points_only(points), &camera, settings, (w, h));
+    let weight = frame.weight.expect("W");
+    let drawn: Vec<bool> = weight.iter().map(|&v| v > 0.0).collect();
+    let size = (w as usize, h as usize);
+    // Mesh pixels with a splat or triangle on them (no tolerance: holes count).
+    let recall = covered_share(&reference, &drawn, size, 0);
+    let precision = covered_share(&drawn, &reference, size, 3);
+    let what = format!("{model:?}, hybrid {}, two-sided {two_sided}", options.hybrid);
+    common::dump_pngs(&[(&what.replace([',', ' '], "-"), &frame.rgba8)], w, h);
+    println!(
+        "{what}: mesh pixels covered {recall:.3}, drawn pixels near the mesh {precision:.3}, {} triangles",
+        stats.prefix_triangles
+    );
+    assert_eq!(stats.prefix_triangles > 0, options.hybrid, "{what}");
+    if two_sided {
+        assert!(recall >= 0.97, "{what}: holes: {recall}");
+        assert!(precision >= 0.9, "{what}: drawn off the mesh: {precision}");
+        let vegetation = frame.class.iter().filter(|&&c| c == CLASS_VEGETATION).count();
         assert!(
-            coverage[1] < coverage[0] - 0.03,
-            "{model:?}: culling back faces should open holes: {coverage:?}"
+            vegetation >= drawn.iter().filter(|&&s| s).count() * 9 / 10,
+            "{what}: class AOV"
         );
     }
+    recall
 }
 
 #[test]

@@ -174,3 +174,42 @@ pub fn plan_frame(
     }
     plan
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::points::build::plants::{build_plant_tree, PlantModel};
+    use crate::points::build::spt::SptOptions;
+
+    #[test]
+    fn thinning_keeps_large_instances_and_a_nested_share_of_small_ones() {
+        let built = build_plant_tree(PlantModel::GrassTuft, 1, 300, false, &SptOptions::default()).unwrap();
+        let mut object = PointObject::new("tuft", built.tree);
+        let pixel = 1e-3;
+        let diameter = 2.0 * f64::from(object.tree.bounds_radius);
+        // At distance d the object spans diameter/(d·pixel) pixels.
+        let distance_for = |pixels: f64| diameter / (pixels * pixel);
+        let n = 20_000;
+        let kept = |object: &PointObject, pixels: f64| -> Vec<usize> {
+            (0..n)
+                .filter(|&i| keeps_instance(object, i, distance_for(pixels), pixel))
+                .collect()
+        };
+        assert_eq!(kept(&object, 0.1).len(), n, "objects without thinning are all drawn");
+        object.thinning = true;
+        assert_eq!(kept(&object, THINNING_SIZE).len(), n);
+        assert_eq!(kept(&object, 10.0).len(), n);
+        let (half, tenth) = (kept(&object, 1.5), kept(&object, 0.3));
+        for (set, pixels) in [(&half, 1.5), (&tenth, 0.3)] {
+            let p = (pixels / THINNING_SIZE).powi(2);
+            let sigma = (n as f64 * p * (1.0 - p)).sqrt();
+            assert!(
+                (set.len() as f64 - n as f64 * p).abs() < 4.5 * sigma,
+                "{pixels} px: {}",
+                set.len()
+            );
+        }
+        // Nested: what is drawn far away stays drawn nearer.
+        assert!(tenth.iter().all(|i| half.binary_search(i).is_ok()));
+    }
+}
