@@ -96,7 +96,8 @@ pub fn plan_frame(
     scene: &PointScene,
     objects: &[ObjectLayout],
     eye: DVec3,
-    (view, view_proj): (DMat4, DMat4),
+    view: DMat4,
+    view_proj: DMat4,
     pixel: f64,
 ) -> FramePlan {
     let planes = frustum_planes(view_proj);

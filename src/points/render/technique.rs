@@ -259,7 +259,7 @@ impl Technique for PointRenderer {
             );
             let view_proj = view.view_proj_f64();
             let pixel = 1.0 / view.intrinsics().fy;
-            let plan = plan_frame(&self.scene, &self.layouts, camera.eye, (view_matrix, view_proj), pixel);
+            let plan = plan_frame(&self.scene, &self.layouts, camera.eye, view_matrix, view_proj, pixel);
             frame.uploads.write_pod(point_view.frame, &header)?;
             frame
                 .uploads
