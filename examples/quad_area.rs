@@ -19,7 +19,7 @@ const HEIGHT: u32 = 720;
 const SIDE: usize = 512;
 
 fn main() -> alpenglow::Result<()> {
-    let default = Scene::default_procedural()?;
+    let default = Scene::default_terrain()?;
     let dem = Scene::new(load_heightmap(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/jacksboro-fault.png"),
         &HeightmapOptions {

@@ -165,7 +165,10 @@ fn main() {
     spt_rate(&ctx, &tree_scene.points.objects[0], frames);
 
     println!("\n3. CPU selection per frame, default scene (300 rock instances):");
-    let scene = Scene::default_procedural().expect("default scene");
+    let mut scene = Scene::default_terrain().expect("default terrain");
+    scene
+        .add_rocks(alpenglow::renderer::scene::DEFAULT_ROCKS.2)
+        .expect("rocks");
     let m = measure(&ctx, &scene, &scene.default_camera(), SplatSettings::default(), frames);
     println!(
         "median {:.3} ms per frame, {:.2} µs per instance",

@@ -104,7 +104,7 @@ fn main() -> alpenglow::Result<()> {
             black_box(importance_map(black_box(&sketch), N, eye, &params).ok());
         }),
     );
-    let scene = Scene::default_procedural()?;
+    let scene = Scene::default_terrain()?;
     let camera = scene.default_camera();
     let aspect = 16.0 / 9.0;
     report(

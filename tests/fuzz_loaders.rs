@@ -10,7 +10,7 @@ use std::path::Path;
 use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
 use alpenglow::points::build::input::{load_points_file, PointInput};
 use alpenglow::points::build::spt_file::{read_spt, write_spt};
-use alpenglow::texturing::layers::{Constraint, LayerTree, MAX_BLUR_RADII, MAX_HEIGHT_BLUR, MAX_SAMPLES};
+use alpenglow::texturing::layers::{vegetation, Constraint, LayerTree, MAX_BLUR_RADII, MAX_HEIGHT_BLUR, MAX_SAMPLES};
 use alpenglow::view::camera_path::load_keyframes;
 use alpenglow::view::rig::Rig;
 use fuzz::mutate::{fix_png_crcs, reseal_spt, Kind};
@@ -93,11 +93,17 @@ fn layers(path: &Path) -> Outcome {
                 && l.color.max_element() <= 1.0
                 && constraints.into_iter().all(sampled_ok)
                 && l.height_blur.map_or(true, |r| r > 0.0 && r <= MAX_HEIGHT_BLUR)
+                && l.vegetation.iter().all(|v| {
+                    (0.0..=vegetation::MAX_DENSITY).contains(&v.density)
+                        && v.scale.0 > 0.0
+                        && v.scale.0 <= v.scale.1
+                        && v.scale.1 <= vegetation::MAX_SCALE
+                })
         });
     Ok(if ok {
         Ok(())
     } else {
-        Err("empty tree, a colour, sampled function or height_blur out of range".into())
+        Err("empty tree, a colour, sampled function, height_blur or vegetation table out of range".into())
     })
 }
 

@@ -18,7 +18,7 @@ struct Splat {
 struct Instance {
     mat4 model_view;     // object → camera (rigid motion × uniform scale), computed in f64
     vec4 params;         // scale, first splat (bits), prefix length (bits), first hybrid triangle (bits)
-    uvec4 ids;           // semantic class, instance id (src/view/aov.rs), 0, 0
+    uvec4 ids;           // semantic class, instance id (src/view/aov.rs), 1 = two-sided object, 0
 };
 
 layout(set = 0, binding = 2, std430) readonly buffer Splats { Splat s[]; } g_splats[];

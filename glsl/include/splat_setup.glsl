@@ -58,7 +58,7 @@ uint splat_setup(uint splat_index, out SplatSetup o) {
     float near = g_point_frame[f].viewport.w;
     mat3 mv = mat3(inst.model_view);
     vec3 n = normalize(mv * s.normal_rmax.xyz);
-    bool two_sided = g_point_frame[f].eye.w != 0.0;
+    bool two_sided = g_point_frame[f].eye.w != 0.0 || inst.ids.z != 0u;  // frame-wide, or this object (plants)
     if (-p.z < near || abs(dot(n, p)) < MIN_COS_VIEW * length(p) || (!two_sided && dot(n, p) > 0.0)) {
         return SPLAT_SETUP_CULLED;
     }

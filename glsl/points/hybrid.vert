@@ -40,7 +40,7 @@ void main() {
     mat3 mv = mat3(inst.model_view);
     vec3 pa = (inst.model_view * vec4(a, 1.0)).xyz;
     vec3 face = cross(mv * (b - a), mv * (c - a));
-    bool two_sided = g_point_frame[f].eye.w != 0.0;
+    bool two_sided = g_point_frame[f].eye.w != 0.0 || inst.ids.z != 0u;
     if (!two_sided && dot(face, pa) >= 0.0) {
         cull();
         return;

@@ -58,7 +58,7 @@ void main() {
     float near = g_point_frame[f].viewport.w;
     mat3 mv = mat3(inst.model_view);
     vec3 n = normalize(mv * in_normal_rmax.xyz);
-    bool two_sided = g_point_frame[f].eye.w != 0.0;
+    bool two_sided = g_point_frame[f].eye.w != 0.0 || inst.ids.z != 0u;  // frame-wide, or this object (plants)
     if (-centre.z < near || abs(dot(n, centre)) < MIN_COS_VIEW * length(centre) ||
         (!two_sided && dot(n, centre) > 0.0)) {
         cull();

@@ -220,9 +220,28 @@ pub struct PointArgs {
     /// Procedural boulders scattered over the built-in terrain (0: none).
     #[arg(long, default_value_t = 300, value_name = "COUNT", value_parser = clap::builder::RangedI64ValueParser::<usize>::new().range(0..))]
     pub rocks: usize,
+    /// Procedural plants of the layer tree's `vegetation` tables (default:
+    /// on for the built-in terrain, off for height maps and --terrain specs).
+    #[arg(long, value_enum, value_name = "on|off")]
+    pub vegetation: Option<VegetationArg>,
+    /// Multiplier of every layer's plant density (≥ 0).
+    #[arg(
+        long = "vegetation-density",
+        default_value_t = 1.0,
+        value_name = "F",
+        allow_hyphen_values = true
+    )]
+    pub vegetation_density: f64,
     /// Draw no terrain: point objects against the sky.
     #[arg(long = "no-terrain")]
     pub no_terrain: bool,
+}
+
+/// Whether plants grow (`--vegetation`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VegetationArg {
+    On,
+    Off,
 }
 
 /// Terrain LOD placement.

@@ -156,6 +156,7 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
         scene.input_maps[*k] = Some(load_heightmap(path, &opts)?);
         warn_unused_input_map(args, &scene, *k);
     }
+    points::add_vegetation(&args.points, &mut scene, builtin)?;
     Ok(scene)
 }
 

@@ -1,15 +1,58 @@
 //! The points part of a scene on the command line: `--points` objects with
-//! their `--points-transform`, the default scene's rocks, and the splat
-//! settings (§10.1–10.3).
+//! their `--points-transform`, the default scene's rocks, the plants of the
+//! layer tree (`--vegetation`), and the splat settings (§10.1–10.3).
 
 use anyhow::{bail, Context as _, Result};
 
 use alpenglow::points::build::spt::epsilon_from_pixels;
 use alpenglow::points::render::{SplatBackend, SplatMode, SplatPrimitive, SplatSettings};
 use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointTransform};
+use alpenglow::points::vegetation::VegetationOptions;
 use alpenglow::renderer::Scene;
 
-use super::args::{PointArgs, SplatArg, SplatBackendArg, SplatPrimitiveArg};
+use super::args::{PointArgs, SplatArg, SplatBackendArg, SplatPrimitiveArg, VegetationArg};
+
+/// Adds the plants of the scene's layer tree when `--vegetation` says so
+/// (default: on for the built-in terrain); call after the layers and input
+/// maps are set.
+pub fn add_vegetation(args: &PointArgs, scene: &mut Scene, builtin: bool) -> Result<()> {
+    if !(args.vegetation_density.is_finite() && args.vegetation_density >= 0.0) {
+        bail!(
+            "--vegetation-density {} must be a finite number ≥ 0",
+            args.vegetation_density
+        );
+    }
+    let on = match args.vegetation {
+        Some(VegetationArg::On) => true,
+        Some(VegetationArg::Off) => false,
+        None => builtin,
+    };
+    if !on || args.no_terrain {
+        return Ok(());
+    }
+    if !scene.layers.has_vegetation() {
+        if args.vegetation == Some(VegetationArg::On) {
+            log::warn!("--vegetation on: no layer of the layer tree has a vegetation table");
+        }
+        return Ok(());
+    }
+    let options = VegetationOptions {
+        density: args.vegetation_density,
+        ..VegetationOptions::default()
+    };
+    let report = scene.add_vegetation(&options).context("--vegetation")?;
+    log::info!(
+        "vegetation: {} plants ({}) from {} candidates, {} prototypes",
+        report.total(),
+        (report.plants.iter())
+            .map(|(m, n)| format!("{n} {}", m.name()))
+            .collect::<Vec<_>>()
+            .join(", "),
+        report.candidates,
+        report.prototypes
+    );
+    Ok(())
+}
 
 /// Adds the `--points` objects to `scene` (and, for the built-in terrain,
 /// the `--rocks`); `builtin` says whether the scene is the built-in one.

@@ -2,13 +2,15 @@
 //! `ALGORITHMS.md` §7–8) for vegetation, rocks and scans. Files follow the
 //! pipeline of chapter 10, in two folders: [`build`] is the offline
 //! preparation (inputs (PLY, OBJ) → surface samples (surfels) → normals and
-//! radii → SPT build and file; rocks, hybrid meshes, normal clusters), run
+//! radii → SPT build and file; rocks, plants, hybrid meshes, normal clusters), run
 //! once at load or by `alpenglow spt build`; [`render`] is the per-frame
-//! part (selection in `prepare`, then the splatting passes).
+//! part (selection in `prepare`, then the splatting passes); [`vegetation`]
+//! scatters plant prototypes over a terrain by its surface layers.
 
 pub mod build;
 pub mod render;
 pub mod scene;
+pub mod vegetation;
 
 use glam::Vec3;
 

@@ -84,6 +84,8 @@ pub enum PointClass {
     /// Anything loaded from a file: scans, meshes.
     #[default]
     Scan,
+    /// A procedural plant (chapter 10 introduction, Fig. 10.12).
+    Vegetation,
 }
 
 impl PointClass {
@@ -92,6 +94,7 @@ impl PointClass {
         match self {
             PointClass::Rock => crate::view::aov::CLASS_ROCK,
             PointClass::Scan => crate::view::aov::CLASS_SCAN,
+            PointClass::Vegetation => crate::view::aov::CLASS_VEGETATION,
         }
     }
 }
@@ -108,6 +111,14 @@ pub struct PointObject {
     pub tree: Arc<SequentialPointTree>,
     /// The triangles drawn where they are large in the image.
     pub hybrid: Option<Arc<HybridMesh>>,
+    /// An open surface (leaves, blades): its back-facing splats and
+    /// triangles are drawn whatever
+    /// [`crate::points::render::SplatSettings::two_sided`] says.
+    pub two_sided: bool,
+    /// Thin its instances stochastically where they are smaller than a few
+    /// pixels ([`crate::points::render::selection`]): for the many small
+    /// copies of vegetation.
+    pub thinning: bool,
 }
 
 impl PointObject {
@@ -118,6 +129,8 @@ impl PointObject {
             class: PointClass::Scan,
             tree: Arc::new(tree),
             hybrid: None,
+            two_sided: false,
+            thinning: false,
         }
     }
 
@@ -260,10 +273,8 @@ pub fn load_point_object(path: &Path, options: &PointLoadOptions) -> Result<Poin
         PointInput::Mesh(mesh) if options.hybrid => {
             let (tree, hybrid) = build_hybrid(&mesh, &sampling, &options.spt, &mut |_| {}).map_err(in_file)?;
             return Ok(PointObject {
-                name,
-                class: PointClass::Scan,
-                tree: Arc::new(tree),
                 hybrid: Some(Arc::new(hybrid)),
+                ..PointObject::new(name, tree)
             });
         }
         PointInput::Mesh(mesh) => sample_mesh(&mesh, &sampling),

@@ -34,7 +34,7 @@ pub struct FrameImages {
     /// 3 floats per pixel (0 for sky).
     pub normal: Vec<f32>,
     /// Semantic class per pixel (sky 0, terrain 1 or 10 + its dominant
-    /// surface layer, rock 2, other point objects 3).
+    /// surface layer, rock 2, other point objects 3, vegetation 4).
     pub class: Vec<u32>,
     /// Point instance id per pixel (1-based; 0 for terrain and sky).
     pub instance: Vec<u32>,

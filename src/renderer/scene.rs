@@ -1,16 +1,21 @@
 //! What is drawn: a height field, point objects and a sun. The built-in
 //! default scene is a procedural ridged-multifractal terrain (§6.1) with
-//! procedural rocks (§6.1.4) scattered over it, under a low afternoon sun.
+//! procedural rocks (§6.1.4) and plants (chapter 10, Fig. 10.12) scattered
+//! over it, under a low afternoon sun.
 
 use glam::{DVec2, DVec3, Vec3};
 
 use crate::error::Result;
 use crate::io::heightmap::HeightField;
+use crate::points::build::plants::scatter::{scatter, ScatterRule};
 use crate::points::build::spt::{epsilon_from_pixels, SptOptions};
 use crate::points::scene::{scatter_rocks, PointScene};
+use crate::points::vegetation::{plant_scene, VegetationOptions, VegetationReport};
 use crate::terrain::geometry_image::TerrainSettings;
 use crate::terrain::ground::Ground;
 use crate::terrain::procedural::ProceduralTerrain;
+use crate::texturing::layers::vegetation::subtree_shares;
+use crate::texturing::reference::ReferenceSurface;
 use crate::view::camera::Camera;
 use crate::view::{Lighting, SunPosition};
 
@@ -39,10 +44,12 @@ pub struct Scene {
 
 impl Scene {
     /// The default scene: 513² samples of the default procedural terrain at
-    /// 20 m spacing (10.24 km square), with [`DEFAULT_ROCKS`] boulders.
+    /// 20 m spacing (10.24 km square), with [`DEFAULT_ROCKS`] boulders and
+    /// the plants of the built-in layer tree ([`Scene::add_vegetation`]).
     pub fn default_procedural() -> Result<Scene> {
         let mut scene = Scene::default_terrain()?;
         scene.add_rocks(DEFAULT_ROCKS.2)?;
+        scene.add_vegetation(&VegetationOptions::default())?;
         Ok(scene)
     }
 
@@ -64,6 +71,46 @@ impl Scene {
         let rocks = scatter_rocks(&self.heights, shapes, samples, count, (3.0, 16.0), 0xA1BE, &spt)?;
         self.points.append(rocks);
         Ok(())
+    }
+
+    /// Plants of the layer tree's `vegetation` tables (§8.2 layers,
+    /// chapter 10 point trees; [`crate::points::vegetation`]): scattered
+    /// over the terrain where their layer shows, as the CPU twin of the
+    /// layer evaluation ([`ReferenceSurface`], full detail, the default
+    /// terrain noise seed) says, standing on [`Scene::ground`] with the
+    /// default terrain settings. Set the layers and input maps first.
+    /// Warns when the cap thinned them.
+    pub fn add_vegetation(&mut self, options: &VegetationOptions) -> Result<VegetationReport> {
+        options.validate()?;
+        let rules: Vec<ScatterRule> = (self.layers.layers.iter().enumerate())
+            .flat_map(|(source, flat)| {
+                flat.layer.vegetation.iter().map(move |v| ScatterRule {
+                    model: v.model,
+                    density: v.density * options.density,
+                    scale: v.scale,
+                    source,
+                })
+            })
+            .collect();
+        if rules.is_empty() {
+            return Ok(VegetationReport::default());
+        }
+        let terrain = TerrainSettings::default();
+        let reference = ReferenceSurface::new(&self.heights, &self.layers, &self.input_maps, terrain.noise_seed)?;
+        let shares = |xy| Ok(subtree_shares(&self.layers, &reference.evaluate(xy, 0.0).coverage));
+        let placed = scatter(&rules, self.heights.extent(), options.seed, options.max_plants, &shares)?;
+        if placed.thinned > 0 {
+            log::warn!(
+                "vegetation: {} of about {} plants left out (at most {}; lower the density)",
+                placed.thinned,
+                placed.thinned + placed.placements.len(),
+                options.max_plants
+            );
+        }
+        let ground = self.ground(&terrain)?;
+        let (plants, report) = plant_scene(&rules, &placed, &mut |xy| ground.height(xy.x, xy.y), options)?;
+        self.points.append(plants);
+        Ok(report)
     }
 
     /// The default lighting of the scene: its sun, a snow line at 80 % of

@@ -54,6 +54,9 @@
 //!   wavelengths in [`WAVELENGTH_RANGE`] m, noise bias and scale within
 //!   ±[`MAX_NOISE_TERM`], constraint values within ±[`MAX_HAT_VALUE`];
 //!   unknown keys are errors.
+//! * **`[[….vegetation]]`** (an array of tables per layer): procedural
+//!   plants that grow where the layer shows ([`vegetation`]); the texture
+//!   does not read it.
 //!
 //! The file format is TOML: `[root]` and nested `[[….children]]` tables (see
 //! [`DEFAULT_LAYERS`]); errors name the file and line.
@@ -76,8 +79,11 @@ pub const INPUT_NAMES: [&str; 3] = ["rainfall", "radiation", "temperature"];
 pub const DEFAULT_LAYERS: &str = include_str!("default_layers.toml");
 
 pub mod constraint;
+pub mod vegetation;
 use constraint::ConstraintFile;
 pub use constraint::{Constraint, Hat, SampledFunction, MAX_HAT_VALUE, MAX_SAMPLES};
+pub use vegetation::Vegetation;
+use vegetation::VegetationFile;
 
 /// One layer (Table 8.1).
 #[derive(Clone, Debug, PartialEq)]
@@ -107,6 +113,8 @@ pub struct Layer {
     /// slope constraints read the height field blurred with a Gaussian of
     /// this standard deviation.
     pub height_blur: Option<f32>,
+    /// Plants growing where the layer shows ([`vegetation`]).
+    pub vegetation: Vec<Vegetation>,
 }
 
 /// A layer in depth-first order with its place in the tree.
@@ -153,6 +161,8 @@ struct LayerFile {
     radiation: Option<ConstraintFile>,
     temperature: Option<ConstraintFile>,
     height_blur: Option<f32>,
+    #[serde(default)]
+    vegetation: Vec<VegetationFile>,
     #[serde(default)]
     children: Vec<toml::Spanned<LayerFile>>,
 }
@@ -329,6 +339,10 @@ fn flatten(
         parse("radiation", f.radiation)?,
         parse("temperature", f.temperature)?,
     ];
+    let vegetation = (f.vegetation.into_iter().enumerate())
+        .map(|(k, v)| v.into_vegetation(k))
+        .collect::<std::result::Result<Vec<_>, _>>()
+        .map_err(bad)?;
     let index = out.len();
     out.push(FlatLayer {
         layer: Layer {
@@ -344,6 +358,7 @@ fn flatten(
             slope,
             inputs,
             height_blur: f.height_blur,
+            vegetation,
         },
         level,
         parent,

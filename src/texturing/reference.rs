@@ -36,6 +36,9 @@ pub struct ReferenceSurface<'a> {
     tile: Vec<f32>,
     /// The height field blurred for each of the tree's `height_blur` radii.
     blurred: Vec<HeightField>,
+    /// The height field's lowest and highest sample (computed once: a
+    /// scan of the whole field per evaluation would dominate its cost).
+    range: (f32, f32),
 }
 
 impl<'a> ReferenceSurface<'a> {
@@ -52,6 +55,7 @@ impl<'a> ReferenceSurface<'a> {
             tree,
             maps,
             tile: noise_tile(noise_seed, NOISE_TILE)?,
+            range: field.min_max(),
             blurred: (tree.blur_radii().into_iter().take(MAX_BLUR_RADII))
                 .map(|r| blurred_height(field, r, "height_blur"))
                 .collect::<Result<_>>()?,
@@ -113,7 +117,7 @@ impl<'a> ReferenceSurface<'a> {
             xy,
             height: sample_bspline(self.field, xy.x, xy.y) as f32,
             gradient: sample_bspline_gradient(self.field, xy.x, xy.y),
-            range: self.field.min_max(),
+            range: self.range,
             maps: [0, 1, 2].map(|k| self.input_map(k, xy)),
             blurred: std::array::from_fn(|k| match self.blurred.get(k) {
                 Some(b) => (

@@ -18,6 +18,7 @@
 //! | 1 | terrain whose surface layer is unknown: a debug view (`--view importance` …), or no atlas tile resident yet |
 //! | 2 | rock (the procedural boulders, §6.1.4) |
 //! | 3 | scan: any other point object (PLY, OBJ, SPT files) |
+//! | 4 | vegetation (the procedural plants, `crate::points::vegetation`) |
 //! | 10 + k | terrain whose dominant surface layer is layer k of the depth-first layer tree (§8.2) |
 //!
 //! The dominant layer of a point is the one with the largest final share
@@ -32,7 +33,7 @@
 //!
 //! Instance ids: the 1-based index of a point instance in the scene's
 //! `PointScene::instances` (one per `--points`
-//! file; one per boulder), 0 for terrain and sky. Point objects blended by
+//! file; one per boulder; one per plant), 0 for terrain and sky. Point objects blended by
 //! EWA splatting never average ids: they are written by `points.visibility`,
 //! where the nearest surfel wins.
 
@@ -44,5 +45,7 @@ pub const CLASS_TERRAIN: u32 = 1;
 pub const CLASS_ROCK: u32 = 2;
 /// Class of other point objects (scans, meshes).
 pub const CLASS_SCAN: u32 = 3;
+/// Class of procedural plants.
+pub const CLASS_VEGETATION: u32 = 4;
 /// Class of terrain whose dominant layer is layer 0; layer k is this + k.
 pub const CLASS_LAYER_BASE: u32 = 10;

@@ -23,8 +23,26 @@ pub fn fresh_dir(test: &str) -> PathBuf {
 
 /// Runs the binary with `args` (the device choice comes from the
 /// environment, `ALPENGLOW_DEVICE`, as for every user). The sky-light bake
-/// is cached under the target folder, not the user's cache.
+/// is cached under the target folder, not the user's cache. Scene commands
+/// (`render`, `bench`, `fly`) that do not say `--vegetation` get
+/// `--vegetation off`: the built-in scene's plants cost about 2 s of scatter
+/// in a debug build, and only `tests/cli_vegetation.rs` looks at them (it
+/// runs the defaults with [`run_as_is`]).
 pub fn run<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(AsRef::as_ref).collect();
+    let scene_command = args
+        .first()
+        .is_some_and(|a| ["render", "bench", "fly"].iter().any(|c| a == c));
+    let says_vegetation = args.iter().any(|a| *a == "--vegetation");
+    let mut args = args;
+    if scene_command && !says_vegetation {
+        args.extend([std::ffi::OsStr::new("--vegetation"), std::ffi::OsStr::new("off")]);
+    }
+    run_as_is(&args)
+}
+
+/// [`run`] without any added option.
+pub fn run_as_is<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
     Command::new(bin())
         .args(args)
         .env(

@@ -3,14 +3,16 @@
 //! never per frame. The files follow chapter 10's pipeline: inputs (PLY,
 //! OBJ) → surfels (even mesh sampling, clip lines at creases; PCA normals and
 //! neighbour radii for clouds) → sequential point tree and its file; beside
-//! it procedural rocks (§6.1.4), hybrid point–polygon meshes (§10.1.8) and
-//! normal clusters (§10.1.10).
+//! it procedural rocks (§6.1.4) and plants (chapter 10 introduction,
+//! Fig. 10.12), hybrid point–polygon meshes (§10.1.8) and normal clusters
+//! (§10.1.10).
 
 pub mod clip;
 pub mod clusters;
 pub mod estimate;
 pub mod hybrid;
 pub mod input;
+pub mod plants;
 pub mod rocks;
 pub mod sampling;
 pub mod spt;

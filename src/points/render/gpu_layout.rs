@@ -99,7 +99,8 @@ pub struct GpuInstance {
     /// Scale, first splat (u32 bits), prefix length (u32 bits), first hybrid triangle (u32 bits).
     pub params: [f32; 4],
     /// Semantic class, instance id (1-based index of the scene's instance;
-    /// `crate::view::aov`), 0, 0.
+    /// `crate::view::aov`), 1 when the object is two-sided (drawn so
+    /// whatever the frame says), 0.
     pub ids: [u32; 4],
 }
 

@@ -5,6 +5,17 @@
 //! outside the view frustum are not drawn. The exact interval test runs in
 //! the vertex stage (`glsl/points/splat.vert`).
 //!
+//! Objects marked for thinning (vegetation, `PointObject::thinning`): an
+//! instance whose bounding sphere spans `s` < [`THINNING_SIZE`] pixels in
+//! the image is drawn with probability
+//! `(s/THINNING_SIZE)²`, decided by a fixed hash of its index
+//! ([`keeps_instance`]). A splat never covers less than the EWA
+//! resampling filter (about three pixels across), so sub-pixel plants
+//! would paint a distant hillside with blobs; thinning keeps their
+//! expected coverage near their true projected area, and their draws few.
+//! Kept instances are a nested set as the camera approaches (each plant
+//! appears at its own distance and stays).
+//!
 //! With normal clusters (§10.1.10) an object's list is cut into 128 sorted
 //! lists by normal direction; clusters whose every splat faces away from the
 //! eye are skipped and the others get their own prefix and draw.
@@ -15,8 +26,29 @@ use glam::{DMat4, DVec3};
 
 use super::gpu_layout::GpuInstance;
 use crate::points::build::clusters::ClusteredTree;
-use crate::points::scene::PointScene;
+use crate::points::scene::{PointObject, PointScene};
+use crate::random::SplitMix64;
 use crate::view::camera::frustum_planes;
+
+/// Image size in pixels below which instances of thinned objects are drawn
+/// with falling probability (module docs).
+pub const THINNING_SIZE: f64 = 3.0;
+
+/// Whether instance `index` of `object`, its bounding sphere's centre
+/// `distance` away from the eye (in object units), is drawn (module docs)
+/// in a view whose pixels are `pixel` wide at unit distance (1/f_y);
+/// always true for objects without thinning.
+pub fn keeps_instance(object: &PointObject, index: usize, distance: f64, pixel: f64) -> bool {
+    if !object.thinning {
+        return true;
+    }
+    let size = 2.0 * f64::from(object.tree.bounds_radius) / (distance.max(1e-9) * pixel.max(1e-12));
+    if size >= THINNING_SIZE {
+        return true;
+    }
+    let u = SplitMix64(index as u64 ^ 0x7468_696e_6e69_6e67).next_f64();
+    u < (size / THINNING_SIZE).powi(2)
+}
 
 /// Where an object's splats are in the splat buffer.
 #[derive(Clone, Debug)]
@@ -58,6 +90,7 @@ pub struct FramePlan {
 }
 
 /// Plans a frame: `view` world → camera, `view_proj` world → clip,
+/// `pixel` the width of a pixel at unit distance (1/f_y, for thinning),
 /// `objects[o]` where object o's list is.
 pub fn plan_frame(
     scene: &PointScene,
@@ -65,6 +98,7 @@ pub fn plan_frame(
     eye: DVec3,
     view: DMat4,
     view_proj: DMat4,
+    pixel: f64,
 ) -> FramePlan {
     let planes = frustum_planes(view_proj);
     let mut plan = FramePlan {
@@ -82,6 +116,9 @@ pub fn plan_frame(
         if planes.iter().any(|p| p.truncate().dot(centre) + p.w < -radius) {
             continue;
         }
+        if !keeps_instance(object, index, (eye - centre).length() / scale, pixel) {
+            continue;
+        }
         // r_lo in object units: the tree's intervals are in object units.
         let r_lo = ((((eye - centre).length() - radius) / scale).max(0.0)) as f32;
         let ranges: Vec<(u32, usize)> = match &layout.clusters {
@@ -92,7 +129,7 @@ pub fn plan_frame(
                     .clusters
                     .iter()
                     .enumerate()
-                    .filter(|(_, c)| !c.is_back_facing(eye_object, c.centre, c.radius))
+                    .filter(|(_, c)| object.two_sided || !c.is_back_facing(eye_object, c.centre, c.radius))
                     .map(|(k, c)| (layout.first + c.first, clustered.cluster_prefix_len(k, r_lo)))
                     .collect()
             }
@@ -106,7 +143,7 @@ pub fn plan_frame(
                 f32::from_bits(count as u32),
                 f32::from_bits(layout.first_triangle),
             ],
-            ids: [object.class.id(), index as u32 + 1, 0, 0],
+            ids: [object.class.id(), index as u32 + 1, u32::from(object.two_sided), 0],
         };
         let first_record = plan.records.len() as u32;
         let mut drawn = false;
@@ -137,4 +174,43 @@ pub fn plan_frame(
         }
     }
     plan
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::points::build::plants::{build_plant_tree, PlantModel};
+    use crate::points::build::spt::SptOptions;
+
+    #[test]
+    fn thinning_keeps_large_instances_and_a_nested_share_of_small_ones() {
+        let built = build_plant_tree(PlantModel::GrassTuft, 1, 300, false, &SptOptions::default()).unwrap();
+        let mut object = PointObject::new("tuft", built.tree);
+        let pixel = 1e-3;
+        let diameter = 2.0 * f64::from(object.tree.bounds_radius);
+        // At distance d the object spans diameter/(d·pixel) pixels.
+        let distance_for = |pixels: f64| diameter / (pixels * pixel);
+        let n = 20_000;
+        let kept = |object: &PointObject, pixels: f64| -> Vec<usize> {
+            (0..n)
+                .filter(|&i| keeps_instance(object, i, distance_for(pixels), pixel))
+                .collect()
+        };
+        assert_eq!(kept(&object, 0.1).len(), n, "objects without thinning are all drawn");
+        object.thinning = true;
+        assert_eq!(kept(&object, THINNING_SIZE).len(), n);
+        assert_eq!(kept(&object, 10.0).len(), n);
+        let (half, tenth) = (kept(&object, 1.5), kept(&object, 0.3));
+        for (set, pixels) in [(&half, 1.5), (&tenth, 0.3)] {
+            let p = (pixels / THINNING_SIZE).powi(2);
+            let sigma = (n as f64 * p * (1.0 - p)).sqrt();
+            assert!(
+                (set.len() as f64 - n as f64 * p).abs() < 4.5 * sigma,
+                "{pixels} px: {}",
+                set.len()
+            );
+        }
+        // Nested: what is drawn far away stays drawn nearer.
+        assert!(tenth.iter().all(|i| half.binary_search(i).is_ok()));
+    }
 }

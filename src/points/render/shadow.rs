@@ -10,7 +10,8 @@
 //! splats' clip lines (sharp edges) are ignored, so edges cast slightly
 //! rounder shadows; both faces cast; the triangles of hybrid objects
 //! (§10.1.8) do not cast, their splats do. Instances whose bounding sphere
-//! cannot reach any cascade's box are skipped ([`CascadePlan::may_cast`]).
+//! cannot reach any cascade's box are skipped ([`CascadePlan::may_cast`]),
+//! and so are those the view thins ([`super::selection::keeps_instance`]).
 //!
 //! Instance records (object → world, in f32 world coordinates like the
 //! terrain's vertices) go into one upload region per view, written in
@@ -21,7 +22,7 @@ use std::sync::Arc;
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
 
-use super::selection::ObjectLayout;
+use super::selection::{keeps_instance, ObjectLayout};
 use super::PointRenderer;
 use crate::error::{Error, Result};
 use crate::graph::{BufferAccess, BufferId, ImageAccess, RenderGraph, Stage, UploadRegion};
@@ -207,19 +208,22 @@ impl PointShadows {
     }
 
     /// The caster records of one view for `plan`, and its draws.
-    fn plan_view(&self, eye: DVec3, plan: &CascadePlan) -> (Vec<ShadowInstance>, Vec<ShadowDraw>) {
+    /// (`pixel`: the view's pixel width at unit distance, for thinning.)
+    fn plan_view(&self, eye: DVec3, plan: &CascadePlan, pixel: f64) -> (Vec<ShadowInstance>, Vec<ShadowDraw>) {
         let (mut records, mut draws) = (Vec::new(), Vec::new());
         if plan.count() == 0 {
             return (records, draws);
         }
-        for inst in &self.scene.instances {
-            let tree = &self.scene.objects[inst.object].tree;
+        for (index, inst) in self.scene.instances.iter().enumerate() {
+            let object = &self.scene.objects[inst.object];
+            let tree = &object.tree;
             let layout = &self.layouts[inst.object];
             let model = inst.transform.matrix();
             let scale = inst.transform.scale;
             let centre = model.transform_point3(tree.bounds_centre.as_dvec3());
             let radius = f64::from(tree.bounds_radius) * scale;
-            if !plan.may_cast(centre, radius) {
+            if !plan.may_cast(centre, radius) || !keeps_instance(object, index, (eye - centre).length() / scale, pixel)
+            {
                 continue;
             }
             let r_lo = ((((eye - centre).length() - radius) / scale).max(0.0)) as f32;
@@ -271,7 +275,7 @@ impl Technique for PointShadows {
                     &self.settings,
                     0,
                 )?;
-                self.plan_view(view.camera.eye, &plan)
+                self.plan_view(view.camera.eye, &plan, 1.0 / view.intrinsics().fy)
             } else {
                 (Vec::new(), Vec::new())
             };

@@ -286,7 +286,8 @@ impl Technique for PointRenderer {
                 self.max_point_size,
             );
             let view_proj = view.view_proj_f64();
-            let plan = plan_frame(&self.scene, &self.layouts, camera.eye, view_matrix, view_proj);
+            let pixel = 1.0 / view.intrinsics().fy;
+            let plan = plan_frame(&self.scene, &self.layouts, camera.eye, view_matrix, view_proj, pixel);
             frame.uploads.write_pod(point_view.frame, &header)?;
             frame
                 .uploads

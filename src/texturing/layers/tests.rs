@@ -65,6 +65,7 @@ fn leaf(name: &str, color: [f32; 3]) -> Layer {
         slope: None,
         inputs: [None, None, None],
         height_blur: None,
+        vegetation: Vec::new(),
     }
 }
 
