@@ -10,13 +10,17 @@
 //  3. split octave o = log2(d0 / d) − SPLIT_BIAS, d the largest 3D distance
 //     to the four grid neighbours (from Φ and the atlas gradient);
 //  4. procedural displacement: wavelet octaves up to o (terrain_detail.glsl);
-//  5. normal from the displaced neighbours (central differences).
+//  5. normal of the surface itself: the B-spline's analytic gradient plus
+//     the detail octaves' (not central differences of the grid: per-line
+//     warps shear the grid, so a vertex's row neighbours can lie hundreds
+//     of metres apart in x and a difference stencil across them misreads
+//     rough ground, seen as rows of bright and dark specks from above).
 // Written straight into the vertex buffer that terrain.draw draws
 // (render-to-vertex-buffer): position (xyz, w = split octave) and normal
 // (xyz, w = debug scalar carried from the CPU).
 //
 // A workgroup computes its 8×8 vertices plus a one-vertex halo (10×10) in
-// shared memory, so normals see displaced neighbours without a second pass.
+// shared memory: the split octave needs the neighbours' positions.
 #include "../include/heap.glsl"
 #include "../include/terrain_detail.glsl"
 #include "../include/bspline_height.glsl"
@@ -40,6 +44,7 @@ layout(push_constant) uniform Push {
 
 shared vec4 s_position[10][10];  // xyz, w = split octave
 shared float s_debug[10][10];
+shared vec3 s_normal[10][10];
 
 // Φ at output vertex g (bilinear in the sketch grid) and the debug scalar.
 vec3 phi(ivec2 g) {
@@ -81,8 +86,10 @@ void main() {
         if (pc.extent.w > 0.5) {
             vec2 dgrad;
             h += detail_octaves(pc.handles.w, p.xy, d0, pc.spacing.z, pc.spacing.w, 0.0, split, dgrad);
+            grad += dgrad;
         }
         s_position[local.y][local.x] = vec4(p.xy, h, split);
+        s_normal[local.y][local.x] = normalize(vec3(-grad, 1.0));
         s_debug[local.y][local.x] = p.z;
     }
     barrier();
@@ -92,16 +99,7 @@ void main() {
         return;
     }
     ivec2 l = ivec2(gl_LocalInvocationID.xy) + 1;
-    // Central differences; at the grid border the halo entry repeats the
-    // border vertex, which makes them one-sided.
-    vec3 ds = s_position[l.y][l.x + 1].xyz - s_position[l.y][l.x - 1].xyz;
-    vec3 dt = s_position[l.y + 1][l.x].xyz - s_position[l.y - 1][l.x].xyz;
-    vec3 n = cross(ds, dt);
-    float len = length(n);
-    n = len > 1e-12 ? n / len : vec3(0.0, 0.0, 1.0);
-    if (n.z < 0.0) {
-        n = -n;
-    }
+    vec3 n = s_normal[l.y][l.x];
     vec4 p = s_position[l.y][l.x];
     uint index = uint(id.y * side + id.x);
     g_vertices[pc.handles.z].v[index].position = p;

@@ -153,8 +153,9 @@ impl<'a> Ground<'a> {
     }
 
     /// Unit upward normal of [`Ground::height`]'s surface at `(x, y)`, from
-    /// its analytic gradient. (The GPU's vertex normals are central
-    /// differences of the displaced grid: close where the grid is fine.)
+    /// its analytic gradient. (The GPU's vertex normals are the same
+    /// analytic gradient with the detail octaves up to the vertex's split
+    /// octave; the finer ones are bump-mapped in `terrain.draw`.)
     pub fn normal(&self, x: f64, y: f64) -> Result<DVec3> {
         let xy = self.inside(x, y)?;
         let (_, g) = self.surface(xy, f64::from(MAX_DETAIL_OCTAVES));
