@@ -7,11 +7,13 @@
 //! ([`terrain`], [`synthesis`], [`texturing`], [`lighting`],
 //! [`points`], [`post`]) →
 //! [`renderer`] (composition: scenes, frames, outputs) → the CLI (binary
-//! only). [`io`], [`profile`], [`random`], [`shaders`] and [`error`] are
-//! leaves every layer may use.
+//! only). [`io`], [`budget`] (the memory model), [`profile`], [`random`],
+//! [`shaders`] and [`error`] are leaves every layer may use.
 //!
 //! Every module but [`vulkan`] is `#[forbid(unsafe_code)]`.
 
+#[forbid(unsafe_code)]
+pub mod budget;
 #[forbid(unsafe_code)]
 pub mod error;
 #[forbid(unsafe_code)]
