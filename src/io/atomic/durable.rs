@@ -13,8 +13,13 @@ use std::path::Path;
 /// Flushes the contents of the regular file `path` to the disk.
 pub(crate) fn sync_file(path: &Path) -> std::io::Result<()> {
     record::step(record::Step::SyncFile, path);
-    // Write access: Windows flushes only handles that may write.
-    std::fs::OpenOptions::new().write(true).open(path)?.sync_all()
+    // Unix flushes through any descriptor (read-only works for a file a
+    // strict umask made unwritable); Windows only through one that may write.
+    std::fs::OpenOptions::new()
+        .read(cfg!(unix))
+        .write(!cfg!(unix))
+        .open(path)?
+        .sync_all()
 }
 
 /// Flushes the entries of the directory `dir` (names created, renamed or

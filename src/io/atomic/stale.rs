@@ -188,7 +188,7 @@ fn recover_if_gone(path: &Path, pid: u32, probe: &impl Fn(u32) -> Seen) -> crate
     if !writer_gone(&journal, written, seen) {
         return Ok(false);
     }
-    if pid == std::process::id() && journal.writer.pid == pid {
+    if pid == std::process::id() {
         log::info!("recovering a commit of an earlier process {pid} (its id is this process's now)");
     }
     journal::recover(path, &journal)?;
