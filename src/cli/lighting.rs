@@ -60,20 +60,63 @@ pub struct LightingArgs {
     #[arg(long = "albedo-override", value_name = "ALBEDO")]
     pub albedo_override: Option<f32>,
     /// Where the sky-light bake is cached (default: $XDG_CACHE_HOME/alpenglow
-    /// or ~/.cache/alpenglow; "none": bake every time).
+    /// or ~/.cache/alpenglow; "none": bake every time). Optional: a cache
+    /// that cannot be read or written is a warning, and the render goes on.
     #[arg(long = "cache-dir", value_name = "DIR|none")]
     pub cache_dir: Option<PathBuf>,
 }
 
-/// The sky-light bake's cache folder of the arguments.
+/// The sky-light bake's cache folder of the arguments: `--cache-dir`, else
+/// the default of [`default_cache_dir`] from the environment (its warning
+/// logged). The cache is optional: None bakes every time.
 pub fn cache_dir(args: &LightingArgs) -> Option<PathBuf> {
     match &args.cache_dir {
         Some(p) if p.as_os_str() == "none" => None,
         Some(p) => Some(p.clone()),
-        None => std::env::var_os("XDG_CACHE_HOME")
-            .map(PathBuf::from)
-            .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
-            .map(|d| d.join("alpenglow")),
+        None => {
+            let (dir, warning) = default_cache_dir(std::env::var_os("XDG_CACHE_HOME"), std::env::var_os("HOME"));
+            if let Some(w) = warning {
+                log::warn!("{w}");
+            }
+            dir
+        }
+    }
+}
+
+/// The default cache folder as the XDG Base Directory specification has it:
+/// `$XDG_CACHE_HOME/alpenglow` when that is an absolute path, else
+/// `$HOME/.cache/alpenglow`; an empty variable counts as unset, and a
+/// relative `XDG_CACHE_HOME` is ignored ("all paths set in these
+/// environment variables must be absolute"), with a warning. Without a
+/// usable `HOME` either there is no cache (and a warning: every run bakes).
+pub fn default_cache_dir(
+    xdg_cache_home: Option<std::ffi::OsString>,
+    home: Option<std::ffi::OsString>,
+) -> (Option<PathBuf>, Option<String>) {
+    let set = |v: Option<std::ffi::OsString>| v.filter(|v| !v.is_empty()).map(PathBuf::from);
+    let mut warning = None;
+    if let Some(xdg) = set(xdg_cache_home) {
+        if xdg.is_absolute() {
+            return (Some(xdg.join("alpenglow")), None);
+        }
+        warning = Some(format!(
+            "XDG_CACHE_HOME={} is not an absolute path; ignored, as the XDG Base Directory specification says",
+            xdg.display()
+        ));
+    }
+    match set(home) {
+        Some(home) if home.is_absolute() => (Some(home.join(".cache").join("alpenglow")), warning),
+        home => {
+            let why = match home {
+                Some(h) => format!("HOME={} is not an absolute path", h.display()),
+                None => "HOME is not set".to_string(),
+            };
+            let w = match warning {
+                Some(w) => format!("{w}, and {why}: no sky-light cache (--cache-dir DIR chooses one); every run bakes"),
+                None => format!("no sky-light cache: {why} and XDG_CACHE_HOME is not set (--cache-dir DIR chooses one); every run bakes"),
+            };
+            (None, Some(w))
+        }
     }
 }
 
@@ -218,4 +261,32 @@ fn sun_position(args: &LightingArgs, l: &mut Lighting) -> anyhow::Result<()> {
         l.sun = sun.position();
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_cache_dir_follows_the_xdg_specification() {
+        let v = |s: &str| Some(std::ffi::OsString::from(s));
+        let dir = |d: &str| Some(PathBuf::from(d));
+        assert_eq!(default_cache_dir(v("/c"), v("/h")), (dir("/c/alpenglow"), None));
+        assert_eq!(default_cache_dir(None, v("/h")), (dir("/h/.cache/alpenglow"), None));
+        assert_eq!(default_cache_dir(v(""), v("/h")), (dir("/h/.cache/alpenglow"), None));
+        let (d, w) = default_cache_dir(v("rel/cache"), v("/h"));
+        assert_eq!(d, dir("/h/.cache/alpenglow"));
+        assert!(w.unwrap().contains("XDG_CACHE_HOME=rel/cache is not an absolute path"));
+        for (xdg, home, needles) in [
+            (None, None, ["HOME is not set", "XDG_CACHE_HOME is not set"]),
+            (v(""), v(""), ["HOME is not set", "no sky-light cache"]),
+            (v("rel"), None, ["XDG_CACHE_HOME=rel", "HOME is not set"]),
+            (None, v("h"), ["HOME=h is not an absolute path", "no sky-light cache"]),
+        ] {
+            let (d, w) = default_cache_dir(xdg, home);
+            let w = w.unwrap();
+            assert_eq!(d, None);
+            assert!(needles.iter().all(|n| w.contains(n)) && !w.contains('\n'), "{w}");
+        }
+    }
 }

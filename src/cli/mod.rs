@@ -189,7 +189,11 @@ fn render_settings(args: &SceneArgs, scene: &Scene, views: &[ViewSpec], readback
         },
         texture_streaming: texture_streaming(args, views)?,
         lighting: Some(lighting),
-        cache_dir: lighting::cache_dir(&args.lighting),
+        // Only a terrain is baked: no cache (nor a warning about it) without one.
+        cache_dir: scene
+            .draw_terrain
+            .then(|| lighting::cache_dir(&args.lighting))
+            .flatten(),
         ..RenderSettings::new(args.width, args.height)
     })
 }

@@ -17,8 +17,56 @@
 //! `.alpenglow-commit-PID-N.journal`. When a run is killed they stay
 //! behind; [`clean_stale`], called by [`OutputTransaction`] for every
 //! directory it writes into, removes those of dead processes (and rolls
-//! back a commit that was interrupted).
+//! back a commit that was interrupted). Every sibling name fits in 255
+//! bytes, whatever the output's name ([`names`]).
+//!
+//! # Durability: the order of `fsync`s
+//!
+//! A rename is atomic for every process, but after a power loss the disk
+//! holds only what was flushed, and a file system may write a rename to the
+//! disk before the data of the file renamed, or the entries of one directory
+//! before those of another. So every step that a later step relies on is
+//! flushed (`fsync`, [`durable`]) before that step:
+//!
+//! [`write_atomically`]: write the temporary → `fsync` it → rename it onto
+//! the target → `fsync` the directory. Without the first `fsync` the
+//! rename could reach the disk before the data and leave an empty or
+//! partial target; without the second the function could return before the
+//! new name is on the disk.
+//!
+//! [`OutputTransaction::commit`]:
+//! 1. write every temporary (staging) → `fsync` each (a staging folder:
+//!    every file and folder in it, bottom up). The journal will name them,
+//!    and what it names must be complete.
+//! 2. write the journal of every directory (each with [`write_atomically`],
+//!    so written → `fsync`ed → renamed → its directory `fsync`ed). From
+//!    here on a power loss is rolled back by the next run, so the journal
+//!    must be on the disk before the first rename.
+//! 3. move old targets aside and rename every temporary into place →
+//!    `fsync` every directory. The renames must be on the disk before the
+//!    commit point: otherwise a power loss after it could leave some
+//!    outputs old and some new, with no journal left to roll them back.
+//! 4. remove the journals (removing the first directory's one is the commit
+//!    point) → `fsync` every directory. The removal must be on the disk
+//!    before the backups go: otherwise a power loss could leave a journal
+//!    that the next run rolls back with its backups already gone — old
+//!    outputs lost, new ones removed.
+//! 5. remove the backups (not flushed: a backup that a power loss brings
+//!    back is a stale sibling of a dead process, and [`clean_stale`]
+//!    removes it).
+//!
+//! A failure before the commit point rolls back (renames undone, then
+//! `fsync`ed) before its journals are removed, and so does [`clean_stale`]
+//! when it recovers a killed commit.
+//!
+//! # Which process wrote a journal
+//!
+//! A journal records its process's id and start time (on Linux field 22
+//! of `/proc/PID/stat`, clock ticks since boot). Its process is the same as
+//! a running one only when both match, so a commit whose process id now
+//! belongs to another process is still rolled back (see [`clean_stale`]).
 
+mod durable;
 mod journal;
 mod names;
 mod stale;
@@ -69,7 +117,8 @@ fn temp_path(dir: &Path, file_name: &std::ffi::OsStr) -> PathBuf {
 /// On failure — the writer returns an error, the writer panics, or the
 /// rename fails — the temporary file is removed and `path` is untouched.
 ///
-/// Errors (one line, naming `path`): `path` has no file name, its parent
+/// Errors (one line, naming `path`): `path` has no file name or one longer
+/// than 255 bytes, its parent
 /// directory does not exist or is not a directory, `path` is an existing
 /// directory or anything else but a regular file (a symbolic link, FIFO,
 /// socket or device node is never replaced), the writer did not create the
@@ -80,6 +129,16 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) ->
     let file_name = path
         .file_name()
         .ok_or_else(|| Error::output(path, "the path does not name a file"))?;
+    let units = names::name_units(file_name);
+    if units > names::NAME_MAX {
+        return Err(Error::output(
+            path,
+            format!(
+                "the file name is {units} bytes long; file systems take at most {}",
+                names::NAME_MAX
+            ),
+        ));
+    }
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -107,13 +166,24 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) ->
         armed: true,
     };
     write(&guard.path)?;
+    durable::record::step(durable::record::Step::Write, &guard.path);
     if !guard.path.is_file() {
         return Err(Error::output(
             path,
             "internal error: the writer did not create the temporary file",
         ));
     }
-    std::fs::rename(&guard.path, path).map_err(|e| {
+    durable::sync_file(&guard.path).map_err(|e| {
+        Error::output(
+            path,
+            format!(
+                "cannot flush {} to the disk: {}",
+                guard.path.display(),
+                super::one_line(e)
+            ),
+        )
+    })?;
+    durable::rename(&guard.path, path).map_err(|e| {
         Error::output(
             path,
             format!(
@@ -124,7 +194,17 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) ->
         )
     })?;
     guard.armed = false;
-    Ok(())
+    // The new name is visible; a failed flush of it is reported but leaves it.
+    durable::sync_dir(dir).map_err(|e| {
+        Error::output(
+            path,
+            format!(
+                "cannot flush directory {} to the disk: {}",
+                dir.display(),
+                super::one_line(e)
+            ),
+        )
+    })
 }
 
 /// Writes `bytes` to `path` atomically (see [`write_atomically`]).

@@ -83,7 +83,9 @@ pub struct RenderSettings {
     pub texture_streaming: TextureStreaming,
     /// The sun's cascaded shadow maps.
     pub shadows: ShadowSettings,
-    /// Where the sky-light bake is cached (None: baked every time).
+    /// Where the sky-light bake is cached (None: baked every time). Optional:
+    /// a cache that cannot be read or written is logged (`log::warn`) and
+    /// the renderer is built without it.
     pub cache_dir: Option<std::path::PathBuf>,
     /// The lighting of the first frames (None: [`Scene::default_lighting`]);
     /// change it between frames with [`Renderer::set_lighting`].

@@ -4,18 +4,43 @@
 //!
 //! A journal is a small text file: a header line, `primary HEX` (the path
 //! of the transaction's first journal, whose removal is the commit point),
-//! `pid PID`, then one `file|dir existed|new N HEX` line per output
-//! (HEX: the canonical target path's bytes). Every directory of the
+//! `pid PID`, `start TICKS` (the process's start time, clock ticks since
+//! boot, or `start unknown`), then one `file|dir existed|new N HEX` line per
+//! output (HEX: the canonical target path's bytes). Every directory of the
 //! transaction gets a copy, so that whichever of them the next run writes
 //! into, it finds the journal.
+//!
+//! Journals of format 1 (before the start time was recorded) are still
+//! read, with no start time (see [`super::clean_stale`] for how their
+//! process is told dead).
 
 use std::path::{Path, PathBuf};
 
+use super::durable;
 use super::names::{self, next_id, parent_dir, Sibling};
 use super::transaction::{exists, remove_any};
 use crate::error::{Error, Result};
 
-const HEADER: &str = "alpenglow commit journal 1";
+const HEADER: &str = "alpenglow commit journal 2";
+/// The format without the `start` line.
+const HEADER_1: &str = "alpenglow commit journal 1";
+
+/// The process that writes a transaction: its id and start time (clock
+/// ticks since boot; None where it cannot be told).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Writer {
+    pub pid: u32,
+    pub start: Option<u64>,
+}
+
+/// A parsed journal.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Journal {
+    /// The first directory's journal, whose removal is the commit point.
+    pub primary: PathBuf,
+    pub writer: Writer,
+    pub entries: Vec<Entry>,
+}
 
 /// A file or a folder output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -76,8 +101,13 @@ fn unhex(text: &str) -> Option<PathBuf> {
     return String::from_utf8(bytes).ok().map(PathBuf::from);
 }
 
-fn encode(primary: &Path, pid: u32, entries: &[Entry]) -> String {
-    let mut text = format!("{HEADER}\nprimary {}\npid {pid}\n", hex(primary));
+fn encode(primary: &Path, writer: Writer, entries: &[Entry]) -> String {
+    let start = writer.start.map_or("unknown".to_string(), |s| s.to_string());
+    let mut text = format!(
+        "{HEADER}\nprimary {}\npid {}\nstart {start}\n",
+        hex(primary),
+        writer.pid
+    );
     for e in entries {
         let kind = if e.kind == Kind::File { "file" } else { "dir" };
         let existed = if e.existed { "existed" } else { "new" };
@@ -86,14 +116,22 @@ fn encode(primary: &Path, pid: u32, entries: &[Entry]) -> String {
     text
 }
 
-/// A parsed journal: primary journal, process id, entries.
-type Parsed = (PathBuf, u32, Vec<Entry>);
-
-fn decode(text: &str) -> Option<Parsed> {
+fn decode(text: &str) -> Option<Journal> {
     let mut lines = text.lines();
-    (lines.next()? == HEADER).then_some(())?;
+    let version = match lines.next()? {
+        HEADER => 2,
+        HEADER_1 => 1,
+        _ => return None,
+    };
     let primary = unhex(lines.next()?.strip_prefix("primary ")?)?;
     let pid = lines.next()?.strip_prefix("pid ")?.parse().ok()?;
+    let start = match version {
+        1 => None,
+        _ => match lines.next()?.strip_prefix("start ")? {
+            "unknown" => None,
+            ticks => Some(ticks.parse().ok()?),
+        },
+    };
     let entries = lines
         .map(|line| {
             let mut f = line.split(' ');
@@ -117,13 +155,22 @@ fn decode(text: &str) -> Option<Parsed> {
             })
         })
         .collect::<Option<Vec<_>>>()?;
-    Some((primary, pid, entries))
+    Some(Journal {
+        primary,
+        writer: Writer { pid, start },
+        entries,
+    })
 }
 
-/// Writes a journal of `entries` into each of their directories (each
-/// atomically), the first directory's first: returns their paths in that
-/// order. On failure removes those written.
-pub(crate) fn write_all(entries: &[Entry], pid: u32) -> Result<Vec<PathBuf>> {
+/// Reads and parses the journal `path`. Errors: it cannot be read, or is
+/// not a journal.
+pub(crate) fn read(path: &Path) -> Result<Journal> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::input(path, crate::io::one_line(e)))?;
+    decode(&text).ok_or_else(|| Error::input(path, "not an alpenglow commit journal"))
+}
+
+/// The directories of `entries`, each once, in the order of the entries.
+pub(crate) fn dirs(entries: &[Entry]) -> Vec<&Path> {
     let mut dirs: Vec<&Path> = Vec::new();
     for e in entries {
         let d = parent_dir(&e.target);
@@ -131,9 +178,28 @@ pub(crate) fn write_all(entries: &[Entry], pid: u32) -> Result<Vec<PathBuf>> {
             dirs.push(d);
         }
     }
+    dirs
+}
+
+/// Flushes the directories of `entries` ([`durable::sync_dirs`]), the
+/// error naming the directory.
+pub(crate) fn sync_dirs(entries: &[Entry]) -> Result<()> {
+    durable::sync_dirs(dirs(entries)).map_err(|(d, e)| {
+        Error::output(
+            d,
+            format!("cannot flush the directory to the disk: {}", crate::io::one_line(e)),
+        )
+    })
+}
+
+/// Writes a journal of `entries` into each of their directories (each
+/// atomically, so flushed with its directory), the first directory's
+/// first: returns their paths in that order. On failure removes those
+/// written.
+pub(crate) fn write_all(entries: &[Entry], writer: Writer) -> Result<Vec<PathBuf>> {
     let n = next_id();
-    let paths: Vec<PathBuf> = dirs.iter().map(|d| names::journal(d, pid, n)).collect();
-    let text = encode(&paths[0], pid, entries);
+    let paths: Vec<PathBuf> = dirs(entries).iter().map(|d| names::journal(d, writer.pid, n)).collect();
+    let text = encode(&paths[0], writer, entries);
     for (i, p) in paths.iter().enumerate() {
         if let Err(e) = super::write_bytes_atomically(p, text.as_bytes()) {
             for q in &paths[..i] {
@@ -159,7 +225,7 @@ pub(crate) fn roll_back(entries: &[Entry], pid: u32) -> std::io::Result<()> {
             if exists(target) {
                 remove_any(target)?;
             }
-            std::fs::rename(&backup, target)?;
+            durable::rename(&backup, target)?;
         } else if !e.existed && !exists(&temp) && exists(target) {
             // The new output was renamed into place.
             remove_any(target)?;
@@ -169,29 +235,40 @@ pub(crate) fn roll_back(entries: &[Entry], pid: u32) -> std::io::Result<()> {
     Ok(())
 }
 
-/// Recovers after the dead process of the journal `path`: rolls its
-/// transaction back unless it committed (its primary journal is gone), then
-/// removes the journal. Errors when the journal cannot be read or parsed,
-/// or the roll-back failed (the journal then stays for a later run).
-pub(crate) fn recover(path: &Path) -> Result<()> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::input(path, crate::io::one_line(e)))?;
-    let (primary, pid, entries) = decode(&text).ok_or_else(|| Error::input(path, "not an alpenglow commit journal"))?;
-    if exists(&primary) {
-        roll_back(&entries, pid)
+/// Recovers after the dead process of the journal `path` (read as
+/// `journal`): rolls its transaction back unless it committed (its primary
+/// journal is gone) and flushes the roll-back to the disk, then removes the
+/// journals (the primary last) and flushes that. Errors when the roll-back
+/// or its flush failed (the journal then stays for a later run).
+pub(crate) fn recover(path: &Path, journal: &Journal) -> Result<()> {
+    let Journal {
+        primary,
+        writer,
+        entries,
+    } = journal;
+    let pid = writer.pid;
+    if exists(primary) {
+        roll_back(entries, pid)
             .map_err(|e| Error::output(path, format!("rolling back failed: {}", crate::io::one_line(e))))?;
+        sync_dirs(entries)?;
         // The primary last: while it exists the others roll back too.
         let mut journals: Vec<PathBuf> = entries
             .iter()
-            .map(|e| names::journal(parent_dir(&e.target), pid, journal_number(&primary)))
-            .filter(|j| j != &primary)
+            .map(|e| names::journal(parent_dir(&e.target), pid, journal_number(primary)))
+            .filter(|j| j != primary)
             .collect();
         journals.dedup();
         for j in journals {
-            let _ = std::fs::remove_file(j);
+            let _ = durable::remove_file(&j);
         }
-        let _ = std::fs::remove_file(&primary);
+        let _ = durable::remove_file(primary);
     }
-    let _ = std::fs::remove_file(path);
+    if exists(path) {
+        let _ = durable::remove_file(path);
+    }
+    if let Err(e) = sync_dirs(entries) {
+        log::warn!("{e}");
+    }
     Ok(())
 }
 
@@ -225,12 +302,23 @@ mod tests {
                 target: PathBuf::from("/c/frames"),
             },
         ];
-        let text = encode(Path::new("/a b/.alpenglow-commit-7-1.journal"), 7, &entries);
-        let (primary, pid, back) = decode(&text).unwrap();
-        assert_eq!(primary, PathBuf::from("/a b/.alpenglow-commit-7-1.journal"));
-        assert_eq!(journal_number(&primary), 1);
-        assert_eq!((pid, back), (7, entries));
+        let primary = PathBuf::from("/a b/.alpenglow-commit-7-1.journal");
+        for start in [Some(123_456), None] {
+            let writer = Writer { pid: 7, start };
+            let text = encode(&primary, writer, &entries);
+            let back = decode(&text).unwrap();
+            assert_eq!(back.primary, primary);
+            assert_eq!(journal_number(&back.primary), 1);
+            assert_eq!((back.writer, &back.entries), (writer, &entries));
+            assert!(decode(&text.replace("file", "fil")).is_none());
+            assert!(decode(&text.replace("start ", "begin ")).is_none());
+        }
         assert!(decode("something else").is_none());
-        assert!(decode(&text.replace("file", "fil")).is_none());
+        // Format 1: no start line, no start time.
+        let old = encode(&primary, Writer { pid: 7, start: Some(1) }, &entries)
+            .replace(HEADER, HEADER_1)
+            .replace("start 1\n", "");
+        let back = decode(&old).unwrap();
+        assert_eq!((back.writer, back.entries), (Writer { pid: 7, start: None }, entries));
     }
 }

@@ -3,15 +3,18 @@
 
 use std::path::{Path, PathBuf};
 
-use super::journal::{self, Entry, Kind};
-use super::names::{next_id, parent_dir, Sibling};
+use super::durable;
+use super::journal::{self, Entry, Kind, Writer};
+use super::names::{self, next_id, parent_dir, Sibling};
 use crate::error::{Error, Result};
 use crate::io::one_line;
 
 /// The outputs of one command, written as a transaction.
 ///
 /// 1. [`OutputTransaction::add_file`] / [`OutputTransaction::add_dir`]
-///    check every path before any work: its directory exists, no two
+///    check every path before any work: its file name fits the file
+///    system's limit (255 bytes), its directory exists and takes a new file
+///    (its temporary is created and removed again), no two
 ///    outputs name one file (compared by canonical directory and file
 ///    name), and what is at the path now is absent or a regular file (an
 ///    empty real directory for a folder output) — symbolic links, FIFOs,
@@ -19,12 +22,14 @@ use crate::io::one_line;
 ///    cleans up after killed runs in its directory ([`super::clean_stale`]).
 /// 2. [`OutputTransaction::stage`] writes each output to a hidden temporary
 ///    sibling (`.NAME.tmp-PID-N`; a folder is filled in `.NAME.partial-PID-N`).
-/// 3. [`OutputTransaction::commit`] writes a commit journal
-///    (`.alpenglow-commit-PID-N.journal`) into every directory involved,
-///    moves existing targets aside (`.NAME.bak-PID-N`), renames every
-///    temporary into place, removes the journals (the commit point: the
-///    journal of the first output's directory) and then the backups. When a
-///    rename fails, every target is restored from its backup and the new
+/// 3. [`OutputTransaction::commit`] flushes every temporary to the disk,
+///    writes a commit journal (`.alpenglow-commit-PID-N.journal`, with the
+///    process's start time) into every directory involved, moves existing
+///    targets aside (`.NAME.bak-PID-N`), renames every temporary into
+///    place, removes the journals (the commit point: the journal of the
+///    first output's directory) and then the backups, flushing the
+///    directories between these steps (the order and why: [`super`]). When
+///    a rename fails, every target is restored from its backup and the new
 ///    files are removed, so a failure never deletes what was there before.
 ///
 /// Dropping a transaction without committing removes its temporaries.
@@ -35,11 +40,13 @@ use crate::io::one_line;
 /// those directories: it finds the journal of the dead process and rolls the
 /// transaction back (every old file restored, every new one removed). A kill
 /// at any other time leaves the old outputs in place, with at most hidden
-/// temporaries that the next run removes. Renames are not `fsync`ed: the
-/// guarantee covers killed processes, not power loss.
+/// temporaries that the next run removes. The same holds after a power
+/// loss, as every step is on the disk before the next one relies on it.
 #[derive(Debug)]
 pub struct OutputTransaction {
     pid: u32,
+    /// This process's start time, for the journal.
+    start: Option<u64>,
     outputs: Vec<Output>,
     committed: bool,
 }
@@ -132,7 +139,10 @@ pub(crate) fn exists(path: &Path) -> bool {
 impl OutputTransaction {
     /// An empty transaction of this process.
     pub fn new() -> Self {
-        OutputTransaction::with_pid(std::process::id())
+        let me = super::stale::this_process();
+        let mut tx = OutputTransaction::with_pid(me.pid);
+        tx.start = me.start;
+        tx
     }
 
     /// A transaction whose hidden files carry `pid` (tests simulate a
@@ -140,6 +150,7 @@ impl OutputTransaction {
     pub(crate) fn with_pid(pid: u32) -> Self {
         OutputTransaction {
             pid,
+            start: None,
             outputs: Vec::new(),
             committed: false,
         }
@@ -147,9 +158,10 @@ impl OutputTransaction {
 
     /// Checks `path` as the file output `what` (an option name such as
     /// `--out`, used in messages) and reserves it. Errors (one line, naming
-    /// `path` and `what`): no file name, a missing directory, a path another
-    /// output of this transaction already names, or something other than a
-    /// regular file at the path.
+    /// `path` and `what`): no file name, a file name longer than 255 bytes,
+    /// a missing directory or one where no file can be created, a path
+    /// another output of this transaction already names, or something other
+    /// than a regular file at the path.
     pub fn add_file(&mut self, path: &Path, what: &str) -> Result<()> {
         self.add(path, what, Kind::File)
     }
@@ -164,6 +176,16 @@ impl OutputTransaction {
         let file_name = path
             .file_name()
             .ok_or_else(|| Error::output(path, format!("{what} does not name a file")))?;
+        let units = names::name_units(file_name);
+        if units > names::NAME_MAX {
+            return Err(Error::output(
+                path,
+                format!(
+                    "{what}: the file name is {units} bytes long; file systems take at most {}",
+                    names::NAME_MAX
+                ),
+            ));
+        }
         let dir = parent_dir(path);
         if !dir.is_dir() {
             return Err(Error::output(
@@ -190,13 +212,15 @@ impl OutputTransaction {
             }
         }
         super::clean_stale(dir);
+        let entry = Entry {
+            kind,
+            n: next_id(),
+            existed: false,
+            target: canonical,
+        };
+        probe(&entry.sibling(entry.temp_kind(), self.pid), path, what)?;
         self.outputs.push(Output {
-            entry: Entry {
-                kind,
-                n: next_id(),
-                existed: false,
-                target: canonical,
-            },
+            entry,
             shown: path.to_path_buf(),
             what: what.to_string(),
             staged: false,
@@ -284,21 +308,47 @@ impl OutputTransaction {
                 Err(_) => false,
             };
         }
+        // Steps 1 to 5 of the order in the module documentation (`super`).
+        for o in &self.outputs {
+            let temp = o.entry.sibling(o.entry.temp_kind(), self.pid);
+            durable::sync_tree(&temp).map_err(|e| {
+                Error::output(
+                    &o.shown,
+                    format!("cannot flush {} to the disk: {}", temp.display(), one_line(e)),
+                )
+            })?;
+        }
         let entries: Vec<Entry> = self.outputs.iter().map(|o| o.entry.clone()).collect();
-        let journals = journal::write_all(&entries, self.pid)?;
-        let renamed = self.rename_all();
-        if renamed.is_err() {
-            // Restore before removing the journals: a kill in between is rolled back by the next run.
-            let _ = journal::roll_back(&entries, self.pid);
+        let writer = Writer {
+            pid: self.pid,
+            start: self.start,
+        };
+        let journals = journal::write_all(&entries, writer)?;
+        let renamed = self.rename_all().and_then(|()| journal::sync_dirs(&entries));
+        if let Err(e) = &renamed {
+            // Restored and flushed before the journals go; if that fails they
+            // stay, and the next run rolls back.
+            let restored = journal::roll_back(&entries, self.pid).is_ok() && journal::sync_dirs(&entries).is_ok();
+            if !restored {
+                log::warn!("{e}; the next run restores the previous outputs");
+                return renamed;
+            }
         }
         // The first journal is the commit point; the others follow it.
         for j in &journals {
-            let _ = std::fs::remove_file(j);
+            let _ = durable::remove_file(j);
         }
+        let flushed = journal::sync_dirs(&entries);
         renamed?;
         self.committed = true;
-        for o in &self.outputs {
-            let _ = remove_any(&o.entry.sibling(Sibling::Backup, self.pid));
+        match flushed {
+            Ok(()) => {
+                for o in &self.outputs {
+                    let _ = remove_any(&o.entry.sibling(Sibling::Backup, self.pid));
+                }
+            }
+            // A backup is needed if the journal's removal is lost; the next run removes it.
+            Err(e) => log::warn!("{e}; the previous outputs stay as hidden backups until the next run"),
         }
         Ok(())
     }
@@ -307,16 +357,37 @@ impl OutputTransaction {
         for o in &self.outputs {
             let (target, backup) = (&o.entry.target, o.entry.sibling(Sibling::Backup, self.pid));
             if o.entry.existed {
-                std::fs::rename(target, &backup)
+                durable::rename(target, &backup)
                     .map_err(|e| Error::output(&o.shown, format!("cannot move the old file aside: {}", one_line(e))))?;
             }
         }
         for o in &self.outputs {
             let temp = o.entry.sibling(o.entry.temp_kind(), self.pid);
-            std::fs::rename(&temp, &o.entry.target)
+            durable::rename(&temp, &o.entry.target)
                 .map_err(|e| Error::output(&o.shown, format!("cannot rename into place: {}", one_line(e))))?;
         }
         Ok(())
+    }
+}
+
+/// Checks that the temporary `temp` of the output `path` (the option
+/// `what`) can be created, by creating it and removing it again.
+fn probe(temp: &Path, path: &Path, what: &str) -> Result<()> {
+    let created = std::fs::OpenOptions::new().write(true).create_new(true).open(temp);
+    match created {
+        Ok(file) => {
+            drop(file);
+            let _ = std::fs::remove_file(temp);
+            Ok(())
+        }
+        Err(e) => Err(Error::output(
+            path,
+            format!(
+                "{what}: cannot create a file in {}: {}",
+                parent_dir(path).display(),
+                one_line(e)
+            ),
+        )),
     }
 }
 

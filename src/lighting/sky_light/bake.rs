@@ -203,9 +203,11 @@ fn run_chunks(
 impl SkyLightBake {
     /// The bake of `field` with `settings`: from `cache` (a directory) when it
     /// holds a valid file of the same key, else computed on the GPU and
-    /// written there. A corrupt, truncated or stale cache file is rebuilt;
-    /// an unreadable or unwritable one is an error naming the file.
-    /// `progress` gets the fraction done (0..=1).
+    /// written there. The cache is only an optimisation: a corrupt,
+    /// truncated or stale cache file is rebuilt, and one that cannot be read
+    /// or written (permissions, a full disk, a read-only file system) is a
+    /// warning naming the file and why (`log::warn`), and the bake goes on
+    /// without it. `progress` gets the fraction done (0..=1).
     pub fn bake(
         ctx: &Context,
         field: &HeightField,
@@ -221,13 +223,19 @@ impl SkyLightBake {
             return SkyLightBake::compute(ctx, field, settings, progress);
         };
         let path = cache::cache_path(dir, &key);
-        if let Some(data) = cache::load(&path, &key)? {
-            let bake = SkyLightBake::upload(ctx, field, settings, &data)?;
-            progress(1.0);
-            return Ok(bake);
+        match cache::load(&path, &key) {
+            Ok(Some(data)) => {
+                let bake = SkyLightBake::upload(ctx, field, settings, &data)?;
+                progress(1.0);
+                return Ok(bake);
+            }
+            Ok(None) => {}
+            Err(e) => log::warn!("sky-light cache not read, baking anew: {e}"),
         }
         let bake = SkyLightBake::compute(ctx, field, settings, progress)?;
-        cache::store(&path, &bake.read_back(ctx)?)?;
+        if let Err(e) = cache::store(&path, &bake.read_back(ctx)?) {
+            log::warn!("sky-light cache not written, rendering without it: {e}");
+        }
         Ok(bake)
     }
 

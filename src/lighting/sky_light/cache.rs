@@ -9,10 +9,12 @@
 //!
 //! A file that is truncated, corrupt (checksum), of another format version
 //! or of another key is rebuilt; one that cannot be read (permissions, a
-//! directory of that name) or written is an error naming it. Never wrong
-//! lighting: the key and the checksum are checked before any use.
+//! directory of that name) or written is an error naming it, which the
+//! bake ([`super::SkyLightBake::bake`]) turns into a warning: the cache is
+//! optional. Never wrong lighting: the key and the checksum are checked
+//! before any use.
 
-use std::io::{BufWriter, Write};
+use std::io::{BufWriter, ErrorKind, Write};
 use std::path::{Path, PathBuf};
 
 use super::bake::BakeSettings;
@@ -209,8 +211,11 @@ fn parse(bytes: &[u8], key: &BakeKey) -> std::result::Result<BakeData, String> {
 /// be read.
 pub fn load(path: &Path, key: &BakeKey) -> Result<Option<BakeData>> {
     // Checked before opening: a FIFO would block, a device never end.
+    // No file there (also when a folder on the way is a file: storing
+    // will say so).
+    let absent = |e: &std::io::Error| matches!(e.kind(), ErrorKind::NotFound | ErrorKind::NotADirectory);
     match std::fs::metadata(path) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) if absent(&e) => return Ok(None),
         Ok(meta) if !meta.is_file() => return Err(Error::input(path, "the sky-light cache is not a regular file")),
         Ok(meta) if meta.len() > MAX_CACHE_BYTES => {
             log::warn!(
@@ -224,7 +229,7 @@ pub fn load(path: &Path, key: &BakeKey) -> Result<Option<BakeData>> {
     }
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) if absent(&e) => return Ok(None),
         Err(e) => {
             return Err(Error::input(
                 path,
