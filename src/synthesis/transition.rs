@@ -86,6 +86,38 @@ impl Band {
     }
 }
 
+/// The band between two `columns`×`rows` fields of `spacing` (module
+/// docs), checked against their size; nothing is allocated, so callers can
+/// estimate the growth's cost ([`crate::synthesis::cost`]) first.
+pub fn band_of(columns: u32, rows: u32, spacing: glam::DVec2, params: &TransitionParams) -> Result<Band> {
+    let (length, spacing) = match params.axis {
+        Axis::X => (columns, spacing.x),
+        Axis::Y => (rows, spacing.y),
+    };
+    let w = params.band_metres;
+    let samples = (w / spacing).round();
+    if !(w.is_finite() && w > 0.0 && samples >= 1.0) {
+        return Err(Error::invalid(
+            "--band",
+            format!("{w} m: the band must be at least one sample ({spacing} m) wide"),
+        ));
+    }
+    if samples > f64::from(length) - 2.0 {
+        return Err(Error::invalid(
+            "--band",
+            format!(
+                "{w} m is {samples} samples, but the fields are {length} samples across (at most {} for the band)",
+                length.saturating_sub(2)
+            ),
+        ));
+    }
+    Ok(Band {
+        axis: params.axis,
+        start: (length - samples as u32) / 2,
+        width: samples as u32,
+    })
+}
+
 /// The composed field (A, an empty band, B), its unknown mask and the band.
 pub fn compose(a: &HeightField, b: &HeightField, params: &TransitionParams) -> Result<(HeightField, Vec<bool>, Band)> {
     if (a.columns, a.rows) != (b.columns, b.rows) {
@@ -106,32 +138,7 @@ pub fn compose(a: &HeightField, b: &HeightField, params: &TransitionParams) -> R
             ),
         ));
     }
-    let (length, spacing) = match params.axis {
-        Axis::X => (a.columns, a.spacing.x),
-        Axis::Y => (a.rows, a.spacing.y),
-    };
-    let w = params.band_metres;
-    let samples = (w / spacing).round();
-    if !(w.is_finite() && w > 0.0 && samples >= 1.0) {
-        return Err(Error::invalid(
-            "--band",
-            format!("{w} m: the band must be at least one sample ({spacing} m) wide"),
-        ));
-    }
-    if samples > f64::from(length) - 2.0 {
-        return Err(Error::invalid(
-            "--band",
-            format!(
-                "{w} m is {samples} samples, but the fields are {length} samples across (at most {} for the band)",
-                length.saturating_sub(2)
-            ),
-        ));
-    }
-    let band = Band {
-        axis: params.axis,
-        start: (length - samples as u32) / 2,
-        width: samples as u32,
-    };
+    let band = band_of(a.columns, a.rows, a.spacing, params)?;
     let mut unknown = Vec::with_capacity(a.heights.len());
     let mut composed = a.clone();
     for r in 0..a.rows {

@@ -347,6 +347,16 @@ impl SequentialPointTree {
     }
 }
 
+/// Peak host bytes per surfel of [`build_spt`] (besides the surfels
+/// themselves), counted from its allocations: the f64 positions and normals
+/// (48), the octree's index lists (4, twice while a cell is split), up to
+/// two build nodes and two tree nodes per surfel (2n − 1 nodes at most),
+/// the tree nodes twice while they are sorted, and the sort's order and
+/// renumbering (8 + 4 per node). `crate::points::build::plan` estimates
+/// `spt build`'s memory with it.
+pub const BUILD_BYTES_PER_SURFEL: u64 =
+    (48 + 8 + 2 * std::mem::size_of::<Work>() + 2 * 2 * std::mem::size_of::<SptNode>() + 2 * 12) as u64;
+
 /// A node during the build, in f64 (sums of many positions and squared
 /// distances stay exact enough and cannot overflow).
 #[derive(Clone, Debug)]
