@@ -234,7 +234,11 @@ mod tests {
         };
         assert!(limits.check("--rocks", "10 boulders", Footprint::host(1000)).is_ok());
         let e = limits
-            .check("--rocks", "100000000 boulders", Footprint::per_item(100_000_000, 128, 0))
+            .check(
+                "--rocks",
+                "100000000 boulders",
+                Footprint::per_item(100_000_000, 128, 0),
+            )
             .unwrap_err()
             .to_string();
         assert_eq!(
@@ -262,9 +266,15 @@ mod tests {
     #[test]
     fn check_duration_names_options_estimate_and_limit() {
         assert!(check_duration("--window", "x", 3600.0, 7200.0, "--max-hours").is_ok());
-        let e = check_duration("--window 63, --candidates 1000000", "growing 400 samples", 9000.0, 7200.0, "--max-hours")
-            .unwrap_err()
-            .to_string();
+        let e = check_duration(
+            "--window 63, --candidates 1000000",
+            "growing 400 samples",
+            9000.0,
+            7200.0,
+            "--max-hours",
+        )
+        .unwrap_err()
+        .to_string();
         assert_eq!(
             e,
             "invalid --window 63, --candidates 1000000: growing 400 samples takes about 2.5 h; \

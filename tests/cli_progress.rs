@@ -64,20 +64,39 @@ fn absurd_synthesis_is_refused_at_once() {
         &dem,
         &mask,
         &out,
-        &["--window", "63", "--candidates", "1000000", "--search", "cpu", "--max-hours", "0.1"],
+        &[
+            "--window",
+            "63",
+            "--candidates",
+            "1000000",
+            "--search",
+            "cpu",
+            "--max-hours",
+            "0.1",
+        ],
     );
     let (result, seconds) = run_timed(&args, &[]);
     assert_one_line_error(
         "synth fill --window 63 --candidates 1000000",
         &result,
-        &["--window 63, --candidates 1000000", "growing 10000 samples", "takes about", "the limit is 6.0 min", "--max-hours"],
+        &[
+            "--window 63, --candidates 1000000",
+            "growing 10000 samples",
+            "takes about",
+            "the limit is 6.0 min",
+            "--max-hours",
+        ],
     );
     assert!(seconds < 1.0, "refused after {seconds:.2} s");
     // The GPU search (default) is refused too, at the latest once the
     // device is known (lavapipe: a CPU).
     let args = fill_args(&dem, &mask, &out, &["--window", "63", "--candidates", "1000000"]);
     let (result, seconds) = run_timed(&args, &[]);
-    assert_one_line_error("synth fill (GPU search)", &result, &["--window 63, --candidates 1000000", "--max-hours"]);
+    assert_one_line_error(
+        "synth fill (GPU search)",
+        &result,
+        &["--window 63, --candidates 1000000", "--max-hours"],
+    );
     assert!(seconds < 10.0, "refused after {seconds:.2} s");
     // Memory: the field itself, named as the user gave it.
     let args = fill_args(&dem, &mask, &out, &["--search", "cpu"]);
@@ -85,7 +104,10 @@ fn absurd_synthesis_is_refused_at_once() {
     assert_one_line_error(
         "synth fill with 16 MiB",
         &result,
-        &[&format!("invalid --input {dem}: 1025×1025 samples"), "of host memory; 16.0 MiB is available"],
+        &[
+            &format!("invalid --input {dem}: 1025×1025 samples"),
+            "of host memory; 16.0 MiB is available",
+        ],
     );
     assert!(seconds < 1.0, "refused after {seconds:.2} s");
     // A blur of a hundred million samples, named by its option.
@@ -104,7 +126,11 @@ fn absurd_synthesis_is_refused_at_once() {
         &out,
     ];
     let (result, seconds) = run_timed(&args, &[]);
-    assert_one_line_error("synth transition --blur 100000000", &result, &["invalid --blur 100000000", "--max-hours"]);
+    assert_one_line_error(
+        "synth transition --blur 100000000",
+        &result,
+        &["invalid --blur 100000000", "--max-hours"],
+    );
     assert!(seconds < 1.0, "refused after {seconds:.2} s");
     std::fs::remove_file(&dem).unwrap();
     std::fs::remove_file(&mask).unwrap();
@@ -132,7 +158,11 @@ fn spt_build_names_the_file_before_sampling() {
     let dir = fresh_dir("progress-spt");
     let out = dir.join("out.spt").display().to_string();
     let flat = dir.join("flat.obj");
-    write_obj(&flat, &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]], &[[0, 1, 2]]);
+    write_obj(
+        &flat,
+        &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]],
+        &[[0, 1, 2]],
+    );
     let huge = dir.join("huge.obj");
     write_obj(
         &huge,
@@ -140,8 +170,9 @@ fn spt_build_names_the_file_before_sampling() {
         &[[0, 1, 2]],
     );
     let same = dir.join("same.ply");
-    let mut ply = "ply\nformat ascii 1.0\nelement vertex 40\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
-        .to_string();
+    let mut ply =
+        "ply\nformat ascii 1.0\nelement vertex 40\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+            .to_string();
     ply += &"1 2 3\n".repeat(40);
     std::fs::write(&same, ply).unwrap();
     let bunny = common::data("models/stanford-bunny.obj");
@@ -162,7 +193,10 @@ fn spt_build_names_the_file_before_sampling() {
         (vec![&bunny, "--samples", "0"], vec!["invalid --samples: 0"]),
         (
             vec![&bunny, "--samples", "100000000"],
-            vec!["invalid --samples 100000000: 100000000 surfels need about", "1.0 GiB is available"],
+            vec![
+                "invalid --samples 100000000: 100000000 surfels need about",
+                "1.0 GiB is available",
+            ],
         ),
         (
             vec![&bunny, "--samples", "5000000", "--max-hours", "0.001"],
@@ -196,7 +230,12 @@ fn progress_shows_on_a_terminal_only() {
     let (dem, mask) = dem_with_hole(&dir, 96, 16);
     let (dem, mask) = (dem.display().to_string(), mask.display().to_string());
     let out = dir.join("out.png").display().to_string();
-    let args = fill_args(&dem, &mask, &out, &["--search", "cpu", "--candidates", "2048", "--batch", "8"]);
+    let args = fill_args(
+        &dem,
+        &mask,
+        &out,
+        &["--search", "cpu", "--candidates", "2048", "--batch", "8"],
+    );
     let piped = run(&args);
     assert_success("synth fill through a pipe", &piped);
     assert_eq!(text(&piped.stderr), "", "no progress on a pipe");
@@ -213,5 +252,35 @@ fn progress_shows_on_a_terminal_only() {
     assert_success("synth fill on a terminal", &terminal);
     let shown = text(&terminal.stdout);
     assert!(shown.contains("samples grown"), "no progress on a terminal: {shown:?}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Ctrl-C (SIGINT) ends a long growth at once and leaves no output: the
+/// output is written only when complete.
+#[test]
+fn an_interrupted_growth_leaves_nothing() {
+    use std::os::unix::process::ExitStatusExt;
+    let dir = fresh_dir("progress-interrupt");
+    let (dem, mask) = dem_with_hole(&dir, 513, 160);
+    let (dem, mask) = (dem.display().to_string(), mask.display().to_string());
+    let out = dir.join("out.png").display().to_string();
+    let mut child = Command::new(bin())
+        .args(fill_args(&dem, &mask, &out, &["--search", "cpu"]))
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let sent = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let started = Instant::now();
+    let status = child.wait().unwrap();
+    assert!(started.elapsed().as_secs_f64() < 2.0, "the run ended at once");
+    assert_eq!(status.signal(), Some(2), "ended by SIGINT: {status:?}");
+    std::fs::remove_file(&dem).unwrap();
+    std::fs::remove_file(&mask).unwrap();
+    assert_no_files_left("interrupted fill", &dir);
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -28,13 +28,19 @@ use super::progress;
 /// checked in the words of its flag.
 fn spt_options(args: &SptBuildArgs) -> alpenglow::Result<SptOptions> {
     if !(args.epsilon.is_finite() && args.epsilon > 0.0) {
-        return Err(Error::invalid("--epsilon", format!("{} px is not a positive number", args.epsilon)));
+        return Err(Error::invalid(
+            "--epsilon",
+            format!("{} px is not a positive number", args.epsilon),
+        ));
     }
     if !(args.fov_y.is_finite() && args.fov_y > 0.0 && args.fov_y < 180.0) {
         return Err(Error::invalid("--fov-y", format!("{}° is not in (0, 180)", args.fov_y)));
     }
     if args.rows == 0 {
-        return Err(Error::invalid("--rows", "0: the threshold needs at least one image row"));
+        return Err(Error::invalid(
+            "--rows",
+            "0: the threshold needs at least one image row",
+        ));
     }
     let epsilon = epsilon_from_pixels(args.epsilon, args.fov_y.to_radians(), args.rows)
         .ok()

@@ -6,9 +6,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{bail, Result};
-use clap::{Args, Subcommand, ValueEnum};
-use glam::DVec2;
 use alpenglow::budget::MemoryLimits;
 use alpenglow::io::heightmap::{load_heightmap, load_heightmap_with_voids, HeightField, HeightmapOptions, RowOrder};
 use alpenglow::io::image_out::{encode_exr_height, encode_png_gray16};
@@ -18,6 +15,9 @@ use alpenglow::synthesis::gpu::GpuSearch;
 use alpenglow::synthesis::search::CpuSearch;
 use alpenglow::synthesis::transition::{band_of, plan_transition, Axis, TransitionParams};
 use alpenglow::vulkan::Context;
+use anyhow::{bail, Result};
+use clap::{Args, Subcommand, ValueEnum};
+use glam::DVec2;
 
 use crate::cli::args::{parse_hours, parse_spacing, RowsArg};
 use crate::cli::outputs::Outputs;

@@ -170,12 +170,7 @@ impl GrowthCost {
         };
         GrowthCost {
             blur: Some(params.blur_radius),
-            ..GrowthCost::fill(
-                columns,
-                rows,
-                u64::from(band.width) * u64::from(across),
-                &params.grow,
-            )
+            ..GrowthCost::fill(columns, rows, u64::from(band.width) * u64::from(across), &params.grow)
         }
     }
 
@@ -285,9 +280,11 @@ impl GrowthCost {
     fn search_footprint(&self, device: SearchDevice) -> Footprint {
         let candidates = self.candidates();
         match device {
-            SearchDevice::Cpu { threads } => {
-                Footprint::host(candidates.saturating_mul(4).saturating_mul(self.cpu_threads(threads) as u64))
-            }
+            SearchDevice::Cpu { threads } => Footprint::host(
+                candidates
+                    .saturating_mul(4)
+                    .saturating_mul(self.cpu_threads(threads) as u64),
+            ),
             SearchDevice::CpuDevice { .. } | SearchDevice::Gpu => {
                 let limits = GpuSearchLimits::default();
                 let taps = u64::from(self.window) * u64::from(self.window) * TAP_BYTES;
@@ -300,10 +297,7 @@ impl GrowthCost {
                     .saturating_add(candidates.saturating_mul(4))
                     .saturating_add(batch.saturating_mul(row))
                     .saturating_add(2 * batch.saturating_mul(taps));
-                Footprint {
-                    host: exemplar,
-                    device,
-                }
+                Footprint { host: exemplar, device }
             }
         }
     }

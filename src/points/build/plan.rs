@@ -17,15 +17,21 @@
 //! # Cost ([`BuildCost`])
 //!
 //! Time: per triangle ([`SECONDS_PER_TRIANGLE`]: areas, creases), per
-//! output sample of blue noise ([`BLUE_NOISE_SECONDS_PER_SAMPLE`], 35,000
-//! samples of the bunny in 0.6 s) or stratified sampling
-//! ([`STRATIFIED_SECONDS_PER_SAMPLE`]), per point whose normal or radius
-//! is estimated ([`COMPLETION_SECONDS_PER_POINT`]) and per surfel of the
-//! tree build ([`BUILD_SECONDS_PER_SURFEL`]); rates of release builds on the
-//! 2-core build VM. Memory: the larger of the sampling's
-//! ([`super::sampling::bytes_per_sample`]) and the build's
-//! ([`super::spt::BUILD_BYTES_PER_SURFEL`] plus the surfels) peaks, both
-//! counted from the allocations, plus the written file.
+//! output sample of blue noise ([`BLUE_NOISE_SECONDS_PER_SAMPLE`]) or
+//! stratified sampling ([`STRATIFIED_SECONDS_PER_SAMPLE`]), per point whose
+//! normal or radius is estimated ([`COMPLETION_SECONDS_PER_POINT`]) and per
+//! surfel of the tree build ([`BUILD_SECONDS_PER_SURFEL`]). Release builds
+//! on the 2-core build VM: 35,000 blue-noise samples of the bunny in 0.6 s
+//! unloaded (17 µs a sample, [`super::sampling`]); whole `spt build` runs
+//! of the bunny at load 6–8 (other builds sharing both cores) took 78 µs a
+//! blue-noise sample (100,000 and 300,000 samples: 7.8 s and 23.1 s) and
+//! 7.3 µs a stratified one (1,000,000: 7.3 s, nearly all of it the tree
+//! build). The rates lie between the unloaded and the loaded figures.
+//! Memory: the largest of the sampling's
+//! ([`super::sampling::bytes_per_sample`]), the build's
+//! ([`super::spt::BUILD_BYTES_PER_SURFEL`] plus the surfels) and the
+//! writing's (the tree and its bytes) peaks, counted from the allocations;
+//! the same runs peaked at 565 bytes a sample of resident memory.
 
 use std::path::Path;
 
@@ -41,19 +47,19 @@ use crate::points::{PointCloud, Surfel, TriangleMesh};
 /// Seconds per mesh triangle (areas, cumulative areas, creases).
 pub const SECONDS_PER_TRIANGLE: f64 = 1.0e-6;
 /// Seconds per output sample of blue-noise sampling (module docs).
-pub const BLUE_NOISE_SECONDS_PER_SAMPLE: f64 = 2.0e-5;
+pub const BLUE_NOISE_SECONDS_PER_SAMPLE: f64 = 3.0e-5;
 /// Seconds per output sample of stratified sampling (1 ms for 35,000).
 pub const STRATIFIED_SECONDS_PER_SAMPLE: f64 = 1.0e-7;
 /// Seconds per point whose normal (PCA of 8 neighbours) or radius (6th
 /// neighbour) is estimated.
 pub const COMPLETION_SECONDS_PER_POINT: f64 = 4.0e-6;
 /// Seconds per surfel of the tree build (octree, errors, sort).
-pub const BUILD_SECONDS_PER_SURFEL: f64 = 2.0e-6;
+pub const BUILD_SECONDS_PER_SURFEL: f64 = 4.0e-6;
 /// Host bytes per point of completing a cloud: its kd-tree (40), neighbour
 /// lists (8 × 4), normals and radii (16).
 const COMPLETION_BYTES_PER_POINT: u64 = 40 + 32 + 16;
-/// Bytes per node of the written file (an upper bound of its record).
-const FILE_BYTES_PER_NODE: u64 = 96;
+/// Bytes per node of the written file (76 measured, with the header).
+const FILE_BYTES_PER_NODE: u64 = 80;
 
 /// What a build of a checked input costs (module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -90,8 +96,10 @@ impl BuildCost {
             None => self.completed.saturating_mul(COMPLETION_BYTES_PER_POINT),
         };
         let build = n.saturating_mul(surfel + BUILD_BYTES_PER_SURFEL);
-        let file = n.saturating_mul(2 * FILE_BYTES_PER_NODE);
-        Footprint::host(first.max(build).saturating_add(file))
+        // Writing: the surfels, the tree (1.6 nodes a surfel) and its bytes.
+        let node = std::mem::size_of::<crate::points::build::spt::SptNode>() as u64;
+        let write = n.saturating_mul(surfel + 8 * (node + FILE_BYTES_PER_NODE) / 5);
+        Footprint::host(first.max(build).max(write))
     }
 
     /// One line for the log.
@@ -116,7 +124,10 @@ impl BuildCost {
         let what = format!("{} surfels", self.surfels);
         limits.check(option, &what, self.footprint())?;
         let what = match self.method {
-            Some(SamplingMethod::BlueNoise) => format!("sampling {} surfels by blue noise and building their tree", self.surfels),
+            Some(SamplingMethod::BlueNoise) => format!(
+                "sampling {} surfels by blue noise and building their tree",
+                self.surfels
+            ),
             Some(SamplingMethod::Stratified) => format!("sampling {} surfels and building their tree", self.surfels),
             None => format!("building the tree of {} points", self.surfels),
         };
@@ -127,7 +138,12 @@ impl BuildCost {
 /// Checks `input`, read from `path`, for a build with `sampling` and
 /// `options` (module docs) and returns its cost. Errors name `path`, or
 /// `--samples` or `--epsilon` and `path` where the option is at fault.
-pub fn plan_build(path: &Path, input: &PointInput, sampling: &SamplingOptions, options: &SptOptions) -> Result<BuildCost> {
+pub fn plan_build(
+    path: &Path,
+    input: &PointInput,
+    sampling: &SamplingOptions,
+    options: &SptOptions,
+) -> Result<BuildCost> {
     let bad = |message: String| Error::input(path, message);
     let (cost, lo, hi, radius) = match input {
         PointInput::Mesh(mesh) => {
@@ -246,14 +262,15 @@ fn check_cloud(cloud: &PointCloud) -> std::result::Result<(DVec3, DVec3, f64, u6
         lo = lo.min(p.as_dvec3());
         hi = hi.max(p.as_dvec3());
     }
-    let needs_normals = cloud
-        .normals
-        .as_ref()
-        .map_or(true, |normals| normals.iter().any(|v| v.normalize_or_zero() == Vec3::ZERO));
+    let needs_normals = cloud.normals.as_ref().map_or(true, |normals| {
+        normals.iter().any(|v| v.normalize_or_zero() == Vec3::ZERO)
+    });
     let valid = |r: &f32| r.is_finite() && *r > 0.0;
     let needs_radii = cloud.radii.as_ref().map_or(true, |radii| !radii.iter().all(valid));
     if needs_normals && n < 3 {
-        return Err(format!("{n} point(s) without normals: estimating them needs at least 3"));
+        return Err(format!(
+            "{n} point(s) without normals: estimating them needs at least 3"
+        ));
     }
     if needs_radii && n < 2 {
         return Err("1 point without a radius: estimating it needs at least 2".into());
