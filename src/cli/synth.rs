@@ -13,7 +13,7 @@ use alpenglow::synthesis::cost::{GrowthCost, SearchDevice};
 use alpenglow::synthesis::fill::{check_hole_fill, plan_hole_fill, FillParams, Growth};
 use alpenglow::synthesis::gpu::GpuSearch;
 use alpenglow::synthesis::search::CpuSearch;
-use alpenglow::synthesis::transition::{band_of, plan_transition, Axis, TransitionParams};
+use alpenglow::synthesis::transition::{band_of, check_fields, plan_transition, Axis, TransitionParams};
 use alpenglow::vulkan::Context;
 use anyhow::{bail, Result};
 use clap::{Args, Subcommand, ValueEnum};
@@ -281,12 +281,12 @@ fn transition(args: TransitionArgs) -> Result<ExitCode> {
         },
         blur_radius: args.blur,
     };
-    // Everything the cost depends on is known from A: B must match it.
+    let b = load_field(&args.b, &args.heights)?;
+    check_fields(&a, &b)?;
     params.grow.validate(a.columns, a.rows)?;
     let band = band_of(a.columns, a.rows, a.spacing, &params)?;
     let cost = GrowthCost::transition(a.columns, a.rows, &band, &params);
     let search = prepare_search(&cost, &args.grow, &format!("{} and {}", args.a, args.b))?;
-    let b = load_field(&args.b, &args.heights)?;
     let (growth, transition) = progress::phase("planning the transition", || plan_transition(&a, &b, &params))?;
     drop(b);
     let started = Instant::now();

@@ -118,8 +118,8 @@ pub fn band_of(columns: u32, rows: u32, spacing: glam::DVec2, params: &Transitio
     })
 }
 
-/// The composed field (A, an empty band, B), its unknown mask and the band.
-pub fn compose(a: &HeightField, b: &HeightField, params: &TransitionParams) -> Result<(HeightField, Vec<bool>, Band)> {
+/// Checks that `a` and `b` can be joined: the same size and spacing.
+pub fn check_fields(a: &HeightField, b: &HeightField) -> Result<()> {
     if (a.columns, a.rows) != (b.columns, b.rows) {
         return Err(Error::invalid(
             "B",
@@ -138,6 +138,12 @@ pub fn compose(a: &HeightField, b: &HeightField, params: &TransitionParams) -> R
             ),
         ));
     }
+    Ok(())
+}
+
+/// The composed field (A, an empty band, B), its unknown mask and the band.
+pub fn compose(a: &HeightField, b: &HeightField, params: &TransitionParams) -> Result<(HeightField, Vec<bool>, Band)> {
+    check_fields(a, b)?;
     let band = band_of(a.columns, a.rows, a.spacing, params)?;
     let mut unknown = Vec::with_capacity(a.heights.len());
     let mut composed = a.clone();
