@@ -31,7 +31,8 @@
 //! ([`super::sampling::bytes_per_sample`]), the build's
 //! ([`super::spt::BUILD_BYTES_PER_SURFEL`] plus the surfels) and the
 //! writing's (the tree and its bytes) peaks, counted from the allocations;
-//! the same runs peaked at 565 bytes a sample of resident memory.
+//! the same runs peaked at 565 bytes a sample of resident memory (300,000
+//! blue-noise samples: 185 MiB estimated, 176 MiB measured).
 
 use std::path::Path;
 
