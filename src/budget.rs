@@ -12,6 +12,11 @@
 //! invalid --rocks: 100000000 boulders need about 12.0 GiB of host memory; 9.7 GiB is available
 //! ```
 //!
+//! Time has a ceiling of its own: long CPU work (synthesis, SPT builds)
+//! estimates its seconds from operation counts at measured rates and
+//! [`check_duration`] refuses an estimate above the command's
+//! `--max-hours` (default [`DEFAULT_MAX_HOURS`]) the same way.
+//!
 //! Host memory is what `/proc/meminfo` calls `MemAvailable` (or
 //! `ALPENGLOW_HOST_MEMORY_MB` when set, for tests and for sharing a machine);
 //! device memory comes from the device's heaps
@@ -149,6 +154,58 @@ pub fn format_bytes(bytes: u64) -> String {
     format!("{value:.1} {}", UNITS[unit])
 }
 
+/// The longest a run may be estimated to take unless its command's
+/// `--max-hours` says otherwise (synthesis, SPT builds): 1 hour. An
+/// estimate beyond it is almost always a typing error (a window or a count
+/// ten times too large) or work that wants a GPU, not a run anyone waits
+/// for at a terminal; a run that really is meant to take longer says so
+/// with the option.
+pub const DEFAULT_MAX_HOURS: f64 = 1.0;
+
+/// Checks an estimated duration against a ceiling: a one-line
+/// [`Error::InvalidArgument`] naming `option` (the options that drive the
+/// cost, e.g. `--window 63, --candidates 1000000`), `what` (the work and the
+/// rate it was estimated at), the estimate and the limit, and
+/// `limit_option` (the option that raises the limit) when `seconds`
+/// exceeds `limit_seconds`. A NaN estimate counts as too long.
+pub fn check_duration(option: &str, what: &str, seconds: f64, limit_seconds: f64, limit_option: &str) -> Result<()> {
+    if seconds <= limit_seconds {
+        return Ok(());
+    }
+    Err(Error::invalid(
+        option,
+        format!(
+            "{what} takes about {}; the limit is {} ({limit_option} raises it)",
+            format_duration(seconds),
+            format_duration(limit_seconds)
+        ),
+    ))
+}
+
+/// `seconds` for people: "0.4 s", "12 s", "3.5 min", "2.1 h", "4.0 days",
+/// "3.2e6 years".
+pub fn format_duration(seconds: f64) -> String {
+    const YEAR: f64 = 365.25 * 86400.0;
+    if !seconds.is_finite() {
+        return "forever".to_string();
+    }
+    if seconds < 10.0 {
+        format!("{seconds:.1} s")
+    } else if seconds < 120.0 {
+        format!("{seconds:.0} s")
+    } else if seconds < 7200.0 {
+        format!("{:.1} min", seconds / 60.0)
+    } else if seconds < 2.0 * 86400.0 {
+        format!("{:.1} h", seconds / 3600.0)
+    } else if seconds < YEAR {
+        format!("{:.1} days", seconds / 86400.0)
+    } else if seconds < 1e4 * YEAR {
+        format!("{:.0} years", seconds / YEAR)
+    } else {
+        format!("{:.1e} years", seconds / YEAR)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -193,5 +250,36 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("3.0 GiB of GPU memory; the device has 2.0 GiB"), "{e}");
+    }
+
+    #[test]
+    fn durations_read_as_people_write_them() {
+        assert_eq!(format_duration(0.42), "0.4 s");
+        assert_eq!(format_duration(75.0), "75 s");
+        assert_eq!(format_duration(210.0), "3.5 min");
+        assert_eq!(format_duration(7560.0), "2.1 h");
+        assert_eq!(format_duration(4.0 * 86400.0), "4.0 days");
+        assert_eq!(format_duration(1e15), "3.2e7 years");
+        assert_eq!(format_duration(f64::INFINITY), "forever");
+    }
+
+    #[test]
+    fn check_duration_names_options_estimate_and_limit() {
+        assert!(check_duration("--window", "x", 3600.0, 7200.0, "--max-hours").is_ok());
+        let e = check_duration(
+            "--window 63, --candidates 1000000",
+            "growing 400 samples",
+            9000.0,
+            7200.0,
+            "--max-hours",
+        )
+        .unwrap_err()
+        .to_string();
+        assert_eq!(
+            e,
+            "invalid --window 63, --candidates 1000000: growing 400 samples takes about 2.5 h; \
+             the limit is 2.0 h (--max-hours raises it)"
+        );
+        assert!(check_duration("--x", "y", f64::NAN, 1.0, "--max-hours").is_err());
     }
 }

@@ -70,7 +70,8 @@ fn bad_inputs_are_one_line_errors_without_output() {
         "--epsilon".as_ref(),
         "0".as_ref(),
     ]);
-    assert_one_line_error("--epsilon 0", &r, &["pixel threshold"]);
+    // The flag the user wrote, before the teapot is even read.
+    assert_one_line_error("--epsilon 0", &r, &["invalid --epsilon: 0 px"]);
     assert_no_files_left("--epsilon 0", &dir);
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -516,6 +516,18 @@ pub struct SptBuildArgs {
     /// Image rows the pixel threshold refers to.
     #[arg(long, default_value_t = 1080, value_name = "PIXELS", value_parser = clap::value_parser!(u32).range(0..))]
     pub rows: u32,
+    /// Longest estimated build accepted, in hours: a build estimated to
+    /// take longer is refused before it samples (README, "Command line").
+    #[arg(long = "max-hours", default_value_t = alpenglow::budget::DEFAULT_MAX_HOURS, value_name = "HOURS", value_parser = parse_hours)]
+    pub max_hours: f64,
+}
+
+/// `--max-hours`: a positive, finite number of hours.
+pub(super) fn parse_hours(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(h) if h.is_finite() && h > 0.0 => Ok(h),
+        _ => Err(format!("'{s}' is not a positive number of hours")),
+    }
 }
 
 fn parse_numbers(s: &str, what: &str) -> Result<Vec<f64>, String> {

@@ -9,6 +9,7 @@ mod lighting;
 mod orbit;
 mod outputs;
 mod points;
+mod progress;
 mod rig;
 mod spt;
 mod synth;

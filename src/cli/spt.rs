@@ -1,51 +1,118 @@
 //! `alpenglow spt build IN OUT`: a PLY or OBJ file → surfels (meshes sampled
 //! evenly, point clouds completed with PCA normals and neighbour radii) →
 //! sequential point tree (§10.1) → versioned SPT file, with a progress bar.
+//!
+//! Every option and the input are checked, and the build's time and memory
+//! estimated ([`alpenglow::points::build::plan`]), before anything is
+//! sampled: a bad option or file is a one-line error within milliseconds.
 
+use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Result;
-use indicatif::{ProgressBar, ProgressStyle};
 
+use alpenglow::budget::MemoryLimits;
+use alpenglow::error::Error;
 use alpenglow::points::build::estimate::complete_cloud;
 use alpenglow::points::build::input::{load_points_file, PointInput};
-use alpenglow::points::build::sampling::{sample_mesh, SamplingMethod, SamplingOptions};
+use alpenglow::points::build::plan::plan_build;
+use alpenglow::points::build::sampling::{sample_mesh_reporting, SamplingMethod, SamplingOptions};
 use alpenglow::points::build::spt::{build_spt, epsilon_from_pixels, SptOptions};
 use alpenglow::points::build::spt_file::write_spt;
 
 use super::args::{SamplingArg, SptBuildArgs};
+use super::progress;
+
+/// The tree's options from `--epsilon`, `--fov-y` and `--rows`, each
+/// checked in the words of its flag.
+fn spt_options(args: &SptBuildArgs) -> alpenglow::Result<SptOptions> {
+    if !(args.epsilon.is_finite() && args.epsilon > 0.0) {
+        return Err(Error::invalid(
+            "--epsilon",
+            format!("{} px is not a positive number", args.epsilon),
+        ));
+    }
+    if !(args.fov_y.is_finite() && args.fov_y > 0.0 && args.fov_y < 180.0) {
+        return Err(Error::invalid("--fov-y", format!("{}° is not in (0, 180)", args.fov_y)));
+    }
+    if args.rows == 0 {
+        return Err(Error::invalid(
+            "--rows",
+            "0: the threshold needs at least one image row",
+        ));
+    }
+    let epsilon = epsilon_from_pixels(args.epsilon, args.fov_y.to_radians(), args.rows)
+        .ok()
+        .filter(|e| e.is_finite() && *e > 0.0)
+        .ok_or_else(|| {
+            Error::invalid(
+                "--epsilon",
+                format!(
+                    "{} px at --fov-y {} over --rows {} is not a representable angle",
+                    args.epsilon, args.fov_y, args.rows
+                ),
+            )
+        })?;
+    Ok(SptOptions {
+        epsilon,
+        ..SptOptions::default()
+    })
+}
+
+/// A library error of sampling or building in the words of the file it
+/// came from: content errors name `path` (the checks of
+/// [`plan_build`] report them first; this keeps any that slip through
+/// naming the file too).
+fn in_file(path: &Path, e: Error) -> Error {
+    match e {
+        Error::InvalidArgument { parameter, message } if !parameter.starts_with("--") => {
+            Error::input(path, format!("{parameter}: {message}"))
+        }
+        other => other,
+    }
+}
 
 pub fn build(args: SptBuildArgs) -> Result<ExitCode> {
     let started = Instant::now();
-    let surfels = match load_points_file(&args.input)? {
-        PointInput::Mesh(mesh) => sample_mesh(
-            &mesh,
-            &SamplingOptions {
-                count: args.samples,
-                method: match args.sampling {
-                    SamplingArg::Stratified => SamplingMethod::Stratified,
-                    SamplingArg::BlueNoise => SamplingMethod::BlueNoise,
-                },
-                seed: args.seed,
-            },
-        )?,
-        PointInput::Points(cloud) => complete_cloud(&cloud)?,
+    let options = spt_options(&args)?;
+    let sampling = SamplingOptions {
+        count: args.samples,
+        method: match args.sampling {
+            SamplingArg::Stratified => SamplingMethod::Stratified,
+            SamplingArg::BlueNoise => SamplingMethod::BlueNoise,
+        },
+        seed: args.seed,
     };
-    let options = SptOptions {
-        epsilon: epsilon_from_pixels(args.epsilon, args.fov_y.to_radians(), args.rows)?,
-        ..SptOptions::default()
+    let input = progress::phase("reading", || load_points_file(&args.input))?;
+    let cost = plan_build(&args.input, &input, &sampling, &options)?;
+    log::info!("spt build estimate: {}", cost.summary());
+    let option = match input {
+        PointInput::Mesh(_) => format!("--samples {}", args.samples),
+        PointInput::Points(_) => args.input.display().to_string(),
     };
-    let bar = ProgressBar::new(1000);
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {percent}% building the point tree")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    cost.check(&option, &MemoryLimits::host_only(), args.max_hours * 3600.0)?;
+
+    let surfels = match &input {
+        PointInput::Mesh(mesh) => {
+            let bar = progress::bar(1000, "{percent:>3}% sampling the mesh");
+            let surfels = sample_mesh_reporting(mesh, &sampling, &mut |f| {
+                bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64)
+            });
+            bar.finish_and_clear();
+            surfels
+        }
+        PointInput::Points(cloud) => progress::phase("estimating normals and radii", || complete_cloud(cloud)),
+    }
+    .map_err(|e| in_file(&args.input, e))?;
+    drop(input);
+    let bar = progress::bar(1000, "{percent:>3}% building the point tree");
     let tree = build_spt(&surfels, &options, &mut |f| {
         bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64)
-    })?;
+    });
     bar.finish_and_clear();
-    write_spt(&args.output, &tree)?;
+    let tree = tree.map_err(|e| in_file(&args.input, e))?;
+    progress::phase("writing", || write_spt(&args.output, &tree))?;
     let leaves = tree.nodes.iter().filter(|n| n.is_leaf).count();
     println!(
         "{}: {} surfels → {} nodes ({} leaves), ε = {} px at {}° over {} rows; {:.2} s → {}",

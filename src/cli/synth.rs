@@ -6,20 +6,22 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use alpenglow::budget::MemoryLimits;
+use alpenglow::io::heightmap::{load_heightmap, load_heightmap_with_voids, HeightField, HeightmapOptions, RowOrder};
+use alpenglow::io::image_out::{encode_exr_height, encode_png_gray16};
+use alpenglow::synthesis::cost::{GrowthCost, SearchDevice};
+use alpenglow::synthesis::fill::{check_hole_fill, plan_hole_fill, FillParams, Growth};
+use alpenglow::synthesis::gpu::GpuSearch;
+use alpenglow::synthesis::search::CpuSearch;
+use alpenglow::synthesis::transition::{band_of, check_fields, plan_transition, Axis, TransitionParams};
+use alpenglow::vulkan::Context;
 use anyhow::{bail, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use glam::DVec2;
-use indicatif::{ProgressBar, ProgressStyle};
 
-use alpenglow::io::heightmap::{load_heightmap, load_heightmap_with_voids, HeightField, HeightmapOptions, RowOrder};
-use alpenglow::io::image_out::{encode_exr_height, encode_png_gray16};
-use alpenglow::synthesis::fill::{plan_hole_fill, FillParams, Growth};
-use alpenglow::synthesis::gpu::GpuSearch;
-use alpenglow::synthesis::search::CpuSearch;
-use alpenglow::synthesis::transition::{plan_transition, Axis, TransitionParams};
-
-use crate::cli::args::{parse_spacing, RowsArg};
+use crate::cli::args::{parse_hours, parse_spacing, RowsArg};
 use crate::cli::outputs::Outputs;
+use crate::cli::progress;
 use crate::cli::terrain_spec::{TerrainSpec, PREFIX};
 
 #[derive(Subcommand, Debug)]
@@ -90,6 +92,10 @@ pub struct GrowArgs {
     /// Neighbourhood search.
     #[arg(long, value_enum, default_value = "gpu", value_name = "DEVICE")]
     pub search: SearchArg,
+    /// Longest estimated run accepted, in hours: a growth estimated to
+    /// take longer is refused before it starts (README, "Height-field synthesis").
+    #[arg(long = "max-hours", default_value_t = alpenglow::budget::DEFAULT_MAX_HOURS, value_name = "HOURS", value_parser = parse_hours)]
+    pub max_hours: f64,
     #[command(flatten)]
     pub device: crate::cli::args::DeviceArgs,
 }
@@ -226,8 +232,11 @@ fn fill(args: FillArgs) -> Result<ExitCode> {
     let mut outputs = reserve_output(&args.out)?;
     let (field, unknown) = load_fill_input(&args)?;
     let params = args.grow.params(FillParams::default());
-    let growth = plan_hole_fill(&field, &unknown, &params)?;
-    let total = growth.unknown_count();
+    check_hole_fill(&field, &unknown, &params)?;
+    let total = unknown.iter().filter(|&&u| u).count();
+    let cost = GrowthCost::fill(field.columns, field.rows, total as u64, &params);
+    let search = prepare_search(&cost, &args.grow, &format!("--input {}", args.input.display()))?;
+    let growth = progress::phase("planning the growth", || plan_hole_fill(&field, &unknown, &params))?;
     if total == 0 {
         log::warn!(
             "{}: no sample is unknown (no --mask and no voids, or an empty mask); writing the input unchanged",
@@ -235,9 +244,11 @@ fn fill(args: FillArgs) -> Result<ExitCode> {
         );
     }
     let started = Instant::now();
-    let filled = grow_with(growth, &args.grow)?;
+    let filled = grow_with(growth, search)?;
     let seconds = started.elapsed().as_secs_f64();
-    outputs.stage(Some(&args.out), || encode_field(&args.out, &filled, &args.heights))?;
+    progress::phase("writing", || {
+        outputs.stage(Some(&args.out), || encode_field(&args.out, &filled, &args.heights))
+    })?;
     outputs.commit()?;
     println!(
         "{}: filled {total} of {}×{} samples in {seconds:.1} s → {}",
@@ -261,7 +272,6 @@ fn load_field(source: &str, args: &HeightArgs) -> Result<HeightField> {
 fn transition(args: TransitionArgs) -> Result<ExitCode> {
     let mut outputs = reserve_output(&args.out)?;
     let a = load_field(&args.a, &args.heights)?;
-    let b = load_field(&args.b, &args.heights)?;
     let params = TransitionParams {
         grow: args.grow.params(TransitionParams::default().grow),
         band_metres: args.band,
@@ -271,13 +281,21 @@ fn transition(args: TransitionArgs) -> Result<ExitCode> {
         },
         blur_radius: args.blur,
     };
-    let (growth, transition) = plan_transition(&a, &b, &params)?;
-    let band = transition.band;
+    let b = load_field(&args.b, &args.heights)?;
+    check_fields(&a, &b)?;
+    params.grow.validate(a.columns, a.rows)?;
+    let band = band_of(a.columns, a.rows, a.spacing, &params)?;
+    let cost = GrowthCost::transition(a.columns, a.rows, &band, &params);
+    let search = prepare_search(&cost, &args.grow, &format!("{} and {}", args.a, args.b))?;
+    let (growth, transition) = progress::phase("planning the transition", || plan_transition(&a, &b, &params))?;
+    drop(b);
     let started = Instant::now();
-    let residual = grow_with(growth, &args.grow)?;
-    let joined = transition.finish(&residual, params.blur_radius);
+    let residual = grow_with(growth, search)?;
+    let joined = progress::phase("blurring the band", || transition.finish(&residual, params.blur_radius));
     let seconds = started.elapsed().as_secs_f64();
-    outputs.stage(Some(&args.out), || encode_field(&args.out, &joined, &args.heights))?;
+    progress::phase("writing", || {
+        outputs.stage(Some(&args.out), || encode_field(&args.out, &joined, &args.heights))
+    })?;
     outputs.commit()?;
     println!(
         "transition {}×{}: a band of {} samples from {} grown in {seconds:.1} s → {}",
@@ -290,33 +308,68 @@ fn transition(args: TransitionArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Grows `growth` with the search of `--search` (on the GPU: the device
-/// of `--device`, validated with `--validation`), with a progress bar on
-/// stderr when it is a terminal.
-fn grow_with(growth: Growth, args: &GrowArgs) -> Result<HeightField> {
-    let bar = ProgressBar::new(growth.unknown_count() as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} samples grown (eta {eta})")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    let mut progress = |done: usize, _| bar.set_position(done as u64);
-    let grown = match args.search {
+/// The search of `--search`, chosen after its cost was checked.
+enum Search {
+    Cpu,
+    /// The GPU passes on the device of `--device`, with its validation report.
+    Gpu(Context),
+}
+
+/// Logs the estimated cost of the growth (info) and refuses it when its
+/// memory or its time on the search of `--search` exceeds the limits
+/// (`--max-hours`); `field` names the input in errors. A GPU search is
+/// first checked at the fastest rate any GPU is assumed to reach, before
+/// the device is made, so that what no device does in time is refused at
+/// once; then at the rate of the device made (lavapipe: a CPU).
+fn prepare_search(cost: &GrowthCost, args: &GrowArgs, field: &str) -> Result<Search> {
+    let limits = MemoryLimits::host_only();
+    let max_seconds = args.max_hours * 3600.0;
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let checked = |device: SearchDevice| -> Result<()> {
+        log::info!("synthesis estimate: {}", cost.summary(device));
+        Ok(cost.check(device, &limits, max_seconds, field)?)
+    };
+    match args.search {
         SearchArg::Cpu => {
+            checked(SearchDevice::Cpu {
+                threads: cost.cpu_threads(threads),
+            })?;
+            Ok(Search::Cpu)
+        }
+        SearchArg::Gpu => {
+            cost.check(SearchDevice::Gpu, &limits, max_seconds, field)?;
+            let ctx = super::context(&args.device)?;
+            checked(if ctx.info().device_type == "CPU" {
+                SearchDevice::CpuDevice { threads }
+            } else {
+                SearchDevice::Gpu
+            })?;
+            Ok(Search::Gpu(ctx))
+        }
+    }
+}
+
+/// Grows `growth` with `search` (on the GPU: validated with `--validation`
+/// when asked), with a progress bar on stderr when it is a terminal.
+fn grow_with(growth: Growth, search: Search) -> Result<HeightField> {
+    let bar = progress::bar(growth.unknown_count() as u64, "{pos}/{len} samples grown");
+    let mut report = |done: usize, _| bar.set_position(done as u64);
+    let grown = match search {
+        Search::Cpu => {
             let mut search = CpuSearch {
                 exemplar: growth.exemplar().clone(),
                 config: growth.search_config(),
             };
-            growth.grow(&mut search, &mut progress)?
+            growth.grow(&mut search, &mut report)?
         }
-        SearchArg::Gpu => {
-            let ctx = super::context(&args.device)?;
-            let report = ctx.validation_report();
+        Search::Gpu(ctx) => {
+            let validation = ctx.validation_report();
             let grown = {
                 let mut search = GpuSearch::new(&ctx, growth.exemplar().clone(), growth.search_config())?;
-                growth.grow(&mut search, &mut progress)?
+                growth.grow(&mut search, &mut report)?
             };
             drop(ctx);
-            super::check_validation(report)?;
+            super::check_validation(validation)?;
             grown
         }
     };

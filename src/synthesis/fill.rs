@@ -200,7 +200,9 @@ impl Growth {
 
     /// Grows every unknown sample with `search` (which must hold
     /// [`Growth::exemplar`] and [`Growth::search_config`]), reporting
-    /// `(filled, total)` after each wave; returns the grown field.
+    /// `(filled, total)` after each wave and, within a wave, as the search
+    /// answers (`filled` then counts the samples searched); returns the
+    /// grown field.
     pub fn grow(
         mut self,
         search: &mut dyn NeighbourhoodSearch,
@@ -213,7 +215,9 @@ impl Growth {
         progress(0, total);
         while let Some(wave) = order.next_wave(self.params.batch)? {
             let queries: Vec<Query> = wave.iter().map(|&p| self.query(p, &weights)).collect();
-            let choices = search.choose(&queries)?;
+            let choices = search.choose_reporting(&queries, &mut |answered| {
+                progress(done + answered.min(wave.len()), total)
+            })?;
             if choices.len() != wave.len() {
                 return Err(Error::Graph(format!(
                     "the search answered {} of {} queries",
@@ -405,14 +409,11 @@ impl FillOrder {
     }
 }
 
-/// Prepares filling the `unknown` samples of `field` (`true`: unknown,
-/// row-major) from its own known windows (module docs of
-/// [`crate::synthesis::exemplar`]).
-///
-/// Errors (one line, naming the parameter): a mask of another size, bad
-/// [`FillParams`], a mask that marks every sample, no fully known window.
-/// No unknown sample is not an error: the growth then returns the field.
-pub fn plan_hole_fill(field: &HeightField, unknown: &[bool], params: &FillParams) -> Result<Growth> {
+/// The checks of [`plan_hole_fill`] that need no allocation: the mask's
+/// size, the parameters, and at least one known sample. Callers run them
+/// before estimating the cost ([`crate::synthesis::cost`]), so that a bad
+/// input is reported as such rather than as an absurd cost.
+pub fn check_hole_fill(field: &HeightField, unknown: &[bool], params: &FillParams) -> Result<()> {
     check_mask(field, unknown, "mask")?;
     params.validate(field.columns, field.rows)?;
     if unknown.iter().all(|&u| u) {
@@ -421,6 +422,18 @@ pub fn plan_hole_fill(field: &HeightField, unknown: &[bool], params: &FillParams
             "marks every sample unknown: there is nothing to copy from",
         ));
     }
+    Ok(())
+}
+
+/// Prepares filling the `unknown` samples of `field` (`true`: unknown,
+/// row-major) from its own known windows (module docs of
+/// [`crate::synthesis::exemplar`]).
+///
+/// Errors (one line, naming the parameter): a mask of another size, bad
+/// [`FillParams`], a mask that marks every sample, no fully known window.
+/// No unknown sample is not an error: the growth then returns the field.
+pub fn plan_hole_fill(field: &HeightField, unknown: &[bool], params: &FillParams) -> Result<Growth> {
+    check_hole_fill(field, unknown, params)?;
     let slopes = slopes(field, unknown);
     let norm = Normalisation::of(field, unknown, &slopes);
     let texels = texels(field, unknown, &slopes, &norm);

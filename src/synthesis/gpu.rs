@@ -311,6 +311,11 @@ impl GpuSearch {
 
 impl NeighbourhoodSearch for GpuSearch {
     fn choose(&mut self, queries: &[Query]) -> Result<Vec<Choice>> {
+        self.choose_reporting(queries, &mut |_| {})
+    }
+
+    /// Reports the queries answered after each batch is read back.
+    fn choose_reporting(&mut self, queries: &[Query], progress: &mut dyn FnMut(usize)) -> Result<Vec<Choice>> {
         check(&self.exemplar, &self.config, queries)?;
         if self.graph.profiles().len() > KEPT_PROFILES {
             self.graph.take_profiles();
@@ -330,11 +335,13 @@ impl NeighbourhoodSearch for GpuSearch {
             let outcome = self.graph.execute(&mut self.frames, &params, &[])?;
             if let Some((done, done_range)) = pending.replace((outcome, range)) {
                 self.collect(done, &queries[done_range], &mut out)?;
+                progress(out.len());
             }
         }
         if let Some((done, done_range)) = pending {
             self.collect(done, &queries[done_range], &mut out)?;
         }
+        progress(out.len());
         Ok(out)
     }
 }

@@ -7,8 +7,10 @@
 //! a CPU twin and GPU compute passes ([`gpu`]) implement the same rule.
 //! [`exemplar`] builds the three channels and the candidate windows,
 //! [`fill`] grows the unknown samples in waves, [`transition`] joins two
-//! height fields across a grown band.
+//! height fields across a grown band; [`cost`] estimates a growth's time and
+//! memory from its sizes before anything is allocated.
 
+pub mod cost;
 pub mod exemplar;
 pub mod fill;
 pub mod gpu;

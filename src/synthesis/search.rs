@@ -29,7 +29,8 @@
 //! the order of evaluation: for a fixed pixel the hashes of the candidates
 //! are independent and uniform, so the smallest one is a uniform choice.
 
-use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering as AtomicOrdering};
+use std::sync::{mpsc, Arc};
 
 use crate::error::{Error, Result};
 
@@ -97,7 +98,20 @@ pub struct Choice {
 pub trait NeighbourhoodSearch {
     /// One choice per query, in query order.
     fn choose(&mut self, queries: &[Query]) -> Result<Vec<Choice>>;
+
+    /// [`NeighbourhoodSearch::choose`], calling `progress` with the number
+    /// of queries answered so far while it works (a long wave is not
+    /// silent: [`CpuSearch`] reports about every [`PROGRESS_INTERVAL`], the
+    /// GPU search after each batch). By default it reports once at the end.
+    fn choose_reporting(&mut self, queries: &[Query], progress: &mut dyn FnMut(usize)) -> Result<Vec<Choice>> {
+        let choices = self.choose(queries)?;
+        progress(queries.len());
+        Ok(choices)
+    }
 }
+
+/// How often [`CpuSearch`] reports the queries answered within a wave.
+pub const PROGRESS_INTERVAL: std::time::Duration = std::time::Duration::from_millis(200);
 
 /// lowbias32 (Chris Wellons' integer hash), the same in GLSL.
 pub fn lowbias32(mut x: u32) -> u32 {
@@ -239,30 +253,54 @@ pub struct CpuSearch {
 
 impl NeighbourhoodSearch for CpuSearch {
     fn choose(&mut self, queries: &[Query]) -> Result<Vec<Choice>> {
+        self.choose_reporting(queries, &mut |_| {})
+    }
+
+    /// The workers count the queries they answered; this thread waits for
+    /// them and reports the count every [`PROGRESS_INTERVAL`].
+    fn choose_reporting(&mut self, queries: &[Query], progress: &mut dyn FnMut(usize)) -> Result<Vec<Choice>> {
         check(&self.exemplar, &self.config, queries)?;
         let threads = std::thread::available_parallelism()
             .map_or(1, |n| n.get())
             .min(queries.len().max(1));
         let chunk = queries.len().div_ceil(threads).max(1);
         let (exemplar, config) = (&*self.exemplar, &self.config);
+        let answered = AtomicUsize::new(0);
         let mut out = Vec::with_capacity(queries.len());
         std::thread::scope(|scope| {
+            let (done_tx, done_rx) = mpsc::channel::<()>();
+            let answered = &answered;
             let workers: Vec<_> = queries
                 .chunks(chunk)
                 .map(|part| {
+                    let done_tx = done_tx.clone();
                     scope.spawn(move || {
                         let mut sums = vec![0.0f32; exemplar.candidates.len()];
-                        part.iter()
+                        let choices = part
+                            .iter()
                             .map(|q| {
                                 for (s, &c) in sums.iter_mut().zip(&exemplar.candidates) {
                                     *s = weighted_mismatch(exemplar, config, q, c);
                                 }
+                                answered.fetch_add(1, AtomicOrdering::Relaxed);
                                 choose_from(&sums, total_weight(q), config, q.pixel)
                             })
-                            .collect::<Vec<_>>()
+                            .collect::<Vec<_>>();
+                        // The receiver outlives every worker; a failed send cannot happen.
+                        let _ = done_tx.send(());
+                        choices
                     })
                 })
                 .collect();
+            drop(done_tx);
+            // Until every worker has sent (or dropped its sender on a panic).
+            loop {
+                match done_rx.recv_timeout(PROGRESS_INTERVAL) {
+                    Ok(()) => {}
+                    Err(mpsc::RecvTimeoutError::Timeout) => progress(answered.load(AtomicOrdering::Relaxed)),
+                    Err(mpsc::RecvTimeoutError::Disconnected) => break,
+                }
+            }
             for worker in workers {
                 // A worker only panics on a bug; report it as an error.
                 match worker.join() {
@@ -272,6 +310,7 @@ impl NeighbourhoodSearch for CpuSearch {
             }
             Ok(())
         })?;
+        progress(queries.len());
         Ok(out)
     }
 }

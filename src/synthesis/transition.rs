@@ -86,29 +86,13 @@ impl Band {
     }
 }
 
-/// The composed field (A, an empty band, B), its unknown mask and the band.
-pub fn compose(a: &HeightField, b: &HeightField, params: &TransitionParams) -> Result<(HeightField, Vec<bool>, Band)> {
-    if (a.columns, a.rows) != (b.columns, b.rows) {
-        return Err(Error::invalid(
-            "B",
-            format!(
-                "is {}×{} samples, A is {}×{}; the fields must be the same size",
-                b.columns, b.rows, a.columns, a.rows
-            ),
-        ));
-    }
-    if a.spacing != b.spacing {
-        return Err(Error::invalid(
-            "B",
-            format!(
-                "has a spacing of ({}, {}) m, A of ({}, {}) m; the fields must have the same spacing",
-                b.spacing.x, b.spacing.y, a.spacing.x, a.spacing.y
-            ),
-        ));
-    }
+/// The band between two `columns`×`rows` fields of `spacing` (module
+/// docs), checked against their size; nothing is allocated, so callers can
+/// estimate the growth's cost ([`crate::synthesis::cost`]) first.
+pub fn band_of(columns: u32, rows: u32, spacing: glam::DVec2, params: &TransitionParams) -> Result<Band> {
     let (length, spacing) = match params.axis {
-        Axis::X => (a.columns, a.spacing.x),
-        Axis::Y => (a.rows, a.spacing.y),
+        Axis::X => (columns, spacing.x),
+        Axis::Y => (rows, spacing.y),
     };
     let w = params.band_metres;
     let samples = (w / spacing).round();
@@ -127,11 +111,40 @@ pub fn compose(a: &HeightField, b: &HeightField, params: &TransitionParams) -> R
             ),
         ));
     }
-    let band = Band {
+    Ok(Band {
         axis: params.axis,
         start: (length - samples as u32) / 2,
         width: samples as u32,
-    };
+    })
+}
+
+/// Checks that `a` and `b` can be joined: the same size and spacing.
+pub fn check_fields(a: &HeightField, b: &HeightField) -> Result<()> {
+    if (a.columns, a.rows) != (b.columns, b.rows) {
+        return Err(Error::invalid(
+            "B",
+            format!(
+                "is {}×{} samples, A is {}×{}; the fields must be the same size",
+                b.columns, b.rows, a.columns, a.rows
+            ),
+        ));
+    }
+    if a.spacing != b.spacing {
+        return Err(Error::invalid(
+            "B",
+            format!(
+                "has a spacing of ({}, {}) m, A of ({}, {}) m; the fields must have the same spacing",
+                b.spacing.x, b.spacing.y, a.spacing.x, a.spacing.y
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The composed field (A, an empty band, B), its unknown mask and the band.
+pub fn compose(a: &HeightField, b: &HeightField, params: &TransitionParams) -> Result<(HeightField, Vec<bool>, Band)> {
+    check_fields(a, b)?;
+    let band = band_of(a.columns, a.rows, a.spacing, params)?;
     let mut unknown = Vec::with_capacity(a.heights.len());
     let mut composed = a.clone();
     for r in 0..a.rows {

@@ -5,13 +5,15 @@
 //! neighbour radii for clouds) → sequential point tree and its file; beside
 //! it procedural rocks (§6.1.4) and plants (chapter 10 introduction,
 //! Fig. 10.12), hybrid point–polygon meshes (§10.1.8) and normal clusters
-//! (§10.1.10).
+//! (§10.1.10). [`plan`] checks an input and estimates a build's cost before
+//! any sampling.
 
 pub mod clip;
 pub mod clusters;
 pub mod estimate;
 pub mod hybrid;
 pub mod input;
+pub mod plan;
 pub mod plants;
 pub mod rocks;
 pub mod sampling;

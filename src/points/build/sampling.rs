@@ -126,10 +126,32 @@ pub fn sample_mesh(mesh: &TriangleMesh, options: &SamplingOptions) -> Result<Vec
     Ok(sample_mesh_traced(mesh, options)?.0)
 }
 
+/// [`sample_mesh`], reporting the fraction done (0 first, 1 last, about
+/// every [`PROGRESS_STEP`] candidates of blue-noise elimination in between).
+pub fn sample_mesh_reporting(
+    mesh: &TriangleMesh,
+    options: &SamplingOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<Vec<Surfel>> {
+    Ok(sample_traced(mesh, options, progress)?.0)
+}
+
+/// Candidates of blue-noise elimination between two progress reports.
+pub const PROGRESS_STEP: usize = 1 << 14;
+
 /// [`sample_mesh`], also returning for each surfel the index in
 /// `mesh.triangles` of the triangle it was sampled on (for hybrid
 /// point–polygon rendering, [`super::hybrid`]).
 pub fn sample_mesh_traced(mesh: &TriangleMesh, options: &SamplingOptions) -> Result<(Vec<Surfel>, Vec<u32>)> {
+    sample_traced(mesh, options, &mut |_| {})
+}
+
+fn sample_traced(
+    mesh: &TriangleMesh,
+    options: &SamplingOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Vec<Surfel>, Vec<u32>)> {
+    progress(0.0);
     let count = options.count;
     if count == 0 {
         return Err(Error::invalid("sample count", "must be positive"));
@@ -151,20 +173,39 @@ pub fn sample_mesh_traced(mesh: &TriangleMesh, options: &SamplingOptions) -> Res
                 .filter(|&m| m <= u32::MAX as usize)
                 .ok_or_else(|| Error::invalid("sample count", format!("{count} is too large for blue noise")))?;
             let candidates = prepared.stratified(candidates, options.seed)?;
-            eliminate(candidates, count, prepared.total_area)
+            progress(0.1);
+            eliminate(candidates, count, prepared.total_area, progress)
         }
     };
     let vertices: Vec<[usize; 3]> = prepared.triangles.iter().map(|t| t.vertices).collect();
     let normals: Vec<Vec3> = prepared.triangles.iter().map(|t| t.face_normal).collect();
     let creases = Creases::new(&mesh.positions, &vertices, &normals);
-    Ok(samples
+    progress(0.95);
+    let traced = samples
         .into_iter()
         .map(|Sample { mut surfel, triangle }| {
             surfel.radius = radius;
             surfel.clip = creases.lines(triangle as usize, surfel.position, surfel.normal, radius);
             (surfel, prepared.triangles[triangle as usize].index)
         })
-        .unzip())
+        .unzip();
+    progress(1.0);
+    Ok(traced)
+}
+
+/// Peak host bytes per output sample of [`sample_mesh`] with `method`,
+/// counted from its allocations: per candidate (one per sample stratified,
+/// [`BLUE_NOISE_CANDIDATES`] for blue noise) the sample and, for blue noise,
+/// its kd-tree entry (40), weight (8), heap slots (8) and removal flag (1);
+/// then the output surfel and its triangle index.
+/// `crate::points::build::plan` estimates `spt build`'s memory with it.
+pub const fn bytes_per_sample(method: SamplingMethod) -> u64 {
+    let sample = std::mem::size_of::<Sample>();
+    let candidates = match method {
+        SamplingMethod::Stratified => sample,
+        SamplingMethod::BlueNoise => BLUE_NOISE_CANDIDATES * (sample + 40 + 8 + 8 + 1),
+    };
+    (candidates + std::mem::size_of::<Surfel>() + 4) as u64
 }
 
 /// A surfel (radius still 0) and the index of the triangle it lies in.
@@ -333,7 +374,8 @@ fn square_to_triangle(u: f32, v: f32) -> [f32; 3] {
 
 /// Yuksel 2015 weighted sample elimination of `candidates` down to `target`
 /// (module docs); keeps the candidates' order.
-fn eliminate(candidates: Vec<Sample>, target: usize, area: f64) -> Vec<Sample> {
+/// Reports fractions 0.1‥0.5 while weighing, 0.5‥0.9 while eliminating.
+fn eliminate(candidates: Vec<Sample>, target: usize, area: f64, progress: &mut dyn FnMut(f32)) -> Vec<Sample> {
     let m = candidates.len();
     if m <= target {
         return candidates;
@@ -357,10 +399,16 @@ fn eliminate(candidates: Vec<Sample>, target: usize, area: f64) -> Vec<Sample> {
             }
         });
         weights[i] = w;
+        if i % PROGRESS_STEP == 0 {
+            progress(0.1 + 0.4 * i as f32 / m as f32);
+        }
     }
     let mut heap = WeightHeap::new(&weights);
     let mut removed = vec![false; m];
-    for _ in target..m {
+    for step in target..m {
+        if step % PROGRESS_STEP == 0 {
+            progress(0.5 + 0.4 * (step - target) as f32 / (m - target) as f32);
+        }
         let Some(i) = heap.pop(&weights) else {
             break;
         };

@@ -347,6 +347,18 @@ impl SequentialPointTree {
     }
 }
 
+/// Peak host bytes per surfel of [`build_spt`] (besides the surfels
+/// themselves), counted from its allocations: the f64 positions and normals
+/// (48), the octree's index lists (4, twice while a cell is split), the
+/// build nodes, the tree nodes twice while they are sorted, and the sort's
+/// order and renumbering (8 + 4 per node), with 1.6 nodes per surfel (the
+/// bunny's trees have 1.50–1.55; at most 2). Measured: 565 bytes a surfel
+/// of peak resident memory for all of `spt build` (100,000 and 300,000
+/// blue-noise samples of the bunny). `crate::points::build::plan`
+/// estimates `spt build`'s memory with it.
+pub const BUILD_BYTES_PER_SURFEL: u64 =
+    (48 + 8 + 8 * (std::mem::size_of::<Work>() + 2 * std::mem::size_of::<SptNode>() + 12) / 5) as u64;
+
 /// A node during the build, in f64 (sums of many positions and squared
 /// distances stay exact enough and cannot overflow).
 #[derive(Clone, Debug)]
