@@ -218,7 +218,7 @@ impl SkyLightBake {
         let field = &*SkyLightBake::fitted(ctx, field, settings);
         let key = BakeKey::new(field, settings);
         let Some(dir) = cache else {
-            return SkyLightBake::compute(ctx, field, settings, progress);
+            return SkyLightBake::compute_fitted(ctx, field, settings, progress);
         };
         let path = cache::cache_path(dir, &key);
         if let Some(data) = cache::load(&path, &key)? {
@@ -226,7 +226,7 @@ impl SkyLightBake {
             progress(1.0);
             return Ok(bake);
         }
-        let bake = SkyLightBake::compute(ctx, field, settings, progress)?;
+        let bake = SkyLightBake::compute_fitted(ctx, field, settings, progress)?;
         cache::store(&path, &bake.read_back(ctx)?)?;
         Ok(bake)
     }
@@ -260,7 +260,18 @@ impl SkyLightBake {
     ) -> Result<SkyLightBake> {
         settings.validate()?;
         field.validate(Path::new("sky-light height field"))?;
-        let field = &*SkyLightBake::fitted(ctx, field, settings);
+        SkyLightBake::compute_fitted(ctx, &SkyLightBake::fitted(ctx, field, settings), settings, progress)
+    }
+
+    /// [`SkyLightBake::compute`] of a field already [`SkyLightBake::fitted`]
+    /// (and validated before fitting: an area average of a legal field may
+    /// have a spacing beyond [`crate::io::heightmap::MAX_SPACING`]).
+    fn compute_fitted(
+        ctx: &Context,
+        field: &HeightField,
+        settings: &BakeSettings,
+        progress: &mut dyn FnMut(f32),
+    ) -> Result<SkyLightBake> {
         let (columns, rows) = (field.columns, field.rows);
         let texels = u64::from(columns) * u64::from(rows);
         let (k, stride) = (settings.azimuths, settings.stride());
