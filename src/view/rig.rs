@@ -299,8 +299,8 @@ impl Rig {
             .enumerate()
             .map(|(i, raw)| {
                 let label = match &raw.name {
-                    Some(n) => format!("view '{n}'"),
-                    None => format!("view {}", i + 1),
+                    Some(n) if !n.is_empty() => format!("view '{n}'"),
+                    _ => format!("view {}", i + 1),
                 };
                 raw.into_view()
                     .map_err(|e| Error::input(origin, format!("{label}: {e}")))
@@ -402,6 +402,9 @@ impl RawView {
     fn into_view(self) -> std::result::Result<RigView, String> {
         check_numbers(&self)?;
         let name = self.name.ok_or("has no name")?;
+        // Every view of a rig file is named, even a lone one: its name
+        // makes the output file names (`{view}`).
+        check_name(&name).map_err(|_| format!("name '{name}': use 1 to 64 letters, digits, '-' or '_'"))?;
         let v3 = |a: [f64; 3]| DVec3::from_array(a);
         let pose = match (self.eye, self.target, self.position, self.yaw_pitch_roll) {
             (Some(eye), Some(target), None, None) => RigPose::World {
@@ -533,7 +536,11 @@ mod tests {
             ),
             ("[[view]]\nname = \"a\"\nfx = 100", "either fov_y or all of"),
             ("[[view]]\nname = \"a\"\nfov_y = 200", "fov_y 200"),
-            ("[[view]]\nname = \"a b\"", "view.name"),
+            ("[[view]]\nname = \"a b\"", "view 'a b': name 'a b'"),
+            // A lone view named "" (accepted before: its files had no name).
+            ("[[view]]\nname = \"\"", "view 1: name ''"),
+            ("[[view]]\nname = \"a\"\n[[view]]\nname = \"\"", "view 2: name ''"),
+            ("[[view]]\nname = \"a\\u001b[2J\"", "name 'a\\u{1b}[2J'"),
             ("[[view]]\nname = \"a\"\n[[view]]\nname = \"a\"", "used twice"),
             ("[[view]]\nname = \"a\"\nwidth = 0\nheight = 10", "width"),
             ("[[view]]\nname = \"a\"\nspeed = 3", "unknown field"),
