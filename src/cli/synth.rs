@@ -222,11 +222,26 @@ fn load_fill_input(args: &FillArgs) -> Result<(HeightField, Vec<bool>)> {
     Ok((field, unknown))
 }
 
+/// An error of the library's `mask` (the unknown samples) in the words of
+/// what made them: `--mask FILE` where one was given, else the input's voids.
+fn unknown_error(e: alpenglow::Error, args: &FillArgs) -> anyhow::Error {
+    match (&e, e.parameter()) {
+        (alpenglow::Error::InvalidArgument { message, .. }, Some("mask")) => match &args.mask {
+            Some(mask) => anyhow::anyhow!("--mask {}: {message}", mask.display()),
+            None => anyhow::anyhow!(
+                "{}: {message} (without --mask the unknown samples are the input's voids, its no-data samples)",
+                args.input.display()
+            ),
+        },
+        _ => e.into(),
+    }
+}
+
 fn fill(args: FillArgs) -> Result<ExitCode> {
     let mut outputs = reserve_output(&args.out)?;
     let (field, unknown) = load_fill_input(&args)?;
     let params = args.grow.params(FillParams::default());
-    let growth = plan_hole_fill(&field, &unknown, &params)?;
+    let growth = plan_hole_fill(&field, &unknown, &params).map_err(|e| unknown_error(e, &args))?;
     let total = growth.unknown_count();
     if total == 0 {
         log::warn!(

@@ -418,7 +418,7 @@ pub fn plan_hole_fill(field: &HeightField, unknown: &[bool], params: &FillParams
     if unknown.iter().all(|&u| u) {
         return Err(Error::invalid(
             "mask",
-            "marks every sample unknown: there is nothing to copy from",
+            "every sample is unknown: there is nothing to copy from",
         ));
     }
     let slopes = slopes(field, unknown);
