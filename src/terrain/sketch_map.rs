@@ -306,14 +306,22 @@ mod tests {
     }
 
     /// A strip far more than a thousand times longer than wide (lengthwise
-    /// in x or in y, at several spacings): every view gives a region of
+    /// in x or in y, by its samples or its spacing): every view gives a region of
     /// positive, finite sides within the strip's width, seen or missed,
     /// for both alignments (the sliver of a missed view used to be wider
     /// than the strip, and its `clamp` bounds crossed).
     #[test]
     fn strips_give_regions_within_their_width() {
-        for (columns, rows, spacing) in [(2048, 2, 30.0), (2, 2048, 30.0), (4000, 3, 1.0), (2, 9000, 0.001)] {
-            let f = HeightField::from_fn(columns, rows, DVec2::splat(spacing), |c, r| ((c + 3 * r) % 7) as f32);
+        let strips = [
+            (2048, 2, DVec2::splat(30.0)),
+            (2, 2048, DVec2::splat(30.0)),
+            (4000, 3, DVec2::ONE),
+            (2, 9000, DVec2::splat(0.001)),
+            // Square in samples, a strip by its spacing (`--spacing 1,2000`).
+            (65, 65, DVec2::new(1.0, 2000.0)),
+        ];
+        for (columns, rows, spacing) in strips {
+            let f = HeightField::from_fn(columns, rows, spacing, |c, r| ((c + 3 * r) % 7) as f32);
             let e = f.extent();
             let centre = (0.5 * e).extend(0.0);
             let size = e.max_element();

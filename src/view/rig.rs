@@ -182,7 +182,8 @@ impl Rig {
     /// `width` wide.
     pub fn ring6(width: u32) -> Rig {
         let names = ["front", "front_left", "rear_left", "rear", "rear_right", "front_right"];
-        let height = (width * 3 / 4).max(1);
+        // In u64: any u32 width (the size checks of `specs` refuse a wrong one).
+        let height = (u64::from(width) * 3 / 4).max(1) as u32;
         // 60° across at 4:3: tan(fov_y/2) = tan(30°)·3/4.
         let fov_y = 2.0 * (30f64.to_radians().tan() * 0.75).atan().to_degrees();
         let views = names
@@ -485,6 +486,22 @@ mod tests {
         assert!(cameras
             .iter()
             .all(|c| c.eye == rig_camera().eye && c.image_up().abs_diff_eq(DVec3::Z, 1e-12)));
+    }
+
+    /// Any width gives a ring (3/4 of u32::MAX fits a u32); one beyond the
+    /// image limits is refused by `specs`, naming the width, not a panic
+    /// on overflow.
+    #[test]
+    fn ring6_of_any_width_is_checked_not_overflowed() {
+        for width in [0, 1, 16_384, 16_385, u32::MAX / 3 + 1, u32::MAX] {
+            let rig = Rig::ring6(width);
+            let (w, h) = rig.views[0].size.unwrap();
+            assert_eq!((w, u64::from(h)), (width, (u64::from(width) * 3 / 4).max(1)));
+            if !(1..=16_384).contains(&width) {
+                let e = rig.specs((64, 48)).unwrap_err();
+                assert_eq!(e.parameter(), Some("width"), "{e}");
+            }
+        }
     }
 
     #[test]
