@@ -232,4 +232,14 @@ fn a_malformed_layer_manifest_names_vk_layer_path() {
         &["validation layer", "VK_LAYER_PATH", layers.to_str().unwrap()],
     );
     assert!(!png.exists());
+    // Without --validation the loader still reads the manifest: the error
+    // says so and names VK_LAYER_PATH too.
+    let out = std::process::Command::new(bin())
+        .arg("info")
+        .env("VK_LAYER_PATH", &layers)
+        .output()
+        .unwrap();
+    if !out.status.success() {
+        assert_one_line_error("info with a malformed manifest", &out, &["VK_LAYER_PATH", "manifest"]);
+    }
 }

@@ -19,7 +19,7 @@ use super::memory::Garbage;
 use super::validation::{messenger_info, ValidationReport};
 use crate::error::{Error, Result};
 
-const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+pub(super) const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
 /// How to create a [`Context`].
 #[derive(Clone, Debug, Default)]
@@ -145,33 +145,6 @@ fn offered_single_pass_features(instance: &ash::Instance, physical: vk::Physical
     )
 }
 
-/// The layer search paths the user set (`VK_LAYER_PATH`,
-/// `VK_ADD_LAYER_PATH`), as `NAME=VALUE`.
-fn layer_paths() -> Vec<String> {
-    ["VK_LAYER_PATH", "VK_ADD_LAYER_PATH"]
-        .iter()
-        .filter_map(|v| std::env::var_os(v).map(|p| format!("{v}={}", p.to_string_lossy())))
-        .collect()
-}
-
-/// The validation layer could not be loaded: `call` failed with `result`.
-/// Names the layer search path the user set, where a broken manifest or
-/// library usually is.
-fn layer_error(call: &str, result: vk::Result) -> Error {
-    let set = layer_paths();
-    let hint = match set.is_empty() {
-        true => "check the installed layer manifests (tools/install-vulkan-runtime.sh)".to_string(),
-        false => format!(
-            "check the layer manifests (.json) and libraries under {}",
-            set.join(" and ")
-        ),
-    };
-    Error::Device(crate::error::printable(&format!(
-        "validation requested but the validation layer {} could not be loaded ({call}: {result}); {hint}",
-        VALIDATION_LAYER.to_string_lossy()
-    )))
-}
-
 pub(crate) fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> Error {
     move |result| Error::Vulkan { call, result }
 }
@@ -190,7 +163,12 @@ impl Context {
         let layers = match unsafe { entry.enumerate_instance_layer_properties() } {
             Ok(layers) => layers,
             Err(_) if !options.validation => Vec::new(),
-            Err(result) => return Err(layer_error("vkEnumerateInstanceLayerProperties", result)),
+            Err(result) => {
+                return Err(super::validation::layer_error(
+                    "vkEnumerateInstanceLayerProperties",
+                    result,
+                ))
+            }
         };
         let layer_version = layers
             .iter()
@@ -244,31 +222,8 @@ impl Context {
                 .push_next(&mut validation_features);
         }
         // SAFETY: every pointer in the create info refers to locals that outlive the call.
-        let instance = unsafe { entry.create_instance(&instance_info, None) }.map_err(|e| match e {
-            vk::Result::ERROR_INCOMPATIBLE_DRIVER => {
-                Error::Device("no Vulkan 1.3 driver found (run tools/install-vulkan-runtime.sh)".into())
-            }
-            // The loader reads every manifest again; a malformed one is
-            // reported as a host allocation failure.
-            vk::Result::ERROR_OUT_OF_HOST_MEMORY if !layer_paths().is_empty() => {
-                Error::Device(crate::error::printable(&format!(
-                    "vkCreateInstance failed ({e}) while the loader read the layer manifests under {}; \
-                     one is probably malformed",
-                    layer_paths().join(" and ")
-                )))
-            }
-            vk::Result::ERROR_LAYER_NOT_PRESENT
-            | vk::Result::ERROR_EXTENSION_NOT_PRESENT
-            | vk::Result::ERROR_INITIALIZATION_FAILED
-                if options.validation =>
-            {
-                layer_error("vkCreateInstance", e)
-            }
-            other => Error::Vulkan {
-                call: "vkCreateInstance",
-                result: other,
-            },
-        })?;
+        let instance = unsafe { entry.create_instance(&instance_info, None) }
+            .map_err(|e| super::validation::instance_error(e, options.validation))?;
 
         let debug_instance = debug_utils.then(|| ash::ext::debug_utils::Instance::new(&entry, &instance));
         let messenger = match (&debug_instance, report.as_deref()) {
