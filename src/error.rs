@@ -69,6 +69,14 @@ fn single_line(text: String) -> String {
         .collect()
 }
 
+/// `text` as it may be printed or logged: control characters (line
+/// breaks, escape sequences that would drive the terminal) escaped as
+/// `\n`, `\u{1b}`. For user-supplied names (layers, views) in anything
+/// that reaches a terminal; [`Error`]'s constructors do the same.
+pub fn printable(text: &str) -> String {
+    single_line(text.to_string())
+}
+
 /// `Result` with [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 

@@ -29,7 +29,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use alpenglow::io::image_out::write_png_rgba8;
 use alpenglow::profile::{chrome_trace, median, summarize};
 use alpenglow::renderer::{Camera, FrameImages, Rig, Scene};
-use alpenglow::view::camera_path::{load_keyframes, CameraPath, Orbit, DEFAULT_START_ANGLE_DEG};
+use alpenglow::view::camera_path::{load_keyframes, CameraPath, Orbit};
 
 use super::args::FlyArgs;
 use super::{
@@ -37,24 +37,36 @@ use super::{
 };
 
 /// The default path: one turn around the terrain's centre at 60 % of its
-/// half-size, 0.4 of its size above the highest point.
+/// half-size, above the highest point ([`Orbit::around`]).
 fn default_orbit(scene: &Scene) -> Orbit {
-    let extent = scene.heights.extent();
     let (lo, hi) = scene.height_range();
-    let size = extent.x.max(extent.y);
-    Orbit {
-        centre: glam::DVec3::new(extent.x * 0.5, extent.y * 0.5, f64::from(lo)),
-        radius: size * 0.3,
-        height: f64::from(hi - lo) + size * 0.08,
-        turns: 1.0,
-        start_angle_deg: DEFAULT_START_ANGLE_DEG,
-    }
+    Orbit::around(scene.heights.extent(), f64::from(lo), f64::from(hi))
 }
 
 /// The cameras of frame `i` of `frames` along `path` (a rig's views each).
-fn frame_cameras(path: &CameraPath, rig: Option<&Rig>, base: &Camera, i: u32, frames: u32) -> Result<Vec<Camera>> {
+/// The path sets eye and target: when they make an invalid camera (eye on
+/// the target, a view along the up vector), the error names the path's
+/// option `source` (`--path FILE`, `--orbit`), not --eye or --target.
+fn frame_cameras(
+    path: &CameraPath,
+    source: &str,
+    rig: Option<&Rig>,
+    base: &Camera,
+    i: u32,
+    frames: u32,
+) -> Result<Vec<Camera>> {
     let c = path.sample_at(i, frames, base);
-    c.validate().with_context(|| format!("camera path frame {i}"))?;
+    c.validate().map_err(|e| {
+        let message = match &e {
+            alpenglow::Error::InvalidArgument { message, .. } => message.clone(),
+            other => other.to_string(),
+        };
+        match e.parameter() {
+            Some("camera.eye" | "camera.target" | "camera") => anyhow::anyhow!("{source}: frame {i}: {message}"),
+            Some("camera.up") => anyhow::anyhow!("{source}: frame {i}: {message} (--up, default 0,0,1)"),
+            _ => anyhow::Error::from(e).context(format!("camera path frame {i}")),
+        }
+    })?;
     rig::frame_cameras(rig, &c).with_context(|| format!("camera path frame {i}"))
 }
 
@@ -83,15 +95,18 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     let (rig, specs) = views(&args.scene)?;
     let scene = load_scene(&args.scene)?;
     let base = camera(&args.scene, &scene)?;
-    let path = match (&args.path, args.orbit) {
-        (Some(file), _) => load_keyframes(file)?,
-        (None, Some(orbit)) => CameraPath::Orbit(orbit),
-        (None, None) => CameraPath::Orbit(default_orbit(&scene)),
+    let (path, source) = match (&args.path, args.orbit) {
+        (Some(file), _) => (load_keyframes(file)?, format!("--path {}", file.display())),
+        (None, Some(orbit)) => (CameraPath::Orbit(orbit), "--orbit".to_string()),
+        (None, None) => (
+            CameraPath::Orbit(default_orbit(&scene)),
+            "the automatic orbit".to_string(),
+        ),
     };
     path.validate()?;
     // Every camera checked before start-up, none kept.
     for i in 0..args.frames {
-        frame_cameras(&path, rig.as_ref(), &base, i, args.frames)?;
+        frame_cameras(&path, &source, rig.as_ref(), &base, i, args.frames)?;
     }
 
     let staging = match &args.out_dir {
@@ -134,7 +149,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
         // wall time is its submission plus its read-back and writes.
         let mut pending = None;
         for i in 0..args.frames {
-            let cams = frame_cameras(&path, rig.as_ref(), &base, i, args.frames)?;
+            let cams = frame_cameras(&path, &source, rig.as_ref(), &base, i, args.frames)?;
             let start = Instant::now();
             let outcome = renderer.render_views(&cams)?;
             wall[i as usize] += start.elapsed();

@@ -75,7 +75,28 @@ impl CameraArgs {
     /// The views a frame renders: the rig's, or one view of `size`.
     pub fn view_specs(&self, rig: Option<&Rig>, size: (u32, u32), fov_y: f64) -> Result<Vec<ViewSpec>> {
         Ok(match rig {
-            Some(rig) => rig.specs(size)?,
+            Some(rig) => {
+                let mut specs = rig.specs(size)?;
+                // A distorted view that inherits the field of view: the
+                // intrinsics of --fov-y at its size.
+                for spec in specs
+                    .iter_mut()
+                    .filter(|s| s.distortion.is_some() && s.intrinsics.is_none())
+                {
+                    spec.intrinsics = Some(Intrinsics::from_fov_y(fov_y, spec.width, spec.height));
+                }
+                // A rig file's views are checked here, so that their errors
+                // name the file and the view, not --distortion.
+                for spec in &specs {
+                    alpenglow::renderer::check_view(spec).map_err(|e| match (&self.rig, &e) {
+                        (Some(path), alpenglow::Error::InvalidArgument { message, .. }) => {
+                            anyhow::anyhow!("{}: view '{}': {message}", path.display(), spec.name)
+                        }
+                        _ => anyhow::Error::from(e),
+                    })?;
+                }
+                specs
+            }
             None => {
                 // A distorted lens needs fixed intrinsics: those of --fov-y by default.
                 let intrinsics = match (self.intrinsics, self.distortion) {
@@ -130,10 +151,18 @@ pub fn frame_cameras(rig: Option<&Rig>, camera: &Camera) -> Result<Vec<Camera>> 
 }
 
 /// Checks an output path against the views: several views need `{view}`
-/// in it (one file per view).
+/// in it (one file per view), and `{view}` needs named views (a rig's; the
+/// command's own camera has no name, and `{view}` would expand to nothing).
 pub fn check_pattern(path: &Option<PathBuf>, flag: &str, views: &[ViewSpec]) -> Result<()> {
     let Some(path) = path else { return Ok(()) };
     let has = path.to_string_lossy().contains(VIEW_PATTERN);
+    if has && views.iter().any(|v| v.name.is_empty()) {
+        bail!(
+            "{flag} {}: {VIEW_PATTERN} is the name of a rig's view, and without --rig or --rig-preset \
+             there is none; remove it from the path",
+            path.display()
+        );
+    }
     if views.len() > 1 && !has {
         bail!(
             "{flag} {}: a rig of {} views writes one file per view; put {VIEW_PATTERN} in the path",
@@ -222,6 +251,11 @@ mod tests {
         let views = rig.specs((64, 48)).unwrap();
         assert!(check_pattern(&Some("out.png".into()), "--out", &views).is_err());
         assert!(check_pattern(&Some("out/{view}.png".into()), "--out", &views).is_ok());
+        // Without a rig there is no view name for {view} to expand to.
+        let single = [ViewSpec::new(64, 48)];
+        let e = check_pattern(&Some("o_{view}.png".into()), "--exr", &single).unwrap_err();
+        assert!(e.to_string().starts_with("--exr o_{view}.png: "), "{e}");
+        assert!(check_pattern(&Some("o.png".into()), "--out", &single).is_ok());
         assert_eq!(
             view_path(Path::new("o/{view}.png"), "rear"),
             PathBuf::from("o/rear.png")

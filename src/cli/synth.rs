@@ -228,15 +228,31 @@ fn load_fill_input(args: &FillArgs) -> Result<(HeightField, Vec<bool>)> {
     Ok((field, unknown))
 }
 
+/// An error of the library's `mask` (the unknown samples) in the words of
+/// what made them: `--mask FILE` where one was given, else the input's voids.
+fn unknown_error(e: alpenglow::Error, args: &FillArgs) -> anyhow::Error {
+    match (&e, e.parameter()) {
+        (alpenglow::Error::InvalidArgument { message, .. }, Some("mask")) => match &args.mask {
+            Some(mask) => anyhow::anyhow!("--mask {}: {message}", mask.display()),
+            None => anyhow::anyhow!(
+                "{}: {message} (without --mask the unknown samples are the input's voids, its no-data samples)",
+                args.input.display()
+            ),
+        },
+        _ => e.into(),
+    }
+}
+
 fn fill(args: FillArgs) -> Result<ExitCode> {
     let mut outputs = reserve_output(&args.out)?;
     let (field, unknown) = load_fill_input(&args)?;
     let params = args.grow.params(FillParams::default());
-    check_hole_fill(&field, &unknown, &params)?;
+    check_hole_fill(&field, &unknown, &params).map_err(|e| unknown_error(e, &args))?;
     let total = unknown.iter().filter(|&&u| u).count();
     let cost = GrowthCost::fill(field.columns, field.rows, total as u64, &params);
     let search = prepare_search(&cost, &args.grow, &format!("--input {}", args.input.display()))?;
-    let growth = progress::phase("planning the growth", || plan_hole_fill(&field, &unknown, &params))?;
+    let growth = progress::phase("planning the growth", || plan_hole_fill(&field, &unknown, &params))
+        .map_err(|e| unknown_error(e, &args))?;
     if total == 0 {
         log::warn!(
             "{}: no sample is unknown (no --mask and no voids, or an empty mask); writing the input unchanged",

@@ -34,6 +34,7 @@ pub use readback::FrameImages;
 pub use scene::Scene;
 
 use readback::Readback;
+pub use view_chain::check_view;
 use view_chain::ViewChain;
 
 use crate::error::{Error, Result};

@@ -180,24 +180,10 @@ impl Scene {
     }
 
     /// A camera that shows the whole terrain: from beyond its southern edge,
-    /// above the highest point, looking at the centre.
+    /// above the highest point, looking at the centre
+    /// ([`Camera::overview`]: valid for every legal height field).
     pub fn default_camera(&self) -> Camera {
-        let extent = self.heights.extent();
         let (lo, hi) = self.height_range();
-        let (lo, hi) = (lo as f64, hi as f64);
-        let size = extent.x.max(extent.y);
-        let centre = DVec3::new(extent.x * 0.5, extent.y * 0.5, lo + (hi - lo) * 0.3);
-        let eye = DVec3::new(extent.x * 0.5, -extent.y * 0.12, hi + (hi - lo) * 0.6 + size * 0.08);
-        Camera {
-            eye,
-            target: centre,
-            up: DVec3::Z,
-            fov_y_deg: 50.0,
-            near: (size * 1e-4).max(0.1),
-            // Ten times the larger of the terrain's size and its height
-            // range: the eye stands above the highest point, and a small
-            // steep field would otherwise lie beyond the far plane.
-            far: size.max(hi - lo) * 10.0,
-        }
+        Camera::overview(self.heights.extent(), f64::from(lo), f64::from(hi))
     }
 }

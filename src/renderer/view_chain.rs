@@ -45,35 +45,52 @@ pub(super) struct ViewChain {
     distortion: Option<LensDistortion>,
 }
 
+/// The distorted camera of `output` and the undistorted render it is
+/// resampled from (None without distortion): errors when the view has no
+/// pinhole intrinsics or its distortion folds within the image. CPU only,
+/// so front ends can check a view before any device work
+/// ([`check_view`]).
+fn distortion_source(output: &ViewSpec) -> Result<Option<(DistortedCamera, distortion::SourceView)>> {
+    let Some(d) = output.distortion else { return Ok(None) };
+    let k = output.intrinsics.ok_or_else(|| {
+        Error::invalid(
+            "distortion",
+            format!(
+                "view '{}' needs pinhole intrinsics with its lens distortion",
+                output.name
+            ),
+        )
+    })?;
+    let camera = DistortedCamera {
+        intrinsics: to_post(k),
+        lens: distortion::BrownConrady {
+            k1: d.k1,
+            k2: d.k2,
+            k3: d.k3,
+            p1: d.p1,
+            p2: d.p2,
+        },
+        width: output.width,
+        height: output.height,
+    };
+    let source = distortion::source_intrinsics(&camera)?;
+    Ok(Some((camera, source)))
+}
+
+/// Checks that `view` can be rendered as specified ([`ViewSpec::validate`]
+/// and its lens distortion), without a device.
+pub fn check_view(view: &ViewSpec) -> Result<()> {
+    view.validate()?;
+    distortion_source(view).map(|_| ())
+}
+
 impl ViewChain {
     /// The chain of `output` with `samples` samples per pixel (1: none).
     pub fn new(ctx: &Context, output: &ViewSpec, samples: u32) -> Result<ViewChain> {
         let (mut size, mut intrinsics) = ((output.width, output.height), output.intrinsics);
-        let distortion = match output.distortion {
+        let distortion = match distortion_source(output)? {
             None => None,
-            Some(d) => {
-                let k = intrinsics.ok_or_else(|| {
-                    Error::invalid(
-                        "distortion",
-                        format!(
-                            "view '{}' needs pinhole intrinsics with its lens distortion",
-                            output.name
-                        ),
-                    )
-                })?;
-                let camera = DistortedCamera {
-                    intrinsics: to_post(k),
-                    lens: distortion::BrownConrady {
-                        k1: d.k1,
-                        k2: d.k2,
-                        k3: d.k3,
-                        p1: d.p1,
-                        p2: d.p2,
-                    },
-                    width: output.width,
-                    height: output.height,
-                };
-                let source = distortion::source_intrinsics(&camera)?;
+            Some((camera, source)) => {
                 size = (source.width, source.height);
                 intrinsics = Some(from_post(source.intrinsics));
                 Some(LensDistortion::new(ctx, &camera, &source)?)

@@ -419,7 +419,7 @@ pub fn check_hole_fill(field: &HeightField, unknown: &[bool], params: &FillParam
     if unknown.iter().all(|&u| u) {
         return Err(Error::invalid(
             "mask",
-            "marks every sample unknown: there is nothing to copy from",
+            "every sample is unknown: there is nothing to copy from",
         ));
     }
     Ok(())

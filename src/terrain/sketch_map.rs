@@ -139,13 +139,17 @@ impl SketchRegion {
         smin = smin.max(tmin);
         smax = smax.min(tmax);
         // A view that misses the terrain: a sliver at the nearest terrain edge
-        // (still a valid, if invisible, mesh).
+        // (still a valid, if invisible, mesh). A sliver is at least a
+        // thousandth of the terrain's length, but never wider than the
+        // terrain itself in that direction: on a strip more than a thousand
+        // times longer than wide the whole width is the sliver.
         let min_side = 1e-3 * extent.max_element();
         for k in 0..2 {
-            if smax[k] - smin[k] < min_side {
-                let c = (0.5 * (smin[k] + smax[k])).clamp(tmin[k], tmax[k] - min_side);
+            let side = min_side.min(tmax[k] - tmin[k]);
+            if smax[k] - smin[k] < side {
+                let c = (0.5 * (smin[k] + smax[k])).clamp(tmin[k], tmax[k] - side);
                 smin[k] = c;
-                smax[k] = c + min_side;
+                smax[k] = c + side;
             }
         }
         let side = smax - smin;
@@ -298,6 +302,66 @@ mod tests {
         let e = f.extent();
         for p in &map.geometry {
             assert!(p.x >= -1e-6 && p.y >= -1e-6 && p.x <= e.x + 1e-6 && p.y <= e.y + 1e-6);
+        }
+    }
+
+    /// A strip far more than a thousand times longer than wide (lengthwise
+    /// in x or in y, by its samples or its spacing): every view gives a region of
+    /// positive, finite sides within the strip's width, seen or missed,
+    /// for both alignments (the sliver of a missed view used to be wider
+    /// than the strip, and its `clamp` bounds crossed).
+    #[test]
+    fn strips_give_regions_within_their_width() {
+        let strips = [
+            (2048, 2, DVec2::splat(30.0)),
+            (2, 2048, DVec2::splat(30.0)),
+            (4000, 3, DVec2::ONE),
+            (2, 9000, DVec2::splat(0.001)),
+            // Square in samples, a strip by its spacing (`--spacing 1,2000`).
+            (65, 65, DVec2::new(1.0, 2000.0)),
+        ];
+        for (columns, rows, spacing) in strips {
+            let f = HeightField::from_fn(columns, rows, spacing, |c, r| ((c + 3 * r) % 7) as f32);
+            let e = f.extent();
+            let centre = (0.5 * e).extend(0.0);
+            let size = e.max_element();
+            let cams = [
+                // Along the strip, across it, straight down, and away from it.
+                camera(centre - DVec3::new(0.6 * e.x, 0.6 * e.y, -0.1 * size), centre),
+                camera(centre + DVec3::new(0.3 * size, -0.3 * size, 0.2 * size), centre),
+                camera(centre + DVec3::new(0.0, 1e-3 * size, 0.1 * size), centre),
+                camera(
+                    centre + DVec3::new(2.0 * size, 0.0, 10.0),
+                    centre + DVec3::new(3.0 * size, 0.0, 0.0),
+                ),
+            ];
+            for cam in cams {
+                let cam = Camera {
+                    near: 1e-3 * size,
+                    far: 100.0 * size,
+                    ..cam
+                };
+                for alignment in [SketchAlignment::View, SketchAlignment::Axes] {
+                    let what = format!("{columns}x{rows} at {spacing} m, {alignment:?}, eye {}", cam.eye);
+                    let region = SketchRegion::for_view(&f, &cam, 4.0 / 3.0, alignment).expect(&what);
+                    let (s, t) = (region.side_s.length(), region.side_t.length());
+                    assert!(
+                        s > 0.0 && t > 0.0 && s.is_finite() && t.is_finite(),
+                        "{what}: sides {s}, {t}"
+                    );
+                    let map = SketchMap::resample(&f, region, 8).expect(&what);
+                    assert!(map.geometry.iter().all(|p| p.is_finite()), "{what}");
+                    if alignment == SketchAlignment::Axes {
+                        let slack = 1e-9 * size;
+                        for p in &map.geometry {
+                            assert!(
+                                p.x >= -slack && p.y >= -slack && p.x <= e.x + slack && p.y <= e.y + slack,
+                                "{what}: texel {p} off the strip {e}"
+                            );
+                        }
+                    }
+                }
+            }
         }
     }
 }

@@ -94,7 +94,7 @@ impl GenerationPasses {
         for (i, flat) in inputs.tree.layers.iter().enumerate() {
             let name = format!(
                 "texturing.layer{i}.{}",
-                flat.layer.name.replace(char::is_whitespace, "_")
+                crate::error::printable(&flat.layer.name.replace(char::is_whitespace, "_"))
             );
             let pipeline = layer_pipeline.clone();
             let mut pass = graph

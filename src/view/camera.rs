@@ -1,7 +1,7 @@
 //! The pinhole camera of the CLI contract: world right-handed, +Z up,
 //! vertical field of view, image row 0 at the top.
 
-use glam::{DMat4, DQuat, DVec3, DVec4, Mat4};
+use glam::{DMat4, DQuat, DVec2, DVec3, DVec4, Mat4};
 
 use crate::error::{Error, Result};
 
@@ -14,6 +14,8 @@ pub const MIN_NEAR: f64 = 1e-6;
 pub const MAX_FAR: f64 = 1e9;
 /// The largest far / near ratio the 32-bit depth buffer resolves.
 pub const MAX_DEPTH_RATIO: f64 = 1e10;
+/// The steepest view of [`Camera::overview`], degrees below the horizontal.
+pub const MAX_OVERVIEW_ELEVATION_DEG: f64 = 80.0;
 
 /// `x` in few characters: plain between 10⁻³ and 10⁷, else in scientific
 /// notation (`1e300`, not three hundred digits).
@@ -26,7 +28,7 @@ pub fn short(x: f64) -> String {
 }
 
 /// A vector as `X,Y,Z` with [`short`] components.
-fn short_vec(v: DVec3) -> String {
+pub(crate) fn short_vec(v: DVec3) -> String {
     format!("{},{},{}", short(v.x), short(v.y), short(v.z))
 }
 
@@ -119,6 +121,76 @@ impl Camera {
             ));
         }
         Ok(())
+    }
+
+    /// The automatic camera of a terrain spanning `[0, extent.x]×[0,
+    /// extent.y]×[lo, hi]`: from beyond its southern edge, above the highest
+    /// point, looking at the centre, with clip planes that hold the whole
+    /// terrain. Valid ([`Camera::validate`]) for the box of every legal
+    /// height field (sides of at least a millimetre, heights within
+    /// ±10⁶ m; [`crate::io::heightmap`]), however thin, flat, steep or large:
+    ///
+    /// * the view is at most [`MAX_OVERVIEW_ELEVATION_DEG`] from the
+    ///   horizontal, so a terrain far higher than wide is seen from the side,
+    ///   not straight down along `up`;
+    /// * the eye is at least 10⁻⁸ of the target's distance from the origin
+    ///   away from the target, so the two differ at their magnitude;
+    /// * eye and target are clamped to ±[`MAX_COORDINATE`] (a terrain
+    ///   larger than that is shown in part);
+    /// * near is at most half the eye's distance to the terrain (a
+    ///   millimetre terrain is not clipped away), far reaches its farthest
+    ///   corner, both within [`MIN_NEAR`], [`MAX_FAR`] and
+    ///   [`MAX_DEPTH_RATIO`].
+    ///
+    /// For ordinary terrains (wider than high, within the limits) this is
+    /// the camera of earlier versions unchanged.
+    pub fn overview(extent: DVec2, lo: f64, hi: f64) -> Camera {
+        let size = extent.x.max(extent.y);
+        let relief = hi - lo;
+        let mut target = DVec3::new(extent.x * 0.5, extent.y * 0.5, lo + relief * 0.3);
+        let mut eye = DVec3::new(extent.x * 0.5, -extent.y * 0.12, hi + relief * 0.6 + size * 0.08);
+        // Not steeper than the limit: move back south.
+        let (run, rise) = (target.y - eye.y, eye.z - target.z);
+        let max_slope = MAX_OVERVIEW_ELEVATION_DEG.to_radians().tan();
+        if rise > run * max_slope {
+            eye.y = target.y - rise / max_slope;
+        }
+        // Far enough from the target to tell them apart at its magnitude
+        // (a millimetre terrain a thousand kilometres up).
+        let offset = eye - target;
+        let min_distance = 1e-8 * target.length().max(1.0);
+        if offset.length() < min_distance {
+            eye = target + offset * (min_distance / offset.length());
+        }
+        let limit = DVec3::splat(MAX_COORDINATE);
+        // eye.y < 0 < target.y before and after clamping: never equal.
+        (eye, target) = (eye.clamp(-limit, limit), target.clamp(-limit, limit));
+        let (box_min, box_max) = (DVec3::new(0.0, 0.0, lo), extent.extend(hi));
+        let nearest = eye.distance(eye.clamp(box_min, box_max));
+        let farthest = (0..8)
+            .map(|k| {
+                let corner = DVec3::new(
+                    if k & 1 == 0 { box_min.x } else { box_max.x },
+                    if k & 2 == 0 { box_min.y } else { box_max.y },
+                    if k & 4 == 0 { box_min.z } else { box_max.z },
+                );
+                eye.distance(corner)
+            })
+            .fold(0.0, f64::max);
+        // Ten times the larger of the terrain's size and its height range
+        // (the eye stands above the highest point, and a small steep field
+        // would otherwise lie beyond the far plane), and past the farthest corner.
+        let far = (size.max(relief) * 10.0).max(farthest * 1.5).min(MAX_FAR);
+        let near = (size * 1e-4).max(0.1).min(0.5 * nearest);
+        let near = near.max(MIN_NEAR).max(far / MAX_DEPTH_RATIO).min(0.5 * far);
+        Camera {
+            eye,
+            target,
+            up: DVec3::Z,
+            fov_y_deg: 50.0,
+            near,
+            far,
+        }
     }
 
     /// Unit forward axis (view-space depth is measured along it).
@@ -316,5 +388,65 @@ mod tests {
             right.x / right.w > 0.0,
             "-Y is to the right when looking along +X with +Z up"
         );
+    }
+
+    /// The automatic camera is valid for the box of every legal height
+    /// field: millimetre squares, strips ten million times longer than
+    /// wide, terrains kilometres beyond the coordinate limit, flat and
+    /// 2000 km high ones. Where the limits allow, near stops short of the
+    /// terrain and far reaches its farthest corner.
+    #[test]
+    fn the_overview_is_valid_for_every_legal_terrain() {
+        let sides = [1e-3, 30.0, 61_410.0, 2.048e8, 32_767.0 * 1e5];
+        let heights = [
+            (0.0, 0.0),
+            (0.0, 100.0),
+            (-1e6, 1e6),
+            (1e6, 1e6),
+            (-1e6, -1e6),
+            (-3.5, 0.25),
+        ];
+        for x in sides {
+            for y in sides {
+                for (lo, hi) in heights {
+                    let extent = DVec2::new(x, y);
+                    let c = Camera::overview(extent, lo, hi);
+                    let what = format!("{extent} × {lo}..{hi}: {c:?}");
+                    c.validate().unwrap_or_else(|e| panic!("{what}: {e}"));
+                    let forward = c.forward();
+                    let steepness = (-forward.z).asin().to_degrees();
+                    assert!(steepness <= MAX_OVERVIEW_ELEVATION_DEG + 1e-6, "{what}: {steepness}°");
+                    if c.eye.abs().max_element() < MAX_COORDINATE && extent.max_element() < MAX_COORDINATE {
+                        let (lo3, hi3) = (DVec3::new(0.0, 0.0, lo), extent.extend(hi));
+                        assert!(
+                            c.near < c.eye.distance(c.eye.clamp(lo3, hi3)),
+                            "{what}: near clips the terrain"
+                        );
+                        let far = c.eye.distance(lo3).max(c.eye.distance(hi3));
+                        assert!(c.far >= far.min(MAX_FAR), "{what}: far stops short of the terrain");
+                    }
+                }
+            }
+        }
+    }
+
+    /// Ordinary terrains keep the automatic camera of earlier versions.
+    #[test]
+    fn the_overview_of_an_ordinary_terrain_is_unchanged() {
+        for (extent, lo, hi) in [
+            (DVec2::new(10_240.0, 10_240.0), 12.0, 900.0),
+            (DVec2::new(5_000.0, 8_000.0), -40.0, 2_500.0),
+        ] {
+            let size: f64 = extent.max_element();
+            let old = Camera {
+                eye: DVec3::new(extent.x * 0.5, -extent.y * 0.12, hi + (hi - lo) * 0.6 + size * 0.08),
+                target: DVec3::new(extent.x * 0.5, extent.y * 0.5, lo + (hi - lo) * 0.3),
+                up: DVec3::Z,
+                fov_y_deg: 50.0,
+                near: (size * 1e-4).max(0.1),
+                far: size.max(hi - lo) * 10.0,
+            };
+            assert_eq!(Camera::overview(extent, lo, hi), old);
+        }
     }
 }

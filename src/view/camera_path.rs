@@ -36,10 +36,10 @@
 use std::f64::consts::TAU;
 use std::path::Path;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use serde::Deserialize;
 
-use super::camera::Camera;
+use super::camera::{self, Camera, MAX_COORDINATE};
 use crate::error::{Error, Result};
 
 /// Latest keyframe time (seconds); times lie in `0..=MAX_KEYFRAME_TIME`, so
@@ -49,6 +49,11 @@ pub const MAX_KEYFRAME_TIME: f64 = 1e6;
 pub const MAX_KEYFRAME_COORDINATE: f64 = 1e7;
 /// Most keyframes in a path.
 pub const MAX_KEYFRAMES: usize = 10_000;
+
+/// Smallest ratio of an orbit's radius to the eye's distance from the
+/// centre (the sine of the angle between the view and the vertical):
+/// steeper orbits look straight down, along the default up vector.
+pub const MIN_ORBIT_SLOPE: f64 = 1e-4;
 
 /// A camera position at a time (seconds).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -79,6 +84,32 @@ pub struct Orbit {
 }
 
 impl Orbit {
+    /// The automatic orbit of a terrain spanning `[0, extent.x]×[0,
+    /// extent.y]×[lo, hi]`: one turn from the south around its centre at
+    /// 60 % of its half-size, 0.08 of its size above the highest point.
+    /// Valid ([`Orbit::validate`]) for the box of every legal height field:
+    /// centre, radius and height are kept within half of
+    /// [`MAX_COORDINATE`] (a larger terrain is circled in part), and the
+    /// radius is at least a fifth of the height (a terrain far higher than
+    /// wide is circled, not looked at from straight above), and the eye
+    /// stays apart from the centre at the centre's magnitude.
+    pub fn around(extent: DVec2, lo: f64, hi: f64) -> Orbit {
+        let size = extent.x.max(extent.y);
+        let limit = 0.5 * MAX_COORDINATE;
+        let centre = DVec3::new(extent.x * 0.5, extent.y * 0.5, lo).min(DVec3::splat(limit));
+        let height = (hi - lo + size * 0.08).min(limit);
+        let radius = (size * 0.3).min(limit).max(height * 0.2);
+        // Far enough from the centre to tell them apart at its magnitude.
+        let grow = (2e-8 * centre.abs().max_element().max(1.0) / radius.hypot(height)).max(1.0);
+        Orbit {
+            centre,
+            radius: radius * grow,
+            height: height * grow,
+            turns: 1.0,
+            start_angle_deg: DEFAULT_START_ANGLE_DEG,
+        }
+    }
+
     /// Eye position at normalised time `t` (clamped to [0, 1]).
     pub fn eye_at(&self, t: f64) -> DVec3 {
         let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
@@ -86,7 +117,11 @@ impl Orbit {
         self.centre + DVec3::new(self.radius * angle.cos(), self.radius * angle.sin(), self.height)
     }
 
-    /// Checks that all numbers are finite and the radius is positive.
+    /// Checks that all numbers are finite, the radius is positive, and
+    /// every camera on the orbit is valid ([`Camera::validate`] with up
+    /// +Z): the eye within ±[`MAX_COORDINATE`], not straight above the
+    /// centre (radius at least [`MIN_ORBIT_SLOPE`] of the distance) and not
+    /// on it.
     pub fn validate(&self) -> Result<()> {
         let finite = self.centre.is_finite()
             && [self.radius, self.height, self.turns, self.start_angle_deg]
@@ -99,6 +134,45 @@ impl Orbit {
             return Err(Error::invalid(
                 "orbit",
                 format!("radius {} must be positive", self.radius),
+            ));
+        }
+        // The cameras of the orbit, checked here so that their problems are
+        // reported as the orbit's (not as an eye the user never gave).
+        let reach = self.centre.truncate().abs().max_element() + self.radius;
+        let (top, centre) = ((self.centre.z + self.height).abs(), self.centre.abs().max_element());
+        if reach > MAX_COORDINATE || top > MAX_COORDINATE || centre > MAX_COORDINATE {
+            return Err(Error::invalid(
+                "orbit",
+                format!(
+                    "centre {}, radius {} and height {} take the eye beyond ±{MAX_COORDINATE:e} m, \
+                     the largest coordinate a camera may have",
+                    camera::short_vec(self.centre),
+                    camera::short(self.radius),
+                    camera::short(self.height)
+                ),
+            ));
+        }
+        let distance = self.radius.hypot(self.height);
+        if self.radius < MIN_ORBIT_SLOPE * distance {
+            return Err(Error::invalid(
+                "orbit",
+                format!(
+                    "radius {} is too small for height {}: the eye would look straight down",
+                    camera::short(self.radius),
+                    camera::short(self.height)
+                ),
+            ));
+        }
+        if distance < 1e-8 * centre.max(1.0) {
+            return Err(Error::invalid(
+                "orbit",
+                format!(
+                    "radius {} and height {} are too small for a centre {} m from the origin: \
+                     the eye would sit on the centre",
+                    camera::short(self.radius),
+                    camera::short(self.height),
+                    camera::short(centre)
+                ),
             ));
         }
         Ok(())

@@ -182,7 +182,8 @@ impl Rig {
     /// `width` wide.
     pub fn ring6(width: u32) -> Rig {
         let names = ["front", "front_left", "rear_left", "rear", "rear_right", "front_right"];
-        let height = (width * 3 / 4).max(1);
+        // In u64: any u32 width (the size checks of `specs` refuse a wrong one).
+        let height = (u64::from(width) * 3 / 4).max(1) as u32;
         // 60° across at 4:3: tan(fov_y/2) = tan(30°)·3/4.
         let fov_y = 2.0 * (30f64.to_radians().tan() * 0.75).atan().to_degrees();
         let views = names
@@ -299,8 +300,8 @@ impl Rig {
             .enumerate()
             .map(|(i, raw)| {
                 let label = match &raw.name {
-                    Some(n) => format!("view '{n}'"),
-                    None => format!("view {}", i + 1),
+                    Some(n) if !n.is_empty() => format!("view '{n}'"),
+                    _ => format!("view {}", i + 1),
                 };
                 raw.into_view()
                     .map_err(|e| Error::input(origin, format!("{label}: {e}")))
@@ -402,6 +403,9 @@ impl RawView {
     fn into_view(self) -> std::result::Result<RigView, String> {
         check_numbers(&self)?;
         let name = self.name.ok_or("has no name")?;
+        // Every view of a rig file is named, even a lone one: its name
+        // makes the output file names (`{view}`).
+        check_name(&name).map_err(|_| format!("name '{name}': use 1 to 64 letters, digits, '-' or '_'"))?;
         let v3 = |a: [f64; 3]| DVec3::from_array(a);
         let pose = match (self.eye, self.target, self.position, self.yaw_pitch_roll) {
             (Some(eye), Some(target), None, None) => RigPose::World {
@@ -484,6 +488,22 @@ mod tests {
             .all(|c| c.eye == rig_camera().eye && c.image_up().abs_diff_eq(DVec3::Z, 1e-12)));
     }
 
+    /// Any width gives a ring (3/4 of u32::MAX fits a u32); one beyond the
+    /// image limits is refused by `specs`, naming the width, not a panic
+    /// on overflow.
+    #[test]
+    fn ring6_of_any_width_is_checked_not_overflowed() {
+        for width in [0, 1, 16_384, 16_385, u32::MAX / 3 + 1, u32::MAX] {
+            let rig = Rig::ring6(width);
+            let (w, h) = rig.views[0].size.unwrap();
+            assert_eq!((w, u64::from(h)), (width, (u64::from(width) * 3 / 4).max(1)));
+            if !(1..=16_384).contains(&width) {
+                let e = rig.specs((64, 48)).unwrap_err();
+                assert_eq!(e.parameter(), Some("width"), "{e}");
+            }
+        }
+    }
+
     #[test]
     fn relative_poses_follow_the_rig() {
         let text = r#"
@@ -533,7 +553,11 @@ mod tests {
             ),
             ("[[view]]\nname = \"a\"\nfx = 100", "either fov_y or all of"),
             ("[[view]]\nname = \"a\"\nfov_y = 200", "fov_y 200"),
-            ("[[view]]\nname = \"a b\"", "view.name"),
+            ("[[view]]\nname = \"a b\"", "view 'a b': name 'a b'"),
+            // A lone view named "" (accepted before: its files had no name).
+            ("[[view]]\nname = \"\"", "view 1: name ''"),
+            ("[[view]]\nname = \"a\"\n[[view]]\nname = \"\"", "view 2: name ''"),
+            ("[[view]]\nname = \"a\\u001b[2J\"", "name 'a\\u{1b}[2J'"),
             ("[[view]]\nname = \"a\"\n[[view]]\nname = \"a\"", "used twice"),
             ("[[view]]\nname = \"a\"\nwidth = 0\nheight = 10", "width"),
             ("[[view]]\nname = \"a\"\nspeed = 3", "unknown field"),

@@ -19,7 +19,7 @@ use super::memory::Garbage;
 use super::validation::{messenger_info, ValidationReport};
 use crate::error::{Error, Result};
 
-const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+pub(super) const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
 /// How to create a [`Context`].
 #[derive(Clone, Debug, Default)]
@@ -156,8 +156,20 @@ impl Context {
         // well-behaved shared library.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::Loader(e.to_string()))?;
         // SAFETY: plain queries with no external state.
-        let layers = unsafe { entry.enumerate_instance_layer_properties() }
-            .map_err(vk_err("vkEnumerateInstanceLayerProperties"))?;
+        // The loader fails to list the layers when a manifest it finds is
+        // malformed (reported as a host allocation failure). Layers are only
+        // needed for validation: without it go on with none; with it, say
+        // that the validation layer could not be loaded, and where from.
+        let layers = match unsafe { entry.enumerate_instance_layer_properties() } {
+            Ok(layers) => layers,
+            Err(_) if !options.validation => Vec::new(),
+            Err(result) => {
+                return Err(super::validation::layer_error(
+                    "vkEnumerateInstanceLayerProperties",
+                    result,
+                ))
+            }
+        };
         let layer_version = layers
             .iter()
             .find(|l| l.layer_name_as_c_str().ok() == Some(VALIDATION_LAYER))
@@ -210,15 +222,8 @@ impl Context {
                 .push_next(&mut validation_features);
         }
         // SAFETY: every pointer in the create info refers to locals that outlive the call.
-        let instance = unsafe { entry.create_instance(&instance_info, None) }.map_err(|e| match e {
-            vk::Result::ERROR_INCOMPATIBLE_DRIVER => {
-                Error::Device("no Vulkan 1.3 driver found (run tools/install-vulkan-runtime.sh)".into())
-            }
-            other => Error::Vulkan {
-                call: "vkCreateInstance",
-                result: other,
-            },
-        })?;
+        let instance = unsafe { entry.create_instance(&instance_info, None) }
+            .map_err(|e| super::validation::instance_error(e, options.validation))?;
 
         let debug_instance = debug_utils.then(|| ash::ext::debug_utils::Instance::new(&entry, &instance));
         let messenger = match (&debug_instance, report.as_deref()) {

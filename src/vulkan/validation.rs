@@ -143,6 +143,64 @@ unsafe extern "system" fn debug_callback(
     vk::FALSE
 }
 
+/// The layer search paths the user set (`VK_LAYER_PATH`,
+/// `VK_ADD_LAYER_PATH`), as `NAME=VALUE`.
+pub(super) fn layer_paths() -> Vec<String> {
+    ["VK_LAYER_PATH", "VK_ADD_LAYER_PATH"]
+        .iter()
+        .filter_map(|v| std::env::var_os(v).map(|p| format!("{v}={}", p.to_string_lossy())))
+        .collect()
+}
+
+/// The validation layer could not be loaded: `call` failed with `result`.
+/// Names the layer search path the user set, where a broken manifest or
+/// library usually is.
+pub(super) fn layer_error(call: &str, result: vk::Result) -> crate::error::Error {
+    let set = layer_paths();
+    let hint = match set.is_empty() {
+        true => "check the installed layer manifests (tools/install-vulkan-runtime.sh)".to_string(),
+        false => format!(
+            "check the layer manifests (.json) and libraries under {}",
+            set.join(" and ")
+        ),
+    };
+    crate::error::Error::Device(crate::error::printable(&format!(
+        "validation requested but the validation layer {} could not be loaded ({call}: {result}); {hint}",
+        super::context::VALIDATION_LAYER.to_string_lossy()
+    )))
+}
+
+/// The error of a failed `vkCreateInstance` (`validation`: the validation
+/// layer was asked for): a missing driver, a layer that could not be loaded,
+/// a malformed manifest under the layer path the user set (the loader
+/// reports it as a host allocation failure), or the plain Vulkan error.
+pub(super) fn instance_error(result: vk::Result, validation: bool) -> crate::error::Error {
+    use crate::error::Error;
+    match result {
+        vk::Result::ERROR_INCOMPATIBLE_DRIVER => {
+            Error::Device("no Vulkan 1.3 driver found (run tools/install-vulkan-runtime.sh)".into())
+        }
+        vk::Result::ERROR_OUT_OF_HOST_MEMORY if !layer_paths().is_empty() => {
+            Error::Device(crate::error::printable(&format!(
+                "vkCreateInstance failed ({result}) while the loader read the layer manifests under {}; \
+                 one is probably malformed",
+                layer_paths().join(" and ")
+            )))
+        }
+        vk::Result::ERROR_LAYER_NOT_PRESENT
+        | vk::Result::ERROR_EXTENSION_NOT_PRESENT
+        | vk::Result::ERROR_INITIALIZATION_FAILED
+            if validation =>
+        {
+            layer_error("vkCreateInstance", result)
+        }
+        other => Error::Vulkan {
+            call: "vkCreateInstance",
+            result: other,
+        },
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

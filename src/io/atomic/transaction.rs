@@ -228,12 +228,35 @@ impl OutputTransaction {
         Ok(())
     }
 
+    /// The output added as `path`: by the path as given, else by its
+    /// canonical form. Its folder may have vanished since it was added:
+    /// that is the output's error, naming it, not an internal one.
     fn find(&mut self, path: &Path, kind: Kind) -> Result<&mut Output> {
-        let canonical = parent_dir(path)
-            .canonicalize()
-            .ok()
-            .zip(path.file_name())
-            .map(|(d, n)| d.join(n));
+        if let Some(k) = self
+            .outputs
+            .iter()
+            .position(|o| o.shown == path && o.entry.kind == kind)
+        {
+            let output = &mut self.outputs[k];
+            let dir = parent_dir(&output.entry.target);
+            if !dir.is_dir() {
+                return Err(Error::output(
+                    path,
+                    format!("its folder {} no longer exists", dir.display()),
+                ));
+            }
+            return Ok(output);
+        }
+        let dir = parent_dir(path);
+        let canonical = match dir.canonicalize() {
+            Ok(d) => path.file_name().map(|n| d.join(n)),
+            Err(e) => {
+                return Err(Error::output(
+                    path,
+                    format!("its folder {}: {}", dir.display(), one_line(e)),
+                ))
+            }
+        };
         self.outputs
             .iter_mut()
             .find(|o| Some(&o.entry.target) == canonical.as_ref() && o.entry.kind == kind)

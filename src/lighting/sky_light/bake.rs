@@ -220,7 +220,7 @@ impl SkyLightBake {
         let field = &*SkyLightBake::fitted(ctx, field, settings);
         let key = BakeKey::new(field, settings);
         let Some(dir) = cache else {
-            return SkyLightBake::compute(ctx, field, settings, progress);
+            return SkyLightBake::compute_fitted(ctx, field, settings, progress);
         };
         let path = cache::cache_path(dir, &key);
         match cache::load(&path, &key) {
@@ -232,7 +232,7 @@ impl SkyLightBake {
             Ok(None) => {}
             Err(e) => log::warn!("sky-light cache not read, baking anew: {e}"),
         }
-        let bake = SkyLightBake::compute(ctx, field, settings, progress)?;
+        let bake = SkyLightBake::compute_fitted(ctx, field, settings, progress)?;
         if let Err(e) = cache::store(&path, &bake.read_back(ctx)?) {
             log::warn!("sky-light cache not written, rendering without it: {e}");
         }
@@ -268,7 +268,18 @@ impl SkyLightBake {
     ) -> Result<SkyLightBake> {
         settings.validate()?;
         field.validate(Path::new("sky-light height field"))?;
-        let field = &*SkyLightBake::fitted(ctx, field, settings);
+        SkyLightBake::compute_fitted(ctx, &SkyLightBake::fitted(ctx, field, settings), settings, progress)
+    }
+
+    /// [`SkyLightBake::compute`] of a field already [`SkyLightBake::fitted`]
+    /// (and validated before fitting: an area average of a legal field may
+    /// have a spacing beyond [`crate::io::heightmap::MAX_SPACING`]).
+    fn compute_fitted(
+        ctx: &Context,
+        field: &HeightField,
+        settings: &BakeSettings,
+        progress: &mut dyn FnMut(f32),
+    ) -> Result<SkyLightBake> {
         let (columns, rows) = (field.columns, field.rows);
         let texels = u64::from(columns) * u64::from(rows);
         let (k, stride) = (settings.azimuths, settings.stride());

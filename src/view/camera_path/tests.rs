@@ -223,6 +223,43 @@ fn orbit_validation_names_the_orbit() {
     orbit_around(DVec3::ZERO, 1.0, 0.0, 0.0).validate().unwrap();
 }
 
+/// An orbit either fails its own validation, naming the orbit, or every
+/// camera on it is valid: huge radii and heights, eyes straight above the
+/// centre, tiny orbits far from the origin (these used to pass and fail
+/// later as the camera's eye or up, which the user never gave).
+#[test]
+fn a_valid_orbit_gives_valid_cameras() {
+    let base = base();
+    let centres = [
+        DVec3::ZERO,
+        DVec3::new(5e7, -9e7, 3e4),
+        DVec3::new(1e8, 0.0, 0.0),
+        DVec3::splat(-2e8),
+    ];
+    let lengths = [1e-9, 1e-3, 1.0, 3e3, 5e7, 1e9, 1e300];
+    for centre in centres {
+        for radius in lengths {
+            for height in lengths.iter().flat_map(|&h| [h, -h, 0.0]) {
+                let orbit = orbit_around(centre, radius, height, 1.25);
+                let path = CameraPath::Orbit(orbit);
+                match orbit.validate() {
+                    Ok(()) => {
+                        for i in 0..9 {
+                            let c = path.sample_at(i, 9, &base);
+                            c.validate().unwrap_or_else(|e| panic!("{orbit:?} frame {i}: {e}"));
+                        }
+                    }
+                    Err(e) => {
+                        assert_eq!(e.parameter(), Some("orbit"), "{orbit:?}: {e}");
+                        let line = e.to_string();
+                        assert!(line.len() < 300, "{line}");
+                    }
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn sample_counts_and_valid_cameras() {
     let paths = [
@@ -301,4 +338,30 @@ fn keyframe_files_are_read_through_read_input_as_utf8() {
     assert!(message.ends_with("not UTF-8 text"), "{message}");
     let message = load_keyframes(&std::env::temp_dir()).unwrap_err().to_string();
     assert!(message.contains("is a directory"), "{message}");
+}
+
+/// The automatic orbit is valid for the box of every legal height field,
+/// and unchanged for an ordinary one.
+#[test]
+fn the_automatic_orbit_is_valid_for_every_legal_terrain() {
+    let sides = [1e-3, 30.0, 61_410.0, 2.048e8, 32_767.0 * 1e5];
+    for x in sides {
+        for y in sides {
+            for (lo, hi) in [(0.0, 0.0), (0.0, 100.0), (-1e6, 1e6), (1e6, 1e6), (-1e6, -1e6)] {
+                let orbit = Orbit::around(DVec2::new(x, y), lo, hi);
+                orbit
+                    .validate()
+                    .unwrap_or_else(|e| panic!("{x}×{y}, {lo}..{hi}: {orbit:?}: {e}"));
+            }
+        }
+    }
+    assert_eq!(
+        Orbit::around(DVec2::new(10_240.0, 8_000.0), 100.0, 1_300.0),
+        orbit_around(
+            DVec3::new(5_120.0, 4_000.0, 100.0),
+            10_240.0 * 0.3,
+            1_200.0 + 10_240.0 * 0.08,
+            1.0
+        )
+    );
 }

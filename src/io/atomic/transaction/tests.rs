@@ -523,3 +523,28 @@ fn an_atomic_write_flushes_the_file_before_renaming_and_the_directory_after() {
     assert_eq!(steps, [Step::Write, Step::SyncFile, Step::Rename, Step::SyncDir]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// An output whose folder vanished after it was added is that output's
+/// error, naming it and the folder (it was "internal error: the output
+/// was not added"), for files and folders alike.
+#[test]
+fn a_vanished_folder_is_the_outputs_error() {
+    let dir = scratch("vanished");
+    let sub = dir.join("sub");
+    std::fs::create_dir(&sub).unwrap();
+    let (file, frames) = (sub.join("o.png"), sub.join("frames"));
+    let mut tx = OutputTransaction::new();
+    tx.add_file(&file, "--out").unwrap();
+    tx.add_dir(&frames, "--out-dir").unwrap();
+    std::fs::remove_dir(&sub).unwrap();
+    for e in [
+        tx.stage_bytes(&file, b"x").unwrap_err(),
+        tx.stage_dir(&frames).unwrap_err(),
+    ] {
+        let line = e.to_string();
+        assert!(line.contains("sub") && line.contains("no longer exists"), "{line}");
+        assert!(!line.contains("internal error"), "{line}");
+    }
+    drop(tx);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
