@@ -27,17 +27,29 @@ pub struct Footprint {
     pub host: u64,
     /// Bytes of device-local (GPU) memory.
     pub device: u64,
+    /// Bytes of the largest single device allocation (an image or a
+    /// buffer), checked against the device's `maxMemoryAllocationSize` and
+    /// `maxBufferSize`.
+    pub device_allocation: u64,
 }
 
 impl Footprint {
     /// `bytes` of host memory only.
     pub fn host(bytes: u64) -> Footprint {
-        Footprint { host: bytes, device: 0 }
+        Footprint {
+            host: bytes,
+            ..Footprint::default()
+        }
     }
 
-    /// `bytes` of device memory only.
-    pub fn device(bytes: u64) -> Footprint {
-        Footprint { host: 0, device: bytes }
+    /// `bytes` of device memory only, in allocations of at most
+    /// `largest` bytes each.
+    pub fn device(bytes: u64, largest: u64) -> Footprint {
+        Footprint {
+            device: bytes,
+            device_allocation: largest,
+            ..Footprint::default()
+        }
     }
 
     /// `count` items of `host_each` and `device_each` bytes, saturating.
@@ -45,14 +57,27 @@ impl Footprint {
         Footprint {
             host: count.saturating_mul(host_each),
             device: count.saturating_mul(device_each),
+            device_allocation: 0,
         }
     }
 
-    /// The sum of two footprints, saturating.
+    /// The sum of two footprints, saturating (the larger of the two
+    /// largest allocations).
     pub fn plus(self, other: Footprint) -> Footprint {
         Footprint {
             host: self.host.saturating_add(other.host),
             device: self.device.saturating_add(other.device),
+            device_allocation: self.device_allocation.max(other.device_allocation),
+        }
+    }
+
+    /// `count` times this footprint, saturating (the largest allocation
+    /// stays as it is).
+    pub fn times(self, count: u64) -> Footprint {
+        Footprint {
+            host: self.host.saturating_mul(count),
+            device: self.device.saturating_mul(count),
+            device_allocation: self.device_allocation,
         }
     }
 }
@@ -72,6 +97,11 @@ pub struct MemoryLimits {
 
 /// Environment variable that overrides the host memory available, in MiB.
 pub const HOST_MEMORY_ENV: &str = "ALPENGLOW_HOST_MEMORY_MB";
+
+/// Environment variable that caps the device memory (the heap and the
+/// largest single allocation) below what the device reports, in MiB: for
+/// tests of the bounds without huge images, and for sharing a GPU.
+pub const DEVICE_MEMORY_ENV: &str = "ALPENGLOW_DEVICE_MEMORY_MB";
 
 impl MemoryLimits {
     /// The host's available memory, with no device known yet.
@@ -98,6 +128,16 @@ impl MemoryLimits {
                 ),
             ));
         }
+        if footprint.device_allocation > self.device_allocation {
+            return Err(Error::invalid(
+                option,
+                format!(
+                    "{what} need a single GPU allocation of about {}; the device allows at most {} in one",
+                    format_bytes(footprint.device_allocation),
+                    format_bytes(self.device_allocation)
+                ),
+            ));
+        }
         if footprint.device > self.device {
             return Err(Error::invalid(
                 option,
@@ -110,16 +150,37 @@ impl MemoryLimits {
         }
         Ok(())
     }
+
+    /// Whether `footprint` fits these limits.
+    pub fn fits(&self, footprint: Footprint) -> bool {
+        self.check("", "", footprint).is_ok()
+    }
+
+    /// These limits with the device side capped by
+    /// [`DEVICE_MEMORY_ENV`] when it is set.
+    pub fn with_device_override(self) -> MemoryLimits {
+        match env_mib(DEVICE_MEMORY_ENV) {
+            Some(cap) => MemoryLimits {
+                device: self.device.min(cap),
+                device_allocation: self.device_allocation.min(cap),
+                ..self
+            },
+            None => self,
+        }
+    }
+}
+
+/// An environment variable's value in MiB, in bytes.
+fn env_mib(name: &str) -> Option<u64> {
+    let mib = std::env::var(name).ok()?.trim().parse::<u64>().ok()?;
+    Some(mib.saturating_mul(1 << 20))
 }
 
 /// Bytes of host memory available: `ALPENGLOW_HOST_MEMORY_MB` when set,
 /// else `MemAvailable` of `/proc/meminfo`, else 8 GiB.
 pub fn host_available_bytes() -> u64 {
-    if let Some(mib) = std::env::var(HOST_MEMORY_ENV)
-        .ok()
-        .and_then(|v| v.trim().parse::<u64>().ok())
-    {
-        return mib.saturating_mul(1 << 20);
+    if let Some(bytes) = env_mib(HOST_MEMORY_ENV) {
+        return bytes;
     }
     std::fs::read_to_string("/proc/meminfo")
         .ok()
@@ -177,7 +238,11 @@ mod tests {
         };
         assert!(limits.check("--rocks", "10 boulders", Footprint::host(1000)).is_ok());
         let e = limits
-            .check("--rocks", "100000000 boulders", Footprint::per_item(100_000_000, 128, 0))
+            .check(
+                "--rocks",
+                "100000000 boulders",
+                Footprint::per_item(100_000_000, 128, 0),
+            )
             .unwrap_err()
             .to_string();
         assert_eq!(
@@ -185,9 +250,22 @@ mod tests {
             "invalid --rocks: 100000000 boulders need about 11.9 GiB of host memory; 1.0 GiB is available"
         );
         let e = limits
-            .check("--width", "a 16384×16384 image", Footprint::device(3 << 30))
+            .check("--width", "16384×16384 pixels", Footprint::device(3 << 30, 1 << 30))
             .unwrap_err()
             .to_string();
         assert!(e.contains("3.0 GiB of GPU memory; the device has 2.0 GiB"), "{e}");
+        let e = limits
+            .check("--width", "16384×16384 pixels", Footprint::device(1 << 30, 4 << 30))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("a single GPU allocation of about 4.0 GiB; the device allows at most 1.0 GiB in one"),
+            "{e}"
+        );
+        assert!(limits.fits(Footprint::device(2 << 30, 1 << 30)));
+        assert_eq!(
+            Footprint::device(5, 3).plus(Footprint::device(1, 4)).times(2),
+            Footprint::device(12, 4)
+        );
     }
 }

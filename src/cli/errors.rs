@@ -66,6 +66,8 @@ const FLAGS: &[(&str, &str)] = &[
     ("from_image.sun_elevation_deg", "--sun-elevation"),
     ("from_image.snow_min_altitude", "--snow-min-altitude"),
     ("msaa", "--msaa"),
+    ("rocks", "--rocks"),
+    ("vegetation.density", "--vegetation-density"),
     ("shutter", "--shutter"),
     ("distortion", "--distortion"),
     ("lens.k1", "--distortion (k1)"),

@@ -8,9 +8,10 @@ use std::time::Instant;
 use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
 
+use alpenglow::budget::MemoryLimits;
 use alpenglow::points::build::estimate::complete_cloud;
 use alpenglow::points::build::input::{load_points_file, PointInput};
-use alpenglow::points::build::sampling::{sample_mesh, SamplingMethod, SamplingOptions};
+use alpenglow::points::build::sampling::{sample_mesh, sampling_footprint, SamplingMethod, SamplingOptions};
 use alpenglow::points::build::spt::{build_spt, epsilon_from_pixels, SptOptions};
 use alpenglow::points::build::spt_file::write_spt;
 
@@ -18,7 +19,9 @@ use super::args::{SamplingArg, SptBuildArgs};
 
 pub fn build(args: SptBuildArgs) -> Result<ExitCode> {
     let started = Instant::now();
-    let surfels = match load_points_file(&args.input)? {
+    let input = load_points_file(&args.input)?;
+    check_memory(&args, &input)?;
+    let surfels = match input {
         PointInput::Mesh(mesh) => sample_mesh(
             &mesh,
             &SamplingOptions {
@@ -60,4 +63,31 @@ pub fn build(args: SptBuildArgs) -> Result<ExitCode> {
         args.output.display()
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// The memory bound of the build ([`alpenglow::budget`]), before any
+/// sampling: a mesh's `--samples`, or a point cloud's point count (named by
+/// its file), against the host's available memory.
+fn check_memory(args: &SptBuildArgs, input: &PointInput) -> Result<()> {
+    let limits = MemoryLimits::host_only();
+    match input {
+        PointInput::Mesh(_) => limits.check(
+            "--samples",
+            &format!("{} samples", args.samples),
+            sampling_footprint(args.samples, sampling_method(args.sampling)),
+        )?,
+        PointInput::Points(cloud) => limits.check(
+            &args.input.display().to_string(),
+            &format!("its {} points", cloud.positions.len()),
+            sampling_footprint(cloud.positions.len(), SamplingMethod::Stratified),
+        )?,
+    }
+    Ok(())
+}
+
+fn sampling_method(arg: SamplingArg) -> SamplingMethod {
+    match arg {
+        SamplingArg::Stratified => SamplingMethod::Stratified,
+        SamplingArg::BlueNoise => SamplingMethod::BlueNoise,
+    }
 }

@@ -104,6 +104,8 @@ pub(crate) struct Shared {
     pub heap: ManuallyDrop<DescriptorHeap>,
     pub info: DeviceInfo,
     pub limits: vk::PhysicalDeviceLimits,
+    /// Heap and single-allocation limits ([`Context::memory_limits`]).
+    memory: super::device_memory::DeviceMemory,
     report: Option<Arc<ValidationReport>>,
 }
 
@@ -315,16 +317,22 @@ impl Context {
         v12 = v12.shader_buffer_int64_atomics(optional.shader_buffer_int64_atomics);
         let mut interlock =
             vk::PhysicalDeviceFragmentShaderInterlockFeaturesEXT::default().fragment_shader_pixel_interlock(true);
-        let extensions = [ash::ext::fragment_shader_interlock::NAME.as_ptr()];
+        let memory_budget = super::device_memory::offers_memory_budget(&instance, candidate.physical);
+        let mut extensions = Vec::new();
+        if optional.fragment_shader_pixel_interlock {
+            extensions.push(ash::ext::fragment_shader_interlock::NAME.as_ptr());
+        }
+        if memory_budget {
+            extensions.push(ash::ext::memory_budget::NAME.as_ptr());
+        }
         let mut device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_features(&base)
+            .enabled_extension_names(&extensions)
             .push_next(&mut v12)
             .push_next(&mut v13);
         if optional.fragment_shader_pixel_interlock {
-            device_info = device_info
-                .enabled_extension_names(&extensions)
-                .push_next(&mut interlock);
+            device_info = device_info.push_next(&mut interlock);
         }
         // SAFETY: the features were checked as supported by `inspect`; pointers are to locals.
         let device = match unsafe { instance.create_device(candidate.physical, &device_info, None) } {
@@ -391,6 +399,7 @@ impl Context {
             },
             validation: report.is_some(),
         };
+        let memory = super::device_memory::query(&instance, candidate.physical, memory_budget);
         let shared = Shared {
             _entry: entry,
             instance,
@@ -407,6 +416,7 @@ impl Context {
             heap: ManuallyDrop::new(heap),
             info,
             limits: props.limits,
+            memory,
             report,
         };
         log::info!("device: {} ({})", shared.info.name, shared.info.driver_info);
@@ -443,6 +453,19 @@ impl Context {
             Ok(allocator) => allocator.generate_report().total_allocated_bytes,
             Err(_) => 0,
         }
+    }
+
+    /// What this machine and device can take ([`crate::budget`]): the
+    /// host's available memory, the largest device-local heap (its
+    /// `VK_EXT_memory_budget` budget where offered) and the largest single
+    /// allocation, capped by `ALPENGLOW_DEVICE_MEMORY_MB` when set.
+    pub fn memory_limits(&self) -> crate::budget::MemoryLimits {
+        crate::budget::MemoryLimits {
+            device: self.shared.memory.heap,
+            device_allocation: self.shared.memory.allocation,
+            ..crate::budget::MemoryLimits::host_only()
+        }
+        .with_device_override()
     }
 
     /// The largest 2-D image side the device accepts.

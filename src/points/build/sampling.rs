@@ -115,6 +115,29 @@ pub struct SamplingOptions {
     pub seed: u64,
 }
 
+/// Host bytes each blue-noise candidate holds during elimination: the
+/// sample, its position (12 B) and k-d tree entry (16 B), weight (8 B),
+/// heap slot and position (8 B) and removal flag (1 B).
+const CANDIDATE_BYTES: u64 = std::mem::size_of::<Sample>() as u64 + 12 + 16 + 8 + 8 + 1;
+
+/// Host bytes per output surfel after sampling: the surfel, and the
+/// sequential point tree built from it (`build_spt`: about two nodes a
+/// surfel, each with its octree entry, 8 B).
+const SURFEL_BYTES: u64 =
+    std::mem::size_of::<Surfel>() as u64 + 2 * (std::mem::size_of::<super::spt::SptNode>() as u64 + 8);
+
+/// Host memory sampling `count` surfels with `method` and building their
+/// point tree needs at its peak ([`crate::budget`]): blue noise holds
+/// [`BLUE_NOISE_CANDIDATES`] candidates a surfel (about 550 B a surfel in
+/// all), stratified sampling the surfel and its tree (about 200 B).
+pub fn sampling_footprint(count: usize, method: SamplingMethod) -> crate::budget::Footprint {
+    let candidates = match method {
+        SamplingMethod::Stratified => 0,
+        SamplingMethod::BlueNoise => BLUE_NOISE_CANDIDATES as u64 * CANDIDATE_BYTES,
+    };
+    crate::budget::Footprint::per_item(count as u64, candidates + SURFEL_BYTES, 0)
+}
+
 /// Samples `options.count` surfels evenly (area-weighted) over the mesh
 /// (§10.1; method, attributes and radius in the module docs), with clip
 /// lines along the mesh's creases (§10.2.4, [`super::clip`]).
@@ -134,6 +157,11 @@ pub fn sample_mesh_traced(mesh: &TriangleMesh, options: &SamplingOptions) -> Res
     if count == 0 {
         return Err(Error::invalid("sample count", "must be positive"));
     }
+    crate::budget::MemoryLimits::host_only().check(
+        "sample count",
+        &format!("{count} samples"),
+        sampling_footprint(count, options.method),
+    )?;
     let prepared = Prepared::new(mesh)?;
     let radius =
         ((prepared.total_area / (std::f64::consts::PI * count as f64)).sqrt() as f32) * options.method.radius_overlap();
@@ -853,6 +881,25 @@ mod tests {
                 assert_eq!(clipped, 0);
             }
         }
+    }
+
+    #[test]
+    fn sample_counts_are_bounded_by_memory() {
+        // The sizes the estimate is made of, and what it comes to.
+        let blue = sampling_footprint(1, SamplingMethod::BlueNoise).host;
+        let stratified = sampling_footprint(1, SamplingMethod::Stratified).host;
+        println!("{blue} B a blue-noise sample, {stratified} B a stratified one");
+        assert!(
+            (400..=800).contains(&blue) && (100..=400).contains(&stratified),
+            "{blue} {stratified}"
+        );
+        assert_eq!(sampling_footprint(1000, SamplingMethod::BlueNoise).host, 1000 * blue);
+        assert_eq!(sampling_footprint(usize::MAX, SamplingMethod::BlueNoise).host, u64::MAX);
+        // 10⁸ samples need more than any test machine has left after this;
+        // the error comes before anything is sampled.
+        let e = sample_mesh(&unit_square(), &options(usize::MAX / 64, SamplingMethod::BlueNoise, 1)).unwrap_err();
+        assert_eq!(e.parameter(), Some("sample count"));
+        assert!(e.to_string().contains("of host memory;"), "{e}");
     }
 
     #[test]
