@@ -2,7 +2,7 @@
 //! frame's views, the height field and the point instances need, checked
 //! in [`super::Renderer::new`] against the device's limits before anything
 //! is allocated, with an error naming the setting at fault (`width/height`,
-//! `msaa`, `views`, `heights`, `points.instances`).
+//! `msaa`, `views`, `height field`, `point instances`).
 
 use crate::budget::{Footprint, MemoryLimits};
 use crate::error::Result;
@@ -133,9 +133,9 @@ pub fn check_scene(limits: &MemoryLimits, (columns, rows): (u32, u32), instances
     let samples = u64::from(columns) * u64::from(rows);
     let heights =
         Footprint::per_item(samples, HEIGHT_HOST_BYTES, HEIGHT_DEVICE_BYTES).plus(Footprint::device(0, samples * 4));
-    limits.check("heights", &format!("{columns}×{rows} height samples"), heights)?;
+    limits.check("height field", &format!("{columns}×{rows} height samples"), heights)?;
     limits.check(
-        "points.instances",
+        "point instances",
         &format!("{instances} point instances in {views} views"),
         instances_footprint(instances, views),
     )
@@ -221,9 +221,9 @@ mod tests {
     fn height_fields_and_instances_are_bounded() {
         assert!(check_scene(&limits(64), (513, 513), 300, 1).is_ok());
         let e = check_scene(&limits(64), (8193, 8193), 0, 1).unwrap_err();
-        assert_eq!(e.parameter(), Some("heights"));
+        assert_eq!(e.parameter(), Some("height field"));
         assert!(e.to_string().contains("8193×8193 height samples need"), "{e}");
         let e = check_scene(&limits(64), (513, 513), 10_000_000, 6).unwrap_err();
-        assert_eq!(e.parameter(), Some("points.instances"));
+        assert_eq!(e.parameter(), Some("point instances"));
     }
 }

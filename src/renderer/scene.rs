@@ -23,17 +23,25 @@ use crate::view::{Lighting, SunPosition};
 /// Rocks of the default scene: distinct shapes, surfels per shape, instances.
 pub const DEFAULT_ROCKS: (usize, usize, usize) = (4, 4000, 300);
 
-/// Host bytes per point instance (boulder or plant): the instance, twice
-/// (a growing vector doubles), and the per-frame selection entry of the
-/// points renderer (an index and a sort key, 16 B).
+/// Host bytes of the point instance itself: the instance (72 B) twice (a
+/// growing vector doubles) and the per-frame selection entry (16 B).
 pub const INSTANCE_HOST_BYTES: u64 = 2 * std::mem::size_of::<PointInstance>() as u64 + 16;
 
-/// What `count` boulders need ([`Scene::add_rocks`]): their instances on
-/// the host and, for one view, their records on the device
-/// ([`super::footprint::instances_footprint`]); the few rock shapes are
-/// small and fixed.
+/// Host bytes per point instance (boulder or plant) at the peak of a
+/// render, measured: 10⁶ boulders raised the peak resident memory of a
+/// 64×48 render on lavapipe by 1.83 GB. Beyond [`INSTANCE_HOST_BYTES`] this
+/// is the renderer's copy of the scene, the per-view draw and shadow-caster
+/// records ([`super::footprint::instances_footprint`]: a 96 B
+/// `GpuInstance` per frame in flight, and the casters' records) in
+/// host-visible upload memory, and the selection's per-frame lists. On a
+/// CPU device all of it is host memory; on a GPU the upload regions still
+/// live in host-visible memory.
+pub const INSTANCE_PEAK_BYTES: u64 = 1900;
+
+/// What `count` boulders need ([`Scene::add_rocks`]): [`INSTANCE_PEAK_BYTES`]
+/// each; the few rock shapes are small and fixed.
 pub fn rocks_footprint(count: usize) -> Footprint {
-    Footprint::per_item(count as u64, INSTANCE_HOST_BYTES, 0).plus(super::footprint::instances_footprint(count, 1))
+    Footprint::per_item(count as u64, INSTANCE_PEAK_BYTES, 0)
 }
 
 /// Most plants the vegetation rules may ask for over a terrain before the
@@ -53,7 +61,7 @@ fn check_plant_count(rules: &[ScatterRule], extent: DVec2, options: &VegetationO
         return Err(Error::invalid(
             "vegetation.density",
             format!(
-                "{} asks for about {expected:.3e} plants over the {:.0} m × {:.0} m terrain; at most {MAX_EXPECTED_PLANTS:e} (the cap then keeps {})",
+                "{:e} asks for about {expected:.3e} plants over the {:.0} m × {:.0} m terrain; at most {MAX_EXPECTED_PLANTS:e} (the cap then keeps {})",
                 options.density, extent.x, extent.y, options.max_plants
             ),
         ));
@@ -61,7 +69,7 @@ fn check_plant_count(rules: &[ScatterRule], extent: DVec2, options: &VegetationO
     let plants = (expected.ceil() as usize).min(options.max_plants);
     // Per kept plant: its instance and the scatter's placements (up to
     // `CANDIDATES_PER_PLANT` accepted before the cap, 48 B each).
-    let per_plant = INSTANCE_HOST_BYTES + 4 * 48;
+    let per_plant = INSTANCE_PEAK_BYTES + 4 * 48;
     MemoryLimits::host_only().check(
         "vegetation.max_plants",
         &format!("{plants} plants"),
@@ -264,10 +272,11 @@ mod tests {
 
     #[test]
     fn boulders_are_bounded_before_they_are_built() {
-        // The instance is 72 B: 160 B a boulder on the host, 10⁸ about 15 GiB.
+        // The instance is 72 B; a boulder about 1.9 kB at a render's peak,
+        // so 10⁸ of them about 177 GiB.
         assert_eq!(INSTANCE_HOST_BYTES, 2 * 72 + 16);
-        assert_eq!(rocks_footprint(100_000_000).host, 16_000_000_000);
-        assert!(rocks_footprint(1).device > 0);
+        assert!(INSTANCE_PEAK_BYTES > INSTANCE_HOST_BYTES + 2 * 96);
+        assert_eq!(rocks_footprint(100_000_000).host, 190_000_000_000);
         let mut scene = small_scene();
         let e = scene.add_rocks(usize::MAX / 256).unwrap_err();
         assert_eq!(e.parameter(), Some("rocks"));
