@@ -87,6 +87,30 @@ fn counts_that_do_not_fit_the_host_name_their_option() {
         &o,
         &["--samples", "100000000 samples need about", "4.0 GiB is available"],
     );
+    // Height fields: a procedural grid and a DEM file, before they are made.
+    let tiny = [("ALPENGLOW_HOST_MEMORY_MB", "4")];
+    let o = run_with(
+        &tiny,
+        &render_args(out, &["--terrain", "procedural:fbm,size=1025,spacing=20"]),
+    );
+    assert_one_line_error(
+        "1025² grid in 4 MiB",
+        &o,
+        &[
+            "--terrain",
+            "1025×1025 height samples need about 8.0 MiB of host memory",
+        ],
+    );
+    let dem = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/jacksboro-fault.png");
+    let o = run_with(
+        &[("ALPENGLOW_HOST_MEMORY_MB", "1")],
+        &render_args(out, &["--heightmap", dem, "--spacing", "30"]),
+    );
+    assert_one_line_error(
+        "403×344 DEM in 1 MiB",
+        &o,
+        &["jacksboro-fault.png", "403×344 pixels needs about", "of host memory"],
+    );
     assert_no_files_left("host bounds", &dir);
 }
 

@@ -67,6 +67,7 @@ const FLAGS: &[(&str, &str)] = &[
     ("from_image.snow_min_altitude", "--snow-min-altitude"),
     ("msaa", "--msaa"),
     ("rocks", "--rocks"),
+    ("terrain grid", "--terrain"),
     ("vegetation.density", "--vegetation-density"),
     ("shutter", "--shutter"),
     ("distortion", "--distortion"),

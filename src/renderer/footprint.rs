@@ -6,6 +6,7 @@
 
 use crate::budget::{Footprint, MemoryLimits};
 use crate::error::Result;
+use crate::io::heightmap::{HEIGHT_DEVICE_BYTES, HEIGHT_HOST_BYTES};
 use crate::points::render::gpu_layout::INSTANCE_BYTES;
 use crate::post::resolve::supersampled_size;
 use crate::view::rig::ViewSpec;
@@ -57,12 +58,6 @@ pub const READBACK_BYTES_PER_PIXEL: u64 = 64;
 /// back into vectors): rgba8 4, hdr 16, depth 4, weight 4, visibility 8,
 /// normal 12, class 4, instance 4, motion 8, distance 4.
 pub const FRAME_IMAGES_BYTES_PER_PIXEL: u64 = 68;
-
-/// Height-field bytes per sample: on the host the scene's field and the
-/// renderer's copy (f32 each); on the device the R32F sketch atlas and its
-/// staging upload, the atlas being one allocation of 4 B a sample.
-pub const HEIGHT_HOST_BYTES: u64 = 8;
-pub const HEIGHT_DEVICE_BYTES: u64 = 8;
 
 /// What one `width`×`height` output view rendered at `render` size needs:
 /// the scene targets at the render size, again at the output size where

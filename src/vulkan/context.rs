@@ -43,6 +43,13 @@ pub struct DeviceInfo {
     pub index: usize,
     pub timestamp_period_ns: f32,
     pub max_image_dimension_2d: u32,
+    /// Bytes of the largest device-local heap (its budget where
+    /// `VK_EXT_memory_budget` is offered) and of the largest single
+    /// allocation ([`Context::memory_limits`]).
+    pub memory_heap_bytes: u64,
+    pub max_allocation_bytes: u64,
+    /// Whether `VK_EXT_memory_budget` is enabled.
+    pub memory_budget: bool,
     pub features: Vec<String>,
     /// Optional features the device offers and alpenglow enabled.
     pub optional_features: Vec<String>,
@@ -373,6 +380,7 @@ impl Context {
             unsafe { device.create_semaphore(&semaphore_info, None) }.map_err(vk_err("vkCreateSemaphore"))?;
         let heap = DescriptorHeap::new(&device)?;
 
+        let memory = super::device_memory::query(&instance, candidate.physical, memory_budget);
         let props = &candidate.properties;
         let info = DeviceInfo {
             name: candidate.name.clone(),
@@ -390,6 +398,9 @@ impl Context {
             index: candidate.index,
             timestamp_period_ns: props.limits.timestamp_period,
             max_image_dimension_2d: props.limits.max_image_dimension2_d,
+            memory_heap_bytes: memory.heap,
+            max_allocation_bytes: memory.allocation,
+            memory_budget,
             features: REQUIRED_FEATURES.iter().map(|s| s.to_string()).collect(),
             optional_features: optional.names(),
             max_point_size: if optional.large_points {
@@ -399,7 +410,6 @@ impl Context {
             },
             validation: report.is_some(),
         };
-        let memory = super::device_memory::query(&instance, candidate.physical, memory_budget);
         let shared = Shared {
             _entry: entry,
             instance,
