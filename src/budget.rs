@@ -1,22 +1,37 @@
 //! One memory model: what an option's count or size costs in host and device
 //! memory, checked *before* anything is allocated.
 //!
-//! Every option or file count that scales memory (rocks, plants, SPT
-//! samples, image size × MSAA × views, rig views, synthesis windows and
-//! candidates, DEM samples) turns into a [`Footprint`] through the estimate
-//! functions of the module that allocates it; the footprint is checked
-//! against [`MemoryLimits`] with [`MemoryLimits::check`], which gives a
-//! one-line error naming the option, the estimate and the limit:
+//! Every option or file count that scales memory turns into a [`Footprint`]
+//! through the estimate of the module that allocates it; the footprint is
+//! checked against [`MemoryLimits`] with [`MemoryLimits::check`], which gives
+//! a one-line error naming the option, the estimate and the limit:
 //!
 //! ```text
-//! invalid --rocks: 100000000 boulders need about 12.0 GiB of host memory; 9.7 GiB is available
+//! invalid --rocks: 100000000 boulders need about 177.0 GiB of host memory; 22.5 GiB is available
 //! ```
 //!
+//! The estimates, each derived from the data structures it counts (see the
+//! constants' docs) and checked where the count is first known:
+//!
+//! | count | estimate | checked in |
+//! |---|---|---|
+//! | boulders (`--rocks`) | 1.9 kB each, measured at a render's peak | `Scene::add_rocks` |
+//! | plants (`--vegetation-density`) | at most 10¹² asked for; the kept ones as boulders | `Scene::add_vegetation` |
+//! | mesh samples (`--samples`, `--points-samples`) | ≈ 550 B blue noise, ≈ 200 B stratified | `sampling::sample_mesh`, the CLI before sampling |
+//! | height samples (`--terrain`, `--heightmap`) | 8 B host, 8 B device (4 B in one allocation) | `ProceduralTerrain::try_generate`, `InputLimits::check_image_fits`, `Renderer::new` |
+//! | pixels × `--msaa` × views | 64–100 B device per rendered pixel, 16 B in one allocation, 196 B host readback per output pixel | `renderer::footprint::check_views` in `Renderer::new` |
+//! | point instances × views | two 96 B records per view and frame in flight | `renderer::footprint::check_scene` |
+//!
 //! Host memory is what `/proc/meminfo` calls `MemAvailable` (or
-//! `ALPENGLOW_HOST_MEMORY_MB` when set, for tests and for sharing a machine);
-//! device memory comes from the device's heaps
-//! (`VkPhysicalDeviceMemoryProperties`, and `VK_EXT_memory_budget` where
-//! offered) through the Vulkan context.
+//! [`HOST_MEMORY_ENV`], `ALPENGLOW_HOST_MEMORY_MB`, when set, for tests and
+//! for sharing a machine). Device memory comes from the device through
+//! `Context::memory_limits`: the largest device-local heap
+//! (`VkPhysicalDeviceMemoryProperties`, its budget with `VK_EXT_memory_budget`
+//! where offered) and the largest single allocation (`maxMemoryAllocationSize`,
+//! `maxBufferSize`, the heap), both capped by [`DEVICE_MEMORY_ENV`]
+//! (`ALPENGLOW_DEVICE_MEMORY_MB`) when set. lavapipe allows 2 GiB in one
+//! allocation, so its largest image is 11585² (the RGBA32F radiance target,
+//! 16 B a pixel).
 
 use crate::error::{Error, Result};
 
@@ -119,34 +134,22 @@ impl MemoryLimits {
     /// estimate and the limit when either side does not fit.
     pub fn check(&self, option: &str, what: &str, footprint: Footprint) -> Result<()> {
         if footprint.host > self.host {
-            return Err(Error::invalid(
-                option,
-                format!(
-                    "{what} need about {} of host memory; {} is available",
-                    format_bytes(footprint.host),
-                    format_bytes(self.host)
-                ),
-            ));
+            return Err(Error::invalid(option, {
+                let (need, have) = estimate_and_limit(footprint.host, self.host);
+                format!("{what} need about {need} of host memory; {have} is available")
+            }));
         }
         if footprint.device_allocation > self.device_allocation {
-            return Err(Error::invalid(
-                option,
-                format!(
-                    "{what} need a single GPU allocation of about {}; the device allows at most {} in one",
-                    format_bytes(footprint.device_allocation),
-                    format_bytes(self.device_allocation)
-                ),
-            ));
+            return Err(Error::invalid(option, {
+                let (need, have) = estimate_and_limit(footprint.device_allocation, self.device_allocation);
+                format!("{what} need a single GPU allocation of about {need}; the device allows at most {have} in one")
+            }));
         }
         if footprint.device > self.device {
-            return Err(Error::invalid(
-                option,
-                format!(
-                    "{what} need about {} of GPU memory; the device has {}",
-                    format_bytes(footprint.device),
-                    format_bytes(self.device)
-                ),
-            ));
+            return Err(Error::invalid(option, {
+                let (need, have) = estimate_and_limit(footprint.device, self.device);
+                format!("{what} need about {need} of GPU memory; the device has {have}")
+            }));
         }
         Ok(())
     }
@@ -193,6 +196,16 @@ fn meminfo_field(text: &str, field: &str) -> Option<u64> {
     let line = text.lines().find(|l| l.starts_with(field))?;
     let kb: u64 = line[field.len()..].split_whitespace().next()?.parse().ok()?;
     Some(kb.saturating_mul(1024))
+}
+
+/// An estimate and its limit for people ([`format_bytes`]), in bytes where
+/// the two would read the same ("2.0 GiB" against "2.0 GiB").
+fn estimate_and_limit(estimate: u64, limit: u64) -> (String, String) {
+    let (a, b) = (format_bytes(estimate), format_bytes(limit));
+    match a == b {
+        true => (format!("{estimate} B"), format!("{limit} B")),
+        false => (a, b),
+    }
 }
 
 /// `bytes` for people: "512 B", "3.0 KiB", "12.4 GiB".
@@ -263,6 +276,19 @@ mod tests {
             "{e}"
         );
         assert!(limits.fits(Footprint::device(2 << 30, 1 << 30)));
+        // Estimates that would read as their limit are said in bytes.
+        let e = limits
+            .check(
+                "--width",
+                "11586×11586 pixels",
+                Footprint::device(1 << 30, (1 << 30) + 4096),
+            )
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("about 1073745920 B; the device allows at most 1073741824 B in one"),
+            "{e}"
+        );
         assert_eq!(
             Footprint::device(5, 3).plus(Footprint::device(1, 4)).times(2),
             Footprint::device(12, 4)

@@ -100,7 +100,7 @@ const MAX_EDGE_SLOPE: f32 = 0.5;
 /// gathered per query rather than stored per triangle, which grew with the
 /// square of a vertex's triangle count (a fanned cap of 50,000 triangles
 /// took 8.5 GB). A long list (a fan's hub) is kept in spatial order with an
-/// implicit bounding-box tree ([`VertexTree`]), so a query visits only the
+/// implicit bounding-box tree (`VertexTree`), so a query visits only the
 /// creases whose projection can come within the surfel's radius.
 #[derive(Clone, Debug, Default)]
 pub struct Creases {
