@@ -275,7 +275,7 @@ mod tests {
         // The instance is 72 B; a boulder about 1.9 kB at a render's peak,
         // so 10⁸ of them about 177 GiB.
         assert_eq!(INSTANCE_HOST_BYTES, 2 * 72 + 16);
-        assert!(INSTANCE_PEAK_BYTES > INSTANCE_HOST_BYTES + 2 * 96);
+        const { assert!(INSTANCE_PEAK_BYTES > INSTANCE_HOST_BYTES + 2 * 96) };
         assert_eq!(rocks_footprint(100_000_000).host, 190_000_000_000);
         let mut scene = small_scene();
         let e = scene.add_rocks(usize::MAX / 256).unwrap_err();
