@@ -112,7 +112,7 @@ pub(crate) struct Shared {
     pub info: DeviceInfo,
     pub limits: vk::PhysicalDeviceLimits,
     /// Heap and single-allocation limits ([`Context::memory_limits`]).
-    memory: super::device_memory::DeviceMemory,
+    pub(super) memory: super::device_memory::DeviceMemory,
     report: Option<Arc<ValidationReport>>,
 }
 
@@ -463,19 +463,6 @@ impl Context {
             Ok(allocator) => allocator.generate_report().total_allocated_bytes,
             Err(_) => 0,
         }
-    }
-
-    /// What this machine and device can take ([`crate::budget`]): the
-    /// host's available memory, the largest device-local heap (its
-    /// `VK_EXT_memory_budget` budget where offered) and the largest single
-    /// allocation, capped by `ALPENGLOW_DEVICE_MEMORY_MB` when set.
-    pub fn memory_limits(&self) -> crate::budget::MemoryLimits {
-        crate::budget::MemoryLimits {
-            device: self.shared.memory.heap,
-            device_allocation: self.shared.memory.allocation,
-            ..crate::budget::MemoryLimits::host_only()
-        }
-        .with_device_override()
     }
 
     /// The largest 2-D image side the device accepts.

@@ -5,6 +5,8 @@
 
 use ash::vk;
 
+use super::Context;
+
 /// The device's memory limits as Vulkan reports them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct DeviceMemory {
@@ -64,5 +66,20 @@ pub(crate) fn query(instance: &ash::Instance, physical: vk::PhysicalDevice, budg
         allocation: limit(maintenance3.max_memory_allocation_size)
             .min(limit(maintenance4.max_buffer_size))
             .min(limit(largest_heap)),
+    }
+}
+
+impl Context {
+    /// What this machine and device can take ([`crate::budget`]): the
+    /// host's available memory, the largest device-local heap (its
+    /// `VK_EXT_memory_budget` budget where offered) and the largest single
+    /// allocation, capped by `ALPENGLOW_DEVICE_MEMORY_MB` when set.
+    pub fn memory_limits(&self) -> crate::budget::MemoryLimits {
+        crate::budget::MemoryLimits {
+            device: self.shared.memory.heap,
+            device_allocation: self.shared.memory.allocation,
+            ..crate::budget::MemoryLimits::host_only()
+        }
+        .with_device_override()
     }
 }
