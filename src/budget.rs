@@ -1,16 +1,26 @@
 //! One memory model: what an option's count or size costs in host and device
 //! memory, checked *before* anything is allocated.
 //!
-//! Every option or file count that scales memory (rocks, plants, SPT
-//! samples, image size × MSAA × views, rig views, synthesis windows and
-//! candidates, DEM samples) turns into a [`Footprint`] through the estimate
-//! functions of the module that allocates it; the footprint is checked
-//! against [`MemoryLimits`] with [`MemoryLimits::check`], which gives a
-//! one-line error naming the option, the estimate and the limit:
+//! Every option or file count that scales memory turns into a [`Footprint`]
+//! through the estimate of the module that allocates it; the footprint is
+//! checked against [`MemoryLimits`] with [`MemoryLimits::check`], which gives
+//! a one-line error naming the option, the estimate and the limit:
 //!
 //! ```text
-//! invalid --rocks: 100000000 boulders need about 12.0 GiB of host memory; 9.7 GiB is available
+//! invalid --rocks: 100000000 boulders need about 177.0 GiB of host memory; 22.5 GiB is available
 //! ```
+//!
+//! The estimates, each derived from the data structures it counts (see the
+//! constants' docs) and checked where the count is first known:
+//!
+//! | count | estimate | checked in |
+//! |---|---|---|
+//! | boulders (`--rocks`) | 1.9 kB each, measured at a render's peak | `Scene::add_rocks` |
+//! | plants (`--vegetation-density`) | at most 10¹² asked for; the kept ones as boulders | `Scene::add_vegetation` |
+//! | mesh samples (`--samples`, `--points-samples`) | ≈ 550 B blue noise, ≈ 200 B stratified | `sampling::sample_mesh`, the CLI before sampling |
+//! | height samples (`--terrain`, `--heightmap`) | 8 B host, 8 B device (4 B in one allocation) | `ProceduralTerrain::try_generate`, `InputLimits::check_image_fits`, `Renderer::new` |
+//! | pixels × `--msaa` × views | 64–100 B device per rendered pixel, 16 B in one allocation, 196 B host readback per output pixel | `renderer::footprint::check_views` in `Renderer::new` |
+//! | point instances × views | two 96 B records per view and frame in flight | `renderer::footprint::check_scene` |
 //!
 //! Time has a ceiling of its own: long CPU work (synthesis, SPT builds)
 //! estimates its seconds from operation counts at measured rates and
@@ -18,10 +28,15 @@
 //! `--max-hours` (default [`DEFAULT_MAX_HOURS`]) the same way.
 //!
 //! Host memory is what `/proc/meminfo` calls `MemAvailable` (or
-//! `ALPENGLOW_HOST_MEMORY_MB` when set, for tests and for sharing a machine);
-//! device memory comes from the device's heaps
-//! (`VkPhysicalDeviceMemoryProperties`, and `VK_EXT_memory_budget` where
-//! offered) through the Vulkan context.
+//! [`HOST_MEMORY_ENV`], `ALPENGLOW_HOST_MEMORY_MB`, when set, for tests and
+//! for sharing a machine). Device memory comes from the device through
+//! `Context::memory_limits`: the largest device-local heap
+//! (`VkPhysicalDeviceMemoryProperties`, its budget with `VK_EXT_memory_budget`
+//! where offered) and the largest single allocation (`maxMemoryAllocationSize`,
+//! `maxBufferSize`, the heap), both capped by [`DEVICE_MEMORY_ENV`]
+//! (`ALPENGLOW_DEVICE_MEMORY_MB`) when set. lavapipe allows 2 GiB in one
+//! allocation, so its largest image is 11585² (the RGBA32F radiance target,
+//! 16 B a pixel).
 
 use crate::error::{Error, Result};
 
@@ -32,17 +47,29 @@ pub struct Footprint {
     pub host: u64,
     /// Bytes of device-local (GPU) memory.
     pub device: u64,
+    /// Bytes of the largest single device allocation (an image or a
+    /// buffer), checked against the device's `maxMemoryAllocationSize` and
+    /// `maxBufferSize`.
+    pub device_allocation: u64,
 }
 
 impl Footprint {
     /// `bytes` of host memory only.
     pub fn host(bytes: u64) -> Footprint {
-        Footprint { host: bytes, device: 0 }
+        Footprint {
+            host: bytes,
+            ..Footprint::default()
+        }
     }
 
-    /// `bytes` of device memory only.
-    pub fn device(bytes: u64) -> Footprint {
-        Footprint { host: 0, device: bytes }
+    /// `bytes` of device memory only, in allocations of at most
+    /// `largest` bytes each.
+    pub fn device(bytes: u64, largest: u64) -> Footprint {
+        Footprint {
+            device: bytes,
+            device_allocation: largest,
+            ..Footprint::default()
+        }
     }
 
     /// `count` items of `host_each` and `device_each` bytes, saturating.
@@ -50,14 +77,27 @@ impl Footprint {
         Footprint {
             host: count.saturating_mul(host_each),
             device: count.saturating_mul(device_each),
+            device_allocation: 0,
         }
     }
 
-    /// The sum of two footprints, saturating.
+    /// The sum of two footprints, saturating (the larger of the two
+    /// largest allocations).
     pub fn plus(self, other: Footprint) -> Footprint {
         Footprint {
             host: self.host.saturating_add(other.host),
             device: self.device.saturating_add(other.device),
+            device_allocation: self.device_allocation.max(other.device_allocation),
+        }
+    }
+
+    /// `count` times this footprint, saturating (the largest allocation
+    /// stays as it is).
+    pub fn times(self, count: u64) -> Footprint {
+        Footprint {
+            host: self.host.saturating_mul(count),
+            device: self.device.saturating_mul(count),
+            device_allocation: self.device_allocation,
         }
     }
 }
@@ -78,6 +118,11 @@ pub struct MemoryLimits {
 /// Environment variable that overrides the host memory available, in MiB.
 pub const HOST_MEMORY_ENV: &str = "ALPENGLOW_HOST_MEMORY_MB";
 
+/// Environment variable that caps the device memory (the heap and the
+/// largest single allocation) below what the device reports, in MiB: for
+/// tests of the bounds without huge images, and for sharing a GPU.
+pub const DEVICE_MEMORY_ENV: &str = "ALPENGLOW_DEVICE_MEMORY_MB";
+
 impl MemoryLimits {
     /// The host's available memory, with no device known yet.
     pub fn host_only() -> MemoryLimits {
@@ -94,37 +139,56 @@ impl MemoryLimits {
     /// estimate and the limit when either side does not fit.
     pub fn check(&self, option: &str, what: &str, footprint: Footprint) -> Result<()> {
         if footprint.host > self.host {
-            return Err(Error::invalid(
-                option,
-                format!(
-                    "{what} need about {} of host memory; {} is available",
-                    format_bytes(footprint.host),
-                    format_bytes(self.host)
-                ),
-            ));
+            return Err(Error::invalid(option, {
+                let (need, have) = estimate_and_limit(footprint.host, self.host);
+                format!("{what} need about {need} of host memory; {have} is available")
+            }));
+        }
+        if footprint.device_allocation > self.device_allocation {
+            return Err(Error::invalid(option, {
+                let (need, have) = estimate_and_limit(footprint.device_allocation, self.device_allocation);
+                format!("{what} need a single GPU allocation of about {need}; the device allows at most {have} in one")
+            }));
         }
         if footprint.device > self.device {
-            return Err(Error::invalid(
-                option,
-                format!(
-                    "{what} need about {} of GPU memory; the device has {}",
-                    format_bytes(footprint.device),
-                    format_bytes(self.device)
-                ),
-            ));
+            return Err(Error::invalid(option, {
+                let (need, have) = estimate_and_limit(footprint.device, self.device);
+                format!("{what} need about {need} of GPU memory; the device has {have}")
+            }));
         }
         Ok(())
     }
+
+    /// Whether `footprint` fits these limits.
+    pub fn fits(&self, footprint: Footprint) -> bool {
+        self.check("", "", footprint).is_ok()
+    }
+
+    /// These limits with the device side capped by
+    /// [`DEVICE_MEMORY_ENV`] when it is set.
+    pub fn with_device_override(self) -> MemoryLimits {
+        match env_mib(DEVICE_MEMORY_ENV) {
+            Some(cap) => MemoryLimits {
+                device: self.device.min(cap),
+                device_allocation: self.device_allocation.min(cap),
+                ..self
+            },
+            None => self,
+        }
+    }
+}
+
+/// An environment variable's value in MiB, in bytes.
+fn env_mib(name: &str) -> Option<u64> {
+    let mib = std::env::var(name).ok()?.trim().parse::<u64>().ok()?;
+    Some(mib.saturating_mul(1 << 20))
 }
 
 /// Bytes of host memory available: `ALPENGLOW_HOST_MEMORY_MB` when set,
 /// else `MemAvailable` of `/proc/meminfo`, else 8 GiB.
 pub fn host_available_bytes() -> u64 {
-    if let Some(mib) = std::env::var(HOST_MEMORY_ENV)
-        .ok()
-        .and_then(|v| v.trim().parse::<u64>().ok())
-    {
-        return mib.saturating_mul(1 << 20);
+    if let Some(bytes) = env_mib(HOST_MEMORY_ENV) {
+        return bytes;
     }
     std::fs::read_to_string("/proc/meminfo")
         .ok()
@@ -137,6 +201,16 @@ fn meminfo_field(text: &str, field: &str) -> Option<u64> {
     let line = text.lines().find(|l| l.starts_with(field))?;
     let kb: u64 = line[field.len()..].split_whitespace().next()?.parse().ok()?;
     Some(kb.saturating_mul(1024))
+}
+
+/// An estimate and its limit for people ([`format_bytes`]), in bytes where
+/// the two would read the same ("2.0 GiB" against "2.0 GiB").
+fn estimate_and_limit(estimate: u64, limit: u64) -> (String, String) {
+    let (a, b) = (format_bytes(estimate), format_bytes(limit));
+    match a == b {
+        true => (format!("{estimate} B"), format!("{limit} B")),
+        false => (a, b),
+    }
 }
 
 /// `bytes` for people: "512 B", "3.0 KiB", "12.4 GiB".
@@ -246,10 +320,36 @@ mod tests {
             "invalid --rocks: 100000000 boulders need about 11.9 GiB of host memory; 1.0 GiB is available"
         );
         let e = limits
-            .check("--width", "a 16384×16384 image", Footprint::device(3 << 30))
+            .check("--width", "16384×16384 pixels", Footprint::device(3 << 30, 1 << 30))
             .unwrap_err()
             .to_string();
         assert!(e.contains("3.0 GiB of GPU memory; the device has 2.0 GiB"), "{e}");
+        let e = limits
+            .check("--width", "16384×16384 pixels", Footprint::device(1 << 30, 4 << 30))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("a single GPU allocation of about 4.0 GiB; the device allows at most 1.0 GiB in one"),
+            "{e}"
+        );
+        assert!(limits.fits(Footprint::device(2 << 30, 1 << 30)));
+        // Estimates that would read as their limit are said in bytes.
+        let e = limits
+            .check(
+                "--width",
+                "11586×11586 pixels",
+                Footprint::device(1 << 30, (1 << 30) + 4096),
+            )
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("about 1073745920 B; the device allows at most 1073741824 B in one"),
+            "{e}"
+        );
+        assert_eq!(
+            Footprint::device(5, 3).plus(Footprint::device(1, 4)).times(2),
+            Footprint::device(12, 4)
+        );
     }
 
     #[test]

@@ -517,6 +517,12 @@ fn info(args: DeviceArgs) -> Result<ExitCode> {
     println!("timestamps:  {} ns per tick", i.timestamp_period_ns);
     println!("max image:   {} px per side", i.max_image_dimension_2d);
     println!(
+        "memory:      {} device heap{}, at most {} in one allocation",
+        alpenglow::budget::format_bytes(i.memory_heap_bytes),
+        if i.memory_budget { " (VK_EXT_memory_budget)" } else { "" },
+        alpenglow::budget::format_bytes(i.max_allocation_bytes)
+    );
+    println!(
         "validation:  {}",
         if i.validation {
             "on (with synchronization validation)"

@@ -4,6 +4,8 @@
 
 use anyhow::{bail, Context as _, Result};
 
+use alpenglow::budget::MemoryLimits;
+use alpenglow::points::build::sampling::{sampling_footprint, SamplingMethod};
 use alpenglow::points::build::spt::epsilon_from_pixels;
 use alpenglow::points::render::{SplatBackend, SplatMode, SplatPrimitive, SplatSettings};
 use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointTransform};
@@ -66,6 +68,13 @@ pub fn add_points(args: &PointArgs, scene: &mut Scene, builtin: bool) -> Result<
     }
     if args.samples == 0 {
         bail!("--points-samples must be at least 1");
+    }
+    if !args.points.is_empty() {
+        MemoryLimits::host_only().check(
+            "--points-samples",
+            &format!("{} samples", args.samples),
+            sampling_footprint(args.samples, SamplingMethod::default()),
+        )?;
     }
     if builtin && args.rocks > 0 && !args.no_terrain {
         scene.add_rocks(args.rocks)?;

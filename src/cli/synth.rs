@@ -341,25 +341,30 @@ fn prepare_search(cost: &GrowthCost, args: &GrowArgs, field: &str) -> Result<Sea
     let limits = MemoryLimits::host_only();
     let max_seconds = args.max_hours * 3600.0;
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let checked = |device: SearchDevice| -> Result<()> {
+    let checked = |device: SearchDevice, limits: &MemoryLimits| -> Result<()> {
         log::info!("synthesis estimate: {}", cost.summary(device));
-        Ok(cost.check(device, &limits, max_seconds, field)?)
+        Ok(cost.check(device, limits, max_seconds, field)?)
     };
     match args.search {
         SearchArg::Cpu => {
-            checked(SearchDevice::Cpu {
-                threads: cost.cpu_threads(threads),
-            })?;
+            checked(
+                SearchDevice::Cpu {
+                    threads: cost.cpu_threads(threads),
+                },
+                &limits,
+            )?;
             Ok(Search::Cpu)
         }
         SearchArg::Gpu => {
             cost.check(SearchDevice::Gpu, &limits, max_seconds, field)?;
             let ctx = super::context(&args.device)?;
-            checked(if ctx.info().device_type == "CPU" {
+            // The device's own heaps and largest allocation decide now.
+            let device = if ctx.info().device_type == "CPU" {
                 SearchDevice::CpuDevice { threads }
             } else {
                 SearchDevice::Gpu
-            })?;
+            };
+            checked(device, &ctx.memory_limits())?;
             Ok(Search::Gpu(ctx))
         }
     }

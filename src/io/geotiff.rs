@@ -63,7 +63,7 @@ pub(crate) fn decode_geotiff(path: &Path, bytes: &[u8], limits: &InputLimits, vo
     };
     let decoded_bytes = bits.div_ceil(8).max(1);
     limits
-        .check_image(u64::from(w), u64::from(h), decoded_bytes + 4)
+        .check_image_fits(u64::from(w), u64::from(h), decoded_bytes + 4)
         .map_err(|m| Error::input(path, m))?;
     // Tags first, each at most 1 MiB decoded: the crate bounds a tag's
     // value array by `decoding_buffer_size`, so the image's allowance must

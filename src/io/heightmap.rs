@@ -37,6 +37,14 @@ pub const MIN_SPACING: f64 = 1.0e-3;
 /// Largest sample spacing in metres (100 km).
 pub const MAX_SPACING: f64 = 1.0e5;
 
+/// Height-field bytes per sample for the memory model ([`crate::budget`]):
+/// on the host the field and the renderer's copy (f32 each); on the device
+/// the R32F sketch atlas and its staging upload, the atlas being one
+/// allocation of 4 B a sample.
+pub const HEIGHT_HOST_BYTES: u64 = 8;
+/// See [`HEIGHT_HOST_BYTES`].
+pub const HEIGHT_DEVICE_BYTES: u64 = 8;
+
 /// A regular grid of heights in metres.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HeightField {

@@ -344,7 +344,7 @@ pub(crate) fn decode_exr_channels_limited(
         let channels = header.channels.list.len() as u64;
         // Each channel's samples, as stored (≤ 4 bytes) and as f32.
         limits
-            .check_image(size.width() as u64, size.height() as u64, channels.max(1) * 8)
+            .check_image_fits(size.width() as u64, size.height() as u64, channels.max(1) * 8)
             .map_err(|m| Error::input(path, m))?;
         if header.chunk_count > bytes.len() / 8 {
             return Err(Error::input(

@@ -84,6 +84,31 @@ impl InputLimits {
         }
         Ok(())
     }
+
+    /// [`InputLimits::check_image`], then the memory model
+    /// ([`crate::budget`]): the image decoded at `bytes_per_pixel` plus 4 B
+    /// a sample as kept, against the host's available memory.
+    pub fn check_image_fits(&self, width: u64, height: u64, bytes_per_pixel: u64) -> Result<(), String> {
+        self.check_image(width, height, bytes_per_pixel)?;
+        check_image_memory(width, height, bytes_per_pixel, crate::budget::host_available_bytes())
+    }
+}
+
+/// Whether a `width`×`height` image decoded at `bytes_per_pixel` and kept
+/// at 4 B a sample fits `host` bytes; the error says the estimate and the
+/// limit (one line, without the file name).
+pub fn check_image_memory(width: u64, height: u64, bytes_per_pixel: u64, host: u64) -> Result<(), String> {
+    let need = width
+        .saturating_mul(height)
+        .saturating_mul(bytes_per_pixel.saturating_add(4));
+    if need > host {
+        return Err(format!(
+            "image of {width}×{height} pixels needs about {} of host memory decoded; {} is available",
+            crate::budget::format_bytes(need),
+            crate::budget::format_bytes(host)
+        ));
+    }
+    Ok(())
 }
 
 impl Default for InputLimits {
@@ -101,6 +126,17 @@ impl Default for InputLimits {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn decoded_images_are_checked_against_host_memory() {
+        assert!(check_image_memory(403, 344, 6, 2 << 20).is_ok());
+        let e = check_image_memory(403, 344, 6, 1 << 20).unwrap_err();
+        assert_eq!(
+            e,
+            "image of 403×344 pixels needs about 1.3 MiB of host memory decoded; 1.0 MiB is available"
+        );
+        assert!(check_image_memory(u64::MAX, 2, 8, u64::MAX - 1).is_err());
+    }
 
     #[test]
     fn image_checks_name_the_limit() {

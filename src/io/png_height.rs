@@ -47,7 +47,7 @@ pub(crate) fn decode_png(path: &Path, bytes: &[u8], limits: &InputLimits) -> Res
     let sample_bytes: u64 = if info.bit_depth == BitDepth::Sixteen { 2 } else { 1 };
     // The decoded bytes and the f32 values made from them.
     limits
-        .check_image(u64::from(w), u64::from(h), sample_bytes + 4)
+        .check_image_fits(u64::from(w), u64::from(h), sample_bytes + 4)
         .map_err(|m| Error::input(path, m))?;
     let mut reader = decoder.read_info().map_err(corrupt)?;
     let (color, depth) = reader.output_color_type();

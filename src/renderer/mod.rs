@@ -21,6 +21,7 @@
 //! [`crate::post::aovs`]) → `tonemap` (compute) → `readback` (transfer).
 
 mod aov_readback;
+pub mod footprint;
 mod lighting;
 mod readback;
 pub mod scene;
@@ -193,6 +194,13 @@ impl Renderer {
                 format!("{}×{} exceeds the device limit of {max} per side", v.width, v.height),
             ));
         }
+        // The memory model before any image, buffer or upload: the views
+        // (size × samples × views), the height field and the instances.
+        let limits = ctx.memory_limits();
+        let points_present = !scene.points.is_empty();
+        footprint::check_views(&limits, &specs, settings.msaa, points_present, settings.readback)?;
+        let field = (scene.heights.columns, scene.heights.rows);
+        footprint::check_scene(&limits, field, scene.points.instances.len(), specs.len())?;
         let mut graph = RenderGraph::new();
         let chains: Vec<ViewChain> = (specs.iter())
             .map(|s| ViewChain::new(ctx, s, settings.msaa))
@@ -201,7 +209,6 @@ impl Renderer {
         let views: Vec<View> = (chains.iter()).map(|c| c.render.view(scene.default_camera())).collect();
         let lighting = settings.lighting.unwrap_or_else(|| scene.default_lighting());
         lighting.validate()?;
-        let points_present = !scene.points.is_empty();
         let mut targets: Vec<SceneTargets> = (views.iter())
             .map(|v| SceneTargets::declare(&mut graph, v, points_present))
             .collect();

@@ -5,11 +5,12 @@
 
 use glam::{DVec2, DVec3, Vec3};
 
-use crate::error::Result;
+use crate::budget::{Footprint, MemoryLimits};
+use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
 use crate::points::build::plants::scatter::{scatter, ScatterRule};
 use crate::points::build::spt::{epsilon_from_pixels, SptOptions};
-use crate::points::scene::{scatter_rocks, PointScene};
+use crate::points::scene::{scatter_rocks, PointInstance, PointScene};
 use crate::points::vegetation::{plant_scene, VegetationOptions, VegetationReport};
 use crate::terrain::geometry_image::TerrainSettings;
 use crate::terrain::ground::Ground;
@@ -21,6 +22,60 @@ use crate::view::{Lighting, SunPosition};
 
 /// Rocks of the default scene: distinct shapes, surfels per shape, instances.
 pub const DEFAULT_ROCKS: (usize, usize, usize) = (4, 4000, 300);
+
+/// Host bytes of the point instance itself: the instance (72 B) twice (a
+/// growing vector doubles) and the per-frame selection entry (16 B).
+pub const INSTANCE_HOST_BYTES: u64 = 2 * std::mem::size_of::<PointInstance>() as u64 + 16;
+
+/// Host bytes per point instance (boulder or plant) at the peak of a
+/// render, measured: 10⁶ boulders raised the peak resident memory of a
+/// 64×48 render on lavapipe by 1.83 GB. Beyond [`INSTANCE_HOST_BYTES`] this
+/// is the renderer's copy of the scene, the per-view draw and shadow-caster
+/// records ([`super::footprint::instances_footprint`]: a 96 B
+/// `GpuInstance` per frame in flight, and the casters' records) in
+/// host-visible upload memory, and the selection's per-frame lists. On a
+/// CPU device all of it is host memory; on a GPU the upload regions still
+/// live in host-visible memory.
+pub const INSTANCE_PEAK_BYTES: u64 = 1900;
+
+/// What `count` boulders need ([`Scene::add_rocks`]): [`INSTANCE_PEAK_BYTES`]
+/// each; the few rock shapes are small and fixed.
+pub fn rocks_footprint(count: usize) -> Footprint {
+    Footprint::per_item(count as u64, INSTANCE_PEAK_BYTES, 0)
+}
+
+/// Most plants the vegetation rules may ask for over a terrain before the
+/// cap ([`VegetationOptions::max_plants`]) thins them: 10¹². Beyond it the
+/// thinning ratio and the counts reported lose their meaning (a density
+/// multiplier of 10³⁰⁰ reported saturated counts, 10³⁰⁸ an infinite
+/// expectation and no plants at all).
+pub const MAX_EXPECTED_PLANTS: f64 = 1e12;
+
+/// Checks what the vegetation `rules` ask for over a terrain of `extent`
+/// metres: at most [`MAX_EXPECTED_PLANTS`] before the cap (the error names
+/// `vegetation.density`, the CLI's `--vegetation-density`), and the plants
+/// the cap keeps within the host's memory (`vegetation.max_plants`).
+fn check_plant_count(rules: &[ScatterRule], extent: DVec2, options: &VegetationOptions) -> Result<()> {
+    let expected: f64 = rules.iter().map(|r| r.density * extent.x * extent.y).sum();
+    if !(expected.is_finite() && expected <= MAX_EXPECTED_PLANTS) {
+        return Err(Error::invalid(
+            "vegetation.density",
+            format!(
+                "{:e} asks for about {expected:.3e} plants over the {:.0} m × {:.0} m terrain; at most {MAX_EXPECTED_PLANTS:e} (the cap then keeps {})",
+                options.density, extent.x, extent.y, options.max_plants
+            ),
+        ));
+    }
+    let plants = (expected.ceil() as usize).min(options.max_plants);
+    // Per kept plant: its instance and the scatter's placements (up to
+    // `CANDIDATES_PER_PLANT` accepted before the cap, 48 B each).
+    let per_plant = INSTANCE_PEAK_BYTES + 4 * 48;
+    MemoryLimits::host_only().check(
+        "vegetation.max_plants",
+        &format!("{plants} plants"),
+        Footprint::per_item(plants as u64, per_plant, 0),
+    )
+}
 
 /// A terrain scene.
 #[derive(Clone, Debug)]
@@ -62,7 +117,11 @@ impl Scene {
     /// Scatters `count` procedural boulders (§6.1.4; [`DEFAULT_ROCKS`]
     /// shapes and samples, 1–40 m) over the terrain, as instances of a few
     /// trees built for a one-pixel error at 50° and 720 rows.
+    ///
+    /// Errors, before anything is built, when `count` boulders do not fit
+    /// the host's memory ([`rocks_footprint`]); the parameter is `rocks`.
     pub fn add_rocks(&mut self, count: usize) -> Result<()> {
+        MemoryLimits::host_only().check("rocks", &format!("{count} boulders"), rocks_footprint(count))?;
         let spt = SptOptions {
             epsilon: epsilon_from_pixels(1.0, 50f32.to_radians(), 720)?,
             ..SptOptions::default()
@@ -95,6 +154,7 @@ impl Scene {
         if rules.is_empty() {
             return Ok(VegetationReport::default());
         }
+        check_plant_count(&rules, self.heights.extent(), options)?;
         let terrain = TerrainSettings::default();
         let reference = ReferenceSurface::new(&self.heights, &self.layers, &self.input_maps, terrain.noise_seed)?;
         let shares = |xy| Ok(subtree_shares(&self.layers, &reference.evaluate(xy, 0.0).coverage));
@@ -185,5 +245,45 @@ impl Scene {
     pub fn default_camera(&self) -> Camera {
         let (lo, hi) = self.height_range();
         Camera::overview(self.heights.extent(), f64::from(lo), f64::from(hi))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn small_scene() -> Scene {
+        Scene::new(HeightField::from_fn(33, 33, DVec2::splat(10.0), |c, r| (c + r) as f32))
+    }
+
+    #[test]
+    fn boulders_are_bounded_before_they_are_built() {
+        // The instance is 72 B; a boulder about 1.9 kB at a render's peak,
+        // so 10⁸ of them about 177 GiB.
+        assert_eq!(INSTANCE_HOST_BYTES, 2 * 72 + 16);
+        const { assert!(INSTANCE_PEAK_BYTES > INSTANCE_HOST_BYTES + 2 * 96) };
+        assert_eq!(rocks_footprint(100_000_000).host, 190_000_000_000);
+        let mut scene = small_scene();
+        let e = scene.add_rocks(usize::MAX / 256).unwrap_err();
+        assert_eq!(e.parameter(), Some("rocks"));
+        assert!(e.to_string().contains("boulders need about"), "{e}");
+        assert!(scene.points.is_empty());
+        scene.add_rocks(3).unwrap();
+        assert_eq!(scene.points.instances.len(), 3);
+    }
+
+    #[test]
+    fn absurd_vegetation_densities_are_refused_by_name() {
+        for density in [1e300, 1e308, f64::MAX] {
+            let mut scene = small_scene();
+            let options = VegetationOptions {
+                density,
+                ..VegetationOptions::default()
+            };
+            let e = scene.add_vegetation(&options).unwrap_err();
+            assert_eq!(e.parameter(), Some("vegetation.density"), "{e}");
+            assert!(e.to_string().contains("plants over the 320 m × 320 m terrain"), "{e}");
+            assert!(scene.points.is_empty());
+        }
     }
 }

@@ -297,7 +297,15 @@ impl GrowthCost {
                     .saturating_add(candidates.saturating_mul(4))
                     .saturating_add(batch.saturating_mul(row))
                     .saturating_add(2 * batch.saturating_mul(taps));
-                Footprint { host: exemplar, device }
+                let largest = exemplar
+                    .max(candidates.saturating_mul(4))
+                    .max(batch.saturating_mul(row))
+                    .max(batch.saturating_mul(taps));
+                Footprint {
+                    host: exemplar,
+                    device,
+                    device_allocation: largest,
+                }
             }
         }
     }

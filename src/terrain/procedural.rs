@@ -368,6 +368,15 @@ impl ProceduralTerrain {
                 format!("{columns}×{rows} (needs at least 2×2 and at most 2^28 samples)"),
             ));
         }
+        crate::budget::MemoryLimits::host_only().check(
+            "terrain grid",
+            &format!("{columns}×{rows} height samples"),
+            crate::budget::Footprint::per_item(
+                u64::from(columns) * u64::from(rows),
+                crate::io::heightmap::HEIGHT_HOST_BYTES,
+                0,
+            ),
+        )?;
         if !(spacing.x.is_finite() && spacing.y.is_finite() && spacing.x > 0.0 && spacing.y > 0.0) {
             return Err(Error::invalid(
                 "terrain spacing",

@@ -43,6 +43,13 @@ pub struct DeviceInfo {
     pub index: usize,
     pub timestamp_period_ns: f32,
     pub max_image_dimension_2d: u32,
+    /// Bytes of the largest device-local heap (its budget where
+    /// `VK_EXT_memory_budget` is offered) and of the largest single
+    /// allocation ([`Context::memory_limits`]).
+    pub memory_heap_bytes: u64,
+    pub max_allocation_bytes: u64,
+    /// Whether `VK_EXT_memory_budget` is enabled.
+    pub memory_budget: bool,
     pub features: Vec<String>,
     /// Optional features the device offers and alpenglow enabled.
     pub optional_features: Vec<String>,
@@ -104,6 +111,8 @@ pub(crate) struct Shared {
     pub heap: ManuallyDrop<DescriptorHeap>,
     pub info: DeviceInfo,
     pub limits: vk::PhysicalDeviceLimits,
+    /// Heap and single-allocation limits ([`Context::memory_limits`]).
+    pub(super) memory: super::device_memory::DeviceMemory,
     report: Option<Arc<ValidationReport>>,
 }
 
@@ -320,16 +329,22 @@ impl Context {
         v12 = v12.shader_buffer_int64_atomics(optional.shader_buffer_int64_atomics);
         let mut interlock =
             vk::PhysicalDeviceFragmentShaderInterlockFeaturesEXT::default().fragment_shader_pixel_interlock(true);
-        let extensions = [ash::ext::fragment_shader_interlock::NAME.as_ptr()];
+        let memory_budget = super::device_memory::offers_memory_budget(&instance, candidate.physical);
+        let mut extensions = Vec::new();
+        if optional.fragment_shader_pixel_interlock {
+            extensions.push(ash::ext::fragment_shader_interlock::NAME.as_ptr());
+        }
+        if memory_budget {
+            extensions.push(ash::ext::memory_budget::NAME.as_ptr());
+        }
         let mut device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_features(&base)
+            .enabled_extension_names(&extensions)
             .push_next(&mut v12)
             .push_next(&mut v13);
         if optional.fragment_shader_pixel_interlock {
-            device_info = device_info
-                .enabled_extension_names(&extensions)
-                .push_next(&mut interlock);
+            device_info = device_info.push_next(&mut interlock);
         }
         // SAFETY: the features were checked as supported by `inspect`; pointers are to locals.
         let device = match unsafe { instance.create_device(candidate.physical, &device_info, None) } {
@@ -370,6 +385,7 @@ impl Context {
             unsafe { device.create_semaphore(&semaphore_info, None) }.map_err(vk_err("vkCreateSemaphore"))?;
         let heap = DescriptorHeap::new(&device)?;
 
+        let memory = super::device_memory::query(&instance, candidate.physical, memory_budget);
         let props = &candidate.properties;
         let info = DeviceInfo {
             name: candidate.name.clone(),
@@ -387,6 +403,9 @@ impl Context {
             index: candidate.index,
             timestamp_period_ns: props.limits.timestamp_period,
             max_image_dimension_2d: props.limits.max_image_dimension2_d,
+            memory_heap_bytes: memory.heap,
+            max_allocation_bytes: memory.allocation,
+            memory_budget,
             features: REQUIRED_FEATURES.iter().map(|s| s.to_string()).collect(),
             optional_features: optional.names(),
             max_point_size: if optional.large_points {
@@ -412,6 +431,7 @@ impl Context {
             heap: ManuallyDrop::new(heap),
             info,
             limits: props.limits,
+            memory,
             report,
         };
         log::info!("device: {} ({})", shared.info.name, shared.info.driver_info);

@@ -3,6 +3,7 @@
 
 mod commands;
 mod context;
+mod device_memory;
 mod device_select;
 mod frames;
 mod heap;

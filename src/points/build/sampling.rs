@@ -115,6 +115,15 @@ pub struct SamplingOptions {
     pub seed: u64,
 }
 
+/// Host memory sampling `count` surfels with `method` needs at its peak
+/// ([`crate::budget`]): `count` × [`bytes_per_sample`] (about 550 B a
+/// surfel for blue noise, which holds [`BLUE_NOISE_CANDIDATES`] candidates a
+/// surfel). The point tree built from the surfels is counted by
+/// `crate::points::build::plan`.
+pub fn sampling_footprint(count: usize, method: SamplingMethod) -> crate::budget::Footprint {
+    crate::budget::Footprint::per_item(count as u64, bytes_per_sample(method), 0)
+}
+
 /// Samples `options.count` surfels evenly (area-weighted) over the mesh
 /// (§10.1; method, attributes and radius in the module docs), with clip
 /// lines along the mesh's creases (§10.2.4, [`super::clip`]).
@@ -156,6 +165,11 @@ fn sample_traced(
     if count == 0 {
         return Err(Error::invalid("sample count", "must be positive"));
     }
+    crate::budget::MemoryLimits::host_only().check(
+        "sample count",
+        &format!("{count} samples"),
+        sampling_footprint(count, options.method),
+    )?;
     let prepared = Prepared::new(mesh)?;
     let radius =
         ((prepared.total_area / (std::f64::consts::PI * count as f64)).sqrt() as f32) * options.method.radius_overlap();
@@ -901,6 +915,25 @@ mod tests {
                 assert_eq!(clipped, 0);
             }
         }
+    }
+
+    #[test]
+    fn sample_counts_are_bounded_by_memory() {
+        // The sizes the estimate is made of, and what it comes to.
+        let blue = sampling_footprint(1, SamplingMethod::BlueNoise).host;
+        let stratified = sampling_footprint(1, SamplingMethod::Stratified).host;
+        println!("{blue} B a blue-noise sample, {stratified} B a stratified one");
+        assert!(
+            (400..=800).contains(&blue) && (100..=400).contains(&stratified),
+            "{blue} {stratified}"
+        );
+        assert_eq!(sampling_footprint(1000, SamplingMethod::BlueNoise).host, 1000 * blue);
+        assert_eq!(sampling_footprint(usize::MAX, SamplingMethod::BlueNoise).host, u64::MAX);
+        // 10⁸ samples need more than any test machine has left after this;
+        // the error comes before anything is sampled.
+        let e = sample_mesh(&unit_square(), &options(usize::MAX / 64, SamplingMethod::BlueNoise, 1)).unwrap_err();
+        assert_eq!(e.parameter(), Some("sample count"));
+        assert!(e.to_string().contains("of host memory;"), "{e}");
     }
 
     #[test]
