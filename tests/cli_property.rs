@@ -129,9 +129,10 @@ fn run_case(id: u64, fixtures: &Fixtures, root: &Path) -> Verdict {
         None => Verdict::Error,
         Some((problem, why)) => {
             let line = format!(
-                "case 0x{id:016x} ({problem:?}, {:.1} s, {} MiB peak): {why}\n  command: \
+                "{} case 0x{id:016x} ({problem:?}, {:.1} s, {} MiB peak): {why}\n  command: \
                  ALPENGLOW_HOST_MEMORY_MB={HOST_MEMORY_MB} {} {}\n  replay:  \
                  ALPENGLOW_CLI_PROPTEST_REPLAY=0x{id:016x} cargo test --test cli_property cli_options_property",
+                case.command.words().join(" "),
                 result.seconds,
                 result.peak_rss >> 20,
                 env!("CARGO_BIN_EXE_alpenglow"),
@@ -178,6 +179,9 @@ fn cli_options_property() {
                 let n = next.fetch_add(1, Ordering::Relaxed);
                 if n >= cases && !budget.is_some_and(|b| started.elapsed() < b) {
                     break;
+                }
+                if n > 0 && n % 50 == 0 {
+                    eprintln!("cli property: case {n} at {:.0} s", started.elapsed().as_secs_f64());
                 }
                 let id = splitmix64(base.wrapping_add(n));
                 match run_case(id, &fixtures, &root) {

@@ -514,7 +514,7 @@ pub struct SptBuildArgs {
     #[arg(long = "fov-y", default_value_t = 60.0, value_name = "DEGREES")]
     pub fov_y: f32,
     /// Image rows the pixel threshold refers to.
-    #[arg(long, default_value_t = 1080, value_name = "PIXELS", value_parser = clap::value_parser!(u32).range(0..))]
+    #[arg(long, default_value_t = 1080, value_name = "PIXELS", value_parser = clap::value_parser!(u32).range(1..))]
     pub rows: u32,
 }
 
@@ -547,6 +547,21 @@ pub(super) fn parse_spacing(s: &str) -> Result<(f64, f64), String> {
     };
     alpenglow::io::heightmap::check_spacing(glam::DVec2::new(dx, dy)).map_err(|m| format!("'{s}': {m}"))?;
     Ok((dx, dy))
+}
+
+/// Checks `--height-scale` (finite and positive) and `--height-offset`
+/// (finite) before anything is read or computed, as the height-map loader
+/// does: a command that reads no height map with them (a procedural
+/// terrain, `synth transition` of procedural fields) still refuses a NaN
+/// or an overflowed value (`--height-offset -1e308` is -inf as an f32).
+pub(super) fn check_height_mapping(scale: f32, offset: f32) -> anyhow::Result<()> {
+    if !(scale.is_finite() && scale > 0.0) {
+        anyhow::bail!("invalid --height-scale {scale}: must be finite and positive");
+    }
+    if !offset.is_finite() {
+        anyhow::bail!("invalid --height-offset {offset}: must be finite");
+    }
+    Ok(())
 }
 
 /// `NAME=FILE` of `--input-map`.

@@ -13,6 +13,8 @@ mod rig;
 mod spt;
 mod synth;
 mod terrain_spec;
+#[cfg(test)]
+mod tests;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -39,14 +41,29 @@ use args::{
 
 /// Lets every option that takes a value accept a negative number (`--near
 /// -1` is then a range error naming `--near`, not "unexpected argument
-/// '-1'"), in every subcommand.
+/// '-1'"), in every subcommand; numeric options take any value starting
+/// with a hyphen (`--near -inf` or `--fov-y -1e-300` is then an error naming
+/// the option, not "unexpected argument '-i'": clap's negative numbers are
+/// digits and a point only).
 fn allow_negative_values(command: clap::Command) -> clap::Command {
+    use std::any::TypeId;
     command
         .mut_args(|arg| {
-            if arg.get_action().takes_values() && !arg.is_positional() {
-                arg.allow_negative_numbers(true)
+            if !arg.get_action().takes_values() || arg.is_positional() {
+                return arg;
+            }
+            let parsed = arg.get_value_parser().type_id();
+            let numeric = [
+                TypeId::of::<f32>(),
+                TypeId::of::<f64>(),
+                TypeId::of::<u32>(),
+                TypeId::of::<u64>(),
+                TypeId::of::<usize>(),
+            ];
+            if numeric.iter().any(|t| parsed == *t) {
+                arg.allow_hyphen_values(true)
             } else {
-                arg
+                arg.allow_negative_numbers(true)
             }
         })
         .mut_subcommands(allow_negative_values)
@@ -136,6 +153,7 @@ fn warn_unused_input_map(args: &SceneArgs, scene: &Scene, k: usize) {
 
 fn load_scene(args: &SceneArgs) -> Result<Scene> {
     validate_size(args.width, args.height)?;
+    args::check_height_mapping(args.height_scale, args.height_offset)?;
     let builtin = args.terrain.terrain.is_none() && args.heightmap.is_none();
     let mut scene = load_terrain(args)?;
     points::add_points(&args.points, &mut scene, builtin)?;

@@ -18,7 +18,7 @@ use alpenglow::synthesis::gpu::GpuSearch;
 use alpenglow::synthesis::search::CpuSearch;
 use alpenglow::synthesis::transition::{plan_transition, Axis, TransitionParams};
 
-use crate::cli::args::{parse_spacing, RowsArg};
+use crate::cli::args::{check_height_mapping, parse_spacing, RowsArg};
 use crate::cli::outputs::Outputs;
 use crate::cli::terrain_spec::{TerrainSpec, PREFIX};
 
@@ -223,6 +223,7 @@ fn load_fill_input(args: &FillArgs) -> Result<(HeightField, Vec<bool>)> {
 }
 
 fn fill(args: FillArgs) -> Result<ExitCode> {
+    check_height_mapping(args.heights.height_scale, args.heights.height_offset)?;
     let mut outputs = reserve_output(&args.out)?;
     let (field, unknown) = load_fill_input(&args)?;
     let params = args.grow.params(FillParams::default());
@@ -259,6 +260,7 @@ fn load_field(source: &str, args: &HeightArgs) -> Result<HeightField> {
 }
 
 fn transition(args: TransitionArgs) -> Result<ExitCode> {
+    check_height_mapping(args.heights.height_scale, args.heights.height_offset)?;
     let mut outputs = reserve_output(&args.out)?;
     let a = load_field(&args.a, &args.heights)?;
     let b = load_field(&args.b, &args.heights)?;

@@ -86,7 +86,6 @@ pub enum Output {
 /// A generated command line.
 #[derive(Clone, Debug)]
 pub struct Case {
-    pub id: u64,
     pub command: Command,
     pub args: Vec<String>,
     /// The numeric options varied, with their values.
@@ -102,7 +101,11 @@ pub struct Case {
 impl Case {
     /// The options on the command line.
     pub fn flags(&self) -> Vec<&str> {
-        self.args.iter().filter(|a| a.starts_with("--")).map(String::as_str).collect()
+        self.args
+            .iter()
+            .filter(|a| a.starts_with("--"))
+            .map(String::as_str)
+            .collect()
     }
 
     /// Whether `flag` is on the command line.
@@ -158,7 +161,6 @@ pub fn generate(id: u64, fixtures: &Fixtures, root: &Path) -> Case {
         .map(|o| (o.flag, values::value(&mut rng, o.kind)))
         .collect();
     let mut case = Case {
-        id,
         command,
         args: command.words().iter().map(|w| w.to_string()).collect(),
         varied: varied.clone(),
@@ -169,7 +171,7 @@ pub fn generate(id: u64, fixtures: &Fixtures, root: &Path) -> Case {
     let out = |name: &str| out_dir.join(name);
     let is_varied = |flag: &str| varied.iter().any(|(f, _)| *f == flag);
     let mut base: Vec<String> = Vec::new();
-    let mut push = |args: &[&str], base: &mut Vec<String>| base.extend(args.iter().map(|s| s.to_string()));
+    let push = |args: &[&str], base: &mut Vec<String>| base.extend(args.iter().map(|s| s.to_string()));
     match command {
         Command::Render | Command::Bench | Command::Fly => {
             scene_base(&mut rng, &chosen, fixtures, &mut case, &mut base);
@@ -179,7 +181,8 @@ pub fn generate(id: u64, fixtures: &Fixtures, root: &Path) -> Case {
                     for (flag, path) in [("--out", &png), ("--exr", &exr), ("--profile", &json)] {
                         base.extend([flag.to_string(), path.to_string_lossy().into_owned()]);
                     }
-                    case.outputs.extend([Output::Png(png), Output::Exr(exr), Output::Json(json)]);
+                    case.outputs
+                        .extend([Output::Png(png), Output::Exr(exr), Output::Json(json)]);
                 }
                 Command::Bench => {
                     if !is_varied("--frames") {
@@ -261,7 +264,8 @@ pub fn generate(id: u64, fixtures: &Fixtures, root: &Path) -> Case {
             base.extend(["--out".into(), toml.to_string_lossy().into_owned()]);
             base.extend(["--class-map".into(), map.to_string_lossy().into_owned()]);
             case.files.extend([img, dem]);
-            case.files.extend([toml.to_string_lossy().into_owned(), map.to_string_lossy().into_owned()]);
+            case.files
+                .extend([toml.to_string_lossy().into_owned(), map.to_string_lossy().into_owned()]);
             case.outputs.extend([Output::Layers(toml), Output::Png(map)]);
         }
     }

@@ -104,9 +104,30 @@ const SOLAR: &[(&str, &str)] = &[
 pub const SCENE: &[Opt] = &[
     opt("--width", int(1, 16384, 16384)),
     opt("--height", int(1, 16384, 16384)),
-    opt("--eye", Kind::List { n: &[3], lo: -1e8, hi: 1e8 }),
-    opt("--target", Kind::List { n: &[3], lo: -1e8, hi: 1e8 }),
-    opt("--up", Kind::List { n: &[3], lo: -1.0, hi: 1.0 }),
+    opt(
+        "--eye",
+        Kind::List {
+            n: &[3],
+            lo: -1e8,
+            hi: 1e8,
+        },
+    ),
+    opt(
+        "--target",
+        Kind::List {
+            n: &[3],
+            lo: -1e8,
+            hi: 1e8,
+        },
+    ),
+    opt(
+        "--up",
+        Kind::List {
+            n: &[3],
+            lo: -1.0,
+            hi: 1.0,
+        },
+    ),
     opt("--fov-y", float(0.0, 180.0)),
     opt("--near", float(1e-6, 1e9)),
     opt("--far", float(1e-6, 1e9)),
@@ -115,14 +136,35 @@ pub const SCENE: &[Opt] = &[
         with: &[("--eye", "300,-200,400")],
         ..opt("--rotation", Kind::Special(Special::Rotation))
     },
-    opt("--intrinsics", Kind::List { n: &[4], lo: -100.0, hi: 100.0 }),
-    opt("--distortion", Kind::List { n: &[5], lo: -10.0, hi: 10.0 }),
+    opt(
+        "--intrinsics",
+        Kind::List {
+            n: &[4],
+            lo: -100.0,
+            hi: 100.0,
+        },
+    ),
+    opt(
+        "--distortion",
+        Kind::List {
+            n: &[5],
+            lo: -10.0,
+            hi: 10.0,
+        },
+    ),
     opt("--msaa", Kind::OneOf(&[1, 2, 4, 8, 16])),
     opt("--shutter", float(0.0, 1.0 / 30.0)),
     opt("--fps", float(0.0, 1000.0)),
     Opt {
         scene: Scene::Heightmap,
-        ..opt("--spacing", Kind::List { n: &[1, 2], lo: 0.001, hi: 100000.0 })
+        ..opt(
+            "--spacing",
+            Kind::List {
+                n: &[1, 2],
+                lo: 0.001,
+                hi: 100000.0,
+            },
+        )
     },
     Opt {
         scene: Scene::Heightmap,
@@ -145,7 +187,14 @@ pub const SCENE: &[Opt] = &[
         scene: Scene::Points,
         ..opt("--points-transform", Kind::Special(Special::Transform))
     },
-    opt("--epsilon", Kind::Float { lo: 0.0, hi: BIG, cheap: BIG }),
+    opt(
+        "--epsilon",
+        Kind::Float {
+            lo: 0.0,
+            hi: BIG,
+            cheap: BIG,
+        },
+    ),
     Opt {
         scene: Scene::Points,
         ..opt("--points-samples", int(1, U64, 20_000))
@@ -156,7 +205,14 @@ pub const SCENE: &[Opt] = &[
     },
     Opt {
         scene: Scene::Vegetation,
-        ..opt("--vegetation-density", Kind::Float { lo: 0.0, hi: 1e300, cheap: 4.0 })
+        ..opt(
+            "--vegetation-density",
+            Kind::Float {
+                lo: 0.0,
+                hi: 1e300,
+                cheap: 4.0,
+            },
+        )
     },
     opt("--sun-elevation", float(-90.0, 90.0)),
     opt("--sun-azimuth", float(-BIG, BIG)),
@@ -215,22 +271,33 @@ pub const SCENE_OTHER: &[&str] = &[
 
 pub const RENDER_OTHER: &[&str] = &["--out", "--exr", "--profile", "--trace"];
 
-pub const BENCH: &[Opt] = &[
-    opt("--frames", int(1, 100_000, 2)),
-    opt("--warmup", int(0, 100_000, 1)),
-];
+pub const BENCH: &[Opt] = &[opt("--frames", int(1, 100_000, 2)), opt("--warmup", int(0, 100_000, 1))];
 pub const BENCH_OTHER: &[&str] = &["--profile", "--trace"];
 
 pub const FLY: &[Opt] = &[
     opt("--frames", int(1, 100_000, 3)),
-    opt("--orbit", Kind::List { n: &[5, 6], lo: -1e4, hi: 1e4 }),
+    opt(
+        "--orbit",
+        Kind::List {
+            n: &[5, 6],
+            lo: -1e4,
+            hi: 1e4,
+        },
+    ),
 ];
 pub const FLY_OTHER: &[&str] = &["--path", "--out-dir", "--profile", "--trace"];
 
 pub const SPT: &[Opt] = &[
     opt("--samples", int(1, U64, 5_000)),
     opt("--seed", int(0, U64, U64)),
-    opt("--epsilon", Kind::Float { lo: 0.0, hi: BIG, cheap: BIG }),
+    opt(
+        "--epsilon",
+        Kind::Float {
+            lo: 0.0,
+            hi: BIG,
+            cheap: BIG,
+        },
+    ),
     opt("--fov-y", float(0.0, 180.0)),
     opt("--rows", int(1, U32, U32)),
 ];
@@ -244,25 +311,32 @@ pub const GROW: &[Opt] = &[
     opt("--seed", int(0, U32, U32)),
     opt("--batch", int(1, U64, U64)),
     opt("--candidates", int(1, U64, 100_000)),
-    opt("--spacing", Kind::List { n: &[1, 2], lo: 0.001, hi: 100000.0 }),
+    opt(
+        "--spacing",
+        Kind::List {
+            n: &[1, 2],
+            lo: 0.001,
+            hi: 100000.0,
+        },
+    ),
     opt("--height-scale", float(-BIG, BIG)),
     opt("--height-offset", float(-1e6, 1e6)),
     opt("--max-input-mb", int(1, U64, 1 << 40)),
 ];
-pub const FILL_OTHER: &[&str] = &[
-    "--input",
-    "--mask",
-    "--out",
-    "--search",
-    "--device",
-    "--rows",
-];
+pub const FILL_OTHER: &[&str] = &["--input", "--mask", "--out", "--search", "--device", "--rows"];
 
 pub const TRANSITION: &[Opt] = &[opt("--band", float(0.0, BIG)), opt("--blur", int(0, U32, 16))];
 pub const TRANSITION_OTHER: &[&str] = &["--out", "--axis", "--search", "--device", "--rows"];
 
 pub const LAYERS: &[Opt] = &[
-    opt("--spacing", Kind::List { n: &[1, 2], lo: 0.001, hi: 100000.0 }),
+    opt(
+        "--spacing",
+        Kind::List {
+            n: &[1, 2],
+            lo: 0.001,
+            hi: 100000.0,
+        },
+    ),
     opt("--height-scale", float(-BIG, BIG)),
     opt("--height-offset", float(-1e6, 1e6)),
     opt("--classes", Kind::Special(Special::Classes)),

@@ -20,7 +20,6 @@ pub const TIMEOUT: Duration = Duration::from_secs(60);
 pub struct Run {
     pub code: Option<i32>,
     pub signal: Option<i32>,
-    pub stdout: String,
     pub stderr: String,
     pub peak_rss: u64,
     pub seconds: f64,
@@ -67,7 +66,11 @@ pub fn run(case: &Case, scratch: &Path) -> Run {
         peak = peak.max(peak_rss(child.id()).unwrap_or(0));
         if killed.is_none() {
             if peak > RSS_CAP_BYTES {
-                killed = Some(format!("resident memory {} MiB > {} MiB", peak >> 20, RSS_CAP_BYTES >> 20));
+                killed = Some(format!(
+                    "resident memory {} MiB > {} MiB",
+                    peak >> 20,
+                    RSS_CAP_BYTES >> 20
+                ));
             } else if started.elapsed() > TIMEOUT {
                 killed = Some(format!("still running after {} s", TIMEOUT.as_secs()));
             }
@@ -81,7 +84,6 @@ pub fn run(case: &Case, scratch: &Path) -> Run {
     Run {
         code: status.code(),
         signal: status.signal(),
-        stdout: read(&out_path),
         stderr: read(&err_path),
         peak_rss: peak,
         seconds: started.elapsed().as_secs_f64(),
@@ -127,7 +129,10 @@ pub fn judge(case: &Case, run: &Run) -> Option<(Problem, String)> {
         return Some((Problem::Panic, last_lines(&run.stderr)));
     }
     if let Some(sig) = run.signal {
-        return Some((Problem::Signal, format!("killed by signal {sig}: {}", last_lines(&run.stderr))));
+        return Some((
+            Problem::Signal,
+            format!("killed by signal {sig}: {}", last_lines(&run.stderr)),
+        ));
     }
     if run.code == Some(0) {
         if let Err(why) = check_outputs(case) {
@@ -166,8 +171,13 @@ fn check_shape(stderr: &str) -> Result<(), String> {
     if !last.starts_with("error: ") || last.trim() == "error:" {
         return Err(format!("the last stderr line is not an error: {}", last_lines(stderr)));
     }
-    if let Some(odd) = before.iter().find(|l| !(l.starts_with("[WARN") || l.starts_with("[INFO"))) {
-        return Err(format!("stderr has a line that is neither a log line nor the error: {odd:?}"));
+    if let Some(odd) = before
+        .iter()
+        .find(|l| !(l.starts_with("[WARN") || l.starts_with("[INFO")))
+    {
+        return Err(format!(
+            "stderr has a line that is neither a log line nor the error: {odd:?}"
+        ));
     }
     Ok(())
 }
@@ -205,25 +215,30 @@ pub fn named_flags(line: &str) -> Vec<Vec<String>> {
     groups
 }
 
-/// The error must name an option of the command line (its first named
-/// option group must hold one), or, naming no option, a file or
-/// positional value of it.
+/// The error must name what the command line gave: the first thing it
+/// names (an option group such as `--near/--far`, or a file or positional
+/// value) must be on the command line; a later option may be a remedy
+/// ("set --height-scale").
 fn check_culprit(case: &Case, line: &str) -> Result<(), String> {
     let flags = case.flags();
-    match named_flags(line).first() {
-        Some(group) if group.iter().any(|f| flags.contains(&f.as_str())) => Ok(()),
-        Some(group) => Err(format!("names {} (not on the command line): {line}", group.join("/"))),
-        None => {
-            let names_file = case.files.iter().any(|f| {
-                let name = Path::new(f).file_name().map(|n| n.to_string_lossy().into_owned());
-                line.contains(f.as_str()) || name.is_some_and(|n| line.contains(&n))
-            });
-            if names_file {
-                Ok(())
-            } else {
-                Err(format!("names no option or file of the command line: {line}"))
-            }
-        }
+    let first_flag = named_flags(line).into_iter().next().map(|group| {
+        let at = line.find(group[0].as_str()).unwrap_or(usize::MAX);
+        (at, group)
+    });
+    let first_file = case
+        .files
+        .iter()
+        .filter_map(|f| {
+            let name = Path::new(f).file_name().map(|n| n.to_string_lossy().into_owned());
+            line.find(f.as_str()).or_else(|| name.and_then(|n| line.find(&n)))
+        })
+        .min();
+    match (first_flag, first_file) {
+        (Some((at, _)), Some(file)) if file < at => Ok(()),
+        (Some((_, group)), _) if group.iter().any(|f| flags.contains(&f.as_str())) => Ok(()),
+        (Some((_, group)), _) => Err(format!("names {} (not on the command line): {line}", group.join("/"))),
+        (None, Some(_)) => Ok(()),
+        (None, None) => Err(format!("names no option or file of the command line: {line}")),
     }
 }
 
