@@ -39,12 +39,13 @@ use args::{
     TerrainDebugArgs, ViewArg,
 };
 
-/// Lets every option that takes a value accept a negative number (`--near
-/// -1` is then a range error naming `--near`, not "unexpected argument
-/// '-1'"), in every subcommand; numeric options take any value starting
-/// with a hyphen (`--near -inf` or `--fov-y -1e-300` is then an error naming
-/// the option, not "unexpected argument '-i'": clap's negative numbers are
-/// digits and a point only).
+/// Lets every option that takes a value accept a value that starts with a
+/// hyphen, in every subcommand: `--near -1`, `--near -inf`, `--fov-y
+/// -1e-300`, `--spacing -1,2`, `--time -1:00` are then errors naming the
+/// option, not "unexpected argument '-i'" (clap's negative numbers are
+/// digits and a point only). File options keep clap's reading (a negative
+/// number at most), so `--out --width 3` is still "a value is required for
+/// --out", never a file named `--width`.
 fn allow_negative_values(command: clap::Command) -> clap::Command {
     use std::any::TypeId;
     command
@@ -53,17 +54,11 @@ fn allow_negative_values(command: clap::Command) -> clap::Command {
                 return arg;
             }
             let parsed = arg.get_value_parser().type_id();
-            let numeric = [
-                TypeId::of::<f32>(),
-                TypeId::of::<f64>(),
-                TypeId::of::<u32>(),
-                TypeId::of::<u64>(),
-                TypeId::of::<usize>(),
-            ];
-            if numeric.iter().any(|t| parsed == *t) {
-                arg.allow_hyphen_values(true)
-            } else {
+            let files = [TypeId::of::<PathBuf>(), TypeId::of::<(usize, PathBuf)>()];
+            if files.iter().any(|t| parsed == *t) {
                 arg.allow_negative_numbers(true)
+            } else {
+                arg.allow_hyphen_values(true)
             }
         })
         .mut_subcommands(allow_negative_values)

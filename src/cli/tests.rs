@@ -17,9 +17,9 @@ fn parse(args: &[&str]) -> Result<Cli, String> {
     Cli::from_arg_matches(&matches).map_err(|e| e.to_string())
 }
 
-/// Non-finite and exponent values of numeric options reach their parsers
-/// (then a range error names the option), in nested subcommands too;
-/// clap alone read `-inf` and `-1e-300` as unknown options `-i` and `-1`.
+/// Values with a leading hyphen reach their parsers (then a range error
+/// names the option), in nested subcommands too; clap alone read `-inf`,
+/// `-1e-300` and `-1:27` as unknown options `-i` and `-1`.
 #[test]
 fn numeric_options_take_any_hyphen_value() {
     let Command::Render(render) = parse(&["render", "--near", "-inf", "--fov-y", "-1e-300"])
@@ -37,6 +37,12 @@ fn numeric_options_take_any_hyphen_value() {
         panic!("not spt build");
     };
     assert_eq!(build.epsilon, f32::NEG_INFINITY);
+    let Command::Fly(fly) = parse(&["fly", "--spacing", "2", "--time", "-1:27"]).unwrap().command else {
+        panic!("not fly");
+    };
+    assert_eq!(fly.scene.lighting.time.as_deref(), Some("-1:27"));
+    let e = parse(&["render", "--spacing", "-1e-300,2"]).unwrap_err();
+    assert!(e.contains("'--spacing"), "{e}");
     let e = parse(&["bench", "--frames", "-1e3"]).unwrap_err();
     assert!(e.contains("'--frames"), "{e}");
     // File options still refuse a missing value rather than take the next flag.
