@@ -102,7 +102,7 @@ pub struct SceneArgs {
     #[arg(
         long = "height-scale",
         default_value_t = 1.0,
-        allow_hyphen_values = true,
+        value_parser = parse_height_scale,
         value_name = "FACTOR",
         help_heading = "Terrain"
     )]
@@ -111,7 +111,7 @@ pub struct SceneArgs {
     #[arg(
         long = "height-offset",
         default_value_t = 0.0,
-        allow_hyphen_values = true,
+        value_parser = parse_height_offset,
         value_name = "METRES",
         help_heading = "Terrain"
     )]
@@ -514,7 +514,7 @@ pub struct SptBuildArgs {
     #[arg(long = "fov-y", default_value_t = 60.0, value_name = "DEGREES")]
     pub fov_y: f32,
     /// Image rows the pixel threshold refers to.
-    #[arg(long, default_value_t = 1080, value_name = "PIXELS", value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 1080, value_name = "PIXELS", value_parser = clap::value_parser!(u32).range(0..))]
     pub rows: u32,
 }
 
@@ -549,21 +549,6 @@ pub(super) fn parse_spacing(s: &str) -> Result<(f64, f64), String> {
     Ok((dx, dy))
 }
 
-/// Checks `--height-scale` (finite and positive) and `--height-offset`
-/// (finite) before anything is read or computed, as the height-map loader
-/// does: a command that reads no height map with them (a procedural
-/// terrain, `synth transition` of procedural fields) still refuses a NaN
-/// or an overflowed value (`--height-offset -1e308` is -inf as an f32).
-pub(super) fn check_height_mapping(scale: f32, offset: f32) -> anyhow::Result<()> {
-    if !(scale.is_finite() && scale > 0.0) {
-        anyhow::bail!("invalid --height-scale {scale}: must be finite and positive");
-    }
-    if !offset.is_finite() {
-        anyhow::bail!("invalid --height-offset {offset}: must be finite");
-    }
-    Ok(())
-}
-
 /// `NAME=FILE` of `--input-map`.
 pub(super) fn parse_input_map(s: &str) -> Result<(usize, PathBuf), String> {
     let names = alpenglow::texturing::layers::INPUT_NAMES;
@@ -574,4 +559,28 @@ pub(super) fn parse_input_map(s: &str) -> Result<(usize, PathBuf), String> {
         return Err(format!("'{s}': no file"));
     }
     Ok((k, PathBuf::from(file)))
+}
+
+/// `--height-scale`: a finite, positive factor, refused by the parser
+/// whether or not a height map is read (a procedural terrain or `synth
+/// transition` of procedural fields used to take a NaN, or -1e308, which
+/// is -inf as an f32, without a word).
+pub(super) fn parse_height_scale(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        Ok(v) => Err(format!("{v} must be a finite number > 0")),
+        Err(_) => Err(format!("'{s}' is not a number")),
+    }
+}
+
+/// `--height-offset`: metres within the heights' range (±1000 km,
+/// [`alpenglow::io::heightmap::MAX_ABS_HEIGHT`]); beyond, every height of a
+/// file or an output would be out of range.
+pub(super) fn parse_height_offset(s: &str) -> Result<f32, String> {
+    let limit = alpenglow::io::heightmap::MAX_ABS_HEIGHT;
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && v.abs() <= limit => Ok(v),
+        Ok(v) => Err(format!("{v} m is not within ±{limit} m")),
+        Err(_) => Err(format!("'{s}' is not a number")),
+    }
 }

@@ -148,7 +148,6 @@ fn warn_unused_input_map(args: &SceneArgs, scene: &Scene, k: usize) {
 
 fn load_scene(args: &SceneArgs) -> Result<Scene> {
     validate_size(args.width, args.height)?;
-    args::check_height_mapping(args.height_scale, args.height_offset)?;
     let builtin = args.terrain.terrain.is_none() && args.heightmap.is_none();
     let mut scene = load_terrain(args)?;
     points::add_points(&args.points, &mut scene, builtin)?;

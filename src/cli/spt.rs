@@ -18,7 +18,6 @@ use super::args::{SamplingArg, SptBuildArgs};
 
 pub fn build(args: SptBuildArgs) -> Result<ExitCode> {
     let started = Instant::now();
-    let epsilon = epsilon(&args)?;
     let surfels = match load_points_file(&args.input)? {
         PointInput::Mesh(mesh) => sample_mesh(
             &mesh,
@@ -34,7 +33,7 @@ pub fn build(args: SptBuildArgs) -> Result<ExitCode> {
         PointInput::Points(cloud) => complete_cloud(&cloud)?,
     };
     let options = SptOptions {
-        epsilon,
+        epsilon: epsilon_from_pixels(args.epsilon, args.fov_y.to_radians(), args.rows)?,
         ..SptOptions::default()
     };
     let bar = ProgressBar::new(1000);
@@ -61,22 +60,4 @@ pub fn build(args: SptBuildArgs) -> Result<ExitCode> {
         args.output.display()
     );
     Ok(ExitCode::SUCCESS)
-}
-
-/// The tree's error threshold from `--epsilon` pixels at `--fov-y` over
-/// `--rows`, checked before the input is read; an error names the flag
-/// (the library names its parameters "pixel threshold", "field of view"
-/// and "image height").
-fn epsilon(args: &SptBuildArgs) -> Result<f32> {
-    epsilon_from_pixels(args.epsilon, args.fov_y.to_radians(), args.rows).map_err(|e| match &e {
-        alpenglow::Error::InvalidArgument { parameter, message } => {
-            let (flag, value) = match parameter.as_str() {
-                "field of view" => ("--fov-y", args.fov_y.to_string()),
-                "image height" => ("--rows", args.rows.to_string()),
-                _ => ("--epsilon", args.epsilon.to_string()),
-            };
-            anyhow::anyhow!("invalid {flag} {value}: {parameter} {message}")
-        }
-        _ => anyhow::Error::from(e),
-    })
 }

@@ -18,7 +18,7 @@ use alpenglow::synthesis::gpu::GpuSearch;
 use alpenglow::synthesis::search::CpuSearch;
 use alpenglow::synthesis::transition::{plan_transition, Axis, TransitionParams};
 
-use crate::cli::args::{check_height_mapping, parse_spacing, RowsArg};
+use crate::cli::args::{parse_spacing, RowsArg};
 use crate::cli::outputs::Outputs;
 use crate::cli::terrain_spec::{TerrainSpec, PREFIX};
 
@@ -41,11 +41,11 @@ pub struct HeightArgs {
     pub spacing: Option<(f64, f64)>,
     /// Multiplier of height-map values (to metres); a PNG or EXR output is
     /// written back with the same mapping.
-    #[arg(long = "height-scale", default_value_t = 1.0, value_name = "FACTOR")]
+    #[arg(long = "height-scale", default_value_t = 1.0, value_parser = crate::cli::args::parse_height_scale, value_name = "FACTOR")]
     pub height_scale: f32,
     /// Added to height-map values after scaling, in metres (also used for
     /// the output).
-    #[arg(long = "height-offset", default_value_t = 0.0, value_name = "METRES")]
+    #[arg(long = "height-offset", default_value_t = 0.0, value_parser = crate::cli::args::parse_height_offset, value_name = "METRES")]
     pub height_offset: f32,
     /// Where a PNG, EXR or plain TIFF's first row lies (south-up: rows
     /// kept; north-up: flipped); the output keeps the input's orientation.
@@ -223,7 +223,6 @@ fn load_fill_input(args: &FillArgs) -> Result<(HeightField, Vec<bool>)> {
 }
 
 fn fill(args: FillArgs) -> Result<ExitCode> {
-    check_height_mapping(args.heights.height_scale, args.heights.height_offset)?;
     let mut outputs = reserve_output(&args.out)?;
     let (field, unknown) = load_fill_input(&args)?;
     let params = args.grow.params(FillParams::default());
@@ -260,7 +259,6 @@ fn load_field(source: &str, args: &HeightArgs) -> Result<HeightField> {
 }
 
 fn transition(args: TransitionArgs) -> Result<ExitCode> {
-    check_height_mapping(args.heights.height_scale, args.heights.height_offset)?;
     let mut outputs = reserve_output(&args.out)?;
     let a = load_field(&args.a, &args.heights)?;
     let b = load_field(&args.b, &args.heights)?;

@@ -1,12 +1,13 @@
 //! Command-line parsing and error wording found by the CLI property test
-//! (`tests/cli_property.rs`): values clap took for unknown options, and
-//! library parameter names that reached the user instead of the flag.
+//! (`tests/cli_property.rs`): values clap took for unknown options,
+//! library parameter names that reached the user instead of the flag, and
+//! non-finite height mappings accepted without a word.
 
 use std::path::Path;
 
 use clap::{CommandFactory, FromArgMatches};
 
-use super::args::{check_height_mapping, Cli, Command, SptCommand};
+use super::args::{Cli, Command, SptCommand};
 use super::errors::error_line;
 
 /// `args` parsed as `parse_command_line` parses the real command line.
@@ -50,30 +51,9 @@ fn numeric_options_take_any_hyphen_value() {
     assert!(e.contains("--out"), "{e}");
 }
 
-/// `spt build --epsilon/--fov-y/--rows` errors name the flag, before the
-/// input is read (the library says "pixel threshold", "field of view").
-#[test]
-fn spt_threshold_errors_name_the_flags() {
-    for (args, start) in [
-        (&["--epsilon", "0"][..], "invalid --epsilon 0: "),
-        (&["--epsilon", "inf"][..], "invalid --epsilon inf: "),
-        (&["--fov-y", "180"][..], "invalid --fov-y 180: "),
-        (&["--fov-y", "-1e-300"][..], "invalid --fov-y -0: "),
-    ] {
-        let mut all = vec!["spt", "build", "/nonexistent/in.ply", "out.spt"];
-        all.extend(args);
-        let Command::Spt(SptCommand::Build(build)) = parse(&all).unwrap().command else {
-            panic!("not spt build");
-        };
-        let line = error_line(&super::spt::build(build).unwrap_err());
-        assert!(line.starts_with(start), "{args:?}: {line}");
-    }
-    let e = parse(&["spt", "build", "a", "b", "--rows", "0"]).unwrap_err();
-    assert!(e.contains("--rows") && e.contains("1 or more"), "{e}");
-}
-
-/// Height-map scale, offset and spacing are named by their flags, whether
-/// the loader refuses them or the command reads no height map.
+/// Height-map scale, offset and spacing are named by their flags when the
+/// loader refuses them, and non-finite ones are refused by the parser
+/// whether or not a height map is read.
 #[test]
 fn height_mapping_errors_name_the_flags() {
     use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
@@ -104,9 +84,51 @@ fn height_mapping_errors_name_the_flags() {
         let line = error_line(&anyhow::Error::from(e));
         assert!(line.starts_with(start), "{line}");
     }
-    let line = |r: anyhow::Result<()>| error_line(&r.unwrap_err());
-    assert!(line(check_height_mapping(f32::NAN, 0.0)).starts_with("invalid --height-scale NaN"));
-    assert!(line(check_height_mapping(0.0, 0.0)).starts_with("invalid --height-scale 0"));
-    assert!(line(check_height_mapping(1.0, f32::NEG_INFINITY)).starts_with("invalid --height-offset -inf"));
-    assert!(check_height_mapping(2.5, -100.0).is_ok());
+    // Refused by the parser, with or without a height map to read.
+    for (args, needle) in [
+        (&["render", "--height-scale", "nan"][..], "'--height-scale"),
+        (&["render", "--height-scale", "0"][..], "'--height-scale"),
+        (&["render", "--height-offset", "-1e308"][..], "'--height-offset"),
+        (&["render", "--height-offset", "1000001"][..], "'--height-offset"),
+        (
+            &[
+                "synth",
+                "transition",
+                "procedural:fbm",
+                "procedural:fbm",
+                "--out",
+                "o.png",
+                "--band",
+                "9",
+                "--height-offset",
+                "inf",
+            ][..],
+            "'--height-offset",
+        ),
+        (
+            &[
+                "layers",
+                "from-image",
+                "--image",
+                "i.png",
+                "--heightmap",
+                "h.png",
+                "--out",
+                "o.toml",
+                "--height-scale",
+                "-1",
+            ][..],
+            "'--height-scale",
+        ),
+    ] {
+        let e = parse(args).unwrap_err();
+        assert!(e.contains(needle), "{args:?}: {e}");
+    }
+    let Command::Render(render) = parse(&["render", "--height-scale", "2.5", "--height-offset", "-100"])
+        .unwrap()
+        .command
+    else {
+        panic!("not render");
+    };
+    assert_eq!((render.scene.height_scale, render.scene.height_offset), (2.5, -100.0));
 }

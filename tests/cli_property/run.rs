@@ -300,8 +300,15 @@ fn check_output(case: &Case, output: &Output) -> Result<(), String> {
             Err(e) => fail(p, format!("does not load: {e}")),
         },
         Output::Height(p) => {
+            // Read back with the command's own height mapping.
+            let given = |flag: &str, default: f32| {
+                let at = case.args.iter().position(|a| a == flag);
+                at.and_then(|i| case.args.get(i + 1)?.parse().ok()).unwrap_or(default)
+            };
             let opts = HeightmapOptions {
                 spacing: Some(glam::DVec2::ONE),
+                scale: given("--height-scale", 1.0),
+                offset: given("--height-offset", 0.0),
                 ..HeightmapOptions::default()
             };
             match load_heightmap(p, &opts) {
