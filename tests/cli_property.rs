@@ -17,7 +17,7 @@
 //!   or one of its files, and no output file left behind.
 //!
 //! Environment (as `tests/fuzz_loaders.rs`): `ALPENGLOW_CLI_PROPTEST_CASES`
-//! (default 60), `ALPENGLOW_CLI_PROPTEST_SECONDS` (keep going until this
+//! (default 100), `ALPENGLOW_CLI_PROPTEST_SECONDS` (keep going until this
 //! many seconds have passed), `ALPENGLOW_CLI_PROPTEST_SEED` (base seed,
 //! decimal or 0x hex; fixed by default), `ALPENGLOW_CLI_PROPTEST_REPLAY`
 //! (one case id, as printed by a failure). Cases run on 2 threads. See
@@ -166,7 +166,7 @@ fn cli_options_property() {
         }
         return;
     }
-    let cases = env_u64("ALPENGLOW_CLI_PROPTEST_CASES").unwrap_or(60);
+    let cases = env_u64("ALPENGLOW_CLI_PROPTEST_CASES").unwrap_or(100);
     let budget = env_u64("ALPENGLOW_CLI_PROPTEST_SECONDS").map(Duration::from_secs);
     let base = env_u64("ALPENGLOW_CLI_PROPTEST_SEED").unwrap_or(0xa1be_c11);
     let started = Instant::now();

@@ -54,6 +54,13 @@ pub const KNOWN: &[Known] = &[
         problems: &[Problem::Panic],
         texts: &["min > max"],
     },
+    Known {
+        helper: "panics (/work/wt/panics)",
+        what: "the automatic camera of a legal but extreme terrain is invalid and blames --eye/--up/--target, which were not given",
+        flags: &[],
+        problems: &[Problem::Culprit],
+        texts: &["names --up (not", "names --eye (not", "names --target (not", "names --near/--far (not"],
+    },
 ];
 
 /// The entry that tolerates `problem` of `case` (reason `why`), if any.
