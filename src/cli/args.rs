@@ -102,7 +102,7 @@ pub struct SceneArgs {
     #[arg(
         long = "height-scale",
         default_value_t = 1.0,
-        allow_hyphen_values = true,
+        value_parser = parse_height_scale,
         value_name = "FACTOR",
         help_heading = "Terrain"
     )]
@@ -111,7 +111,7 @@ pub struct SceneArgs {
     #[arg(
         long = "height-offset",
         default_value_t = 0.0,
-        allow_hyphen_values = true,
+        value_parser = parse_height_offset,
         value_name = "METRES",
         help_heading = "Terrain"
     )]
@@ -571,4 +571,28 @@ pub(super) fn parse_input_map(s: &str) -> Result<(usize, PathBuf), String> {
         return Err(format!("'{s}': no file"));
     }
     Ok((k, PathBuf::from(file)))
+}
+
+/// `--height-scale`: a finite, positive factor, refused by the parser
+/// whether or not a height map is read (a procedural terrain or `synth
+/// transition` of procedural fields used to take a NaN, or -1e308, which
+/// is -inf as an f32, without a word).
+pub(super) fn parse_height_scale(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        Ok(v) => Err(format!("{v} must be a finite number > 0")),
+        Err(_) => Err(format!("'{s}' is not a number")),
+    }
+}
+
+/// `--height-offset`: metres within the heights' range (±1000 km,
+/// [`alpenglow::io::heightmap::MAX_ABS_HEIGHT`]); beyond, every height of a
+/// file or an output would be out of range.
+pub(super) fn parse_height_offset(s: &str) -> Result<f32, String> {
+    let limit = alpenglow::io::heightmap::MAX_ABS_HEIGHT;
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && v.abs() <= limit => Ok(v),
+        Ok(v) => Err(format!("{v} m is not within ±{limit} m")),
+        Err(_) => Err(format!("'{s}' is not a number")),
+    }
 }

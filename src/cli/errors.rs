@@ -98,6 +98,9 @@ const FLAGS: &[(&str, &str)] = &[
     ("lighting.latitude", "--latitude"),
     ("lighting.longitude", "--longitude"),
     ("texturing.tile_budget", "--tile-budget"),
+    ("height-map scale", "--height-scale"),
+    ("height-map offset", "--height-offset"),
+    ("height-map spacing", "--spacing"),
 ];
 
 /// The flag(s) that set library parameter `parameter`: a [`FLAGS`] entry;

@@ -40,10 +40,10 @@ pub struct FromImageArgs {
     #[arg(long, value_parser = parse_spacing, value_name = "DX[,DY]")]
     pub spacing: Option<(f64, f64)>,
     /// Multiplier of height-map values (to metres).
-    #[arg(long = "height-scale", default_value_t = 1.0, value_name = "FACTOR")]
+    #[arg(long = "height-scale", default_value_t = 1.0, value_parser = crate::cli::args::parse_height_scale, value_name = "FACTOR")]
     pub height_scale: f32,
     /// Added to height-map values after scaling, in metres.
-    #[arg(long = "height-offset", default_value_t = 0.0, value_name = "METRES")]
+    #[arg(long = "height-offset", default_value_t = 0.0, value_parser = crate::cli::args::parse_height_offset, value_name = "METRES")]
     pub height_offset: f32,
     /// Where the first row of the height map (PNG, EXR, plain TIFF) and of
     /// the image lies: south-up (default, as `render`) or north-up (row 0

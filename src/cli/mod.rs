@@ -14,6 +14,8 @@ mod rig;
 mod spt;
 mod synth;
 mod terrain_spec;
+#[cfg(test)]
+mod tests;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -38,16 +40,26 @@ use args::{
     TerrainDebugArgs, ViewArg,
 };
 
-/// Lets every option that takes a value accept a negative number (`--near
-/// -1` is then a range error naming `--near`, not "unexpected argument
-/// '-1'"), in every subcommand.
+/// Lets every option that takes a value accept a value that starts with a
+/// hyphen, in every subcommand: `--near -1`, `--near -inf`, `--fov-y
+/// -1e-300`, `--spacing -1,2`, `--time -1:00` are then errors naming the
+/// option, not "unexpected argument '-i'" (clap's negative numbers are
+/// digits and a point only). File options keep clap's reading (a negative
+/// number at most), so `--out --width 3` is still "a value is required for
+/// --out", never a file named `--width`.
 fn allow_negative_values(command: clap::Command) -> clap::Command {
+    use std::any::TypeId;
     command
         .mut_args(|arg| {
-            if arg.get_action().takes_values() && !arg.is_positional() {
+            if !arg.get_action().takes_values() || arg.is_positional() {
+                return arg;
+            }
+            let parsed = arg.get_value_parser().type_id();
+            let files = [TypeId::of::<PathBuf>(), TypeId::of::<(usize, PathBuf)>()];
+            if files.iter().any(|t| parsed == *t) {
                 arg.allow_negative_numbers(true)
             } else {
-                arg
+                arg.allow_hyphen_values(true)
             }
         })
         .mut_subcommands(allow_negative_values)

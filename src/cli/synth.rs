@@ -43,11 +43,11 @@ pub struct HeightArgs {
     pub spacing: Option<(f64, f64)>,
     /// Multiplier of height-map values (to metres); a PNG or EXR output is
     /// written back with the same mapping.
-    #[arg(long = "height-scale", default_value_t = 1.0, value_name = "FACTOR")]
+    #[arg(long = "height-scale", default_value_t = 1.0, value_parser = crate::cli::args::parse_height_scale, value_name = "FACTOR")]
     pub height_scale: f32,
     /// Added to height-map values after scaling, in metres (also used for
     /// the output).
-    #[arg(long = "height-offset", default_value_t = 0.0, value_name = "METRES")]
+    #[arg(long = "height-offset", default_value_t = 0.0, value_parser = crate::cli::args::parse_height_offset, value_name = "METRES")]
     pub height_offset: f32,
     /// Where a PNG, EXR or plain TIFF's first row lies (south-up: rows
     /// kept; north-up: flipped); the output keeps the input's orientation.
