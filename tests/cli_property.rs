@@ -168,7 +168,7 @@ fn cli_options_property() {
     }
     let cases = env_u64("ALPENGLOW_CLI_PROPTEST_CASES").unwrap_or(100);
     let budget = env_u64("ALPENGLOW_CLI_PROPTEST_SECONDS").map(Duration::from_secs);
-    let base = env_u64("ALPENGLOW_CLI_PROPTEST_SEED").unwrap_or(0xa1be_c11);
+    let base = env_u64("ALPENGLOW_CLI_PROPTEST_SEED").unwrap_or(0x0a1b_ec11);
     let started = Instant::now();
     let next = AtomicU64::new(0);
     let counts: [AtomicU64; 3] = Default::default();
