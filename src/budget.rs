@@ -308,7 +308,11 @@ mod tests {
         };
         assert!(limits.check("--rocks", "10 boulders", Footprint::host(1000)).is_ok());
         let e = limits
-            .check("--rocks", "100000000 boulders", Footprint::per_item(100_000_000, 128, 0))
+            .check(
+                "--rocks",
+                "100000000 boulders",
+                Footprint::per_item(100_000_000, 128, 0),
+            )
             .unwrap_err()
             .to_string();
         assert_eq!(
