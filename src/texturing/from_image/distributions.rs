@@ -152,13 +152,23 @@ fn map_domain(values: &[f32]) -> Domain {
     }
 }
 
+/// Narrowest altitude domain kept as it is (1 cm): the layer file writes
+/// altitudes to 0.1 mm, so a field flatter than this (a `--height-scale`
+/// of 1e-45 makes every height a denormal) would read back as min = max.
+const MIN_ALTITUDE_SPAN: f32 = 0.01;
+
+/// The altitude domain of a field whose heights span `(lo, hi)`: that
+/// range, or 1 m above `lo` where the field is (nearly) flat.
+fn altitude_domain((lo, hi): (f32, f32)) -> Domain {
+    Domain {
+        min: lo,
+        max: if hi - lo >= MIN_ALTITUDE_SPAN { hi } else { lo + 1.0 },
+    }
+}
+
 /// The distribution functions of every class of `classification`.
 pub fn estimate(classification: &Classification, samples: &Samples, bins: usize) -> Distributions {
-    let (lo, hi) = samples.altitude_range;
-    let altitude_domain = Domain {
-        min: lo,
-        max: if hi > lo { hi } else { lo + 1.0 },
-    };
+    let altitude_domain = altitude_domain(samples.altitude_range);
     let slope = slope_domain(&samples.slope);
     let map_domains = samples.maps.clone().map(|m| m.map(|v| (map_domain(&v), v)));
     let classes = (0..classification.classes.len())
@@ -208,6 +218,12 @@ mod tests {
         assert_eq!(slope_domain(&[3.0, 31.2]), Domain { min: 0.0, max: 35.0 });
         assert_eq!(slope_domain(&[0.0]), Domain { min: 0.0, max: 5.0 });
         assert_eq!(map_domain(&[2.0, f32::NAN, 7.0]), Domain { min: 2.0, max: 7.0 });
+        assert_eq!(altitude_domain((10.0, 250.0)), Domain { min: 10.0, max: 250.0 });
+        // Flat, or flatter than the layer file can write (the property
+        // test's `layers from-image --height-scale 1e-45`): 1 m wide.
+        for hi in [0.0, 1e-45, 0.004] {
+            assert_eq!(altitude_domain((0.0, hi)), Domain { min: 0.0, max: 1.0 });
+        }
         let flat = map_domain(&[3.0, 3.0]);
         assert!(flat.min < 3.0 && flat.max > 3.0);
     }
