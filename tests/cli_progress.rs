@@ -33,26 +33,6 @@ fn run_timed(args: &[&str], env: &[(&str, &str)]) -> (Output, f64) {
     (out, started.elapsed().as_secs_f64())
 }
 
-/// A `side`² DEM with a `hole`² hole in its centre: the DEM and the mask.
-fn dem_with_hole(dir: &Path, side: u32, hole: u32) -> (PathBuf, PathBuf) {
-    let dem = dir.join(format!("dem{side}.png"));
-    let mask = dir.join(format!("mask{side}-{hole}.png"));
-    let values: Vec<u16> = (0..side * side)
-        .map(|i| {
-            let (c, r) = ((i % side) as f32, (i / side) as f32);
-            (1000.0 + 200.0 * (c * 0.05).sin() + 150.0 * (r * 0.031).cos() + (c * r % 13.0)) as u16
-        })
-        .collect();
-    let lo = (side - hole) / 2;
-    let inside = |v: u32| (lo..lo + hole).contains(&v);
-    let holes: Vec<u16> = (0..side * side)
-        .map(|i| if inside(i % side) && inside(i / side) { 255 } else { 0 })
-        .collect();
-    std::fs::write(&dem, encode_png_gray16(&values, side, side).unwrap()).unwrap();
-    std::fs::write(&mask, encode_png_gray16(&holes, side, side).unwrap()).unwrap();
-    (dem, mask)
-}
-
 fn fill_args<'a>(dem: &'a str, mask: &'a str, out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     let mut args = vec![
         "synth",

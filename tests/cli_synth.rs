@@ -270,33 +270,13 @@ fn the_gpu_search_gives_the_cpu_twins_output_under_validation() {
     assert_eq!(outputs[0], outputs[1], "GPU and CPU searches differ");
 }
 
-/// A `side`² DEM with a `hole`² hole in its centre: the DEM and the mask.
-fn dem_with_hole_png(dir: &Path, side: u32, hole: u32) -> (PathBuf, PathBuf) {
-    let dem = dir.join(format!("dem{side}.png"));
-    let mask = dir.join(format!("mask{side}-{hole}.png"));
-    let values: Vec<u16> = (0..side * side)
-        .map(|i| {
-            let (c, r) = ((i % side) as f32, (i / side) as f32);
-            (1000.0 + 200.0 * (c * 0.05).sin() + 150.0 * (r * 0.031).cos() + (c * r % 13.0)) as u16
-        })
-        .collect();
-    let lo = (side - hole) / 2;
-    let inside = |v: u32| (lo..lo + hole).contains(&v);
-    let holes: Vec<u16> = (0..side * side)
-        .map(|i| if inside(i % side) && inside(i / side) { 255 } else { 0 })
-        .collect();
-    write_png(&dem, &values, side, side);
-    write_png(&mask, &holes, side, side);
-    (dem, mask)
-}
-
 /// Ctrl-C (SIGINT) ends a long growth at once and leaves no output: the
 /// output is written only when complete.
 #[test]
 fn an_interrupted_growth_leaves_nothing() {
     use std::os::unix::process::ExitStatusExt;
     let dir = fresh_dir("progress-interrupt");
-    let (dem, mask) = dem_with_hole_png(&dir, 513, 160);
+    let (dem, mask) = dem_with_hole(&dir, 513, 160);
     let (dem, mask) = (dem.display().to_string(), mask.display().to_string());
     let out = dir.join("out.png").display().to_string();
     let args = [

@@ -107,11 +107,6 @@ impl Case {
             .map(String::as_str)
             .collect()
     }
-
-    /// Whether `flag` is on the command line.
-    pub fn has(&self, flag: &str) -> bool {
-        self.args.iter().any(|a| a == flag)
-    }
 }
 
 /// Valid extras of the scene commands (mixed in, none changing the cost

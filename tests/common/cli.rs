@@ -145,3 +145,31 @@ pub fn assert_no_files_left(what: &str, dir: &Path) {
     let left = entries(dir);
     assert!(left.is_empty(), "{what}: files left behind: {left:?}");
 }
+
+/// A `side`² DEM with a `hole`² hole in its centre: the DEM and the mask.
+pub fn dem_with_hole(dir: &Path, side: u32, hole: u32) -> (PathBuf, PathBuf) {
+    let dem = dir.join(format!("dem{side}.png"));
+    let mask = dir.join(format!("mask{side}-{hole}.png"));
+    let values: Vec<u16> = (0..side * side)
+        .map(|i| {
+            let (c, r) = ((i % side) as f32, (i / side) as f32);
+            (1000.0 + 200.0 * (c * 0.05).sin() + 150.0 * (r * 0.031).cos() + (c * r % 13.0)) as u16
+        })
+        .collect();
+    let lo = (side - hole) / 2;
+    let inside = |v: u32| (lo..lo + hole).contains(&v);
+    let holes: Vec<u16> = (0..side * side)
+        .map(|i| if inside(i % side) && inside(i / side) { 255 } else { 0 })
+        .collect();
+    std::fs::write(
+        &dem,
+        alpenglow::io::image_out::encode_png_gray16(&values, side, side).unwrap(),
+    )
+    .unwrap();
+    std::fs::write(
+        &mask,
+        alpenglow::io::image_out::encode_png_gray16(&holes, side, side).unwrap(),
+    )
+    .unwrap();
+    (dem, mask)
+}
