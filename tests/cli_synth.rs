@@ -313,3 +313,48 @@ fn an_interrupted_growth_leaves_nothing() {
     assert_no_files_left("interrupted fill", &dir);
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// Found by the hour-long CLI property run: heights divided by a tiny
+/// `--height-scale` overflowed the EXR's floats and the output held `inf`
+/// (now an error naming `--height-scale`, nothing written); `spt build
+/// --fov-y 1e-45` underflows the threshold angle and the error named only
+/// `--epsilon`, which was not given.
+#[test]
+fn findings_of_the_property_test_name_their_option() {
+    let dir = fresh_dir("synth-property-findings");
+    let exr = dir.join("o.exr");
+    let o = run(&[
+        "synth",
+        "transition",
+        "procedural:fbm,size=33,seed=1",
+        "procedural:fbm,size=33,seed=2",
+        "--band",
+        "200",
+        "--search",
+        "cpu",
+        "--height-scale",
+        "1e-45",
+        "--out",
+        exr.to_str().unwrap(),
+    ]);
+    assert_one_line_error(
+        "transition --height-scale 1e-45",
+        &o,
+        &["--height-scale", "32-bit floats"],
+    );
+    assert_no_files_left("transition --height-scale 1e-45", &dir);
+    let quad = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/points/quad.ply");
+    let spt = dir.join("o.spt");
+    let o = run(&[
+        "spt",
+        "build",
+        quad,
+        spt.to_str().unwrap(),
+        "--samples",
+        "50",
+        "--fov-y",
+        "1e-45",
+    ]);
+    assert_one_line_error("spt build --fov-y 1e-45", &o, &["--fov-y", "not a representable angle"]);
+    assert_no_files_left("spt build --fov-y 1e-45", &dir);
+}

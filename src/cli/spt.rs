@@ -46,10 +46,12 @@ fn spt_options(args: &SptBuildArgs) -> alpenglow::Result<SptOptions> {
         .ok()
         .filter(|e| e.is_finite() && *e > 0.0)
         .ok_or_else(|| {
+            // The three together make the angle: all three are the culprit
+            // (`--fov-y 1e-45` alone underflows it).
             Error::invalid(
-                "--epsilon",
+                "--epsilon/--fov-y/--rows",
                 format!(
-                    "{} px at --fov-y {} over --rows {} is not a representable angle",
+                    "{} px at {}° over {} rows is not a representable angle",
                     args.epsilon, args.fov_y, args.rows
                 ),
             )

@@ -413,7 +413,22 @@ fn encode_field(out: &Path, field: &HeightField, args: &HeightArgs) -> alpenglow
     };
     let is_png = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
     if !is_png {
-        let values: Vec<f32> = (0..w * h).map(|i| raw_at(i).2 as f32).collect();
+        let mut values = Vec::with_capacity(w * h);
+        for i in 0..w * h {
+            let (c, r, raw) = raw_at(i);
+            let value = raw as f32;
+            if !value.is_finite() {
+                // Only a tiny --height-scale divides a finite height past f32.
+                return Err(Error::invalid(
+                    "--height-scale",
+                    format!(
+                        "{scale}: height {} m at column {c}, row {r} divided by it exceeds the EXR's 32-bit floats",
+                        field.heights[r * w + c]
+                    ),
+                ));
+            }
+            values.push(value);
+        }
         return encode_exr_height(&values, field.columns, field.rows);
     }
     let mut values = Vec::with_capacity(w * h);

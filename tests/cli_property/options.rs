@@ -308,6 +308,16 @@ pub const SPT: &[Opt] = &[
     ),
     opt("--fov-y", float(0.0, 180.0)),
     opt("--rows", int(1, U32, U32)),
+    // Any positive number of hours; above the default (1 h) it only lets
+    // slow work run, so larger ceilings are not generated.
+    opt(
+        "--max-hours",
+        Kind::Float {
+            lo: 0.0,
+            hi: BIG,
+            cheap: 1.0,
+        },
+    ),
 ];
 pub const SPT_OTHER: &[&str] = &["--sampling"];
 
@@ -330,6 +340,16 @@ pub const GROW: &[Opt] = &[
     opt("--height-scale", float(-BIG, BIG)),
     opt("--height-offset", float(-1e6, 1e6)),
     opt("--max-input-mb", int(1, U64, 1 << 40)),
+    // Any positive number of hours; above the default (1 h) it only lets
+    // slow work run, so larger ceilings are not generated.
+    opt(
+        "--max-hours",
+        Kind::Float {
+            lo: 0.0,
+            hi: BIG,
+            cheap: 1.0,
+        },
+    ),
 ];
 pub const FILL_OTHER: &[&str] = &["--input", "--mask", "--out", "--search", "--device", "--rows"];
 
