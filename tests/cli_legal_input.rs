@@ -243,3 +243,16 @@ fn a_malformed_layer_manifest_names_vk_layer_path() {
         assert_one_line_error("info with a malformed manifest", &out, &["VK_LAYER_PATH", "manifest"]);
     }
 }
+
+/// Found by the hour-long CLI property run: a `--pose` whose translation is
+/// beyond the camera limits was reported as `--eye`, and `--fov-y 1e-300`
+/// (legal in degrees, infinite in the GPU's 32-bit projection) as
+/// `--epsilon 1`. Both fail before anything renders.
+#[test]
+fn pose_and_narrow_fields_of_view_name_their_option() {
+    let pose = "1,0,0,10,0,1,0,20,0,0,1,1.8446744073709552e19,0,0,0,1";
+    let o = run(&["render", "--width", "32", "--height", "24", "--pose", pose]);
+    assert_one_line_error("--pose beyond the limits", &o, &["invalid --pose", "1e8"]);
+    let o = run(&["render", "--width", "32", "--height", "24", "--fov-y", "1e-300"]);
+    assert_one_line_error("--fov-y 1e-300", &o, &["--fov-y", "32-bit projection"]);
+}

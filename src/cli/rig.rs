@@ -135,7 +135,15 @@ impl CameraArgs {
     pub fn place(&self, camera: Camera) -> Result<Camera> {
         let (fov, near, far) = (camera.fov_y_deg, camera.near, camera.far);
         Ok(match (self.pose, self.rotation) {
-            (Some(pose), _) => Camera::from_pose(pose, fov, near, far)?,
+            // The pose's errors are the pose's (its translation is the eye).
+            (Some(pose), _) => Camera::from_pose(pose, fov, near, far).map_err(|e| match e {
+                alpenglow::Error::InvalidArgument { parameter, message }
+                    if ["camera.eye", "camera.target", "camera.up"].contains(&parameter.as_str()) =>
+                {
+                    anyhow::anyhow!("invalid --pose: {message}")
+                }
+                e => e.into(),
+            })?,
             (None, Some(rotation)) => Camera::from_position_rotation(camera.eye, rotation, fov, near, far)?,
             (None, None) => camera,
         })

@@ -90,6 +90,17 @@ impl Camera {
                 format!("{} degrees; must be in (0, 180)", self.fov_y_deg),
             ));
         }
+        // The GPU's projection holds 1/tan(fov/2) in 32 bits: below about
+        // 1e-36° it is infinite (the CLI property test's `--fov-y 1e-300`).
+        if !((1.0 / (0.5 * self.fov_y_deg.to_radians()).tan()) as f32).is_finite() {
+            return Err(Error::invalid(
+                "camera.fov_y_deg",
+                format!(
+                    "{} degrees is too narrow for the GPU's 32-bit projection",
+                    self.fov_y_deg
+                ),
+            ));
+        }
         if !(self.near > 0.0 && self.near.is_finite() && self.far > self.near && self.far.is_finite()) {
             return Err(Error::invalid(
                 "camera.near/camera.far",
@@ -297,6 +308,27 @@ mod tests {
             near: 1.0,
             far: 1000.0,
         }
+    }
+
+    /// A field of view whose 32-bit projection is infinite is refused by
+    /// name; the narrowest representable one is legal.
+    #[test]
+    fn fields_of_view_too_narrow_for_f32_are_refused() {
+        for fov in [1e-300, 1e-40] {
+            let e = Camera {
+                fov_y_deg: fov,
+                ..camera()
+            }
+            .validate()
+            .unwrap_err();
+            assert_eq!(e.parameter(), Some("camera.fov_y_deg"), "{e}");
+        }
+        assert!(Camera {
+            fov_y_deg: 1e-30,
+            ..camera()
+        }
+        .validate()
+        .is_ok());
     }
 
     #[test]
