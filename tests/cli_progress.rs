@@ -7,11 +7,10 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 use std::time::Instant;
 
-use alpenglow::io::image_out::encode_png_gray16;
 use common::cli::*;
 
 /// The tests of this file run one at a time: they time refusals, and a

@@ -147,7 +147,7 @@ fn absurd_combinations_are_refused_naming_options_estimate_and_limit() {
 fn the_estimate_is_within_an_order_of_magnitude_of_a_tiny_run() {
     let side = 72;
     let field = HeightField::from_fn(side, side, DVec2::ONE, |c, r| {
-        ((c as f32 * 0.31).sin() * 20.0 + (r as f32 * 0.17).cos() * 15.0 + (c * r % 7) as f32) as f32
+        (c as f32 * 0.31).sin() * 20.0 + (r as f32 * 0.17).cos() * 15.0 + (c * r % 7) as f32
     });
     let unknown: Vec<bool> = (0..side * side)
         .map(|i| (30..40).contains(&(i % side)) && (30..40).contains(&(i / side)))
