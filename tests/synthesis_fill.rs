@@ -306,7 +306,7 @@ fn bad_inputs_are_one_line_errors_naming_the_parameter() {
         e
     };
     assert!(error(&unknown[1..], params(1, 1024)).contains("mask"));
-    assert!(error(&vec![true; unknown.len()], params(1, 1024)).contains("every sample unknown"));
+    assert!(error(&vec![true; unknown.len()], params(1, 1024)).contains("every sample is unknown"));
     let even = FillParams {
         window: 6,
         ..params(1, 1024)
