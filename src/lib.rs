@@ -44,4 +44,10 @@ pub mod texturing;
 pub mod view;
 pub mod vulkan;
 
+/// Helpers shared by the in-crate white-box tests (validated context, FLIP,
+/// goldens, the Jacksboro DEM).
+#[cfg(test)]
+#[forbid(unsafe_code)]
+pub(crate) mod test_support;
+
 pub use error::{Error, Result};

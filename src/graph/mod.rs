@@ -344,3 +344,6 @@ impl<P: 'static> PassBuilder<'_, P> {
         self.graph.passes.push(self.decl);
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -574,3 +574,6 @@ fn warped_terrain(
     }
     Ok(terrain)
 }
+
+#[cfg(test)]
+mod tests;

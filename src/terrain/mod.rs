@@ -21,3 +21,6 @@ pub mod wavelet_noise;
 pub mod zoom;
 
 pub use technique::{Terrain, TerrainFrame, TerrainTexturing, TerrainViewFrame};
+
+#[cfg(test)]
+mod tests;

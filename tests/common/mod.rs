@@ -88,11 +88,8 @@ pub fn mean_flip(reference_rgba: &[u8], test_rgba: &[u8], width: u32, height: u3
     let mean = nv_flip::FlipPool::from_image(&error).mean();
     (mean, heatmap)
 }
-pub mod atlas;
 #[cfg(feature = "cli")]
 pub mod cli;
-pub mod plane;
-pub mod points;
 
 /// With `ALPENGLOW_DUMP=DIR` (an existing folder), writes each named RGBA8
 /// image as `DIR/<n>-<name>.png`, n the number of entries already there,
