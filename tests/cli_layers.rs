@@ -5,7 +5,7 @@
 
 mod common;
 
-use alpenglow::texturing::layers::LayerTree;
+use alpenglow::LayerTree;
 use common::data;
 
 #[test]

@@ -5,17 +5,25 @@
 
 mod common;
 
-use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
-use alpenglow::terrain::procedural::ProceduralTerrain;
-use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
+use alpenglow::glam::DVec3;
+use alpenglow::{
+    Camera, Context, ContextOptions, DeviceSelector, ProceduralTerrain, Renderer, Scene, Settings, ShadowSettings,
+    TextureStreaming,
+};
 use common::{assert_validation_clean, validated_context};
-use glam::{DVec2, DVec3};
 
 fn small_scene() -> Scene {
-    let field = ProceduralTerrain::default()
-        .try_generate(65, 49, DVec2::new(40.0, 55.0))
-        .expect("procedural terrain");
-    Scene::new(field)
+    Scene::from_terrain(&ProceduralTerrain::default(), (65, 49), (40.0, 55.0)).expect("procedural terrain")
+}
+
+/// `width`×`height` with the default texture streaming and shadow settings
+/// (not the ones `Settings::new` sizes for the image).
+fn settings(width: u32, height: u32, readback: bool) -> Settings {
+    let mut settings = Settings::new(width, height);
+    settings.readback = readback;
+    settings.texture_streaming = TextureStreaming::default();
+    settings.shadows = ShadowSettings::default();
+    settings
 }
 
 #[test]
@@ -23,21 +31,7 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
     let (ctx, report) = validated_context();
     {
         let scene = small_scene();
-        let settings = RenderSettings {
-            width: 96,
-            height: 64,
-            views: Vec::new(),
-            msaa: 1,
-            motion_blur: None,
-            readback: true,
-            terrain: Default::default(),
-            points: Default::default(),
-            texturing: Default::default(),
-            texture_streaming: Default::default(),
-            shadows: Default::default(),
-            cache_dir: None,
-            lighting: None,
-        };
+        let settings = settings(96, 64, true);
         let mut renderer = Renderer::new(&ctx, &scene, settings).expect("renderer");
         let layers = scene.layers.layers.iter().enumerate();
         let layer_passes = layers.map(|(i, l)| format!("texturing.layer{i}.{}", l.layer.name.replace(' ', "_")));
@@ -109,21 +103,7 @@ fn renders_are_deterministic() {
     let (ctx, report) = validated_context();
     {
         let scene = small_scene();
-        let settings = RenderSettings {
-            width: 80,
-            height: 48,
-            views: Vec::new(),
-            msaa: 1,
-            motion_blur: None,
-            readback: true,
-            terrain: Default::default(),
-            points: Default::default(),
-            texturing: Default::default(),
-            texture_streaming: Default::default(),
-            shadows: Default::default(),
-            cache_dir: None,
-            lighting: None,
-        };
+        let settings = settings(80, 48, true);
         let camera = scene.default_camera();
         let mut first = Renderer::new(&ctx, &scene, settings.clone()).expect("renderer");
         let a = first.render(&camera).and_then(|f| first.read(&f)).expect("frame a");
@@ -169,21 +149,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
         let mut renderer = Renderer::new(
             &ctx,
             &scene,
-            RenderSettings {
-                width: 16,
-                height: 16,
-                views: Vec::new(),
-                msaa: 1,
-                motion_blur: None,
-                readback: true,
-                terrain: Default::default(),
-                points: Default::default(),
-                texturing: Default::default(),
-                texture_streaming: Default::default(),
-                shadows: Default::default(),
-                cache_dir: None,
-                lighting: None,
-            },
+            settings(16, 16, true),
         )
         .unwrap();
         let bad = Camera {
@@ -199,21 +165,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
         assert!(Renderer::new(
             &ctx,
             &scene,
-            RenderSettings {
-                width: 0,
-                height: 16,
-                views: Vec::new(),
-                msaa: 1,
-                motion_blur: None,
-                readback: false,
-                terrain: Default::default(),
-                points: Default::default(),
-                texturing: Default::default(),
-                texture_streaming: Default::default(),
-                shadows: Default::default(),
-                cache_dir: None,
-                lighting: None,
-            }
+            settings(0, 16, false)
         )
         .is_err());
     }

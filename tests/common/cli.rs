@@ -163,12 +163,12 @@ pub fn dem_with_hole(dir: &Path, side: u32, hole: u32) -> (PathBuf, PathBuf) {
         .collect();
     std::fs::write(
         &dem,
-        alpenglow::io::image_out::encode_png_gray16(&values, side, side).unwrap(),
+        alpenglow::files::encode_png_gray16(&values, side, side).unwrap(),
     )
     .unwrap();
     std::fs::write(
         &mask,
-        alpenglow::io::image_out::encode_png_gray16(&holes, side, side).unwrap(),
+        alpenglow::files::encode_png_gray16(&holes, side, side).unwrap(),
     )
     .unwrap();
     (dem, mask)
