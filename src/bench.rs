@@ -1,0 +1,1 @@
+//! What the benchmarks (`examples/*_bench.rs`) need of the internals; not part of the API.
