@@ -4,13 +4,14 @@
 
 use anyhow::{bail, Context as _, Result};
 
-use alpenglow::budget::MemoryLimits;
-use alpenglow::points::build::sampling::{sampling_footprint, SamplingMethod};
-use alpenglow::points::build::spt::epsilon_from_pixels;
-use alpenglow::points::render::{SplatBackend, SplatMode, SplatPrimitive, SplatSettings};
-use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointTransform};
-use alpenglow::points::vegetation::VegetationOptions;
-use alpenglow::renderer::Scene;
+use alpenglow::files::load_point_object;
+use alpenglow::tools::budget::MemoryLimits;
+use alpenglow::tools::spt::epsilon_from_pixels;
+use alpenglow::tools::spt::{sampling_footprint, SamplingMethod};
+use alpenglow::Scene;
+use alpenglow::VegetationOptions;
+use alpenglow::{PointLoadOptions, PointTransform};
+use alpenglow::{SplatBackend, SplatMode, SplatPrimitive, SplatSettings};
 
 use super::args::{PointArgs, SplatArg, SplatBackendArg, SplatPrimitiveArg, VegetationArg};
 
