@@ -159,6 +159,7 @@ pub use renderer::scene::DEFAULT_ROCKS;
 /// # Ok::<(), alpenglow::Error>(())
 /// ```
 pub use renderer::Scene;
+pub use terrain::ground::Ground;
 pub use terrain::procedural::{ProceduralTerrain, TerrainModel};
 pub use texturing::layers::LayerTree;
 

@@ -56,10 +56,12 @@ pub mod budget {
     };
 }
 
-/// Summaries and exports of [`FrameProfile`](crate::FrameProfile)s.
+/// Summaries and exports of [`FrameProfile`](crate::FrameProfile)s, and the
+/// median and quantiles of timings.
 pub mod profile {
     pub use crate::profile::{
         chrome_trace, median, profile_json, summarize, write_chrome_trace, write_profile_json, FrameSummary,
         PassSummary, PassTiming, StageTiming,
     };
+    pub use crate::terrain::zoom::quantile;
 }

@@ -26,11 +26,9 @@ use super::lighting;
 use anyhow::{bail, Context as _, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use alpenglow::files::load_keyframes;
-use alpenglow::files::write_png_rgba8;
+use alpenglow::files::{load_keyframes, write_png_rgba8};
 use alpenglow::tools::profile::{chrome_trace, median, summarize};
-use alpenglow::{Camera, FrameImages, Rig, Scene};
-use alpenglow::{CameraPath, Orbit};
+use alpenglow::{Camera, CameraPath, FrameImages, Orbit, Rig, Scene};
 
 use super::args::FlyArgs;
 use super::{

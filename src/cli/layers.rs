@@ -10,10 +10,10 @@ use anyhow::{bail, Result};
 use clap::{Args, Subcommand};
 use glam::DVec2;
 
-use alpenglow::files::load_heightmap;
-use alpenglow::files::InputLimits;
-use alpenglow::tools::layers::INPUT_NAMES;
-use alpenglow::tools::layers::{build_layers, load_rgb_image, ClassCount, FromImageOptions, PixelStatus, MAX_CLASSES};
+use alpenglow::files::{load_heightmap, InputLimits};
+use alpenglow::tools::layers::{
+    build_layers, load_rgb_image, ClassCount, FromImageOptions, PixelStatus, INPUT_NAMES, MAX_CLASSES,
+};
 use alpenglow::{HeightField, HeightmapOptions, RowOrder};
 
 use super::args::{parse_input_map, parse_spacing, RowsArg};

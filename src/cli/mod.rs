@@ -25,14 +25,11 @@ use glam::DVec2;
 
 use alpenglow::files::load_heightmap;
 use alpenglow::tools::profile::{chrome_trace, profile_json, summarize};
-use alpenglow::FrameProfile;
-use alpenglow::HeightmapOptions;
-use alpenglow::SketchAlignment;
-use alpenglow::TextureSummary;
-use alpenglow::{validate_size, Camera, Scene, Settings, ViewSpec};
-use alpenglow::{Context, ContextOptions, DeviceSelector, ValidationReport};
-use alpenglow::{ImportanceFactors, LodMode, LodSettings};
-use alpenglow::{TerrainSettings, TerrainView, TexturingMode};
+use alpenglow::{
+    validate_size, Camera, Context, ContextOptions, DeviceSelector, FrameProfile, HeightmapOptions, ImportanceFactors,
+    LodMode, LodSettings, Scene, Settings, SketchAlignment, TerrainSettings, TerrainView, TextureSummary,
+    TexturingMode, ValidationReport, ViewSpec,
+};
 pub use errors::error_line;
 
 use outputs::Outputs;

@@ -7,8 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 
-use alpenglow::files::ImageFormat;
-use alpenglow::files::OutputTransaction;
+use alpenglow::files::{ImageFormat, OutputTransaction};
 
 /// The outputs of one command.
 #[derive(Default)]

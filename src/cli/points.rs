@@ -6,12 +6,10 @@ use anyhow::{bail, Context as _, Result};
 
 use alpenglow::files::load_point_object;
 use alpenglow::tools::budget::MemoryLimits;
-use alpenglow::tools::spt::epsilon_from_pixels;
-use alpenglow::tools::spt::{sampling_footprint, SamplingMethod};
-use alpenglow::Scene;
-use alpenglow::VegetationOptions;
-use alpenglow::{PointLoadOptions, PointTransform};
-use alpenglow::{SplatBackend, SplatMode, SplatPrimitive, SplatSettings};
+use alpenglow::tools::spt::{epsilon_from_pixels, sampling_footprint, SamplingMethod};
+use alpenglow::{
+    PointLoadOptions, PointTransform, Scene, SplatBackend, SplatMode, SplatPrimitive, SplatSettings, VegetationOptions,
+};
 
 use super::args::{PointArgs, SplatArg, SplatBackendArg, SplatPrimitiveArg, VegetationArg};
 

@@ -9,8 +9,7 @@ use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 use glam::{DMat4, DQuat};
 
-use alpenglow::{Camera, Rig, ViewSpec};
-use alpenglow::{Distortion, Intrinsics};
+use alpenglow::{Camera, Distortion, Intrinsics, Rig, ViewSpec};
 
 /// The placeholder of a view's name in output paths.
 pub const VIEW_PATTERN: &str = "{view}";

@@ -12,13 +12,12 @@ use std::time::Instant;
 
 use anyhow::Result;
 
-use alpenglow::files::write_spt;
-use alpenglow::files::{load_points_file, PointInput};
+use alpenglow::files::{load_points_file, write_spt, PointInput};
 use alpenglow::tools::budget::MemoryLimits;
-use alpenglow::tools::spt::complete_cloud;
-use alpenglow::tools::spt::plan_build;
-use alpenglow::tools::spt::{build_spt, epsilon_from_pixels, SptOptions};
-use alpenglow::tools::spt::{sample_mesh_reporting, SamplingMethod, SamplingOptions};
+use alpenglow::tools::spt::{
+    build_spt, complete_cloud, epsilon_from_pixels, plan_build, sample_mesh_reporting, SamplingMethod, SamplingOptions,
+    SptOptions,
+};
 use alpenglow::Error;
 
 use super::args::{SamplingArg, SptBuildArgs};

@@ -6,16 +6,13 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-use alpenglow::files::{encode_exr_height, encode_png_gray16};
-use alpenglow::files::{load_heightmap, load_heightmap_with_voids};
+use alpenglow::files::{encode_exr_height, encode_png_gray16, load_heightmap, load_heightmap_with_voids};
 use alpenglow::tools::budget::MemoryLimits;
-use alpenglow::tools::synth::CpuSearch;
-use alpenglow::tools::synth::GpuSearch;
-use alpenglow::tools::synth::{band_of, check_fields, plan_transition, Axis, TransitionParams};
-use alpenglow::tools::synth::{check_hole_fill, plan_hole_fill, FillParams, Growth};
-use alpenglow::tools::synth::{GrowthCost, SearchDevice};
-use alpenglow::Context;
-use alpenglow::{HeightField, HeightmapOptions, RowOrder};
+use alpenglow::tools::synth::{
+    band_of, check_fields, check_hole_fill, plan_hole_fill, plan_transition, Axis, CpuSearch, FillParams, GpuSearch,
+    Growth, GrowthCost, SearchDevice, TransitionParams,
+};
+use alpenglow::{Context, HeightField, HeightmapOptions, RowOrder};
 use anyhow::{bail, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use glam::DVec2;

@@ -17,9 +17,7 @@ use std::str::FromStr;
 
 use glam::DVec2;
 
-use alpenglow::HeightField;
-use alpenglow::{Error, Result};
-use alpenglow::{ProceduralTerrain, TerrainModel};
+use alpenglow::{Error, HeightField, ProceduralTerrain, Result, TerrainModel};
 
 /// The prefix every spec starts with.
 pub const PREFIX: &str = "procedural:";
