@@ -62,6 +62,7 @@ use crate::vulkan::{Context, FrameRing, FRAMES_IN_FLIGHT};
 /// Output size (or the views of a rig), whether frames are read back to
 /// the host, and every technique's settings.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct RenderSettings {
     /// The image size of a single view (ignored when `views` is set).
     pub width: u32,
