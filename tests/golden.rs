@@ -24,8 +24,8 @@ mod common;
 use alpenglow::files::{load_point_object, write_png_rgba8};
 use alpenglow::glam::DVec3;
 use alpenglow::{
-    Camera, Lighting, PointLoadOptions, PointScene, PointTransform, Renderer, Scene, Settings, SplatMode, SplatSettings,
-    SunPosition, TexturingMode,
+    Camera, Lighting, PointLoadOptions, PointScene, PointTransform, Renderer, Scene, Settings, SplatMode,
+    SplatSettings, SunPosition, TexturingMode,
 };
 use common::{
     assert_validation_clean, data, failure_dir, golden_dir, jacksboro_field, jacksboro_valley_camera, mean_flip,

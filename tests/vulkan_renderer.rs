@@ -146,12 +146,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
     let (ctx, report) = validated_context();
     {
         let scene = small_scene();
-        let mut renderer = Renderer::new(
-            &ctx,
-            &scene,
-            settings(16, 16, true),
-        )
-        .unwrap();
+        let mut renderer = Renderer::new(&ctx, &scene, settings(16, 16, true)).unwrap();
         let bad = Camera {
             eye: DVec3::ONE,
             target: DVec3::ONE,
@@ -162,12 +157,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
             .unwrap_err()
             .to_string()
             .contains("eye equals target"));
-        assert!(Renderer::new(
-            &ctx,
-            &scene,
-            settings(0, 16, false)
-        )
-        .is_err());
+        assert!(Renderer::new(&ctx, &scene, settings(0, 16, false)).is_err());
     }
     drop(ctx);
     assert_validation_clean(&report);

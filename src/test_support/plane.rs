@@ -1,5 +1,5 @@
-//! The checkerboard plane of the point-rendering tests (`tests/points_render.rs`,
-//! `tests/points_primitives.rs`, `tests/points_single_pass.rs`): a regularly sampled plane seen at a
+//! The checkerboard plane of the point-rendering tests (`src/points/tests/render.rs`,
+//! `src/points/tests/primitives.rs`, `src/points/tests/single_pass.rs`): a regularly sampled plane seen at a
 //! grazing angle, its analytic (supersampled) reference, the mean FLIP of a
 //! render against it, and its holes (W = 0 where the plane is seen).
 

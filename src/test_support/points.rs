@@ -1,5 +1,5 @@
-//! Helpers of the point-rendering tests (`tests/points_render.rs`,
-//! `tests/points_hybrid.rs`, `tests/points_primitives.rs`): one validated
+//! Helpers of the point-rendering tests (`src/points/tests/render.rs`,
+//! `src/points/tests/hybrid.rs`, `src/points/tests/primitives.rs`): one validated
 //! frame with its point statistics and the bunny scene (the grazing
 //! checkerboard is in `plane.rs`).
 

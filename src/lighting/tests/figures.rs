@@ -15,7 +15,7 @@
 //! 64 patches are closer than 16. With `ALPENGLOW_FIGURES=DIR` it renders
 //! larger, all bounces, and writes the figures' PNGs and `DIR/errors.md`:
 //!
-//! `ALPENGLOW_FIGURES=docs/lighting cargo test --release --test lighting_figures -- --nocapture`
+//! `ALPENGLOW_FIGURES=docs/lighting cargo test --release --lib lighting::tests::figures -- --nocapture`
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -457,7 +457,7 @@ fn write_figures(dir: &Path, shots: &[Shot]) {
     eprintln!("{sun_terms}");
     let mut md = String::from(
         "Errors against the Monte Carlo reference of the same environment and bounces \
-         (written by `tests/lighting_figures.rs`).\n\n",
+         (written by `src/lighting/tests/figures.rs`).\n\n",
     );
     md.push_str(&error_table(shots));
     md.push_str(&sun_terms);

@@ -11,7 +11,7 @@
 //! * the GPU's interval test selects exactly the nodes the CPU reference
 //!   selects (§10.1.6) and never one outside the CPU's prefix (§10.1.7);
 //! * the three screen-space primitives give the same image (the text's
-//!   object-space ones: `tests/points_primitives.rs`).
+//!   object-space ones: `src/points/tests/primitives.rs`).
 
 use crate::points::render::{PointFrameStats, SplatMode, SplatPrimitive, SplatSettings};
 use crate::points::scene::{PointObject, PointScene, PointTransform};

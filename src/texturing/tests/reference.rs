@@ -3,7 +3,7 @@
 //! twin (`src/texturing/reference.rs`, which evaluates the tree with
 //! `texturing::layers::evaluate`): the atlas's colour texels, read back, equal
 //! the CPU's sRGB-encoded colour at the same world positions within
-//! `MAX_CODE_DIFFERENCE` (tests/common/atlas.rs) code values, for the default tree and for a tree
+//! `MAX_CODE_DIFFERENCE` (src/test_support/atlas.rs) code values, for the default tree and for a tree
 //! driven by a rainfall input map, under validation; and a tree of sampled
 //! functions (§8.3) on altitude, slope and rainfall, whose direct-mode frame
 //! (the same evaluation per pixel) also matches the atlas frame.
@@ -21,7 +21,7 @@ use glam::DVec2;
 
 const WIDTH: u32 = 160;
 const HEIGHT: u32 = 90;
-/// Mean FLIP of the atlas frame against the direct frame (as tests/texturing_atlas.rs).
+/// Mean FLIP of the atlas frame against the direct frame (as src/texturing/tests/atlas.rs).
 const MAX_MEAN_FLIP: f32 = 0.05;
 
 /// A settled frame of `camera` in `mode`, under validation.
