@@ -39,6 +39,11 @@ pub mod layers {
         build_layers, load_rgb_image, ClassCount, FromImageOptions, PixelStatus, MAX_CLASSES,
     };
     pub use crate::texturing::layers::INPUT_NAMES;
+    /// The layer tree's limits (what a loaded tree is guaranteed to respect).
+    pub use crate::texturing::layers::{
+        vegetation::{MAX_DENSITY as MAX_VEGETATION_DENSITY, MAX_SCALE as MAX_VEGETATION_SCALE},
+        Constraint, MAX_BLUR_RADII, MAX_HEIGHT_BLUR, MAX_SAMPLES,
+    };
     pub use crate::texturing::reference::srgb8;
 }
 
