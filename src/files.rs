@@ -21,7 +21,8 @@ pub use crate::io::heightmap::{
     check_spacing, load_heightmap, load_heightmap_with_voids, MAX_ABS_HEIGHT, MAX_SPACING, MIN_SPACING,
 };
 pub use crate::io::image_out::{
-    encode_exr_height, encode_exr_samples, encode_png_gray16, write_png_rgba8, ExrSamples, ImageFormat,
+    encode_exr_height, encode_exr_samples, encode_png_gray16, write_exr, write_exr_samples, write_image_by_extension,
+    write_png_rgba8, ExrChannels, ExrSamples, ImageFormat,
 };
 /// Reading back the EXR files alpenglow writes, and an RGBA8 PNG encoder (the tests' fixtures).
 pub use crate::io::image_out::{encode_png_rgba8, read_exr_channels};

@@ -286,3 +286,6 @@ pub use profile::FrameProfile;
 /// ```
 pub use renderer::FrameImages;
 pub use texturing::stats::{TextureFrameStats, TextureSummary};
+/// The semantic classes of [`FrameImages::class`]: terrain with a known
+/// surface layer k is `CLASS_LAYER_BASE + k`.
+pub use view::aov::{CLASS_LAYER_BASE, CLASS_ROCK, CLASS_SCAN, CLASS_SKY, CLASS_TERRAIN, CLASS_VEGETATION};
