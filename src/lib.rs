@@ -66,36 +66,36 @@
 //! `#[forbid(unsafe_code)]`.
 
 #[forbid(unsafe_code)]
-pub mod budget;
+pub(crate) mod budget;
 #[forbid(unsafe_code)]
-pub mod error;
+pub(crate) mod error;
 #[forbid(unsafe_code)]
-pub mod graph;
+pub(crate) mod graph;
 #[forbid(unsafe_code)]
-pub mod io;
+pub(crate) mod io;
 #[forbid(unsafe_code)]
-pub mod lighting;
+pub(crate) mod lighting;
 #[forbid(unsafe_code)]
-pub mod points;
+pub(crate) mod points;
 #[forbid(unsafe_code)]
-pub mod post;
+pub(crate) mod post;
 #[forbid(unsafe_code)]
-pub mod profile;
+pub(crate) mod profile;
 #[forbid(unsafe_code)]
-pub mod random;
+pub(crate) mod random;
 #[forbid(unsafe_code)]
-pub mod renderer;
+pub(crate) mod renderer;
 #[forbid(unsafe_code)]
-pub mod shaders;
+pub(crate) mod shaders;
 #[forbid(unsafe_code)]
-pub mod synthesis;
+pub(crate) mod synthesis;
 #[forbid(unsafe_code)]
-pub mod terrain;
+pub(crate) mod terrain;
 #[forbid(unsafe_code)]
-pub mod texturing;
+pub(crate) mod texturing;
 #[forbid(unsafe_code)]
-pub mod view;
-pub mod vulkan;
+pub(crate) mod view;
+pub(crate) mod vulkan;
 
 /// Helpers shared by the in-crate white-box tests (validated context, FLIP,
 /// goldens, the Jacksboro DEM).
@@ -214,9 +214,6 @@ pub use texturing::streaming::MAX_TILE_BUDGET;
 
 // --- Cameras, views and rigs ---
 
-pub use renderer::{check_view, validate_size, MAX_IMAGE_SIDE};
-pub use view::camera_path::{CameraPath, Orbit, DEFAULT_START_ANGLE_DEG};
-pub use view::lens::{Distortion, Intrinsics};
 /// Several views rendered in one frame, each with its pose relative to the
 /// rig's camera, its size, intrinsics and distortion.
 ///
@@ -228,8 +225,11 @@ pub use view::lens::{Distortion, Intrinsics};
 /// let cameras = rig.cameras(&scene.default_camera())?;
 /// # Ok::<(), alpenglow::Error>(())
 /// ```
-pub use view::rig::Rig;
-pub use view::rig::{ViewSpec, MAX_VIEWS};
+pub use renderer::Rig;
+pub use renderer::{check_view, validate_size, MAX_IMAGE_SIDE};
+pub use renderer::{ViewSpec, MAX_VIEWS};
+pub use view::camera_path::{CameraPath, Orbit, DEFAULT_START_ANGLE_DEG};
+pub use view::lens::{Distortion, Intrinsics};
 /// A pinhole camera: eye, target, up, vertical field of view, near and far
 /// planes (metres, +z up).
 ///

@@ -26,10 +26,13 @@ pub mod spt {
 /// transition between two (`alpenglow synth fill|transition`).
 pub mod synth {
     pub use crate::synthesis::cost::{GrowthCost, SearchDevice};
-    pub use crate::synthesis::fill::{check_hole_fill, fill_holes_cpu, plan_hole_fill, FillParams, Growth};
+    pub use crate::synthesis::fill::{check_hole_fill, fill_holes, fill_holes_cpu, plan_hole_fill, FillParams, Growth};
     pub use crate::synthesis::gpu::GpuSearch;
     pub use crate::synthesis::search::CpuSearch;
-    pub use crate::synthesis::transition::{band_of, check_fields, plan_transition, Axis, TransitionParams};
+    pub use crate::synthesis::search::NeighbourhoodSearch;
+    pub use crate::synthesis::transition::{
+        band_of, check_fields, grow_transition, grow_transition_cpu, plan_transition, Axis, TransitionParams,
+    };
 }
 
 /// A layer tree from a classified image (`alpenglow layers from-image`),

@@ -452,7 +452,7 @@ impl Renderer {
     }
 
     /// Waits for `frame` and copies the first view's images out of the
-    /// readback buffers. Call before rendering [`FRAMES_IN_FLIGHT`] more frames.
+    /// readback buffers. Call before rendering `FRAMES_IN_FLIGHT` more frames.
     pub fn read(&mut self, frame: &FrameOutcome) -> Result<FrameImages> {
         self.read_view(frame, 0)
     }
