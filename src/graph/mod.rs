@@ -35,7 +35,7 @@ mod uploads;
 use std::sync::Arc;
 
 pub use access::{derive_barrier, Access, Stage};
-pub use bake::BakedGraph;
+pub use bake::{BakedGraph, DEFAULT_PROFILE_HISTORY};
 pub use execute::{CpuStage, FrameOutcome, PassContext};
 pub use typed::{BufferAccess, BufferId, ImageAccess, ImageId, Resource};
 pub use uploads::{UploadRegion, UploadWriter};

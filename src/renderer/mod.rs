@@ -44,7 +44,7 @@ pub use view_chain::check_view;
 use view_chain::ViewChain;
 
 use crate::error::{Error, Result};
-use crate::graph::{BakedGraph, FrameOutcome, RenderGraph};
+use crate::graph::{BakedGraph, CpuStage, FrameOutcome, RenderGraph};
 use crate::lighting::shadows::ShadowSettings;
 use crate::lighting::sky::Sky;
 use crate::lighting::technique::SceneLighting;
@@ -186,6 +186,9 @@ pub struct Renderer {
     readback_slots: usize,
     /// Identifies the renderer's tickets.
     id: u64,
+    /// The last frame and its CPU stages, reused by the next.
+    frame: Option<Frame>,
+    stages: Vec<CpuStage>,
     lighting: Lighting,
     /// Frames rendered so far.
     frames_rendered: u64,
@@ -343,6 +346,8 @@ impl Renderer {
             readback,
             readback_slots: slots,
             id: ring::renderer_id(),
+            frame: None,
+            stages: Vec::new(),
             views: specs,
             render_specs: chains.into_iter().map(|c| c.render).collect(),
             lighting,
@@ -384,6 +389,15 @@ impl Renderer {
         &self.ctx
     }
 
+    /// Keeps the profiles of at most `frames` frames (at least 1; default
+    /// [`crate::graph::DEFAULT_PROFILE_HISTORY`]) until
+    /// [`Renderer::finish`] takes them: older ones are dropped and their
+    /// memory reused, so frames allocate nothing for their profiles once
+    /// the history is full.
+    pub fn set_profile_history(&mut self, frames: usize) {
+        self.graph.set_profile_history(frames);
+    }
+
     /// Pass names in execution order.
     pub fn pass_names(&self) -> Vec<String> {
         self.graph.pass_names()
@@ -409,41 +423,59 @@ impl Renderer {
                 format!("{} cameras for {} views", cameras.len(), self.views.len()),
             ));
         }
-        let views: Vec<View> = (self.render_specs.iter().zip(cameras))
-            .map(|(spec, camera)| {
-                let view = spec.view(*camera);
-                view.validate()?;
-                Ok(view)
-            })
-            .collect::<Result<_>>()?;
+        for (spec, camera) in self.render_specs.iter().zip(cameras) {
+            view_of(spec, camera).validate()?;
+        }
         // The slot's previous frame must be done before prepare writes its uploads.
         let index = self.frames.wait_for_next()?;
-        let mut frame = Frame::new(index, views, self.lighting);
-        let mut stages = Vec::new();
-        let mut uploads = self.graph.uploads(index);
+        // The frame (views, prepared data) and its stages are reused frame
+        // after frame: steady-state frames allocate nothing.
+        let mut frame = match self.frame.take() {
+            Some(mut frame) => {
+                frame.reset(index, self.lighting);
+                for (view, camera) in frame.views.iter_mut().zip(cameras) {
+                    view.camera = *camera;
+                }
+                frame
+            }
+            None => {
+                let views = (self.render_specs.iter().zip(cameras)).map(|(s, c)| s.view(*c)).collect();
+                Frame::new(index, views, self.lighting)
+            }
+        };
+        let mut stages = std::mem::take(&mut self.stages);
+        stages.clear();
+        let result = self.prepare_and_execute(&mut frame, &mut stages);
+        (self.frame, self.stages) = (Some(frame), stages);
+        let outcome = result?;
+        self.frames_rendered = outcome.frame + 1;
+        Ok(outcome)
+    }
+
+    /// Every technique's prepare, then the graph records and submits `frame`.
+    fn prepare_and_execute(&mut self, frame: &mut Frame, stages: &mut Vec<CpuStage>) -> Result<FrameOutcome> {
+        let mut uploads = self.graph.uploads(frame.index);
         let t = &mut self.techniques;
         if let Some(shadows) = &mut t.shadows {
-            frame.prepare(&mut shadows.maps, &mut uploads, &mut stages)?;
+            frame.prepare(&mut shadows.maps, &mut uploads, stages)?;
             if let Some(points) = &mut shadows.points {
-                frame.prepare(points, &mut uploads, &mut stages)?;
+                frame.prepare(points, &mut uploads, stages)?;
             }
         }
         // After the shadows: the constants carry their cascades.
-        frame.prepare(&mut t.lighting, &mut uploads, &mut stages)?;
+        frame.prepare(&mut t.lighting, &mut uploads, stages)?;
         if let Some(terrain) = &mut t.terrain {
-            frame.prepare(terrain, &mut uploads, &mut stages)?;
+            frame.prepare(terrain, &mut uploads, stages)?;
         }
         if let Some(atlas) = &mut t.atlas {
             atlas.observe_profiles(self.graph.profiles());
-            frame.prepare(atlas, &mut uploads, &mut stages)?;
+            frame.prepare(atlas, &mut uploads, stages)?;
         }
         if let Some(points) = &mut t.points {
-            frame.prepare(points, &mut uploads, &mut stages)?;
+            frame.prepare(points, &mut uploads, stages)?;
         }
-        frame.prepare(&mut t.aovs, &mut uploads, &mut stages)?;
-        let outcome = self.graph.execute(&mut self.frames, &frame, &stages)?;
-        self.frames_rendered = outcome.frame + 1;
-        Ok(outcome)
+        frame.prepare(&mut t.aovs, &mut uploads, stages)?;
+        self.graph.execute(&mut self.frames, frame, stages)
     }
 
     /// Renders `camera` until every texture tile the view needs is ready
@@ -574,6 +606,18 @@ impl Renderer {
             Some(p) => p.take_stats(),
             None => Ok(Vec::new()),
         }
+    }
+}
+
+/// The view `spec` renders through `camera`, without allocating (the
+/// name stays empty: only the size and intrinsics are checked with it).
+fn view_of(spec: &ViewSpec, camera: &Camera) -> View {
+    View {
+        name: String::new(),
+        camera: *camera,
+        width: spec.width,
+        height: spec.height,
+        intrinsics: spec.intrinsics,
     }
 }
 

@@ -17,6 +17,7 @@ pub use ash::vk::{
     PrimitiveTopology,
 };
 pub use commands::{CommandRecorder, LoadOp};
+pub(crate) use commands::BarrierBatch;
 pub use context::{Context, ContextOptions, DeviceInfo, OptionalFeatures};
 pub use device_select::{DeviceSelector, REQUIRED_FEATURES};
 pub use frames::{CompletedFrame, FrameRing, RecordingFrame, FRAMES_IN_FLIGHT};
