@@ -19,25 +19,26 @@ use common::{assert_validation_clean, validated_context};
 use glam::{DVec2, DVec3};
 
 /// Counts heap allocations (alloc, alloc_zeroed, realloc) of every thread
-/// while [`COUNTING`] is set. With `ALPENGLOW_ALLOC_TRACE=1` in the
-/// environment it prints the backtrace of each counted allocation (to
-/// find what allocates).
+/// while [`COUNTING`] is set. With `ALPENGLOW_ALLOC_TRACE=N` in the
+/// environment it prints the backtrace of every Nth counted allocation
+/// (to find what allocates).
 struct CountingAllocator;
 
 static COUNTING: AtomicBool = AtomicBool::new(false);
 static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
-static TRACE: AtomicBool = AtomicBool::new(false);
+static TRACE: AtomicU64 = AtomicU64::new(0);
 
 thread_local! {
     static IN_TRACE: Cell<bool> = const { Cell::new(false) };
 }
 
 fn count() {
-    if !COUNTING.load(Ordering::SeqCst) {
+    if !COUNTING.load(Ordering::SeqCst) || IN_TRACE.with(|t| t.get()) {
         return;
     }
-    ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-    if TRACE.load(Ordering::Relaxed) && !IN_TRACE.with(|t| t.replace(true)) {
+    let n = ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+    let every = TRACE.load(Ordering::Relaxed);
+    if every > 0 && n % every == 0 && !IN_TRACE.with(|t| t.replace(true)) {
         eprintln!("allocation:\n{}", std::backtrace::Backtrace::force_capture());
         IN_TRACE.with(|t| t.set(false));
     }
@@ -268,15 +269,21 @@ fn requested_output_subsets_are_read_back_and_the_others_refused() {
 
 #[test]
 fn steady_state_frames_allocate_nothing() {
-    const WARM_UP: usize = 40;
-    const MEASURED: usize = 30;
-    TRACE.store(std::env::var_os("ALPENGLOW_ALLOC_TRACE").is_some(), Ordering::Relaxed);
+    // (`ALPENGLOW_ALLOC_FRAMES=W,M` overrides the frame counts when tracing.)
+    let frames = std::env::var("ALPENGLOW_ALLOC_FRAMES").unwrap_or_default();
+    let frames: Vec<usize> = frames.split(',').filter_map(|f| f.parse().ok()).collect();
+    let (warm_up, measured) = match frames[..] {
+        [w, m] => (w, m),
+        _ => (40, 30),
+    };
+    let trace = std::env::var("ALPENGLOW_ALLOC_TRACE").ok().and_then(|v| v.parse().ok());
+    TRACE.store(trace.unwrap_or(0), Ordering::Relaxed);
     with_context(|ctx| {
         let scene = scene();
         let mut renderer = Renderer::new(ctx, &scene, settings(160, 100)).expect("renderer");
         // A bounded profile history: once full, its oldest profile's memory is reused.
         renderer.set_profile_history(8);
-        let cams: Vec<[Camera; 1]> = (0..WARM_UP + MEASURED).map(|k| [camera(&scene, k as u32)]).collect();
+        let cams: Vec<[Camera; 1]> = (0..warm_up + measured).map(|k| [camera(&scene, k as u32)]).collect();
         let mut rgba = vec![0u8; 160 * 100 * 4];
         let mut depth = vec![0f32; 160 * 100];
         let mut run = |renderer: &mut Renderer, frames: std::ops::Range<usize>| -> [u64; 3] {
@@ -301,9 +308,9 @@ fn steady_state_frames_allocate_nothing() {
             counts
         };
         // Warm-up: the texture atlas settles, pools and histories fill.
-        run(&mut renderer, 0..WARM_UP);
-        let counts = run(&mut renderer, WARM_UP..WARM_UP + MEASURED);
-        eprintln!("allocations over {MEASURED} frames: submit {}, read {}", counts[0], counts[1]);
-        assert_eq!(counts[..2], [0, 0], "allocations in submit, read over {MEASURED} frames");
+        run(&mut renderer, 0..warm_up);
+        let counts = run(&mut renderer, warm_up..warm_up + measured);
+        eprintln!("allocations over {measured} frames: submit {}, read {}", counts[0], counts[1]);
+        assert_eq!(counts[..2], [0, 0], "allocations in submit, read over {measured} frames");
     });
 }

@@ -167,24 +167,34 @@ impl CommandRecorder {
             .map(|(i, _)| (i.desc().width, i.desc().height))
             .or(depth.map(|(i, _)| (i.desc().width, i.desc().height)))
             .unwrap_or((1, 1));
-        let color_infos: Vec<_> = colors
-            .iter()
-            .map(|(image, load)| {
-                let (op, clear) = match load {
-                    LoadOp::Clear(c) => (vk::AttachmentLoadOp::CLEAR, *c),
-                    LoadOp::Load => (vk::AttachmentLoadOp::LOAD, [0.0; 4]),
-                    LoadOp::DontCare => (vk::AttachmentLoadOp::DONT_CARE, [0.0; 4]),
-                };
-                vk::RenderingAttachmentInfo::default()
-                    .image_view(image.view)
-                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                    .load_op(op)
-                    .store_op(vk::AttachmentStoreOp::STORE)
-                    .clear_value(vk::ClearValue {
-                        color: vk::ClearColorValue { float32: clear },
-                    })
-            })
-            .collect();
+        // On the stack (no allocation per pass); more attachments than any
+        // device offers spill to the heap.
+        let color_info = |(image, load): &(&Image, LoadOp)| {
+            let (op, clear) = match load {
+                LoadOp::Clear(c) => (vk::AttachmentLoadOp::CLEAR, *c),
+                LoadOp::Load => (vk::AttachmentLoadOp::LOAD, [0.0; 4]),
+                LoadOp::DontCare => (vk::AttachmentLoadOp::DONT_CARE, [0.0; 4]),
+            };
+            vk::RenderingAttachmentInfo::default()
+                .image_view(image.view)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(op)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    color: vk::ClearColorValue { float32: clear },
+                })
+        };
+        let mut inline = [vk::RenderingAttachmentInfo::default(); 8];
+        let spilled: Vec<vk::RenderingAttachmentInfo<'_>>;
+        let color_infos: &[vk::RenderingAttachmentInfo<'_>] = if colors.len() <= inline.len() {
+            for (slot, color) in inline.iter_mut().zip(colors) {
+                *slot = color_info(color);
+            }
+            &inline[..colors.len()]
+        } else {
+            spilled = colors.iter().map(color_info).collect();
+            &spilled
+        };
         let depth_info = depth.map(|(image, clear)| {
             // A depth buffer the graph declared read-only is neither cleared nor stored.
             let read_only = image.state().layout == vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL;
@@ -219,7 +229,7 @@ impl CommandRecorder {
         let mut info = vk::RenderingInfo::default()
             .render_area(area)
             .layer_count(1)
-            .color_attachments(&color_infos);
+            .color_attachments(color_infos);
         if let Some(d) = depth_info.as_ref() {
             info = info.depth_attachment(d);
         }
