@@ -39,7 +39,12 @@ fn options() -> alpenglow::Result<Options> {
             "--frames" => o.frames = number("--frames")?,
             "--outputs" if value == "all" => o.outputs = Outputs::ALL,
             "--outputs" => o.outputs = value.split(',').map(str::parse).collect::<alpenglow::Result<_>>()?,
-            other => return Err(alpenglow::error::Error::invalid("option", format!("unknown option {other}"))),
+            other => {
+                return Err(alpenglow::error::Error::invalid(
+                    "option",
+                    format!("unknown option {other}"),
+                ))
+            }
         }
     }
     Ok(o)
@@ -120,6 +125,9 @@ fn main() -> alpenglow::Result<()> {
     let fps = |t: &[f64]| t.len() as f64 / t.iter().sum::<f64>();
     let (blocking, pipelined) = (fps(&times[0]), fps(&times[1]));
     println!("blocking:  {blocking:.2} frames/s");
-    println!("pipelined: {pipelined:.2} frames/s ({:+.0} %)", (pipelined / blocking - 1.0) * 100.0);
+    println!(
+        "pipelined: {pipelined:.2} frames/s ({:+.0} %)",
+        (pipelined / blocking - 1.0) * 100.0
+    );
     Ok(())
 }

@@ -231,7 +231,6 @@ impl<P> BakedGraph<P> {
             if let Err(e) = (pass.record)(&mut ctx, params) {
                 result = Err(Error::Graph(format!("pass '{}': {e}", pass.name)));
             }
-            drop(ctx);
             let cmd = &mut recording.recorder;
             cmd.write_timestamp(pool, 2 * i as u32 + 1, PipelineStageFlags2::ALL_COMMANDS);
             cmd.end_label();
@@ -260,7 +259,13 @@ impl<P> BakedGraph<P> {
             cpu_passes,
             prepare: prepare
                 .iter()
-                .map(|s| (s.name.clone(), s.duration, s.start.saturating_duration_since(frame_start)))
+                .map(|s| {
+                    (
+                        s.name.clone(),
+                        s.duration,
+                        s.start.saturating_duration_since(frame_start),
+                    )
+                })
                 .fold(PrepareTimes::default(), PrepareTimes::with),
         });
         Ok(FrameOutcome { frame, timeline })

@@ -63,7 +63,11 @@ impl<'a> Plane<'a> {
     fn wrong_type(&self, what: &str) -> Error {
         Error::invalid(
             "output",
-            format!("'{}' holds {:?} samples, not {what}", self.output, self.output.element()),
+            format!(
+                "'{}' holds {:?} samples, not {what}",
+                self.output,
+                self.output.element()
+            ),
         )
     }
 
@@ -225,17 +229,24 @@ impl<'a> FrameData<'a> {
 
     /// View `k` (in the order of the settings' views).
     pub fn view(&self, k: usize) -> Result<ViewData<'a>> {
-        let readback = self.views.get(k).ok_or_else(|| {
-            Error::invalid("view", format!("{k}; the frame has {} views", self.views.len()))
-        })?;
-        Ok(ViewData { readback, slot: self.slot })
+        let readback = self
+            .views
+            .get(k)
+            .ok_or_else(|| Error::invalid("view", format!("{k}; the frame has {} views", self.views.len())))?;
+        Ok(ViewData {
+            readback,
+            slot: self.slot,
+        })
     }
 
     /// The view named `name`.
     pub fn view_named(&self, name: &str) -> Result<ViewData<'a>> {
         let readback = (self.views.iter().find(|r| r.name() == name))
             .ok_or_else(|| Error::invalid("view", format!("no view is named '{name}'")))?;
-        Ok(ViewData { readback, slot: self.slot })
+        Ok(ViewData {
+            readback,
+            slot: self.slot,
+        })
     }
 
     /// Every view, in order.
@@ -301,9 +312,13 @@ mod tests {
     fn ids_deinterleave_and_normals_widen() {
         let ids: Vec<u8> = [1u32, 7, 2, 9].iter().flat_map(|v| v.to_le_bytes()).collect();
         let mut out = [0u32; 2];
-        plane(Output::Instance, Element::U32, 2, 1, &ids).copy_into_u32(&mut out).expect("instance");
+        plane(Output::Instance, Element::U32, 2, 1, &ids)
+            .copy_into_u32(&mut out)
+            .expect("instance");
         assert_eq!(out, [7, 9]);
-        plane(Output::Class, Element::U32, 2, 0, &ids).copy_into_u32(&mut out).expect("class");
+        plane(Output::Class, Element::U32, 2, 0, &ids)
+            .copy_into_u32(&mut out)
+            .expect("class");
         assert_eq!(out, [1, 2]);
         let halves: Vec<u8> = [0x3c00u16, 0xc000, 0, 0x7bff, 0x3c00, 0x3c00, 0x3c00, 0]
             .iter()

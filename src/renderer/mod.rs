@@ -439,7 +439,9 @@ impl Renderer {
                 frame
             }
             None => {
-                let views = (self.render_specs.iter().zip(cameras)).map(|(s, c)| s.view(*c)).collect();
+                let views = (self.render_specs.iter().zip(cameras))
+                    .map(|(s, c)| s.view(*c))
+                    .collect();
                 Frame::new(index, views, self.lighting)
             }
         };

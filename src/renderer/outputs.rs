@@ -205,7 +205,10 @@ mod tests {
         assert_eq!(set.iter().collect::<Vec<_>>(), [Output::Rgba8, Output::Class]);
         assert_eq!(Outputs::ALL.iter().count(), 10);
         assert!(Outputs::NONE.is_empty());
-        assert_eq!(set.without(Output::Class).with(Output::Hdr), Outputs::of(&[Output::Rgba8, Output::Hdr]));
+        assert_eq!(
+            set.without(Output::Class).with(Output::Hdr),
+            Outputs::of(&[Output::Rgba8, Output::Hdr])
+        );
         for o in Output::ALL {
             assert_eq!(o.name().parse::<Output>().expect("name"), o);
         }

@@ -139,7 +139,9 @@ impl Readback {
         let mut copies: Vec<(ImageId, BufferId)> = Vec::new();
         for output in outputs.iter() {
             let (source, element, stride, _) = layout(output);
-            let Some(image) = image_of(targets, source) else { continue };
+            let Some(image) = image_of(targets, source) else {
+                continue;
+            };
             rb.outputs = rb.outputs.with(output);
             if !rb.buffers[source as usize].is_empty() {
                 continue;

@@ -16,8 +16,8 @@ pub use ash::vk::{
     AccessFlags2, BufferUsageFlags, CompareOp, Format, ImageLayout, ImageUsageFlags, PipelineStageFlags2,
     PrimitiveTopology,
 };
-pub use commands::{CommandRecorder, LoadOp};
 pub(crate) use commands::BarrierBatch;
+pub use commands::{CommandRecorder, LoadOp};
 pub use context::{Context, ContextOptions, DeviceInfo, OptionalFeatures};
 pub use device_select::{DeviceSelector, REQUIRED_FEATURES};
 pub use frames::{CompletedFrame, FrameRing, RecordingFrame, FRAMES_IN_FLIGHT};

@@ -72,7 +72,7 @@ impl ValidationReport {
 
     /// Counts a message (allocating only for those kept: errors and warnings).
     fn record(&self, severity: vk::DebugUtilsMessageSeverityFlagsEXT, text: &str) {
-        if self.set_aside_bindless_hazards && is_descriptor_array_hazard(&text) {
+        if self.set_aside_bindless_hazards && is_descriptor_array_hazard(text) {
             self.set_aside.fetch_add(1, Ordering::SeqCst);
             log::debug!("validation (set aside, layer bug #3450): {text}");
             return;
@@ -136,7 +136,10 @@ unsafe extern "system" fn debug_callback(
         let report = &*(user_data as *const ValidationReport);
         // Borrowed unless the message is not UTF-8: the layers' per-draw
         // messages (INFO, the set-aside hazards) allocate nothing.
-        let text = (*data).message_as_c_str().map(|s| s.to_string_lossy()).unwrap_or_default();
+        let text = (*data)
+            .message_as_c_str()
+            .map(|s| s.to_string_lossy())
+            .unwrap_or_default();
         // Loader chatter ("Inserted device layer", ICD search) is INFO and not counted.
         report.record(severity, &text);
     }

@@ -206,10 +206,23 @@ impl ShadowMaps {
     }
 
     /// [`ShadowMaps::plan`] into `plan`, reusing its memory.
-    fn plan_into(&self, plan: &mut CascadePlan, (index, view): (ViewIndex, &View), sun: glam::Vec3, mode: ShadowMode) -> Result<()> {
+    fn plan_into(
+        &self,
+        plan: &mut CascadePlan,
+        (index, view): (ViewIndex, &View),
+        sun: glam::Vec3,
+        mode: ShadowMode,
+    ) -> Result<()> {
         let target = self.target(index)?;
         let camera = view.culling_camera();
-        plan_cascades_into(plan, (&camera, view.culling_aspect()), sun, self.bounds, &self.settings, target.handle)?;
+        plan_cascades_into(
+            plan,
+            (&camera, view.culling_aspect()),
+            sun,
+            self.bounds,
+            &self.settings,
+            target.handle,
+        )?;
         if mode != ShadowMode::Cascaded {
             plan.cascades.clear();
         }

@@ -27,8 +27,8 @@ use super::PointRenderer;
 use crate::error::{Error, Result};
 use crate::graph::{BufferAccess, BufferId, ImageAccess, RenderGraph, Stage, UploadRegion};
 use crate::lighting::shadows::{
-    plan_cascades, plan_cascades_into, record_cascades, CascadePlan, SceneBounds, ShadowFrame, ShadowMaps, ShadowSettings, ShadowTarget,
-    SHADOW_FORMAT,
+    plan_cascades, plan_cascades_into, record_cascades, CascadePlan, SceneBounds, ShadowFrame, ShadowMaps,
+    ShadowSettings, ShadowTarget, SHADOW_FORMAT,
 };
 use crate::points::scene::PointScene;
 use crate::shaders;
@@ -304,7 +304,12 @@ impl Technique for PointShadows {
                     }
                     None => plan_cascades(&camera, aspect, sun, bounds, &self.settings, 0)?,
                 };
-                self.plan_view(view.camera.eye, &plan, 1.0 / view.intrinsics().fy, (&mut records, draws));
+                self.plan_view(
+                    view.camera.eye,
+                    &plan,
+                    1.0 / view.intrinsics().fy,
+                    (&mut records, draws),
+                );
                 plan.cascades.clear();
                 self.scratch_plan = Some(plan);
             }
