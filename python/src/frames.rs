@@ -131,10 +131,7 @@ fn rgba8(image: &Bound<'_, PyAny>) -> PyResult<(Vec<u8>, (u32, u32))> {
 
 fn png_bytes(image: &Bound<'_, PyAny>) -> PyResult<Vec<u8>> {
     let (pixels, (w, h)) = rgba8(image)?;
-    image
-        .py()
-        .detach(|| engine::encode_png(&pixels, w, h))
-        .map_err(lib_err)
+    image.py().detach(|| engine::encode_png(&pixels, w, h)).map_err(lib_err)
 }
 
 /// The PNG of `image` (a frame dict or a uint8 (H, W, 4) array), as bytes.
@@ -149,10 +146,7 @@ pub fn encode_png<'py>(image: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyBytes
 #[pyfunction]
 pub fn write_png(path: PathBuf, image: &Bound<'_, PyAny>) -> PyResult<()> {
     let bytes = png_bytes(image)?;
-    image
-        .py()
-        .detach(|| engine::write_file(&path, &bytes))
-        .map_err(lib_err)
+    image.py().detach(|| engine::write_file(&path, &bytes)).map_err(lib_err)
 }
 
 /// The OpenEXR file of a frame dict (RGBA from "hdr", Z from "depth", and
