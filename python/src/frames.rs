@@ -38,6 +38,9 @@ pub(crate) fn frame_dict(py: Python<'_>, images: FrameImages) -> PyResult<Bound<
     Ok(d)
 }
 
+/// Row-major values and their image size (rows, columns).
+type Plane<T> = (Vec<T>, (usize, usize));
+
 /// `frame[key]` as a `T` array of shape (H, W, channels) (channels 1: (H, W)),
 /// copied row-major; None when absent and not `required`.
 fn plane<T: Element + Copy>(
@@ -46,7 +49,7 @@ fn plane<T: Element + Copy>(
     channels: usize,
     size: Option<(usize, usize)>,
     required: bool,
-) -> PyResult<Option<(Vec<T>, (usize, usize))>> {
+) -> PyResult<Option<Plane<T>>> {
     let Some(value) = frame.get_item(key)? else {
         return match required {
             true => Err(invalid("frame", format!("no {key:?} array"))),
