@@ -197,8 +197,8 @@ impl Renderer {
     }
 
     /// The frame of `ticket` once the GPU finished it. Errors
-    /// (`alpenglow.Error`) for a ticket read already, unknown, or whose
-    /// readback slot later frames reused.
+    /// (`alpenglow.Error`) for an unknown ticket or one whose readback slot
+    /// later frames reused (never stale data).
     fn wait<'py>(&self, py: Python<'py>, ticket: Ticket) -> PyResult<Bound<'py, PyAny>> {
         let views = self.with_engine(py, |e| e.wait(ticket))?.map_err(lib_err)?;
         result(py, self.multi(), views)

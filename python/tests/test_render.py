@@ -68,14 +68,16 @@ def test_submit_then_wait_equals_render(renderer, camera):
         np.testing.assert_array_equal(frame[key], settled[key], err_msg=key)
 
 
-def test_try_read_and_poll_give_the_frame_once(renderer, camera):
+def test_try_read_and_poll_give_the_frame(renderer, camera):
     first, second = renderer.submit(camera), renderer.submit(camera)
     assert second != first
     frame = renderer.try_read(first)
     assert frame is not None and frame["rgba8"].shape == (HEIGHT, WIDTH, 4)
     assert renderer.poll(second) is not None
+    # Read again while its readback slot holds it: the same frame.
+    np.testing.assert_array_equal(renderer.wait(first)["hdr"], frame["hdr"])
     with pytest.raises(ag.Error, match="ticket"):
-        renderer.wait(first)
+        renderer.wait(10**9)
 
 
 def test_a_ticket_whose_slot_was_reused_is_an_error(renderer, camera):
