@@ -23,8 +23,7 @@ use crate::{arg_err, invalid, lib_err};
 /// (procedural displacement and bump mapping), `grid` (the terrain's
 /// geometry-image side), `texturing` ("atlas", "direct", "classic"),
 /// `lighting` (a `Lighting`; default: the scene's), `cache_dir` (where the
-/// sky-light bake is cached), `settle_frames` (most frames `render` spends
-/// without texture progress).
+/// sky-light bake is cached).
 #[pyclass(module = "alpenglow", frozen)]
 pub struct Renderer {
     engine: Mutex<Engine>,
