@@ -21,16 +21,6 @@ use crate::error::{Error, Result};
 /// Bytes of push constants every pipeline may use.
 pub const PUSH_CONSTANT_BYTES: u32 = 128;
 
-/// The fixed samplers, by heap index.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u32)]
-pub enum SamplerKind {
-    LinearClamp = 0,
-    NearestClamp = 1,
-    LinearRepeat = 2,
-    NearestRepeat = 3,
-}
-
 /// The descriptor arrays of the heap.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HeapKind {
@@ -258,6 +248,9 @@ impl DescriptorHeap {
     pub fn recycle(&self, completed: u64) {
         if let Ok(mut handles) = self.handles.lock() {
             for allocator in handles.iter_mut() {
+                if !allocator.pending.iter().any(|(after, _)| *after <= completed) {
+                    continue;
+                }
                 let (ready, waiting): (Vec<_>, Vec<_>) =
                     allocator.pending.drain(..).partition(|(after, _)| *after <= completed);
                 allocator.pending = waiting;
