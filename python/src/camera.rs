@@ -233,7 +233,12 @@ impl Distortion {
 #[pyclass(module = "alpenglow", frozen, from_py_object)]
 #[derive(Clone)]
 pub struct View {
-    pub(crate) inner: engine::RigView,
+    pub(crate) inner: engine::RigViewParams,
+}
+
+/// A rig error about the caller's views: `ValueError`.
+fn rig_err(e: engine::Error) -> PyErr {
+    pyo3::exceptions::PyValueError::new_err(e.to_string())
 }
 
 #[pymethods]
@@ -259,35 +264,27 @@ impl View {
             .map(|p| vec3("position", p))
             .transpose()?
             .unwrap_or(DVec3::ZERO);
-        let lens = match (fov_y, intrinsics) {
-            (Some(_), Some(_)) => return Err(invalid("fov_y", "give fov_y or intrinsics, not both")),
-            (Some(f), None) => engine::RigLens::FovY(f),
-            (None, Some(k)) => engine::RigLens::Pinhole(k.inner),
-            (None, None) => engine::RigLens::Inherit,
-        };
+        if fov_y.is_some() && intrinsics.is_some() {
+            return Err(invalid("fov_y", "give fov_y or intrinsics, not both"));
+        }
         let size = match (width, height) {
             (Some(w), Some(h)) => Some((w, h)),
             (None, None) => None,
             _ => return Err(invalid("width", "give width and height together")),
         };
-        let view = engine::RigView {
+        let view = engine::RigViewParams {
             name,
-            pose: engine::RigPose::Relative {
-                position,
-                yaw_pitch_roll_deg: DVec3::new(yaw, pitch, roll),
-            },
-            lens,
+            position: position.to_array(),
+            yaw_pitch_roll: [yaw, pitch, roll],
+            fov_y,
+            intrinsics: intrinsics.map(|k| k.inner),
             distortion: distortion.map(|d| d.inner),
             size,
             near,
             far,
         };
         // Checks the name, size, lens and distortion the way a rig file's are.
-        engine::Rig {
-            views: vec![view.clone()],
-        }
-        .specs((1, 1))
-        .map_err(arg_err)?;
+        engine::rig_from_views(std::slice::from_ref(&view)).map_err(rig_err)?;
         Ok(View { inner: view })
     }
 
@@ -312,10 +309,11 @@ pub struct Rig {
 impl Rig {
     #[new]
     fn new(views: Vec<View>) -> PyResult<Rig> {
-        let inner = engine::Rig {
-            views: views.into_iter().map(|v| v.inner).collect(),
-        };
-        inner.specs((1, 1)).map_err(arg_err)?;
+        if views.is_empty() {
+            return Err(invalid("views", "a rig has 1 to 16 views"));
+        }
+        let views: Vec<engine::RigViewParams> = views.into_iter().map(|v| v.inner).collect();
+        let inner = engine::rig_from_views(&views).map_err(rig_err)?;
         Ok(Rig { inner })
     }
 

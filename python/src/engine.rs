@@ -5,30 +5,24 @@
 //! Settings, …}`) and to the non-blocking readback ring (`submit`,
 //! `try_read`, `wait` with tickets) is an edit of this file only.
 //!
-//! Today the frames are rendered with the blocking `Renderer::render_views`
-//! and read with `Renderer::read_views`: [`Engine::submit`] records and
-//! submits a frame and returns its ticket; [`Engine::wait`] waits for the
-//! GPU and copies the frame out of the mapped readback buffers (one copy:
-//! the `Vec`s of [`FrameImages`] become the NumPy arrays' memory).
+//! Frames go through the renderer's readback ring: [`Engine::submit`]
+//! records and submits a frame and returns its ticket; [`Engine::try_read`]
+//! and [`Engine::wait`] copy the finished frame's planes out of the mapped
+//! readback slot (one copy, converting f16 normals and de-interleaving the
+//! ids; the `Vec`s of [`FrameImages`] become the NumPy arrays' memory).
 
 use std::collections::VecDeque;
 use std::path::Path;
 
-pub use alpenglow::io::heightmap::{check_spacing, load_heightmap, HeightField, HeightmapOptions, RowOrder};
-pub use alpenglow::io::limits::InputLimits;
-pub use alpenglow::lighting::solar::{parse_date, parse_time, solar_position, Clock};
-pub use alpenglow::points::vegetation::VegetationOptions;
-pub use alpenglow::renderer::{Camera, FrameImages, RenderSettings as Settings, Renderer, Rig, Scene, ViewSpec};
-pub use alpenglow::terrain::procedural::{ProceduralTerrain, TerrainModel};
-pub use alpenglow::texturing::gpu_layout::TexturingMode;
-pub use alpenglow::view::lens::Distortion;
-pub use alpenglow::view::rig::{RigLens, RigPose, RigView};
-pub use alpenglow::view::{Exposure, Intrinsics, Lighting, ShadowMode, SkyLightMode, SkyModel, SunPosition};
-pub use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
-pub use alpenglow::{Error, Result};
-
-use alpenglow::graph::FrameOutcome;
-use alpenglow::io::image_out::{encode_exr_height, encode_exr_samples, encode_png_rgba8, ExrSamples};
+pub use alpenglow::files::{check_spacing, load_heightmap, InputLimits};
+use alpenglow::files::{encode_exr_height, encode_exr_samples, encode_png_rgba8, write_bytes_atomically, ExrSamples};
+pub use alpenglow::tools::solar::{parse_date, parse_time, solar_position, Clock};
+pub use alpenglow::{
+    Camera, Context, ContextOptions, DeviceSelector, Distortion, Error, Exposure, FrameImages, HeightField,
+    HeightmapOptions, Intrinsics, Lighting, ProceduralTerrain, Renderer, Result, Rig, RowOrder, Scene, Settings,
+    ShadowMode, SkyLightMode, SkyModel, SunPosition, TerrainModel, TexturingMode, VegetationOptions, ViewSpec,
+};
+use alpenglow::{FrameData, Output, Ticket as RingTicket, ViewData};
 
 /// Frames rendered in a row, at most, while the texture atlas settles
 /// (the CLI's bound).
@@ -70,7 +64,7 @@ pub fn scene_procedural(model: &str, seed: u64, size: u32, spacing: f64) -> Resu
 /// (south-up rows), atomically.
 pub fn write_heightmap(path: &Path, heights: &[f32], columns: u32, rows: u32) -> Result<()> {
     let bytes = encode_exr_height(heights, columns, rows)?;
-    alpenglow::io::atomic::write_bytes_atomically(path, &bytes)
+    write_bytes_atomically(path, &bytes)
 }
 
 /// The PNG of an sRGB RGBA8 image (the CLI's encoder).
@@ -100,12 +94,76 @@ pub fn encode_exr(size: (u32, u32), hdr: &[f32], depth: &[f32], planes: &[(&str,
 
 /// Writes `bytes` to `path` atomically (a temporary file renamed over it).
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
-    alpenglow::io::atomic::write_bytes_atomically(path, bytes)
+    write_bytes_atomically(path, bytes)
 }
 
 /// Submitted frames whose tickets are remembered (their readback slots were
 /// reused long before).
 const REMEMBERED_FRAMES: usize = 64;
+
+/// One view of a rig (the fields of a rig file's `[[view]]` table).
+#[derive(Clone, Debug, Default)]
+pub struct RigViewParams {
+    pub name: String,
+    /// Metres along (forward, left, up) of the rig camera.
+    pub position: [f64; 3],
+    pub yaw_pitch_roll: [f64; 3],
+    pub fov_y: Option<f64>,
+    pub intrinsics: Option<Intrinsics>,
+    pub distortion: Option<Distortion>,
+    pub size: Option<(u32, u32)>,
+    pub near: Option<f64>,
+    pub far: Option<f64>,
+}
+
+/// The rig of `views`, checked the way a rig file is (its text is one:
+/// the front door builds rigs from files).
+pub fn rig_from_views(views: &[RigViewParams]) -> Result<Rig> {
+    use std::fmt::Write;
+    let mut text = String::new();
+    let num = |v: f64| -> Result<String> {
+        match v.is_finite() {
+            true => Ok(format!("{v:?}")),
+            false => Err(Error::invalid("view", format!("{v}; numbers must be finite"))),
+        }
+    };
+    for v in views {
+        let mut line = |key: &str, value: String| {
+            let _ = writeln!(text, "{key} = {value}");
+        };
+        line("[[view]]\nname", format!("{:?}", v.name));
+        let triple =
+            |a: [f64; 3]| -> Result<String> { Ok(format!("[{}, {}, {}]", num(a[0])?, num(a[1])?, num(a[2])?)) };
+        line("position", triple(v.position)?);
+        line("yaw_pitch_roll", triple(v.yaw_pitch_roll)?);
+        if let Some(f) = v.fov_y {
+            line("fov_y", num(f)?);
+        }
+        if let Some(k) = v.intrinsics {
+            for (key, value) in [("fx", k.fx), ("fy", k.fy), ("cx", k.cx), ("cy", k.cy)] {
+                line(key, num(value)?);
+            }
+        }
+        if let Some(d) = v.distortion {
+            for (key, value) in [("k1", d.k1), ("k2", d.k2), ("k3", d.k3), ("p1", d.p1), ("p2", d.p2)] {
+                line(key, num(value)?);
+            }
+        }
+        if let Some((w, h)) = v.size {
+            line("width", w.to_string());
+            line("height", h.to_string());
+        }
+        if let Some(n) = v.near {
+            line("near", num(n)?);
+        }
+        if let Some(f) = v.far {
+            line("far", num(f)?);
+        }
+    }
+    let rig = Rig::parse(&text, Path::new("rig"))?;
+    rig.specs((1, 1))?;
+    Ok(rig)
+}
 
 /// A submitted frame's handle.
 pub type Ticket = u64;
@@ -114,7 +172,7 @@ pub type Ticket = u64;
 pub struct Engine {
     renderer: Renderer,
     /// The latest submitted frames (more than any readback ring keeps).
-    pending: VecDeque<(Ticket, FrameOutcome)>,
+    pending: VecDeque<(Ticket, RingTicket)>,
     next_ticket: Ticket,
 }
 
@@ -142,10 +200,11 @@ impl Engine {
         self.renderer.read_views(&frame)
     }
 
-    /// Submits one frame of `cameras` (one per view); read it with
-    /// [`Engine::wait`] before several more frames are submitted.
+    /// Submits one frame of `cameras` (one per view) without waiting for
+    /// the GPU; read it with [`Engine::try_read`] or [`Engine::wait`]
+    /// before `readback_slots` more frames are submitted.
     pub fn submit(&mut self, cameras: &[Camera]) -> Result<Ticket> {
-        let frame = self.renderer.render_views(cameras)?;
+        let frame = self.renderer.submit(cameras)?;
         let ticket = self.next_ticket;
         self.next_ticket += 1;
         if self.pending.len() == REMEMBERED_FRAMES {
@@ -155,27 +214,72 @@ impl Engine {
         Ok(ticket)
     }
 
-    /// The views of `ticket` once the GPU is done (blocking today), or an
-    /// error when the ticket is unknown or its readback slot was reused by
-    /// later frames (never stale data). A ticket may be read again until then.
-    pub fn wait(&mut self, ticket: Ticket) -> Result<Vec<FrameImages>> {
+    fn ring_ticket(&self, ticket: Ticket) -> Result<RingTicket> {
         let (_, frame) = *self.pending.iter().find(|(t, _)| *t == ticket).ok_or_else(|| {
             Error::invalid(
                 "ticket",
                 format!("{ticket} is not a frame of this renderer (or too old to remember)"),
             )
         })?;
-        self.renderer.read_views(&frame)
+        Ok(frame)
+    }
+
+    /// The views of `ticket` once the GPU is done, or an error when the
+    /// ticket is unknown or its readback slot was reused by later frames
+    /// (never stale data). A ticket may be read again until then.
+    pub fn wait(&mut self, ticket: Ticket) -> Result<Vec<FrameImages>> {
+        let frame = self.ring_ticket(ticket)?;
+        owned(&self.renderer.wait(frame)?)
     }
 
     /// [`Engine::wait`], or `None` while the GPU is still busy with the
-    /// frame. Today's renderer has no non-blocking query: this waits.
+    /// frame (never blocks).
     pub fn try_read(&mut self, ticket: Ticket) -> Result<Option<Vec<FrameImages>>> {
-        self.wait(ticket).map(Some)
+        let frame = self.ring_ticket(ticket)?;
+        self.renderer.try_read(frame)?.map(|data| owned(&data)).transpose()
     }
 
     /// Drains the GPU (the profiles are dropped).
     pub fn finish(&mut self) -> Result<()> {
         self.renderer.finish().map(drop)
     }
+}
+
+/// A frame's views copied out of the readback slot (the one copy).
+fn owned(data: &FrameData<'_>) -> Result<Vec<FrameImages>> {
+    data.views().map(|view| owned_view(&view)).collect()
+}
+
+fn owned_view(view: &ViewData<'_>) -> Result<FrameImages> {
+    let pixels = view.width() as usize * view.height() as usize;
+    let floats = |output: Output| -> Result<Vec<f32>> {
+        let mut values = vec![0.0; pixels * output.channels()];
+        view.plane(output)?.copy_into_f32(&mut values)?;
+        Ok(values)
+    };
+    let ids = |output: Output| -> Result<Vec<u32>> {
+        let mut values = vec![0; pixels];
+        view.plane(output)?.copy_into_u32(&mut values)?;
+        Ok(values)
+    };
+    let mut rgba8 = vec![0; pixels * 4];
+    view.copy_into(Output::Rgba8, &mut rgba8)?;
+    Ok(FrameImages {
+        name: view.name().to_string(),
+        width: view.width(),
+        height: view.height(),
+        rgba8,
+        hdr: floats(Output::Hdr)?,
+        depth: floats(Output::Depth)?,
+        weight: match view.outputs().contains(Output::Weight) {
+            true => Some(floats(Output::Weight)?),
+            false => None,
+        },
+        visibility: floats(Output::Visibility)?,
+        normal: floats(Output::Normal)?,
+        class: ids(Output::Class)?,
+        instance: ids(Output::Instance)?,
+        motion: floats(Output::Motion)?,
+        distance: floats(Output::Distance)?,
+    })
 }

@@ -23,7 +23,8 @@ use crate::{arg_err, invalid, lib_err};
 /// (procedural displacement and bump mapping), `grid` (the terrain's
 /// geometry-image side), `texturing` ("atlas", "direct", "classic"),
 /// `lighting` (a `Lighting`; default: the scene's), `cache_dir` (where the
-/// sky-light bake is cached).
+/// sky-light bake is cached), `readback_slots` (frames that can be
+/// submitted before the oldest unread one is lost; default 3).
 #[pyclass(module = "alpenglow", frozen)]
 pub struct Renderer {
     engine: Mutex<Engine>,
@@ -121,7 +122,7 @@ impl Renderer {
 #[pymethods]
 impl Renderer {
     #[new]
-    #[pyo3(signature = (ctx, scene, width = 640, height = 360, *, rig = None, intrinsics = None, distortion = None, msaa = 1, terrain_detail = true, grid = None, texturing = "atlas", lighting = None, cache_dir = None))]
+    #[pyo3(signature = (ctx, scene, width = 640, height = 360, *, rig = None, intrinsics = None, distortion = None, msaa = 1, terrain_detail = true, grid = None, texturing = "atlas", lighting = None, cache_dir = None, readback_slots = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -138,6 +139,7 @@ impl Renderer {
         texturing: &str,
         lighting: Option<Lighting>,
         cache_dir: Option<PathBuf>,
+        readback_slots: Option<usize>,
     ) -> PyResult<Renderer> {
         let rig = rig.map(|r| r.inner);
         let specs = match &rig {
@@ -167,6 +169,9 @@ impl Renderer {
         settings.texturing = self::texturing(texturing)?;
         settings.lighting = lighting.map(|l| l.inner);
         settings.cache_dir = cache_dir;
+        if let Some(n) = readback_slots {
+            settings.readback_slots = n;
+        }
         let light = settings.lighting.unwrap_or_else(|| scene.inner.default_lighting());
         let (ctx, scene) = (&ctx.inner, &scene.inner);
         let engine = py.detach(|| Engine::new(ctx, scene, settings)).map_err(arg_err)?;

@@ -143,3 +143,14 @@ def test_the_gil_is_released_while_the_gpu_works(renderer, camera):
     # A render takes far longer than 50 ms on lavapipe; holding the GIL
     # would have stopped this loop for all of it.
     assert ticks > 50
+
+
+def test_readback_slots_bound_the_unread_frames(ctx, scene, camera):
+    with pytest.raises(ValueError, match="readback_slots"):
+        ag.Renderer(ctx, scene, width=32, height=24, readback_slots=0)
+    r = ag.Renderer(ctx, scene, width=32, height=24, terrain_detail=False, readback_slots=1)
+    old = r.submit(camera)
+    new = r.submit(camera)
+    with pytest.raises(ag.Error, match="readback_slots"):
+        r.wait(old)
+    assert r.wait(new)["rgba8"].shape == (24, 32, 4)
