@@ -139,7 +139,7 @@ def render(
     address: str | None = None,
     *,
     local: bool = False,
-    backend: str = "auto",
+    backend="auto",
     workers: int | None = None,
     progress: bool = True,
     on_frame: Callable[[FrameEvent], None] | None = None,
