@@ -29,7 +29,10 @@ _IN_FLIGHT = 2
 def _one_line(e: BaseException) -> str:
     text = getattr(e, "cause", None) or e
     lines = [l.strip() for l in str(text).splitlines() if l.strip()]
-    return lines[-1] if lines else type(e).__name__
+    line = lines[-1] if lines else type(e).__name__
+    # Ray's actor-death messages run on for a paragraph: keep the first sentence.
+    first = line.split(". ")[0]
+    return first if len(first) <= 200 else first[:197] + "..."
 
 
 def _default_workers(ray, job) -> int:
