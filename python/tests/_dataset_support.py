@@ -19,7 +19,8 @@ except ImportError:
 def write_job(folder, **sections) -> str:
     """A small job file in `folder`; `sections` replace whole tables (TOML text)."""
     tables = {
-        "scene": 'procedural = "ridged"\nseed = 7\nsize = 129\nspacing = 20.0\ngrid = 64',
+        "scene": 'procedural = "ridged"\nseed = 7\nsize = 129\nspacing = 20.0',
+        "render": "grid = 64",
         "camera": "width = 64\nheight = 40\nfov_y = 50.0",
         "path": "type = \"orbit\"\nframes = 8\ncenter = [1280.0, 1280.0, 0.0]\nradius = 1500.0\nheight = 800.0",
         "output": 'dir = "out"\naovs = ["rgba8", "depth", "class"]\nformats = { class = "npy" }\nshard_size = 4',

@@ -67,6 +67,8 @@ BAD_JOBS = [
     ({"ray": "num_gpus = true"}, "ray.num_gpus"),
     ({"rig": '[[rig.view]]\nname = "a/b"'}, "rig.view[0].name"),
     ({"rig": '[[rig.view]]\nname = "a"\n[[rig.view]]\nname = "a"'}, "rig.view[1].name"),
+    ({"render": "grid = [64]"}, "render.grid"),
+    ({"lighting": "sun_elevation = nan"}, "lighting.sun_elevation"),
     ({"extra": "x = 1"}, "extra"),
 ]
 

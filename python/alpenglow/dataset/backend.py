@@ -71,12 +71,18 @@ class NativeBackend:
                 self.scene = ag.Scene.procedural(job.scene["procedural"], **options)
         except (TypeError, ValueError) as e:
             raise JobError(f"{job.source}: scene: {e}") from None
+        settings = dict(job.render)
         try:
-            self.renderer = ag.Renderer(
-                self.ctx, self.scene, width=job.width, height=job.height, **job.camera["settings"]
-            )
+            if job.lighting:
+                settings["lighting"] = ag.Lighting(**job.lighting)
         except (TypeError, ValueError) as e:
-            raise JobError(f"{job.source}: camera.settings: {e}") from None
+            raise JobError(f"{job.source}: lighting: {e}") from None
+        if job.camera["intrinsics"] is not None:
+            settings["intrinsics"] = ag.Intrinsics(*job.camera["intrinsics"])
+        try:
+            self.renderer = ag.Renderer(self.ctx, self.scene, width=job.width, height=job.height, **settings)
+        except (TypeError, ValueError) as e:
+            raise JobError(f"{job.source}: render: {e}") from None
 
     def render(self, cam: CameraSpec) -> dict[str, np.ndarray]:
         kw: dict[str, Any] = dict(eye=cam.eye, target=cam.target, up=cam.up, fov_y=cam.fov_y)
@@ -84,8 +90,6 @@ class NativeBackend:
             kw["near"] = cam.near
         if cam.far is not None:
             kw["far"] = cam.far
-        if cam.intrinsics is not None:
-            kw["intrinsics"] = cam.intrinsics
         camera = self.ag.Camera.look_at(**kw)
         return self.renderer.render(camera)
 
@@ -109,7 +113,8 @@ class CliBackend:
     `scene` keys become options (``height_scale = 2`` → ``--height-scale 2``,
     ``terrain_detail = false`` → ``--no-terrain-detail``); with
     ``procedural``, the model's keys (seed, size, spacing, ...) go into
-    ``--terrain procedural:MODEL,key=value``. `camera.settings` likewise.
+    ``--terrain procedural:MODEL,key=value``. `render` and `lighting` keys
+    likewise (``grid = 64`` → ``--grid 64``).
     """
 
     def __init__(self, job: Job):
@@ -135,7 +140,7 @@ class CliBackend:
             args += ["--terrain", ",".join(parts)]
         for key, value in sorted(options.items()):
             args += _flag(key, value)
-        for key, value in sorted(job.camera["settings"].items()):
+        for key, value in sorted({**job.render, **job.lighting}.items()):
             args += _flag(key, value)
         self.args = args
         self.need_exr = any(a != "rgba8" for a in job.aovs)

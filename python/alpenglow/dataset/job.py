@@ -12,9 +12,13 @@ import hashlib
 import json
 import math
 import os
-import tomllib
 from dataclasses import dataclass, field
 from typing import Any
+
+try:
+    import tomllib
+except ImportError:  # Python < 3.11: the same parser from PyPI
+    import tomli as tomllib  # type: ignore[no-redef]
 
 #: Every AOV a renderer hands out, and the formats each can be written in.
 AOVS: dict[str, tuple[str, ...]] = {
@@ -30,7 +34,7 @@ AOVS: dict[str, tuple[str, ...]] = {
 #: The format an AOV is written in when `output.formats` does not say.
 DEFAULT_FORMAT = {a: f[0] for a, f in AOVS.items()}
 
-_SECTIONS = ("scene", "camera", "path", "rig", "output", "frames", "ray")
+_SECTIONS = ("scene", "camera", "render", "lighting", "path", "rig", "output", "frames", "ray")
 
 
 class JobError(ValueError):
@@ -72,6 +76,8 @@ class Job:
     base_dir: str
     scene: dict[str, Any]
     camera: dict[str, Any]
+    render: dict[str, Any]
+    lighting: dict[str, Any]
     path: dict[str, Any]
     views: list[View]
     aovs: list[str]
@@ -103,6 +109,8 @@ class Job:
         content = {
             "scene": self.scene,
             "camera": self.camera,
+            "render": self.render,
+            "lighting": self.lighting,
             "path": self.path,
             "views": [v.__dict__ for v in self.views],
             "aovs": self.aovs,
@@ -248,12 +256,20 @@ def _camera(r: _Reader) -> dict[str, Any]:
         raise r.fail("fov_y", f"must be below 180 degrees, got {cam['fov_y']!r}")
     if cam["near"] is not None and cam["far"] is not None and cam["far"] <= cam["near"]:
         raise r.fail("far", f"must be beyond camera.near ({cam['near']!r}), got {cam['far']!r}")
-    settings = r.table_of("settings")
-    for key, value in settings.items():
-        if not isinstance(value, (bool, int, float, str)):
-            raise r.fail(f"settings.{key}", f"expected a number, string or boolean, got {value!r}")
-    cam["settings"] = dict(settings)
     return cam
+
+
+def _keywords(r: _Reader) -> dict[str, Any]:
+    """A table of keyword settings handed to the renderer as they are (numbers, strings, booleans)."""
+    out = {}
+    for key, value in r.table.items():
+        r.get(key)
+        if isinstance(value, float) and not math.isfinite(value):
+            raise r.fail(key, f"expected a finite number, got {value!r}")
+        if not isinstance(value, (bool, int, float, str)):
+            raise r.fail(key, f"expected a number, string or boolean, got {value!r}")
+        out[key] = value
+    return out
 
 
 def _path(r: _Reader) -> dict[str, Any]:
@@ -367,6 +383,8 @@ def parse_job(data: dict[str, Any], source: str = "<job>", base_dir: str = ".") 
             raise top.fail(key, f"the [{key}] table is required")
     scene = _scene(sections["scene"], base_dir)
     camera = _camera(sections["camera"])
+    render = _keywords(sections["render"])
+    lighting = _keywords(sections["lighting"])
     path = _path(sections["path"])
     views = _views(sections["rig"])
     out_dir, aovs, formats = _output(sections["output"], base_dir)
@@ -390,7 +408,7 @@ def parse_job(data: dict[str, Any], source: str = "<job>", base_dir: str = ".") 
     for reader in sections.values():
         if reader.prefix != "scene":
             reader.finish()
-    return Job(source, base_dir, scene, camera, path, views, aovs, formats, out_dir, start, end, shard_size, ray)
+    return Job(source, base_dir, scene, camera, render, lighting, path, views, aovs, formats, out_dir, start, end, shard_size, ray)
 
 
 def load_job(path: str | os.PathLike) -> Job:
