@@ -40,29 +40,32 @@ def native_available() -> bool:
     return all(hasattr(alpenglow, n) for n in ("Context", "Scene", "Renderer", "Camera"))
 
 
-def open_backend(job: Job, kind: str = "auto"):
+def open_backend(job: Job, kind="auto", device: str | None = None):
     """A renderer for `job`: `kind` is auto, native, cli, or a callable(job) returning
-    an object with ``render(CameraSpec) -> dict of arrays`` (tests use a fake)."""
+    an object with ``render(CameraSpec) -> dict of arrays`` (tests use a fake);
+    `device`: a Vulkan device index or name substring (None: the default one)."""
     if callable(kind):
         return kind(job)
     if kind == "auto":
         kind = "native" if native_available() else "cli"
     if kind == "native":
-        return NativeBackend(job)
+        return NativeBackend(job, device)
     if kind == "cli":
-        return CliBackend(job)
+        return CliBackend(job, device)
     raise ValueError(f"backend: {kind!r} is not one of auto, native, cli")
 
 
 class NativeBackend:
     """The Python API of issue 26: Context, Scene, Renderer, Camera.look_at."""
 
-    def __init__(self, job: Job):
+    def __init__(self, job: Job, device: str | None = None):
         import alpenglow as ag
 
         self.ag = ag
         self.job = job
-        self.ctx = ag.Context(validation=False, device=os.environ.get("ALPENGLOW_DEVICE") or None)
+        if device is not None and device.isdigit():
+            device = int(device)
+        self.ctx = ag.Context(validation=False, device=device)
         options = dict(job.scene["options"])
         try:
             if "heightmap" in job.scene:
@@ -117,8 +120,9 @@ class CliBackend:
     likewise (``grid = 64`` → ``--grid 64``).
     """
 
-    def __init__(self, job: Job):
+    def __init__(self, job: Job, device: str | None = None):
         self.job = job
+        self.env = dict(os.environ, ALPENGLOW_DEVICE=device) if device is not None else None
         binary = os.environ.get("ALPENGLOW_BIN") or shutil.which("alpenglow")
         if not binary or not os.path.isfile(binary):
             raise RuntimeError(
@@ -161,7 +165,7 @@ class CliBackend:
             cmd += ["--out", png]
             if self.need_exr:
                 cmd += ["--exr", exr]
-            proc = subprocess.run(cmd, capture_output=True, text=True)
+            proc = subprocess.run(cmd, capture_output=True, text=True, env=self.env)
             if proc.returncode != 0:
                 lines = [l for l in proc.stderr.splitlines() if l.strip()] or [f"exit status {proc.returncode}"]
                 raise RuntimeError(f"alpenglow render: {lines[-1]}")

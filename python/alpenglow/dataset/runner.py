@@ -76,7 +76,7 @@ class FrameWorker:
         from .backend import open_backend
 
         self.job = job
-        self.backend = open_backend(job, backend)
+        self.backend = open_backend(job, backend, _device())
         self.last_frame = None
 
     def pid(self) -> int:
@@ -105,6 +105,28 @@ class FrameWorker:
             else:
                 files[rel] = encode.encode_npy(np.asarray(array))
         return frame, files, os.getpid()
+
+
+def _device() -> str | None:
+    """The Vulkan device of this worker: $ALPENGLOW_DEVICE, else the GPU Ray assigned.
+
+    Vulkan does not read CUDA_VISIBLE_DEVICES, so a Ray actor holding GPU k
+    would otherwise open device 0 like every other actor on its node; index k
+    assumes Vulkan lists the node's GPUs in the same order as CUDA does (set
+    ALPENGLOW_DEVICE on nodes where it does not).
+    """
+    device = os.environ.get("ALPENGLOW_DEVICE")
+    if device:
+        return device
+    if "ray" not in sys.modules:
+        return None
+    try:
+        import ray
+
+        ids = ray.get_gpu_ids() if ray.is_initialized() else []
+    except Exception:  # noqa: BLE001 - not in a Ray worker
+        return None
+    return str(int(ids[0])) if ids else None
 
 
 class Progress:
