@@ -220,3 +220,15 @@ def test_imports_and_renders_without_ray(tmp_path):
     lines = proc.stdout.splitlines()
     assert lines[:2] == ["8", "0"]
     assert lines[2].startswith("ray is not installed: pip install"), proc.stdout
+
+
+def test_command_line_errors_are_one_line(tmp_path, capsys):
+    from alpenglow.dataset.__main__ import main
+
+    path = write_job(tmp_path, camera="width = 64\nheight = 0")
+    assert main(["render", path, "--local"]) == 1
+    err = capsys.readouterr().err
+    assert err == "error: job.toml: camera.height: must be at least 1, got 0\n"
+    with pytest.raises(SystemExit):
+        main(["render", path, "--workers", "0"])
+    assert "--workers: must be at least 1, got 0" in capsys.readouterr().err
