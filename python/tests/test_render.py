@@ -1,0 +1,116 @@
+"""Renders of a small height field: shapes, dtypes and values of every
+output, the pipelined pair, cameras from poses, intrinsics, lighting."""
+
+import numpy as np
+import pytest
+
+import alpenglow as ag
+from conftest import HEIGHT, WIDTH
+
+SHAPES = {
+    "rgba8": ((HEIGHT, WIDTH, 4), np.uint8),
+    "hdr": ((HEIGHT, WIDTH, 4), np.float32),
+    "depth": ((HEIGHT, WIDTH), np.float32),
+    "distance": ((HEIGHT, WIDTH), np.float32),
+    "normal": ((HEIGHT, WIDTH, 3), np.float32),
+    "class": ((HEIGHT, WIDTH), np.uint32),
+    "instance": ((HEIGHT, WIDTH), np.uint32),
+    "motion": ((HEIGHT, WIDTH, 2), np.float32),
+    "visibility": ((HEIGHT, WIDTH, 2), np.float32),
+}
+
+
+def test_render_gives_every_output_with_its_shape_and_dtype(renderer, camera):
+    out = renderer.render(camera)
+    for key, (shape, dtype) in SHAPES.items():
+        assert out[key].shape == shape, key
+        assert out[key].dtype == dtype, key
+    # The scene has no point objects: no splat weight.
+    assert "weight" not in out
+
+
+def test_render_values_are_plausible(renderer, camera):
+    out = renderer.render(camera)
+    depth, distance = out["depth"], out["distance"]
+    sky = ~np.isfinite(depth)
+    # Sky at the top row, terrain at the bottom row.
+    assert sky[0].all()
+    assert np.isfinite(depth[-1]).all()
+    assert (depth[~sky] > 0).all()
+    # Euclidean distance along the ray is at least the view-space depth.
+    assert (distance[~sky] >= depth[~sky] * (1 - 1e-4)).all()
+    assert np.isinf(distance[sky]).all()
+    # Sky is class 0; terrain class 1 or 10 + its surface layer.
+    assert (out["class"][sky] == 0).all()
+    assert ((out["class"][~sky] == 1) | (out["class"][~sky] >= 10)).all()
+    assert (out["instance"] == 0).all()
+    # Unit shading normals on the terrain, pointing up-ish; zero for sky.
+    n = out["normal"][~sky]
+    assert np.allclose(np.linalg.norm(n, axis=1), 1.0, atol=1e-2)
+    assert (n[:, 2] > 0).mean() > 0.9
+    # Opaque, not black, and the sky brighter and bluer than its red.
+    rgba = out["rgba8"]
+    assert (rgba[..., 3] == 255).all()
+    assert rgba[..., :3].mean() > 20
+    top = rgba[0, :, :3].astype(float).mean(axis=0)
+    assert top[2] > top[0]
+    assert np.isfinite(out["hdr"]).all() and (out["hdr"][..., :3] >= 0).all()
+
+
+def test_submit_then_wait_equals_render(renderer, camera):
+    settled = renderer.render(camera)
+    ticket = renderer.submit(camera)
+    frame = renderer.wait(ticket)
+    for key in SHAPES:
+        np.testing.assert_array_equal(frame[key], settled[key], err_msg=key)
+
+
+def test_try_read_and_poll_give_the_frame_once(renderer, camera):
+    first, second = renderer.submit(camera), renderer.submit(camera)
+    assert second != first
+    frame = renderer.try_read(first)
+    assert frame is not None and frame["rgba8"].shape == (HEIGHT, WIDTH, 4)
+    assert renderer.poll(second) is not None
+    with pytest.raises(ag.Error, match="ticket"):
+        renderer.wait(first)
+
+
+def test_a_ticket_whose_slot_was_reused_is_an_error(renderer, camera):
+    old = renderer.submit(camera)
+    for _ in range(4):
+        renderer.wait(renderer.submit(camera))
+    with pytest.raises(ag.Error, match="overwritten"):
+        renderer.wait(old)
+
+
+def test_camera_from_pose_round_trips(camera):
+    again = ag.Camera.from_pose(camera.pose, fov_y=camera.fov_y, near=camera.near, far=camera.far)
+    np.testing.assert_allclose(again.pose, camera.pose, atol=1e-9)
+    np.testing.assert_allclose(again.eye, camera.eye)
+    # The OpenGL convention: the camera looks down its -z axis.
+    forward = -camera.pose[:3, 2]
+    direction = np.subtract(camera.target, camera.eye)
+    np.testing.assert_allclose(forward, direction / np.linalg.norm(direction), atol=1e-12)
+
+
+def test_centred_intrinsics_equal_the_field_of_view(ctx, scene, camera, renderer):
+    k = ag.Intrinsics.from_fov_y(camera.fov_y, WIDTH, HEIGHT)
+    assert k.cx == pytest.approx(WIDTH / 2) and k.fx == pytest.approx(k.fy)
+    pinhole = ag.Renderer(ctx, scene, width=WIDTH, height=HEIGHT, terrain_detail=False, intrinsics=k)
+    a, b = pinhole.render(camera), renderer.render(camera)
+    np.testing.assert_allclose(a["depth"], b["depth"], rtol=1e-3)
+
+
+def test_time_of_day_moves_the_sun(renderer, camera):
+    noon = ag.Lighting().time_of_day("2024-06-21", "12:00", latitude=36.4, longitude=-84.1)
+    dusk = ag.Lighting().time_of_day("2024-06-21", "19:30", latitude=36.4, longitude=-84.1)
+    assert noon.sun_direction[2] > 0.9 > dusk.sun_direction[2]
+    before = renderer.render(camera)["hdr"]
+    renderer.lighting = dusk
+    try:
+        assert renderer.lighting.sun_direction == dusk.sun_direction
+        after = renderer.render(camera)["hdr"]
+    finally:
+        renderer.lighting = ag.Lighting()
+    assert not np.array_equal(before, after)
+    assert after[..., :3].mean() < before[..., :3].mean()
