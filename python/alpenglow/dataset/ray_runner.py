@@ -106,7 +106,7 @@ def _schedule(ray, job, shards, backend, workers, manifest, report, result, on_f
     for _ in range(n):
         start_actor()
     result.workers = n
-    report.note(f"{len(shards)} shards on {n} Ray workers")
+    report.note(f"{len(shards)} shard{'s' * (len(shards) != 1)} on {n} Ray worker{'s' * (n != 1)}")
     try:
         for w in list(actors):
             feed(w)
