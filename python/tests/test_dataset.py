@@ -69,6 +69,13 @@ BAD_JOBS = [
     ({"rig": '[[rig.view]]\nname = "a"\n[[rig.view]]\nname = "a"'}, "rig.view[1].name"),
     ({"render": "grid = [64]"}, "render.grid"),
     ({"lighting": "sun_elevation = nan"}, "lighting.sun_elevation"),
+    (
+        {
+            "rig": '[[rig.view]]\nname = "a"\n[[rig.view]]\nname = "b"',
+            "output": 'dir = "o"\naovs = ["motion"]',
+        },
+        "output.aovs",
+    ),
     ({"extra": "x = 1"}, "extra"),
 ]
 

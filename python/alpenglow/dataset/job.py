@@ -388,6 +388,10 @@ def parse_job(data: dict[str, Any], source: str = "<job>", base_dir: str = ".") 
     path = _path(sections["path"])
     views = _views(sections["rig"])
     out_dir, aovs, formats = _output(sections["output"], base_dir)
+    if "motion" in aovs and len(views) > 1:
+        # Views are rendered one after the other: motion would be measured from
+        # the previous view's camera, not from the same view's previous frame.
+        raise sections["output"].fail("aovs", "motion with several rig views is not supported yet (render one view per job)")
     fr, oc = sections["frames"], sections["output"]
     start = fr.integer("start", 0, minimum=0)
     end = fr.integer("end", path["frames"], minimum=1)
