@@ -13,11 +13,18 @@ use crate::{arg_err, invalid, lib_err};
 /// `obj` (a sequence or array) as a float64 array of `shape`, row-major.
 fn floats(parameter: &str, obj: &Bound<'_, PyAny>, shape: &[usize]) -> PyResult<Vec<f64>> {
     let np = obj.py().import("numpy")?;
-    let what = || format!("expected {} numbers of shape {shape:?}", shape.iter().product::<usize>());
+    let what = || {
+        format!(
+            "expected {} numbers of shape {shape:?}",
+            shape.iter().product::<usize>()
+        )
+    };
     let array = np
         .call_method1("asarray", (obj, "float64"))
         .map_err(|_| invalid(parameter, what()))?;
-    let array = array.cast::<PyArrayDyn<f64>>().map_err(|_| invalid(parameter, what()))?;
+    let array = array
+        .cast::<PyArrayDyn<f64>>()
+        .map_err(|_| invalid(parameter, what()))?;
     if array.shape() != shape {
         return Err(invalid(parameter, format!("shape {:?}; {}", array.shape(), what())));
     }
@@ -140,7 +147,8 @@ impl Camera {
 }
 
 /// Pinhole intrinsics in pixels: focal lengths `fx`, `fy` and principal
-/// point `cx`, `cy` (pixel centres at +0.5).
+/// point `cx`, `cy` (pixel centres at integers: a centred principal point
+/// is ((W − 1)/2, (H − 1)/2)).
 #[pyclass(module = "alpenglow", frozen, from_py_object)]
 #[derive(Clone)]
 pub struct Intrinsics {
@@ -210,7 +218,10 @@ impl Distortion {
 
     fn __repr__(&self) -> String {
         let d = &self.inner;
-        format!("Distortion(k1={}, k2={}, k3={}, p1={}, p2={})", d.k1, d.k2, d.k3, d.p1, d.p2)
+        format!(
+            "Distortion(k1={}, k2={}, k3={}, p1={}, p2={})",
+            d.k1, d.k2, d.k3, d.p1, d.p2
+        )
     }
 }
 
@@ -244,7 +255,10 @@ impl View {
         near: Option<f64>,
         far: Option<f64>,
     ) -> PyResult<View> {
-        let position = position.map(|p| vec3("position", p)).transpose()?.unwrap_or(DVec3::ZERO);
+        let position = position
+            .map(|p| vec3("position", p))
+            .transpose()?
+            .unwrap_or(DVec3::ZERO);
         let lens = match (fov_y, intrinsics) {
             (Some(_), Some(_)) => return Err(invalid("fov_y", "give fov_y or intrinsics, not both")),
             (Some(f), None) => engine::RigLens::FovY(f),

@@ -11,7 +11,7 @@
 //! GPU and copies the frame out of the mapped readback buffers (one copy:
 //! the `Vec`s of [`FrameImages`] become the NumPy arrays' memory).
 
-use std::collections::HashMap;
+use std::collections::VecDeque;
 use std::path::Path;
 
 pub use alpenglow::io::heightmap::{check_spacing, load_heightmap, HeightField, HeightmapOptions, RowOrder};
@@ -103,13 +103,18 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
     alpenglow::io::atomic::write_bytes_atomically(path, bytes)
 }
 
+/// Submitted frames whose tickets are remembered (their readback slots were
+/// reused long before).
+const REMEMBERED_FRAMES: usize = 64;
+
 /// A submitted frame's handle.
 pub type Ticket = u64;
 
 /// A renderer with the frames it has submitted but not yet handed out.
 pub struct Engine {
     renderer: Renderer,
-    pending: HashMap<Ticket, FrameOutcome>,
+    /// The latest submitted frames (more than any readback ring keeps).
+    pending: VecDeque<(Ticket, FrameOutcome)>,
     next_ticket: Ticket,
 }
 
@@ -117,7 +122,7 @@ impl Engine {
     pub fn new(ctx: &Context, scene: &Scene, settings: Settings) -> Result<Engine> {
         Ok(Engine {
             renderer: Renderer::new(ctx, scene, settings)?,
-            pending: HashMap::new(),
+            pending: VecDeque::with_capacity(REMEMBERED_FRAMES),
             next_ticket: 1,
         })
     }
@@ -143,22 +148,21 @@ impl Engine {
         let frame = self.renderer.render_views(cameras)?;
         let ticket = self.next_ticket;
         self.next_ticket += 1;
-        // Tickets too old to read stay refused by the renderer; drop their
-        // bookkeeping so it stays bounded.
-        let oldest = ticket.saturating_sub(1024);
-        self.pending.retain(|&t, _| t > oldest);
-        self.pending.insert(ticket, frame);
+        if self.pending.len() == REMEMBERED_FRAMES {
+            self.pending.pop_front();
+        }
+        self.pending.push_back((ticket, frame));
         Ok(ticket)
     }
 
     /// The views of `ticket` once the GPU is done (blocking today), or an
-    /// error when the ticket is unknown, was read already, or its readback
-    /// slot was reused by later frames.
+    /// error when the ticket is unknown or its readback slot was reused by
+    /// later frames (never stale data). A ticket may be read again until then.
     pub fn wait(&mut self, ticket: Ticket) -> Result<Vec<FrameImages>> {
-        let frame = self.pending.remove(&ticket).ok_or_else(|| {
+        let (_, frame) = *self.pending.iter().find(|(t, _)| *t == ticket).ok_or_else(|| {
             Error::invalid(
                 "ticket",
-                format!("{ticket} is not a frame waiting to be read (unknown or read already)"),
+                format!("{ticket} is not a frame of this renderer (or too old to remember)"),
             )
         })?;
         self.renderer.read_views(&frame)

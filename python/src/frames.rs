@@ -38,6 +38,9 @@ pub(crate) fn frame_dict(py: Python<'_>, images: FrameImages) -> PyResult<Bound<
     Ok(d)
 }
 
+/// Row-major values and their image size (rows, columns).
+type Plane<T> = (Vec<T>, (usize, usize));
+
 /// `frame[key]` as a `T` array of shape (H, W, channels) (channels 1: (H, W)),
 /// copied row-major; None when absent and not `required`.
 fn plane<T: Element + Copy>(
@@ -46,7 +49,7 @@ fn plane<T: Element + Copy>(
     channels: usize,
     size: Option<(usize, usize)>,
     required: bool,
-) -> PyResult<Option<(Vec<T>, (usize, usize))>> {
+) -> PyResult<Option<Plane<T>>> {
     let Some(value) = frame.get_item(key)? else {
         return match required {
             true => Err(invalid("frame", format!("no {key:?} array"))),
@@ -131,10 +134,7 @@ fn rgba8(image: &Bound<'_, PyAny>) -> PyResult<(Vec<u8>, (u32, u32))> {
 
 fn png_bytes(image: &Bound<'_, PyAny>) -> PyResult<Vec<u8>> {
     let (pixels, (w, h)) = rgba8(image)?;
-    image
-        .py()
-        .detach(|| engine::encode_png(&pixels, w, h))
-        .map_err(lib_err)
+    image.py().detach(|| engine::encode_png(&pixels, w, h)).map_err(lib_err)
 }
 
 /// The PNG of `image` (a frame dict or a uint8 (H, W, 4) array), as bytes.
@@ -149,10 +149,7 @@ pub fn encode_png<'py>(image: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyBytes
 #[pyfunction]
 pub fn write_png(path: PathBuf, image: &Bound<'_, PyAny>) -> PyResult<()> {
     let bytes = png_bytes(image)?;
-    image
-        .py()
-        .detach(|| engine::write_file(&path, &bytes))
-        .map_err(lib_err)
+    image.py().detach(|| engine::write_file(&path, &bytes)).map_err(lib_err)
 }
 
 /// The OpenEXR file of a frame dict (RGBA from "hdr", Z from "depth", and

@@ -23,7 +23,10 @@ fn sky(name: &str) -> PyResult<engine::SkyModel> {
     match name {
         "physical" => Ok(engine::SkyModel::Physical),
         "preetham" => Ok(engine::SkyModel::Preetham),
-        _ => Err(invalid("sky", format!("{name:?}; expected \"physical\" or \"preetham\""))),
+        _ => Err(invalid(
+            "sky",
+            format!("{name:?}; expected \"physical\" or \"preetham\""),
+        )),
     }
 }
 

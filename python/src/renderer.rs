@@ -90,7 +90,10 @@ impl Renderer {
             return match &self.rig {
                 Some(rig) => rig.cameras(&c).map_err(arg_err),
                 None if self.names.len() == 1 => Ok(vec![c]),
-                None => Err(invalid("camera", format!("expected a list of {} cameras", self.names.len()))),
+                None => Err(invalid(
+                    "camera",
+                    format!("expected a list of {} cameras", self.names.len()),
+                )),
             };
         }
         let list = camera
@@ -181,8 +184,7 @@ impl Renderer {
     /// package documentation), or with a rig a dict of them per view name.
     fn render<'py>(&self, py: Python<'py>, camera: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         let cameras = self.cameras(camera)?;
-        let views = self.with_engine(py, |e| e.render_settled(&cameras))?
-            .map_err(lib_err)?;
+        let views = self.with_engine(py, |e| e.render_settled(&cameras))?.map_err(lib_err)?;
         result(py, self.multi(), views)
     }
 
@@ -191,23 +193,20 @@ impl Renderer {
     /// returns its ticket for `try_read`, `poll` or `wait`.
     fn submit(&self, py: Python<'_>, camera: &Bound<'_, PyAny>) -> PyResult<Ticket> {
         let cameras = self.cameras(camera)?;
-        self.with_engine(py, |e| e.submit(&cameras))?
-            .map_err(lib_err)
+        self.with_engine(py, |e| e.submit(&cameras))?.map_err(lib_err)
     }
 
     /// The frame of `ticket` once the GPU finished it. Errors
-    /// (`alpenglow.Error`) for a ticket read already, unknown, or whose
-    /// readback slot later frames reused.
+    /// (`alpenglow.Error`) for an unknown ticket or one whose readback slot
+    /// later frames reused (never stale data).
     fn wait<'py>(&self, py: Python<'py>, ticket: Ticket) -> PyResult<Bound<'py, PyAny>> {
-        let views = self.with_engine(py, |e| e.wait(ticket))?
-            .map_err(lib_err)?;
+        let views = self.with_engine(py, |e| e.wait(ticket))?.map_err(lib_err)?;
         result(py, self.multi(), views)
     }
 
     /// The frame of `ticket`, or None while the GPU is still at work.
     fn try_read<'py>(&self, py: Python<'py>, ticket: Ticket) -> PyResult<Option<Bound<'py, PyAny>>> {
-        let views = self.with_engine(py, |e| e.try_read(ticket))?
-            .map_err(lib_err)?;
+        let views = self.with_engine(py, |e| e.try_read(ticket))?.map_err(lib_err)?;
         views.map(|v| result(py, self.multi(), v)).transpose()
     }
 
@@ -230,8 +229,7 @@ impl Renderer {
     #[setter]
     fn set_lighting(&self, py: Python<'_>, lighting: Lighting) -> PyResult<()> {
         let inner = lighting.inner;
-        self.with_engine(py, |e| e.set_lighting(inner))?
-            .map_err(arg_err)?;
+        self.with_engine(py, |e| e.set_lighting(inner))?.map_err(arg_err)?;
         if let Ok(mut l) = self.lighting.lock() {
             *l = inner;
         }
@@ -252,8 +250,7 @@ impl Renderer {
 
     /// Waits until the GPU finished every submitted frame.
     fn finish(&self, py: Python<'_>) -> PyResult<()> {
-        self.with_engine(py, |e| e.finish())?
-            .map_err(lib_err)
+        self.with_engine(py, |e| e.finish())?.map_err(lib_err)
     }
 
     fn __repr__(&self) -> String {

@@ -82,10 +82,7 @@ pub(crate) fn height_array(parameter: &str, h: &Bound<'_, PyAny>) -> PyResult<(V
         ));
     }
     if !array.dtype().is_equiv_to(&numpy::dtype::<f32>(h.py())) {
-        return Err(invalid(
-            parameter,
-            format!("dtype {}; expected float32", array.dtype()),
-        ));
+        return Err(invalid(parameter, format!("dtype {}; expected float32", array.dtype())));
     }
     let (rows, cols) = (array.shape()[0], array.shape()[1]);
     let size = |n: usize| u32::try_from(n).ok().filter(|&n| n >= 2);
@@ -100,7 +97,12 @@ pub(crate) fn height_array(parameter: &str, h: &Bound<'_, PyAny>) -> PyResult<(V
     if let Some(i) = values.iter().position(|v| !v.is_finite()) {
         return Err(invalid(
             parameter,
-            format!("height at row {}, column {} is {}; heights must be finite", i / cols, i % cols, values[i]),
+            format!(
+                "height at row {}, column {} is {}; heights must be finite",
+                i / cols,
+                i % cols,
+                values[i]
+            ),
         ));
     }
     Ok((values, c, r))
@@ -153,7 +155,10 @@ impl Scene {
     ) -> PyResult<Scene> {
         let spacing = spacing.map(spacing_pair).transpose()?;
         if !(height_scale.is_finite() && height_scale > 0.0) {
-            return Err(invalid("height_scale", format!("{height_scale}; must be finite and positive")));
+            return Err(invalid(
+                "height_scale",
+                format!("{height_scale}; must be finite and positive"),
+            ));
         }
         if !height_offset.is_finite() {
             return Err(invalid("height_offset", format!("{height_offset}; must be finite")));
@@ -164,7 +169,12 @@ impl Scene {
         let rows = match rows {
             "south-up" => engine::RowOrder::SouthUp,
             "north-up" => engine::RowOrder::NorthUp,
-            other => return Err(invalid("rows", format!("{other:?}; expected \"south-up\" or \"north-up\""))),
+            other => {
+                return Err(invalid(
+                    "rows",
+                    format!("{other:?}; expected \"south-up\" or \"north-up\""),
+                ))
+            }
         };
         let options = engine::HeightmapOptions {
             scale: height_scale,
@@ -173,9 +183,7 @@ impl Scene {
             rows,
             limits: engine::InputLimits::with_max_file_mib(max_input_mb),
         };
-        let field = py
-            .detach(|| engine::load_heightmap(&path, &options))
-            .map_err(lib_err)?;
+        let field = py.detach(|| engine::load_heightmap(&path, &options)).map_err(lib_err)?;
         Ok(Scene {
             inner: engine::Scene::new(field),
         })

@@ -38,9 +38,9 @@ def scene(heights):
 
 @pytest.fixture(scope="session")
 def camera():
-    # From beyond the southern edge, looking north over the hill: terrain in
-    # the lower half of the image, sky in the upper.
-    return ag.Camera.look_at(eye=(320.0, -250.0, 150.0), target=(320.0, 400.0, 100.0), fov_y=50.0, near=1.0, far=1e4)
+    # Above the southern part, looking north over the hill: terrain in the
+    # lower part of the image, sky at the top.
+    return ag.Camera.look_at(eye=(320.0, 40.0, 220.0), target=(320.0, 500.0, 60.0), fov_y=50.0, near=1.0, far=1e4)
 
 
 @pytest.fixture(scope="session")

@@ -137,3 +137,12 @@ def test_the_library_scales_and_flips_like_the_cli(tmp_path):
     ag.write_heightmap(path, h)
     scene = ag.Scene.from_file(path, spacing=2.0, height_scale=2.0, height_offset=5.0, rows="north-up")
     np.testing.assert_allclose(scene.heights, (h * 2.0 + 5.0)[::-1], rtol=1e-6)
+
+
+def test_an_unknown_device_raises_the_library_error():
+    with pytest.raises(ag.Error, match="no Vulkan device named like 'nonexistent'"):
+        ag.Context(device="nonexistent")
+    with pytest.raises(ag.Error, match="index 7"):
+        ag.Context(device=7)
+    with pytest.raises(ValueError, match="device"):
+        ag.Context(device=1.5)
