@@ -1,0 +1,314 @@
+//! The only file of the C layer that names alpenglow's Rust paths.
+//!
+//! Today it imports the deep paths (`alpenglow::renderer::…`,
+//! `alpenglow::vulkan::…`, `alpenglow::io::heightmap::…`) and implements the
+//! non-blocking pair over the blocking `render` + `read`: a submitted frame
+//! is remembered by its [`FrameOutcome`], and polling or waiting reads it
+//! (blocking until the GPU is done). When the crate's front door and its
+//! readback ring land (`alpenglow::{Renderer, Settings, Ticket, FrameData}`,
+//! `Renderer::{submit, try_read, wait}`), this file switches to them and
+//! the rest of the C layer stays as it is.
+
+use std::collections::VecDeque;
+use std::path::Path;
+
+pub use alpenglow::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
+pub use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
+pub use alpenglow::Error;
+
+use alpenglow::graph::FrameOutcome;
+use alpenglow::io::heightmap::{check_spacing, load_heightmap, HeightField, HeightmapOptions, RowOrder};
+use alpenglow::terrain::procedural::{ProceduralTerrain, TerrainModel};
+use glam::{DVec2, DVec3};
+
+use crate::status::{Failure, Outcome};
+
+/// How many submitted frames are remembered for `poll`/`wait`: more than
+/// the renderer keeps in flight, so that the renderer (not this list)
+/// decides when a frame was overwritten.
+const REMEMBERED_FRAMES: usize = 8;
+
+/// A height field from a caller's row-major samples (row 0 at y = 0),
+/// checked: at least 2×2, `columns·rows` samples, spacing in range, every
+/// height finite. Errors name `heights` or `spacing`.
+pub fn scene_from_heights(heights: &[f32], columns: u32, rows: u32, spacing: (f64, f64)) -> Outcome<Scene> {
+    let spacing = DVec2::new(spacing.0, spacing.1);
+    check_spacing(spacing).map_err(|m| Failure::invalid("spacing", m))?;
+    let field = HeightField {
+        columns,
+        rows,
+        spacing,
+        heights: heights.to_vec(),
+    };
+    field
+        .validate(Path::new("heights"))
+        .map_err(|e| Failure::new(crate::ag_status::AG_ERROR_INVALID_ARGUMENT, e.to_string()))?;
+    Ok(Scene::new(field))
+}
+
+/// How a height-map file's values become metres (see `ag_heightmap_options`).
+pub struct FileOptions {
+    pub scale: f32,
+    pub offset: f32,
+    /// None: from the file's georeferencing, else 1 m.
+    pub spacing: Option<(f64, f64)>,
+    pub north_up: bool,
+}
+
+/// A scene from a height-map file (PNG, EXR, GeoTIFF, `.hgt`).
+pub fn scene_from_file(path: &Path, options: &FileOptions) -> Outcome<Scene> {
+    let options = HeightmapOptions {
+        scale: options.scale,
+        offset: options.offset,
+        spacing: options.spacing.map(|(x, y)| DVec2::new(x, y)),
+        rows: match options.north_up {
+            true => RowOrder::NorthUp,
+            false => RowOrder::SouthUp,
+        },
+        ..HeightmapOptions::default()
+    };
+    Ok(Scene::new(load_heightmap(path, &options)?))
+}
+
+/// A `size`² procedural terrain of `model` ("fbm", "multifractal",
+/// "heterogeneous", "hybrid", "ridged") with `seed`, `spacing` metres apart.
+pub fn scene_procedural(model: &str, seed: u32, size: u32, spacing: f64) -> Outcome<Scene> {
+    let model = TerrainModel::from_name(model).ok_or_else(|| {
+        let names: Vec<&str> = TerrainModel::ALL.iter().map(|m| m.name()).collect();
+        Failure::invalid("model", format!("{model:?}; expected one of {}", names.join(", ")))
+    })?;
+    check_spacing(DVec2::splat(spacing)).map_err(|m| Failure::invalid("spacing", m))?;
+    let terrain = ProceduralTerrain {
+        model,
+        seed: u64::from(seed),
+        ..ProceduralTerrain::default()
+    };
+    Ok(Scene::new(terrain.try_generate(size, size, DVec2::splat(spacing))?))
+}
+
+/// Adds `count` procedural boulders.
+pub fn add_rocks(scene: &mut Scene, count: usize) -> Outcome {
+    Ok(scene.add_rocks(count)?)
+}
+
+/// A camera from plain numbers (checked when a frame is rendered).
+pub fn camera(eye: [f64; 3], target: [f64; 3], up: [f64; 3], fov_y_deg: f64, near: f64, far: f64) -> Camera {
+    Camera {
+        eye: DVec3::from_array(eye),
+        target: target.into(),
+        up: up.into(),
+        fov_y_deg,
+        near,
+        far,
+    }
+}
+
+/// `(eye, target, up, fov_y_deg, near, far)` of `camera`.
+pub fn camera_parts(camera: &Camera) -> ([f64; 3], [f64; 3], [f64; 3], f64, f64, f64) {
+    (
+        camera.eye.to_array(),
+        camera.target.to_array(),
+        camera.up.to_array(),
+        camera.fov_y_deg,
+        camera.near,
+        camera.far,
+    )
+}
+
+/// The renderer's settings from the C settings' values.
+pub fn render_settings(width: u32, height: u32, msaa: u32, terrain_detail: bool) -> RenderSettings {
+    let mut settings = RenderSettings::new(width, height);
+    settings.msaa = msaa;
+    settings.terrain.detail = terrain_detail;
+    settings
+}
+
+/// The outputs a frame hands to C, in `ag_output` order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    Rgba8,
+    Hdr,
+    Depth,
+    Distance,
+    Normal,
+    Class,
+    Instance,
+    Motion,
+}
+
+impl Output {
+    pub const ALL: [Output; 8] = [
+        Output::Rgba8,
+        Output::Hdr,
+        Output::Depth,
+        Output::Distance,
+        Output::Normal,
+        Output::Class,
+        Output::Instance,
+        Output::Motion,
+    ];
+
+    /// Bytes per pixel in the caller's buffer.
+    pub fn pixel_bytes(self) -> usize {
+        match self {
+            Output::Rgba8 | Output::Depth | Output::Distance | Output::Class | Output::Instance => 4,
+            Output::Motion => 8,
+            Output::Normal => 12,
+            Output::Hdr => 16,
+        }
+    }
+
+    /// The name of the output's field in `ag_frame_buffers`.
+    pub fn field(self) -> &'static str {
+        match self {
+            Output::Rgba8 => "rgba8",
+            Output::Hdr => "hdr",
+            Output::Depth => "depth",
+            Output::Distance => "distance",
+            Output::Normal => "normal",
+            Output::Class => "class_id",
+            Output::Instance => "instance_id",
+            Output::Motion => "motion",
+        }
+    }
+}
+
+/// One read frame's view, as bytes per output.
+pub struct ViewImages(FrameImages);
+
+impl ViewImages {
+    /// The bytes of `output`, `pixel_bytes` per pixel, row 0 at the top.
+    pub fn bytes(&self, output: Output) -> &[u8] {
+        let images = &self.0;
+        match output {
+            Output::Rgba8 => &images.rgba8,
+            Output::Hdr => bytemuck::cast_slice(&images.hdr),
+            Output::Depth => bytemuck::cast_slice(&images.depth),
+            Output::Distance => bytemuck::cast_slice(&images.distance),
+            Output::Normal => bytemuck::cast_slice(&images.normal),
+            Output::Class => bytemuck::cast_slice(&images.class),
+            Output::Instance => bytemuck::cast_slice(&images.instance),
+            Output::Motion => bytemuck::cast_slice(&images.motion),
+        }
+    }
+}
+
+/// A renderer and the frames submitted to it that may still be read.
+pub struct FramePipe {
+    renderer: Renderer,
+    /// (ticket, frame), oldest first.
+    submitted: VecDeque<(u64, FrameOutcome)>,
+}
+
+impl FramePipe {
+    pub fn new(ctx: &Context, scene: &Scene, settings: RenderSettings) -> Outcome<FramePipe> {
+        Ok(FramePipe {
+            renderer: Renderer::new(ctx, scene, settings)?,
+            submitted: VecDeque::new(),
+        })
+    }
+
+    /// `(width, height)` of every view, in order.
+    pub fn view_sizes(&self) -> Vec<(u32, u32)> {
+        self.renderer.views().iter().map(|v| (v.width, v.height)).collect()
+    }
+
+    /// Renders `cameras` until the texture atlas settled (at most
+    /// `settle_frames` frames without progress) and reads the first `views` views.
+    pub fn render_blocking(
+        &mut self,
+        cameras: &[Camera],
+        settle_frames: u32,
+        views: usize,
+    ) -> Outcome<Vec<ViewImages>> {
+        let frame = self.renderer.render_views_settled(cameras, settle_frames)?;
+        self.read(&frame, views)
+    }
+
+    /// Submits a frame of `cameras`; its ticket (never 0).
+    pub fn submit(&mut self, cameras: &[Camera]) -> Outcome<u64> {
+        let frame = self.renderer.render_views(cameras)?;
+        let ticket = frame.frame + 1;
+        if self.submitted.len() == REMEMBERED_FRAMES {
+            self.submitted.pop_front();
+        }
+        self.submitted.push_back((ticket, frame));
+        Ok(ticket)
+    }
+
+    /// The first `views` views of the frame of `ticket`, or None while the
+    /// GPU is still at work. Interim: blocks until the frame is done
+    /// (the blocking renderer has no completion query), so never None.
+    pub fn try_read(&mut self, ticket: u64, views: usize) -> Outcome<Option<Vec<ViewImages>>> {
+        self.wait(ticket, views).map(Some)
+    }
+
+    /// Blocks until the frame of `ticket` is done and reads its first `views` views.
+    pub fn wait(&mut self, ticket: u64, views: usize) -> Outcome<Vec<ViewImages>> {
+        let frame = (self.submitted.iter())
+            .find(|(t, _)| *t == ticket)
+            .map(|(_, frame)| *frame)
+            .ok_or_else(|| {
+                Failure::invalid(
+                    "ticket",
+                    format!("{ticket} was not submitted to this renderer or is too old to read"),
+                )
+            })?;
+        self.read(&frame, views)
+    }
+
+    fn read(&mut self, frame: &FrameOutcome, views: usize) -> Outcome<Vec<ViewImages>> {
+        (0..views)
+            .map(|k| Ok(ViewImages(self.renderer.read_view(frame, k)?)))
+            .collect()
+    }
+}
+
+/// A context with `validation` on the device `device` ("NAME" or "INDEX";
+/// None: the best one).
+pub fn context(validation: bool, device: Option<&str>) -> Outcome<Context> {
+    let device = match device {
+        Some(text) => text
+            .parse::<DeviceSelector>()
+            .map_err(|e| Failure::invalid("device", e))?,
+        None => DeviceSelector::default(),
+    };
+    Ok(Context::new(&ContextOptions { validation, device })?)
+}
+
+/// Validation messages so far (None: the context has no validation).
+pub fn validation_messages(ctx: &Context) -> Option<(u64, Vec<String>)> {
+    ctx.validation_report().map(|r| (r.total(), r.messages()))
+}
+
+/// Destroys `ctx` (the device goes once no renderer holds it) and returns
+/// the validation messages counted by then.
+pub fn destroy_context(ctx: Context) -> Option<(u64, Vec<String>)> {
+    let report = ctx.validation_report();
+    drop(ctx);
+    report.map(|r| (r.total(), r.messages()))
+}
+
+/// The scene's default camera.
+pub fn default_camera(scene: &Scene) -> Camera {
+    scene.default_camera()
+}
+
+/// The name of the context's device.
+pub fn device_name(ctx: &Context) -> String {
+    ctx.info().name.clone()
+}
+
+/// Refuses a readback ring size this version cannot honour (interim:
+/// the renderer keeps a fixed number of frames in flight).
+pub fn check_readback_slots(slots: u32) -> Outcome {
+    let fixed = alpenglow::vulkan::FRAMES_IN_FLIGHT;
+    match slots as usize {
+        0 => Ok(()),
+        n if n == fixed => Ok(()),
+        n => Err(Failure::invalid(
+            "settings.readback_slots",
+            format!("{n}; this version keeps {fixed} frames in flight (0: the default)"),
+        )),
+    }
+}
