@@ -34,7 +34,9 @@ mod uploads;
 
 use std::sync::Arc;
 
-pub use access::{derive_barrier, Access, Stage};
+#[cfg(test)]
+pub use access::derive_barrier;
+pub use access::{Access, Stage};
 pub use bake::BakedGraph;
 pub use execute::{CpuStage, FrameOutcome, PassContext};
 pub use typed::{BufferAccess, BufferId, ImageAccess, ImageId, Resource};

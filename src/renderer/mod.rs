@@ -62,6 +62,7 @@ use crate::vulkan::{Context, FrameRing, FRAMES_IN_FLIGHT};
 /// Output size (or the views of a rig), whether frames are read back to
 /// the host, and every technique's settings.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct RenderSettings {
     /// The image size of a single view (ignored when `views` is set).
     pub width: u32,
@@ -451,7 +452,7 @@ impl Renderer {
     }
 
     /// Waits for `frame` and copies the first view's images out of the
-    /// readback buffers. Call before rendering [`FRAMES_IN_FLIGHT`] more frames.
+    /// readback buffers. Call before rendering `FRAMES_IN_FLIGHT` more frames.
     pub fn read(&mut self, frame: &FrameOutcome) -> Result<FrameImages> {
         self.read_view(frame, 0)
     }

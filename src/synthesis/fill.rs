@@ -411,7 +411,7 @@ impl FillOrder {
 
 /// The checks of [`plan_hole_fill`] that need no allocation: the mask's
 /// size, the parameters, and at least one known sample. Callers run them
-/// before estimating the cost ([`crate::synthesis::cost`]), so that a bad
+/// before estimating the cost (`crate::synthesis::cost`), so that a bad
 /// input is reported as such rather than as an absurd cost.
 pub fn check_hole_fill(field: &HeightField, unknown: &[bool], params: &FillParams) -> Result<()> {
     check_mask(field, unknown, "mask")?;
@@ -427,7 +427,7 @@ pub fn check_hole_fill(field: &HeightField, unknown: &[bool], params: &FillParam
 
 /// Prepares filling the `unknown` samples of `field` (`true`: unknown,
 /// row-major) from its own known windows (module docs of
-/// [`crate::synthesis::exemplar`]).
+/// `crate::synthesis::exemplar`).
 ///
 /// Errors (one line, naming the parameter): a mask of another size, bad
 /// [`FillParams`], a mask that marks every sample, no fully known window.

@@ -171,7 +171,7 @@ pub struct SketchMap {
     pub n: usize,
     pub region: SketchRegion,
     /// World `(x, y, h)` per texel, row-major; heights are the cubic
-    /// B-spline of the atlas ([`sample_bspline`]), clamped at its edges.
+    /// B-spline of the atlas (`sample_bspline`), clamped at its edges.
     pub geometry: Vec<DVec3>,
     /// Texels outside the terrain's rectangle (possible at the corners of a
     /// view-aligned region).
