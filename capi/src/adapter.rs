@@ -1,27 +1,28 @@
-//! The only file of the C layer that names alpenglow's Rust paths.
+//! The only file of the C layer that names alpenglow's Rust API.
 //!
-//! Today it imports the deep paths (`alpenglow::renderer::…`,
-//! `alpenglow::vulkan::…`, `alpenglow::io::heightmap::…`) and implements the
-//! non-blocking pair over the blocking `render` + `read`: a submitted frame
-//! is remembered by its [`FrameOutcome`], and polling or waiting reads it
-//! (blocking until the GPU is done). When the crate's front door and its
-//! readback ring land (`alpenglow::{Renderer, Settings, Ticket, FrameData}`,
-//! `Renderer::{submit, try_read, wait}`), this file switches to them and
-//! the rest of the C layer stays as it is.
+//! It uses the crate's front door (`alpenglow::{Scene, Renderer, Settings,
+//! Camera, …}`) and implements the non-blocking pair over the blocking
+//! `render` + `read`: a submitted frame is remembered by its
+//! [`FrameOutcome`], and polling or waiting reads it (blocking until the
+//! GPU is done). When the readback ring lands (`alpenglow::{Ticket,
+//! FrameData}`, `Renderer::{submit, try_read, wait}`), this file switches
+//! to it and the rest of the C layer stays as it is.
 
 use std::collections::VecDeque;
 use std::path::Path;
 
-pub use alpenglow::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
-pub use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
-pub use alpenglow::Error;
+pub use alpenglow::Settings as RenderSettings;
+pub use alpenglow::{Camera, Context, ContextOptions, DeviceSelector, Error, FrameImages, Renderer, Scene};
 
-use alpenglow::graph::FrameOutcome;
-use alpenglow::io::heightmap::{check_spacing, load_heightmap, HeightField, HeightmapOptions, RowOrder};
-use alpenglow::terrain::procedural::{ProceduralTerrain, TerrainModel};
-use glam::{DVec2, DVec3};
+use alpenglow::glam::DVec3;
+use alpenglow::{FrameOutcome, HeightmapOptions, RowOrder};
 
 use crate::status::{Failure, Outcome};
+
+/// Frames the renderer keeps in flight (its `FRAMES_IN_FLIGHT`, which the
+/// front door does not export): the only `settings.readback_slots` besides 0
+/// this version honours, until the readback ring lands.
+const FRAMES_IN_FLIGHT: usize = 2;
 
 /// How many submitted frames are remembered for `poll`/`wait`: more than
 /// the renderer keeps in flight, so that the renderer (not this list)
@@ -32,18 +33,7 @@ const REMEMBERED_FRAMES: usize = 8;
 /// checked: at least 2×2, `columns·rows` samples, spacing in range, every
 /// height finite. Errors name `heights` or `spacing`.
 pub fn scene_from_heights(heights: &[f32], columns: u32, rows: u32, spacing: (f64, f64)) -> Outcome<Scene> {
-    let spacing = DVec2::new(spacing.0, spacing.1);
-    check_spacing(spacing).map_err(|m| Failure::invalid("spacing", m))?;
-    let field = HeightField {
-        columns,
-        rows,
-        spacing,
-        heights: heights.to_vec(),
-    };
-    field
-        .validate(Path::new("heights"))
-        .map_err(|e| Failure::new(crate::ag_status::AG_ERROR_INVALID_ARGUMENT, e.to_string()))?;
-    Ok(Scene::new(field))
+    Ok(Scene::from_heights(heights, columns, rows, spacing)?)
 }
 
 /// How a height-map file's values become metres (see `ag_heightmap_options`).
@@ -60,30 +50,20 @@ pub fn scene_from_file(path: &Path, options: &FileOptions) -> Outcome<Scene> {
     let options = HeightmapOptions {
         scale: options.scale,
         offset: options.offset,
-        spacing: options.spacing.map(|(x, y)| DVec2::new(x, y)),
+        spacing: options.spacing.map(|(x, y)| alpenglow::glam::DVec2::new(x, y)),
         rows: match options.north_up {
             true => RowOrder::NorthUp,
             false => RowOrder::SouthUp,
         },
         ..HeightmapOptions::default()
     };
-    Ok(Scene::new(load_heightmap(path, &options)?))
+    Ok(Scene::from_file(path, &options)?)
 }
 
 /// A `size`² procedural terrain of `model` ("fbm", "multifractal",
 /// "heterogeneous", "hybrid", "ridged") with `seed`, `spacing` metres apart.
 pub fn scene_procedural(model: &str, seed: u32, size: u32, spacing: f64) -> Outcome<Scene> {
-    let model = TerrainModel::from_name(model).ok_or_else(|| {
-        let names: Vec<&str> = TerrainModel::ALL.iter().map(|m| m.name()).collect();
-        Failure::invalid("model", format!("{model:?}; expected one of {}", names.join(", ")))
-    })?;
-    check_spacing(DVec2::splat(spacing)).map_err(|m| Failure::invalid("spacing", m))?;
-    let terrain = ProceduralTerrain {
-        model,
-        seed: u64::from(seed),
-        ..ProceduralTerrain::default()
-    };
-    Ok(Scene::new(terrain.try_generate(size, size, DVec2::splat(spacing))?))
+    Ok(Scene::procedural(model, seed, size, spacing)?)
 }
 
 /// Adds `count` procedural boulders.
@@ -302,7 +282,7 @@ pub fn device_name(ctx: &Context) -> String {
 /// Refuses a readback ring size this version cannot honour (interim:
 /// the renderer keeps a fixed number of frames in flight).
 pub fn check_readback_slots(slots: u32) -> Outcome {
-    let fixed = alpenglow::vulkan::FRAMES_IN_FLIGHT;
+    let fixed = FRAMES_IN_FLIGHT;
     match slots as usize {
         0 => Ok(()),
         n if n == fixed => Ok(()),
