@@ -195,6 +195,20 @@ mod tests {
     }
 
     #[test]
+    fn the_last_error_is_per_thread() {
+        set_last_error("on the test thread");
+        let other = std::thread::spawn(|| {
+            // SAFETY: as above.
+            let message = unsafe { CStr::from_ptr(ag_last_error()) };
+            message.to_str().unwrap().to_owned()
+        });
+        assert_eq!(other.join().unwrap(), "");
+        // SAFETY: as above.
+        let message = unsafe { CStr::from_ptr(ag_last_error()) };
+        assert_eq!(message.to_str().unwrap(), "on the test thread");
+    }
+
+    #[test]
     fn messages_with_nul_bytes_are_kept() {
         set_last_error("a\0b");
         // SAFETY: as above.
