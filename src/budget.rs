@@ -19,7 +19,7 @@
 //! | plants (`--vegetation-density`) | at most 10¹² asked for; the kept ones as boulders | `Scene::add_vegetation` |
 //! | mesh samples (`--samples`, `--points-samples`) | ≈ 550 B blue noise, ≈ 200 B stratified | `sampling::sample_mesh`, the CLI before sampling |
 //! | height samples (`--terrain`, `--heightmap`) | 8 B host, 8 B device (4 B in one allocation) | `ProceduralTerrain::try_generate`, `InputLimits::check_image_fits`, `Renderer::new` |
-//! | pixels × `--msaa` × views | 64–100 B device per rendered pixel, 16 B in one allocation, 196 B host readback per output pixel | `renderer::footprint::check_views` in `Renderer::new` |
+//! | pixels × `--msaa` × views | 64–100 B device per rendered pixel, 16 B in one allocation, 64 B host readback per output pixel and readback slot + 68 B for the owned copy | `renderer::footprint::check_views` in `Renderer::new` |
 //! | point instances × views | two 96 B records per view and frame in flight | `renderer::footprint::check_scene` |
 //!
 //! Time has a ceiling of its own: long CPU work (synthesis, SPT builds)

@@ -97,6 +97,12 @@ pub(crate) mod texturing;
 pub(crate) mod view;
 pub(crate) mod vulkan;
 
+/// Helpers shared by the in-crate white-box tests (validated context, FLIP,
+/// goldens, the Jacksboro DEM).
+#[cfg(test)]
+#[forbid(unsafe_code)]
+pub(crate) mod test_support;
+
 #[forbid(unsafe_code)]
 mod front;
 
@@ -279,6 +285,31 @@ pub use profile::FrameProfile;
 /// # Ok(()) }
 /// ```
 pub use renderer::FrameImages;
+/// Frames read without blocking: [`Renderer::submit`] returns a [`Ticket`];
+/// [`Renderer::try_read`] (never blocks) and [`Renderer::wait`] hand out a
+/// [`FrameData`] borrowing the mapped readback slot: per view a
+/// [`ViewData`], per requested [`Output`] a [`Plane`] (bytes, [`Element`]
+/// format) with copy-into helpers for caller-owned buffers. The ring has
+/// [`Settings::readback_slots`] slots; a ticket whose slot was reused is an
+/// error, never stale data.
+///
+/// ```no_run
+/// # fn drive(renderer: &mut alpenglow::Renderer, path: &[alpenglow::Camera]) -> alpenglow::Result<()> {
+/// use alpenglow::Output;
+/// let mut depth = vec![0f32; 320 * 240];
+/// let mut previous = None;
+/// for camera in path {
+///     let ticket = renderer.submit(std::slice::from_ref(camera))?;
+///     // The GPU renders this frame while the previous one is consumed.
+///     if let Some(earlier) = previous.replace(ticket) {
+///         let frame = renderer.wait(earlier)?;
+///         frame.view(0)?.plane(Output::Depth)?.copy_into_f32(&mut depth)?;
+///     }
+/// }
+/// # Ok(()) }
+/// ```
+pub use renderer::Ticket;
+pub use renderer::{Element, FrameData, Output, Outputs, Plane, ViewData};
 pub use texturing::stats::{TextureFrameStats, TextureSummary};
 /// The semantic classes of [`FrameImages::class`]: terrain with a known
 /// surface layer k is `CLASS_LAYER_BASE + k`.

@@ -43,6 +43,8 @@ impl Physical {
 
 pub(crate) struct BakedPass<P> {
     pub name: String,
+    /// The debug label (the name as a C string, made once).
+    pub label: std::ffi::CString,
     pub kind: PassKind,
     pub uses: Vec<(ResourceId, Access)>,
     pub record: super::RecordFn<P>,
@@ -55,8 +57,12 @@ pub(crate) struct PendingFrame {
     /// Per pass: CPU start (ms from frame start) and CPU recording time.
     pub cpu_passes: Vec<(f64, f64)>,
     /// The CPU stages before recording (techniques' `prepare`).
-    pub prepare: Vec<crate::profile::StageTiming>,
+    pub prepare: super::execute::PrepareTimes,
 }
+
+/// The most frame profiles a graph keeps by default (about a minute at
+/// 60 frames per second).
+pub const DEFAULT_PROFILE_HISTORY: usize = 4096;
 
 /// A baked render graph: passes in execution order with their resources,
 /// ready to record frame after frame ([`BakedGraph::execute`]).
@@ -73,6 +79,14 @@ pub struct BakedGraph<P> {
     pub(crate) culled: Vec<String>,
     pub(crate) pending: VecDeque<PendingFrame>,
     pub(crate) profiles: Vec<FrameProfile>,
+    /// The most profiles kept (the oldest are dropped and their memory
+    /// reused): [`BakedGraph::set_profile_history`].
+    pub(crate) profile_history: usize,
+    /// Per-frame scratch reused by every frame (no allocation per frame):
+    /// which resources the frame touched, and the CPU times of the passes
+    /// of completed frames.
+    pub(crate) touched: Vec<bool>,
+    pub(crate) spare_cpu_passes: Vec<Vec<(f64, f64)>>,
     pub(crate) epoch: Instant,
     /// The upload arena, when a region was declared.
     pub(crate) uploads: Option<UploadArena>,
@@ -82,6 +96,15 @@ impl<P> BakedGraph<P> {
     /// Names of the passes in execution order.
     pub fn pass_names(&self) -> Vec<String> {
         self.passes.iter().map(|p| p.name.clone()).collect()
+    }
+
+    /// Keeps at most `frames` profiles (at least 1): older ones are
+    /// dropped and their memory reused, so a renderer that never takes
+    /// its profiles stops allocating for them once the history is full.
+    pub fn set_profile_history(&mut self, frames: usize) {
+        self.profile_history = frames.max(1);
+        let excess = self.profiles.len().saturating_sub(self.profile_history);
+        self.profiles.drain(..excess);
     }
 
     /// Names of the passes that were culled because nothing used their output.
@@ -353,6 +376,7 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
         } = decl;
         match (alive, record) {
             (true, Some(record)) => passes.push(BakedPass {
+                label: std::ffi::CString::new(name.replace('\0', " ")).unwrap_or_default(),
                 name,
                 kind,
                 uses,
@@ -376,6 +400,9 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
         culled,
         pending: VecDeque::new(),
         profiles: Vec::new(),
+        profile_history: DEFAULT_PROFILE_HISTORY,
+        touched: Vec::new(),
+        spare_cpu_passes: Vec::new(),
         epoch: Instant::now(),
         uploads,
     })

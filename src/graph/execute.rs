@@ -11,7 +11,8 @@ use super::{BufferId, ImageId, PassKind, ResourceId};
 use crate::error::{Error, Result};
 use crate::profile::{FrameProfile, PassTiming, StageTiming};
 use crate::vulkan::{
-    AccessFlags2, AccessState, Barrier, Buffer, CommandRecorder, CompletedFrame, FrameRing, Image, PipelineStageFlags2,
+    AccessFlags2, AccessState, BarrierBatch, Buffer, CommandRecorder, CompletedFrame, FrameRing, Image,
+    PipelineStageFlags2,
 };
 
 /// What a pass's recording closure gets: the command recorder and the
@@ -27,18 +28,19 @@ pub struct PassContext<'a> {
 /// the profile and the trace.
 #[derive(Clone, Debug)]
 pub struct CpuStage {
-    pub name: String,
+    /// Shared, so that timing a stage allocates nothing.
+    pub name: std::sync::Arc<str>,
     pub start: Instant,
     pub duration: Duration,
 }
 
 impl CpuStage {
     /// Runs `f` as the stage `name`, appending its timing to `stages`.
-    pub fn time<T>(stages: &mut Vec<CpuStage>, name: &str, f: impl FnOnce() -> T) -> T {
+    pub fn time<T>(stages: &mut Vec<CpuStage>, name: &std::sync::Arc<str>, f: impl FnOnce() -> T) -> T {
         let start = Instant::now();
         let value = f();
         stages.push(CpuStage {
-            name: name.into(),
+            name: name.clone(),
             start,
             duration: start.elapsed(),
         });
@@ -151,16 +153,10 @@ impl<P> BakedGraph<P> {
         }
     }
 
-    /// Derives and records the barriers before `uses`, updating tracked states.
-    fn emit_barriers(
-        &mut self,
-        cmd: &mut CommandRecorder,
-        uses: &[(ResourceId, super::Access)],
-        frame: u64,
-        touched: &mut [bool],
-    ) {
-        let mut image_barriers: Vec<(usize, Barrier)> = Vec::new();
-        let mut buffer_barriers: Vec<(usize, Barrier)> = Vec::new();
+    /// Derives and records the barriers before `uses`, updating tracked
+    /// states (gathered on the stack: no allocation).
+    fn emit_barriers(&mut self, cmd: &mut CommandRecorder, uses: &[(ResourceId, super::Access)], frame: u64) {
+        let mut batch = BarrierBatch::default();
         for &(r, access) in uses {
             let mut state = self.state_of(r, frame);
             if let Some(slot) = self.alias_of[r.0] {
@@ -168,36 +164,29 @@ impl<P> BakedGraph<P> {
                 let (stages, accesses, _) = access.state();
                 self.alias_slots[slot].record(r.0, stages, accesses & write_access_bits());
             }
-            let discard = !self.imported[r.0] && !touched[r.0];
-            touched[r.0] = true;
-            if let Some(mut b) = derive_barrier(&mut state, access, discard) {
-                if access.is_image() && b.old_layout != b.new_layout {
-                    // A layout transition (e.g. the first use of a transient image
-                    // this frame, or an atlas texture going from sampled to
-                    // storage) waits for everything before. A few per frame cost
-                    // little, and it keeps validation layers before 1.3.268
-                    // quiet: they count every draw and dispatch as touching every
-                    // image of the bindless heap (KhronosGroup/Vulkan-ValidationLayers#3450).
-                    b.src_stages |= PipelineStageFlags2::ALL_COMMANDS;
-                    b.src_access |= AccessFlags2::MEMORY_WRITE;
-                }
-                if access.is_image() && matches!(self.physical[r.0], Physical::Image(_)) {
-                    image_barriers.push((r.0, b));
-                } else {
-                    buffer_barriers.push((r.0, b));
-                }
-            }
+            let discard = !self.imported[r.0] && !self.touched[r.0];
+            self.touched[r.0] = true;
+            let barrier = derive_barrier(&mut state, access, discard);
             self.set_state_of(r, frame, state);
+            let Some(mut b) = barrier else { continue };
+            if access.is_image() && b.old_layout != b.new_layout {
+                // A layout transition (e.g. the first use of a transient image
+                // this frame, or an atlas texture going from sampled to
+                // storage) waits for everything before. A few per frame cost
+                // little, and it keeps validation layers before 1.3.268
+                // quiet: they count every draw and dispatch as touching every
+                // image of the bindless heap (KhronosGroup/Vulkan-ValidationLayers#3450).
+                b.src_stages |= PipelineStageFlags2::ALL_COMMANDS;
+                b.src_access |= AccessFlags2::MEMORY_WRITE;
+            }
+            let physical = &self.physical[r.0];
+            match (access.is_image(), physical.image(frame), physical.buffer(frame)) {
+                (true, Some(image), _) => batch.image(cmd, image, &b),
+                (_, _, Some(buffer)) => batch.buffer(cmd, buffer, &b),
+                _ => {}
+            }
         }
-        let images: Vec<(&Image, Barrier)> = image_barriers
-            .iter()
-            .filter_map(|(r, b)| Some((&**self.physical[*r].image(frame)?, *b)))
-            .collect();
-        let buffers: Vec<(&Buffer, Barrier)> = buffer_barriers
-            .iter()
-            .filter_map(|(r, b)| Some((&**self.physical[*r].buffer(frame)?, *b)))
-            .collect();
-        cmd.barriers(&buffers, &images);
+        batch.flush(cmd);
     }
 
     /// Records and submits one frame from its prepared data `params`;
@@ -209,6 +198,9 @@ impl<P> BakedGraph<P> {
         // Waits for the frame slot (the GPU) first; CPU times start after it,
         // or with the first prepare stage.
         let (mut recording, completed) = frames.begin(query_count)?;
+        if let Some(c) = &completed {
+            self.complete(c);
+        }
         let record_start = Instant::now();
         let frame_start = prepare
             .iter()
@@ -216,21 +208,20 @@ impl<P> BakedGraph<P> {
             .min()
             .unwrap_or(record_start)
             .min(record_start);
-        if let Some(c) = completed {
-            self.complete(c);
-        }
         let frame = recording.frame;
         let pool = recording.query_pool();
-        let mut touched = vec![false; self.physical.len()];
-        let mut cpu_passes = Vec::with_capacity(self.passes.len());
+        self.touched.clear();
+        self.touched.resize(self.physical.len(), false);
+        let mut cpu_passes = self.spare_cpu_passes.pop().unwrap_or_default();
+        cpu_passes.clear();
         let passes = std::mem::take(&mut self.passes);
         let mut result = Ok(());
         for (i, pass) in passes.iter().enumerate() {
             let pass_start = Instant::now();
             let cmd = &mut recording.recorder;
-            cmd.begin_label(&pass.name, label_color(pass.kind));
+            cmd.begin_label_c(&pass.label, label_color(pass.kind));
             cmd.write_timestamp(pool, 2 * i as u32, PipelineStageFlags2::TOP_OF_PIPE);
-            self.emit_barriers(cmd, &pass.uses, frame, &mut touched);
+            self.emit_barriers(cmd, &pass.uses, frame);
             let mut ctx = PassContext {
                 cmd,
                 physical: &self.physical,
@@ -252,12 +243,15 @@ impl<P> BakedGraph<P> {
             }
         }
         self.passes = passes;
-        let finals = self.final_accesses.clone();
-        self.emit_barriers(&mut recording.recorder, &finals, frame, &mut touched);
+        let finals = std::mem::take(&mut self.final_accesses);
+        self.emit_barriers(&mut recording.recorder, &finals, frame);
+        self.final_accesses = finals;
         // Submit even after a failed pass so the frame slot stays consistent.
         let timeline = recording.submit()?;
+        if let Some(c) = completed {
+            frames.recycle(c);
+        }
         result?;
-        let ms_since = |t: Instant| t.saturating_duration_since(frame_start).as_secs_f64() * 1e3;
         self.pending.push_back(PendingFrame {
             frame,
             cpu_start_ms: frame_start.saturating_duration_since(self.epoch).as_secs_f64() * 1e3,
@@ -265,51 +259,66 @@ impl<P> BakedGraph<P> {
             cpu_passes,
             prepare: prepare
                 .iter()
-                .map(|s| StageTiming {
-                    name: s.name.clone(),
-                    cpu_ms: s.duration.as_secs_f64() * 1e3,
-                    cpu_start_ms: ms_since(s.start),
+                .map(|s| {
+                    (
+                        s.name.clone(),
+                        s.duration,
+                        s.start.saturating_duration_since(frame_start),
+                    )
                 })
-                .collect(),
+                .fold(PrepareTimes::default(), PrepareTimes::with),
         });
         Ok(FrameOutcome { frame, timeline })
     }
 
-    fn complete(&mut self, completed: CompletedFrame) {
+    fn complete(&mut self, completed: &CompletedFrame) {
         while let Some(p) = self.pending.front() {
             if p.frame > completed.frame {
                 return;
             }
             let p = self.pending.pop_front().expect("front exists");
             if p.frame < completed.frame {
+                self.spare_cpu_passes.push(p.cpu_passes);
                 continue;
             }
+            // Reuse the oldest profile's memory once the history is full.
+            let mut profile = match self.profiles.len() >= self.profile_history {
+                true => self.profiles.remove(0),
+                false => FrameProfile::default(),
+            };
             let ts = &completed.timestamps_ns;
-            let mut passes = Vec::with_capacity(self.passes.len());
+            profile.passes.truncate(self.passes.len());
             for (i, pass) in self.passes.iter().enumerate() {
                 let (begin, end) = (
                     ts.get(2 * i).copied().unwrap_or(0.0),
                     ts.get(2 * i + 1).copied().unwrap_or(0.0),
                 );
                 let (cpu_start_ms, cpu_ms) = p.cpu_passes.get(i).copied().unwrap_or((0.0, 0.0));
-                passes.push(PassTiming {
-                    name: pass.name.clone(),
+                let timing = PassTiming {
+                    name: String::new(),
                     gpu_ms: (end - begin).max(0.0) / 1e6,
                     cpu_ms,
                     gpu_start_ms: begin / 1e6,
                     cpu_start_ms,
-                });
+                };
+                match profile.passes.get_mut(i) {
+                    Some(t) => {
+                        let name = std::mem::take(&mut t.name);
+                        *t = PassTiming { name, ..timing };
+                    }
+                    None => profile.passes.push(timing),
+                }
+                set_name(&mut profile.passes[i].name, &pass.name);
             }
+            p.prepare.write_into(&mut profile.prepare);
             let first = ts.iter().copied().fold(f64::INFINITY, f64::min);
             let last = ts.iter().copied().fold(0.0, f64::max);
-            self.profiles.push(FrameProfile {
-                frame: p.frame,
-                prepare: p.prepare,
-                passes,
-                gpu_ms: if first.is_finite() { (last - first) / 1e6 } else { 0.0 },
-                cpu_ms: p.cpu_ms,
-                cpu_start_ms: p.cpu_start_ms,
-            });
+            profile.frame = p.frame;
+            profile.gpu_ms = if first.is_finite() { (last - first) / 1e6 } else { 0.0 };
+            profile.cpu_ms = p.cpu_ms;
+            profile.cpu_start_ms = p.cpu_start_ms;
+            self.profiles.push(profile);
+            self.spare_cpu_passes.push(p.cpu_passes);
             return;
         }
     }
@@ -317,7 +326,7 @@ impl<P> BakedGraph<P> {
     /// Waits for every frame in flight and collects its timings.
     pub fn finish(&mut self, frames: &mut FrameRing) -> Result<()> {
         for c in frames.finish()? {
-            self.complete(c);
+            self.complete(&c);
         }
         Ok(())
     }
@@ -330,5 +339,55 @@ impl<P> BakedGraph<P> {
     /// Timings of the frames completed so far (oldest first), removing them.
     pub fn take_profiles(&mut self) -> Vec<FrameProfile> {
         std::mem::take(&mut self.profiles)
+    }
+}
+
+/// Sets `name` to `value`, reusing its memory (no allocation once it has
+/// held a name as long).
+fn set_name(name: &mut String, value: &str) {
+    if name != value {
+        name.clear();
+        name.push_str(value);
+    }
+}
+
+/// The CPU stages of a pending frame: (name, duration, start from the
+/// frame's start), at most [`PrepareTimes::CAPACITY`] (a frame has one per
+/// technique), kept inline so a frame allocates nothing for them.
+#[derive(Clone, Default)]
+pub(crate) struct PrepareTimes {
+    stages: [Option<(std::sync::Arc<str>, Duration, Duration)>; PrepareTimes::CAPACITY],
+    len: usize,
+}
+
+impl PrepareTimes {
+    const CAPACITY: usize = 16;
+
+    fn with(mut self, stage: (std::sync::Arc<str>, Duration, Duration)) -> PrepareTimes {
+        if self.len < Self::CAPACITY {
+            self.stages[self.len] = Some(stage);
+            self.len += 1;
+        }
+        self
+    }
+
+    /// The stages as profile timings, reusing `out`'s memory.
+    fn write_into(&self, out: &mut Vec<StageTiming>) {
+        out.truncate(self.len);
+        for (i, (name, duration, start)) in self.stages.iter().flatten().enumerate() {
+            let timing = StageTiming {
+                name: String::new(),
+                cpu_ms: duration.as_secs_f64() * 1e3,
+                cpu_start_ms: start.as_secs_f64() * 1e3,
+            };
+            match out.get_mut(i) {
+                Some(t) => {
+                    let n = std::mem::take(&mut t.name);
+                    *t = StageTiming { name: n, ..timing };
+                }
+                None => out.push(timing),
+            }
+            set_name(&mut out[i].name, name);
+        }
     }
 }

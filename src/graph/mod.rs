@@ -37,7 +37,7 @@ use std::sync::Arc;
 #[cfg(test)]
 pub use access::derive_barrier;
 pub use access::{Access, Stage};
-pub use bake::BakedGraph;
+pub use bake::{BakedGraph, DEFAULT_PROFILE_HISTORY};
 pub use execute::{CpuStage, FrameOutcome, PassContext};
 pub use typed::{BufferAccess, BufferId, ImageAccess, ImageId, Resource};
 pub use uploads::{UploadRegion, UploadWriter};
@@ -346,3 +346,6 @@ impl<P: 'static> PassBuilder<'_, P> {
         self.graph.passes.push(self.decl);
     }
 }
+
+#[cfg(test)]
+mod tests;

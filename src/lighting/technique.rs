@@ -46,6 +46,8 @@ pub struct SceneLighting {
     pub reference: Option<MonteCarloReference>,
     /// The physical atmosphere's lookup tables (Hillaire 2020).
     pub atmosphere: Option<PhysicalAtmosphere>,
+    /// The previous frame's prepared data, reused ([`Technique::recycle`]).
+    spare: Vec<LightingFrame>,
 }
 
 impl SceneLighting {
@@ -57,6 +59,7 @@ impl SceneLighting {
             sky_light: None,
             reference: None,
             atmosphere: None,
+            spare: Vec::new(),
         }
     }
 
@@ -139,7 +142,8 @@ impl Technique for SceneLighting {
 
     fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<PreparedLighting> {
         frame.lighting.validate()?;
-        let mut views = Vec::with_capacity(frame.views.len());
+        let mut views = std::mem::take(&mut self.spare);
+        views.clear();
         for (k, view) in frame.views.iter().enumerate() {
             let mut constants = self.constants(frame.lighting)?;
             if let Some(atmosphere) = &self.atmosphere {
@@ -169,5 +173,9 @@ impl Technique for SceneLighting {
             views.push(constants);
         }
         Ok(PreparedLighting { views })
+    }
+
+    fn recycle(&mut self, previous: PreparedLighting) {
+        self.spare = previous.views;
     }
 }

@@ -53,3 +53,6 @@ pub struct PointCloud {
     /// Per-point clip lines (§10.2.4), when the file had them.
     pub clip: Option<Vec<ClipLines>>,
 }
+
+#[cfg(test)]
+mod tests;

@@ -100,6 +100,8 @@ pub struct Aovs {
     pipeline: Arc<GraphicsPipeline>,
     views: Vec<AovView>,
     previous: Vec<Option<DMat4>>,
+    /// The previous frame's prepared data, reused ([`Technique::recycle`]).
+    spare: Vec<bool>,
 }
 
 impl Aovs {
@@ -117,6 +119,7 @@ impl Aovs {
             pipeline: Arc::new(pipeline),
             views: Vec::new(),
             previous: Vec::new(),
+            spare: Vec::new(),
         })
     }
 
@@ -174,7 +177,8 @@ impl Technique for Aovs {
     /// Per view: the constants from this frame's camera and the previous
     /// frame's transform, then this frame's transform kept for the next.
     fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<AovsFrame> {
-        let mut with_motion = Vec::with_capacity(self.views.len());
+        let mut with_motion = std::mem::take(&mut self.spare);
+        with_motion.clear();
         for (view, previous) in self.views.iter().zip(&mut self.previous) {
             let v = frame
                 .views
@@ -186,6 +190,10 @@ impl Technique for Aovs {
             *previous = Some(v.view_proj_f64());
         }
         Ok(AovsFrame { with_motion })
+    }
+
+    fn recycle(&mut self, previous: AovsFrame) {
+        self.spare = previous.with_motion;
     }
 }
 

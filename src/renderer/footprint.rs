@@ -49,7 +49,7 @@ pub fn target_bytes_per_pixel(points: bool) -> u64 {
 }
 
 /// Host-visible bytes per output pixel of one frame slot's readback
-/// buffers (`readback.rs`, `aov_readback.rs`): HDR 16, depth 4, sRGB 4,
+/// buffers (`readback.rs`): HDR 16, depth 4, sRGB 4,
 /// lighting visibility 8, normal 8, class and instance 8, motion 8,
 /// distance 4, splat weight 4.
 pub const READBACK_BYTES_PER_PIXEL: u64 = 64;
@@ -61,10 +61,10 @@ pub const FRAME_IMAGES_BYTES_PER_PIXEL: u64 = 68;
 
 /// What one `width`×`height` output view rendered at `render` size needs:
 /// the scene targets at the render size, again at the output size where
-/// it differs (the resolve's targets), and with `readback` a host-visible
+/// it differs (the resolve's targets), and with `readback` (the slot count) a host-visible
 /// buffer set per frame in flight and the frame's copy in vectors. The
 /// largest single allocation is an RGBA32F image or buffer.
-pub fn view_footprint(output: (u32, u32), render: (u32, u32), points: bool, readback: bool) -> Footprint {
+pub fn view_footprint(output: (u32, u32), render: (u32, u32), points: bool, readback: Option<usize>) -> Footprint {
     let pixels = |(w, h): (u32, u32)| u64::from(w) * u64::from(h);
     let (out, rendered) = (pixels(output), pixels(render));
     let per_pixel = target_bytes_per_pixel(points);
@@ -74,8 +74,8 @@ pub fn view_footprint(output: (u32, u32), render: (u32, u32), points: bool, read
     }
     let largest = rendered.max(out).saturating_mul(16);
     let mut footprint = Footprint::device(device, largest);
-    if readback {
-        let slots = FRAMES_IN_FLIGHT as u64;
+    if let Some(slots) = readback {
+        let slots = slots as u64;
         footprint = footprint.plus(Footprint::host(
             out.saturating_mul(READBACK_BYTES_PER_PIXEL * slots + FRAME_IMAGES_BYTES_PER_PIXEL),
         ));
@@ -95,7 +95,13 @@ pub fn instances_footprint(instances: usize, views: usize) -> Footprint {
 /// `readback`) against `limits`. The error names `msaa` when the views
 /// would fit without it, `views` for a rig, else `width/height`; the
 /// message says the sizes, the estimate and the limit.
-pub fn check_views(limits: &MemoryLimits, specs: &[ViewSpec], msaa: u32, points: bool, readback: bool) -> Result<()> {
+pub fn check_views(
+    limits: &MemoryLimits,
+    specs: &[ViewSpec],
+    msaa: u32,
+    points: bool,
+    readback: Option<usize>,
+) -> Result<()> {
     let total = |samples: u32| -> Result<Footprint> {
         specs.iter().try_fold(Footprint::default(), |sum, v| {
             let render = supersampled_size(v.width, v.height, samples)?;
@@ -152,12 +158,12 @@ mod tests {
     fn per_pixel_bytes_follow_the_target_formats() {
         assert_eq!(target_bytes_per_pixel(false), 64);
         assert_eq!(target_bytes_per_pixel(true), 100);
-        let f = view_footprint((100, 50), (100, 50), false, true);
+        let f = view_footprint((100, 50), (100, 50), false, Some(2));
         assert_eq!(f.device, 5000 * 64);
         assert_eq!(f.device_allocation, 5000 * 16);
-        assert_eq!(f.host, 5000 * (64 * FRAMES_IN_FLIGHT as u64 + 68));
+        assert_eq!(f.host, 5000 * (64 * 2 + 68));
         // Supersampled: the render targets and the output's again.
-        let f = view_footprint((100, 50), (400, 200), true, false);
+        let f = view_footprint((100, 50), (400, 200), true, None);
         assert_eq!((f.device, f.host), ((80_000 + 5000) * 100, 0));
         assert_eq!(f.device_allocation, 80_000 * 16);
     }
@@ -165,9 +171,9 @@ mod tests {
     #[test]
     fn the_error_names_the_size_the_samples_or_the_rig() {
         let one = |w, h| vec![ViewSpec::new(w, h)];
-        assert!(check_views(&limits(64), &one(640, 480), 1, true, true).is_ok());
+        assert!(check_views(&limits(64), &one(640, 480), 1, true, Some(2)).is_ok());
         // 1024² RGBA32F is 16 MiB in one allocation.
-        let e = check_views(&limits(8), &one(1024, 1024), 1, false, false).unwrap_err();
+        let e = check_views(&limits(8), &one(1024, 1024), 1, false, None).unwrap_err();
         assert_eq!(e.parameter(), Some("width/height"));
         let text = e.to_string();
         assert!(
@@ -176,12 +182,12 @@ mod tests {
         );
         assert!(text.contains("at most 8.0 MiB"), "{text}");
         // Fits alone, not supersampled 16 times.
-        let e = check_views(&limits(64), &one(512, 512), 16, true, false).unwrap_err();
+        let e = check_views(&limits(64), &one(512, 512), 16, true, None).unwrap_err();
         assert_eq!(e.parameter(), Some("msaa"));
         assert!(e.to_string().contains("512×512 pixels at 16 samples per pixel"), "{e}");
         // Six views that fit one by one, not together.
         let rig: Vec<ViewSpec> = (0..6).map(|_| ViewSpec::new(512, 512)).collect();
-        let e = check_views(&limits(64), &rig, 1, true, false).unwrap_err();
+        let e = check_views(&limits(64), &rig, 1, true, None).unwrap_err();
         assert_eq!(e.parameter(), Some("views"));
         assert!(
             e.to_string().contains("6 views of 1572864 pixels in all need about"),
@@ -197,14 +203,14 @@ mod tests {
             device: 64 << 30,
             device_allocation: 4 << 30,
         };
-        assert!(check_views(&big, &[ViewSpec::new(16384, 16384)], 1, true, true).is_ok());
+        assert!(check_views(&big, &[ViewSpec::new(16384, 16384)], 1, true, Some(2)).is_ok());
         // lavapipe allows 2 GiB in one allocation: 11585² fits, 11586² does not.
         let lavapipe = MemoryLimits {
             device_allocation: 2 << 30,
             ..big
         };
-        assert!(check_views(&lavapipe, &[ViewSpec::new(11585, 11585)], 1, true, true).is_ok());
-        let e = check_views(&lavapipe, &[ViewSpec::new(11586, 11586)], 1, true, true).unwrap_err();
+        assert!(check_views(&lavapipe, &[ViewSpec::new(11585, 11585)], 1, true, Some(2)).is_ok());
+        let e = check_views(&lavapipe, &[ViewSpec::new(11586, 11586)], 1, true, Some(2)).unwrap_err();
         assert!(
             e.to_string()
                 .contains("11586×11586 pixels need a single GPU allocation"),

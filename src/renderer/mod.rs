@@ -20,10 +20,12 @@
 //! `aovs` (full screen: distance and motion from view depth,
 //! [`crate::post::aovs`]) → `tonemap` (compute) → `readback` (transfer).
 
-mod aov_readback;
 pub mod footprint;
+mod frame_data;
 mod lighting;
+mod outputs;
 mod readback;
+mod ring;
 pub mod scene;
 mod view_chain;
 
@@ -31,7 +33,10 @@ use std::sync::Arc;
 
 pub use crate::view::rig::{Rig, ViewSpec, MAX_VIEWS};
 pub use crate::view::{validate_size, Camera, MAX_IMAGE_SIDE};
+pub use frame_data::{FrameData, Plane, ViewData};
+pub use outputs::{Element, Output, Outputs};
 pub use readback::FrameImages;
+pub use ring::Ticket;
 pub use scene::Scene;
 
 use readback::Readback;
@@ -39,7 +44,7 @@ pub use view_chain::check_view;
 use view_chain::ViewChain;
 
 use crate::error::{Error, Result};
-use crate::graph::{BakedGraph, FrameOutcome, RenderGraph};
+use crate::graph::{BakedGraph, CpuStage, FrameOutcome, RenderGraph};
 use crate::lighting::shadows::ShadowSettings;
 use crate::lighting::sky::Sky;
 use crate::lighting::technique::SceneLighting;
@@ -59,6 +64,12 @@ use crate::view::rig::validate_views;
 use crate::view::{Frame, Lighting, SceneTargets, View};
 use crate::vulkan::{Context, FrameRing, FRAMES_IN_FLIGHT};
 
+/// The default [`RenderSettings::readback_slots`]: one frame being read,
+/// one in flight and one being recorded.
+pub const DEFAULT_READBACK_SLOTS: usize = 3;
+/// The most [`RenderSettings::readback_slots`].
+pub const MAX_READBACK_SLOTS: usize = 16;
+
 /// Output size (or the views of a rig), whether frames are read back to
 /// the host, and every technique's settings.
 #[derive(Clone, Debug)]
@@ -75,8 +86,17 @@ pub struct RenderSettings {
     pub msaa: u32,
     /// Motion blur (§3.3) along the motion AOV; None: off.
     pub motion_blur: Option<MotionBlurSettings>,
-    /// Copy HDR, depth and sRGB images to host memory every frame.
+    /// Copy the view's images ([`RenderSettings::outputs`]) to host memory
+    /// every frame.
     pub readback: bool,
+    /// Which outputs are copied (default: all); the copies of the others
+    /// are skipped.
+    pub outputs: Outputs,
+    /// Readback slots (1 to [`MAX_READBACK_SLOTS`], default 3): frame `k`
+    /// is read back into slot `k % readback_slots`, so a frame can be read
+    /// until `readback_slots` more frames were submitted
+    /// ([`Renderer::submit`], [`Renderer::try_read`]).
+    pub readback_slots: usize,
     pub terrain: TerrainSettings,
     /// How point objects are splatted.
     pub points: SplatSettings,
@@ -105,6 +125,8 @@ impl RenderSettings {
             msaa: 1,
             motion_blur: None,
             readback: true,
+            outputs: Outputs::ALL,
+            readback_slots: DEFAULT_READBACK_SLOTS,
             terrain: TerrainSettings::default(),
             points: SplatSettings::default(),
             texturing: TexturingMode::default(),
@@ -159,8 +181,15 @@ pub struct Renderer {
     views: Vec<ViewSpec>,
     /// What the techniques render for each (supersampled, undistorted).
     render_specs: Vec<ViewSpec>,
-    /// Per view, when reading back.
-    readback: Option<Vec<Readback>>,
+    /// Per view, when reading back (empty: nothing is read back).
+    readback: Vec<Readback>,
+    /// The readback ring's size.
+    readback_slots: usize,
+    /// Identifies the renderer's tickets.
+    id: u64,
+    /// The last frame and its CPU stages, reused by the next.
+    frame: Option<Frame>,
+    stages: Vec<CpuStage>,
     lighting: Lighting,
     /// Frames rendered so far.
     frames_rendered: u64,
@@ -199,7 +228,15 @@ impl Renderer {
         // (size × samples × views), the height field and the instances.
         let limits = ctx.memory_limits();
         let points_present = !scene.points.is_empty();
-        footprint::check_views(&limits, &specs, settings.msaa, points_present, settings.readback)?;
+        let slots = settings.readback_slots;
+        if !(1..=MAX_READBACK_SLOTS).contains(&slots) {
+            return Err(Error::invalid(
+                "readback_slots",
+                format!("{slots}; it must be 1 to {MAX_READBACK_SLOTS}"),
+            ));
+        }
+        let readback_slots = settings.readback.then_some(slots);
+        footprint::check_views(&limits, &specs, settings.msaa, points_present, readback_slots)?;
         let field = (scene.heights.columns, scene.heights.rows);
         footprint::check_scene(&limits, field, scene.points.instances.len(), specs.len())?;
         let mut graph = RenderGraph::new();
@@ -293,9 +330,13 @@ impl Renderer {
             let targets = chain.declare(&mut graph, rendered, (&resolve, blur))?;
             let exposure = exposure.declare(&mut graph, view, &targets);
             tonemap.declare(&mut graph, view, &targets, exposure);
-            match settings.readback {
-                true => readback.push(Readback::declare(ctx, &mut graph, view, &targets)?),
-                false => graph.keep(targets.display),
+            let outputs = match settings.readback {
+                true => settings.outputs,
+                false => Outputs::NONE,
+            };
+            match Readback::declare(ctx, &mut graph, view, &targets, (outputs, slots))? {
+                Some(rb) => readback.push(rb),
+                None => graph.keep(targets.display),
             }
         }
         let graph = graph.bake(ctx)?;
@@ -303,7 +344,11 @@ impl Renderer {
             ctx: ctx.clone(),
             frames: FrameRing::new(ctx)?,
             graph,
-            readback: settings.readback.then_some(readback),
+            readback,
+            readback_slots: slots,
+            id: ring::renderer_id(),
+            frame: None,
+            stages: Vec::new(),
             views: specs,
             render_specs: chains.into_iter().map(|c| c.render).collect(),
             lighting,
@@ -345,6 +390,15 @@ impl Renderer {
         &self.ctx
     }
 
+    /// Keeps the profiles of at most `frames` frames (at least 1; default
+    /// [`crate::graph::DEFAULT_PROFILE_HISTORY`]) until
+    /// [`Renderer::finish`] takes them: older ones are dropped and their
+    /// memory reused, so frames allocate nothing for their profiles once
+    /// the history is full.
+    pub fn set_profile_history(&mut self, frames: usize) {
+        self.graph.set_profile_history(frames);
+    }
+
     /// Pass names in execution order.
     pub fn pass_names(&self) -> Vec<String> {
         self.graph.pass_names()
@@ -370,41 +424,61 @@ impl Renderer {
                 format!("{} cameras for {} views", cameras.len(), self.views.len()),
             ));
         }
-        let views: Vec<View> = (self.render_specs.iter().zip(cameras))
-            .map(|(spec, camera)| {
-                let view = spec.view(*camera);
-                view.validate()?;
-                Ok(view)
-            })
-            .collect::<Result<_>>()?;
+        for (spec, camera) in self.render_specs.iter().zip(cameras) {
+            view_of(spec, camera).validate()?;
+        }
         // The slot's previous frame must be done before prepare writes its uploads.
         let index = self.frames.wait_for_next()?;
-        let mut frame = Frame::new(index, views, self.lighting);
-        let mut stages = Vec::new();
-        let mut uploads = self.graph.uploads(index);
+        // The frame (views, prepared data) and its stages are reused frame
+        // after frame: steady-state frames allocate nothing.
+        let mut frame = match self.frame.take() {
+            Some(mut frame) => {
+                frame.reset(index, self.lighting);
+                for (view, camera) in frame.views.iter_mut().zip(cameras) {
+                    view.camera = *camera;
+                }
+                frame
+            }
+            None => {
+                let views = (self.render_specs.iter().zip(cameras))
+                    .map(|(s, c)| s.view(*c))
+                    .collect();
+                Frame::new(index, views, self.lighting)
+            }
+        };
+        let mut stages = std::mem::take(&mut self.stages);
+        stages.clear();
+        let result = self.prepare_and_execute(&mut frame, &mut stages);
+        (self.frame, self.stages) = (Some(frame), stages);
+        let outcome = result?;
+        self.frames_rendered = outcome.frame + 1;
+        Ok(outcome)
+    }
+
+    /// Every technique's prepare, then the graph records and submits `frame`.
+    fn prepare_and_execute(&mut self, frame: &mut Frame, stages: &mut Vec<CpuStage>) -> Result<FrameOutcome> {
+        let mut uploads = self.graph.uploads(frame.index);
         let t = &mut self.techniques;
         if let Some(shadows) = &mut t.shadows {
-            frame.prepare(&mut shadows.maps, &mut uploads, &mut stages)?;
+            frame.prepare(&mut shadows.maps, &mut uploads, stages)?;
             if let Some(points) = &mut shadows.points {
-                frame.prepare(points, &mut uploads, &mut stages)?;
+                frame.prepare(points, &mut uploads, stages)?;
             }
         }
         // After the shadows: the constants carry their cascades.
-        frame.prepare(&mut t.lighting, &mut uploads, &mut stages)?;
+        frame.prepare(&mut t.lighting, &mut uploads, stages)?;
         if let Some(terrain) = &mut t.terrain {
-            frame.prepare(terrain, &mut uploads, &mut stages)?;
+            frame.prepare(terrain, &mut uploads, stages)?;
         }
         if let Some(atlas) = &mut t.atlas {
             atlas.observe_profiles(self.graph.profiles());
-            frame.prepare(atlas, &mut uploads, &mut stages)?;
+            frame.prepare(atlas, &mut uploads, stages)?;
         }
         if let Some(points) = &mut t.points {
-            frame.prepare(points, &mut uploads, &mut stages)?;
+            frame.prepare(points, &mut uploads, stages)?;
         }
-        frame.prepare(&mut t.aovs, &mut uploads, &mut stages)?;
-        let outcome = self.graph.execute(&mut self.frames, &frame, &stages)?;
-        self.frames_rendered = outcome.frame + 1;
-        Ok(outcome)
+        frame.prepare(&mut t.aovs, &mut uploads, stages)?;
+        self.graph.execute(&mut self.frames, frame, stages)
     }
 
     /// Renders `camera` until every texture tile the view needs is ready
@@ -452,31 +526,31 @@ impl Renderer {
     }
 
     /// Waits for `frame` and copies the first view's images out of the
-    /// readback buffers. Call before rendering `FRAMES_IN_FLIGHT` more frames.
+    /// readback buffers. Call before rendering
+    /// [`RenderSettings::readback_slots`] more frames.
     pub fn read(&mut self, frame: &FrameOutcome) -> Result<FrameImages> {
         self.read_view(frame, 0)
     }
 
     /// [`Renderer::read`] of view `view`.
     pub fn read_view(&mut self, frame: &FrameOutcome, view: usize) -> Result<FrameImages> {
-        let rb = self
-            .readback
-            .as_ref()
-            .ok_or_else(|| Error::invalid("readback", "the renderer was created without readback"))?;
-        let rb = rb
-            .get(view)
+        if self.readback.is_empty() {
+            return Err(Error::invalid("readback", "the renderer was created without readback"));
+        }
+        let rb = (self.readback.get(view))
             .ok_or_else(|| Error::invalid("view", format!("{view}; the renderer has {} views", self.views.len())))?;
-        if self.frames_rendered > frame.frame + FRAMES_IN_FLIGHT as u64 {
+        let slots = self.readback_slots as u64;
+        if self.frames_rendered > frame.frame + slots {
             return Err(Error::invalid(
                 "readback",
                 format!(
-                    "frame {} was overwritten: read a frame before rendering {FRAMES_IN_FLIGHT} more",
+                    "frame {} was overwritten: read a frame before rendering {slots} more (readback_slots)",
                     frame.frame
                 ),
             ));
         }
         self.ctx.wait(frame.timeline)?;
-        rb.read(frame.frame as usize % FRAMES_IN_FLIGHT)
+        rb.read((frame.frame % slots) as usize)
     }
 
     /// [`Renderer::read`] of every view, in order.
@@ -538,6 +612,18 @@ impl Renderer {
     }
 }
 
+/// The view `spec` renders through `camera`, without allocating (the
+/// name stays empty: only the size and intrinsics are checked with it).
+fn view_of(spec: &ViewSpec, camera: &Camera) -> View {
+    View {
+        name: String::new(),
+        camera: *camera,
+        width: spec.width,
+        height: spec.height,
+        intrinsics: spec.intrinsics,
+    }
+}
+
 /// The atlas streaming of `settings`, resized for supersampled renders
 /// (their tiles are finer than the outputs'); the budget stays the caller's.
 fn streaming_for(settings: &RenderSettings, chains: &[ViewChain]) -> TextureStreaming {
@@ -575,3 +661,6 @@ fn warped_terrain(
     }
     Ok(terrain)
 }
+
+#[cfg(test)]
+mod tests;

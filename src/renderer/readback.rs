@@ -1,16 +1,23 @@
-//! Host copies of a view's images: per frame slot, the `readback` pass
-//! copies them into host-visible buffers that [`super::Renderer::read_view`]
-//! reads once the frame completed.
+//! Host copies of a view's images: the `readback` pass copies the
+//! requested [`Output`]s of frame `k` into the host-visible buffers of
+//! readback slot `k % slots` (a ring sized by
+//! [`super::RenderSettings::readback_slots`]); the graph imports each
+//! output's slot buffers as one resource and picks the frame's by its
+//! number, so it derives every barrier. [`super::FrameData`] hands out
+//! borrowed slices of a completed slot, [`FrameImages`] owned copies.
 
 use std::sync::Arc;
 
-use super::aov_readback::AovReadback;
-use crate::error::Result;
-use crate::graph::RenderGraph;
+use super::frame_data::Plane;
+use super::outputs::{Element, Output, Outputs};
+use crate::error::{Error, Result};
+use crate::graph::{BufferId, ImageId, RenderGraph};
 use crate::view::{pass_name, Frame, SceneTargets, View};
 use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Context, MemoryLocation};
 
-/// A rendered view in host memory. Row 0 is the top of the image.
+/// A rendered view in host memory. Row 0 is the top of the image. An
+/// output the renderer does not read back ([`super::RenderSettings::outputs`])
+/// is empty (`weight`: None).
 #[derive(Clone, Debug)]
 pub struct FrameImages {
     /// The view's name (empty for a single unnamed view).
@@ -53,92 +60,200 @@ impl FrameImages {
     }
 }
 
-/// One view's readback buffers, one per frame slot each.
+/// The readback buffers: one per image copied (class and instance share
+/// the ids image's).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Source {
+    Display,
+    Radiance,
+    ViewDepth,
+    Distance,
+    Normal,
+    Ids,
+    Motion,
+    Visibility,
+    Weight,
+}
+
+const SOURCES: usize = 9;
+
+/// Where `output` lives: its buffer, the stored element, samples per
+/// pixel and the output's first sample within a pixel.
+fn layout(output: Output) -> (Source, Element, usize, usize) {
+    match output {
+        Output::Rgba8 => (Source::Display, Element::U8, 4, 0),
+        Output::Hdr => (Source::Radiance, Element::F32, 4, 0),
+        Output::Depth => (Source::ViewDepth, Element::F32, 1, 0),
+        Output::Distance => (Source::Distance, Element::F32, 1, 0),
+        Output::Normal => (Source::Normal, Element::F16, 4, 0),
+        Output::Class => (Source::Ids, Element::U32, 2, 0),
+        Output::Instance => (Source::Ids, Element::U32, 2, 1),
+        Output::Motion => (Source::Motion, Element::F32, 2, 0),
+        Output::Visibility => (Source::Visibility, Element::F32, 2, 0),
+        Output::Weight => (Source::Weight, Element::F32, 1, 0),
+    }
+}
+
+/// The image of `targets` that `source` copies (None: the view has none).
+fn image_of(targets: &SceneTargets, source: Source) -> Option<ImageId> {
+    Some(match source {
+        Source::Display => targets.display,
+        Source::Radiance => targets.radiance,
+        Source::ViewDepth => targets.view_depth,
+        Source::Distance => targets.distance,
+        Source::Normal => targets.normal,
+        Source::Ids => targets.ids,
+        Source::Motion => targets.motion,
+        Source::Visibility => targets.visibility,
+        Source::Weight => targets.weight?,
+    })
+}
+
+/// One view's readback ring: per copied image, one host buffer per slot.
 pub(super) struct Readback {
     name: String,
     size: (u32, u32),
-    hdr: Vec<Arc<Buffer>>,
-    depth: Vec<Arc<Buffer>>,
-    ldr: Vec<Arc<Buffer>>,
-    weight: Option<Vec<Arc<Buffer>>>,
-    visibility: Vec<Arc<Buffer>>,
-    aovs: AovReadback,
-}
-
-/// One readback buffer per frame slot.
-pub(super) fn host_buffers(ctx: &Context, name: &str, size: u64) -> Result<Vec<Arc<Buffer>>> {
-    Buffer::per_frame(
-        ctx,
-        BufferDesc {
-            name: format!("{name} readback"),
-            size,
-            usage: BufferUsageFlags::TRANSFER_DST,
-            location: MemoryLocation::GpuToCpu,
-        },
-    )
+    /// The outputs read back (requested and present in the view).
+    outputs: Outputs,
+    buffers: [Vec<Arc<Buffer>>; SOURCES],
 }
 
 impl Readback {
-    /// Declares the view's `readback`: its images into per-frame host buffers.
+    /// Declares the view's `readback` pass copying `outputs` of `targets`
+    /// into `slots` host buffers each; returns None (and declares nothing)
+    /// when there is nothing to copy.
     pub(super) fn declare(
         ctx: &Context,
         graph: &mut RenderGraph<Frame>,
         view: &View,
         targets: &SceneTargets,
-    ) -> Result<Readback> {
+        (outputs, slots): (Outputs, usize),
+    ) -> Result<Option<Readback>> {
         let pixels = u64::from(targets.width) * u64::from(targets.height);
-        let buffers = |what: &str, size| host_buffers(ctx, &pass_name(what, &view.name), size);
-        let mut copies = Vec::new();
-        let rb = Readback {
-            aovs: AovReadback::declare(ctx, graph, view, targets, &mut copies)?,
+        let mut rb = Readback {
             name: view.name.clone(),
             size: (targets.width, targets.height),
-            hdr: buffers("hdr", pixels * 16)?,
-            depth: buffers("depth", pixels * 4)?,
-            ldr: buffers("srgb", pixels * 4)?,
-            visibility: buffers("lighting visibility", pixels * 8)?,
-            weight: match targets.weight {
-                Some(_) => Some(buffers("splat weight", pixels * 4)?),
-                None => None,
-            },
+            outputs: Outputs::NONE,
+            buffers: Default::default(),
         };
-        copies.extend([
-            (targets.radiance, graph.import_buffers_per_frame(rb.hdr.clone())),
-            (targets.view_depth, graph.import_buffers_per_frame(rb.depth.clone())),
-            (targets.display, graph.import_buffers_per_frame(rb.ldr.clone())),
-            (
-                targets.visibility,
-                graph.import_buffers_per_frame(rb.visibility.clone()),
-            ),
-        ]);
-        if let (Some(image), Some(buffers)) = (targets.weight, &rb.weight) {
+        let mut copies: Vec<(ImageId, BufferId)> = Vec::new();
+        for output in outputs.iter() {
+            let (source, element, stride, _) = layout(output);
+            let Some(image) = image_of(targets, source) else {
+                continue;
+            };
+            rb.outputs = rb.outputs.with(output);
+            if !rb.buffers[source as usize].is_empty() {
+                continue;
+            }
+            let name = pass_name(&format!("{} readback", output.name()), &view.name);
+            let size = pixels * (stride * element.size()) as u64;
+            let buffers = (0..slots)
+                .map(|slot| host_buffer(ctx, format!("{name} {slot}"), size))
+                .collect::<Result<Vec<_>>>()?;
             copies.push((image, graph.import_buffers_per_frame(buffers.clone())));
+            rb.buffers[source as usize] = buffers;
+        }
+        if copies.is_empty() {
+            return Ok(None);
         }
         graph.read_back_images(&pass_name("readback", &view.name), copies);
-        Ok(rb)
+        Ok(Some(rb))
     }
 
-    /// The images of frame slot `slot` (its frame must have completed).
+    /// The view's name.
+    pub(super) fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The output size.
+    pub(super) fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// The outputs read back.
+    pub(super) fn outputs(&self) -> Outputs {
+        self.outputs
+    }
+
+    /// `output` in slot `slot` (its frame must have completed).
+    pub(super) fn plane(&self, output: Output, slot: usize) -> Result<Plane<'_>> {
+        let (source, element, stride, offset) = layout(output);
+        let buffer = match self.outputs.contains(output) {
+            true => self.buffers[source as usize].get(slot),
+            false => None,
+        };
+        let buffer = buffer.ok_or_else(|| {
+            let why = match output {
+                Output::Weight => "(it needs point objects and `outputs` with it)",
+                _ => "(see the settings' `outputs`)",
+            };
+            Error::invalid(
+                "output",
+                format!("'{output}' is not read back for view '{}' {why}", self.name),
+            )
+        })?;
+        Ok(Plane {
+            output,
+            width: self.size.0,
+            height: self.size.1,
+            element,
+            stride,
+            offset,
+            bytes: buffer.mapped()?,
+        })
+    }
+
+    /// Owned copies of the images in slot `slot` (its frame must have completed).
     pub(super) fn read(&self, slot: usize) -> Result<FrameImages> {
-        let floats = |b: &Buffer| -> Result<Vec<f32>> { Ok(bytemuck::pod_collect_to_vec(b.mapped()?)) };
-        let aovs = self.aovs.read(slot)?;
+        let pixels = self.size.0 as usize * self.size.1 as usize;
+        let floats = |o: Output| -> Result<Vec<f32>> {
+            if !self.outputs.contains(o) {
+                return Ok(Vec::new());
+            }
+            let mut v = vec![0.0; pixels * o.channels()];
+            self.plane(o, slot)?.copy_into_f32(&mut v)?;
+            Ok(v)
+        };
+        let ids = |o: Output| -> Result<Vec<u32>> {
+            if !self.outputs.contains(o) {
+                return Ok(Vec::new());
+            }
+            let mut v = vec![0; pixels];
+            self.plane(o, slot)?.copy_into_u32(&mut v)?;
+            Ok(v)
+        };
         Ok(FrameImages {
             name: self.name.clone(),
             width: self.size.0,
             height: self.size.1,
-            rgba8: self.ldr[slot].mapped()?.to_vec(),
-            hdr: floats(&self.hdr[slot])?,
-            depth: floats(&self.depth[slot])?,
-            weight: match &self.weight {
-                Some(w) => Some(floats(&w[slot])?),
-                None => None,
+            rgba8: match self.outputs.contains(Output::Rgba8) {
+                true => self.plane(Output::Rgba8, slot)?.bytes.to_vec(),
+                false => Vec::new(),
             },
-            visibility: floats(&self.visibility[slot])?,
-            normal: aovs.normal,
-            class: aovs.class,
-            instance: aovs.instance,
-            motion: aovs.motion,
-            distance: aovs.distance,
+            hdr: floats(Output::Hdr)?,
+            depth: floats(Output::Depth)?,
+            weight: match self.outputs.contains(Output::Weight) {
+                true => Some(floats(Output::Weight)?),
+                false => None,
+            },
+            visibility: floats(Output::Visibility)?,
+            normal: floats(Output::Normal)?,
+            class: ids(Output::Class)?,
+            instance: ids(Output::Instance)?,
+            motion: floats(Output::Motion)?,
+            distance: floats(Output::Distance)?,
         })
     }
+}
+
+/// A host-visible readback buffer of `size` bytes.
+fn host_buffer(ctx: &Context, name: String, size: u64) -> Result<Arc<Buffer>> {
+    let desc = BufferDesc {
+        name,
+        size,
+        usage: BufferUsageFlags::TRANSFER_DST,
+        location: MemoryLocation::GpuToCpu,
+    };
+    Buffer::new(ctx, desc).map(Arc::new)
 }

@@ -37,14 +37,14 @@
 //! wide, so even there `o` is only 4–5 (octaves 5–8, 0.49 … 0.08 m in
 //! amplitude, are bump-mapped): 3 m above the ground, the drawn ground
 //! within 30 m differs from [`Ground::height`] by 0.15 m rms, 0.43 m at
-//! most (`tests/ground.rs`; the vertices' bound there is 1.9 m). A coarse
+//! most (`src/terrain/tests/ground.rs`; the vertices' bound there is 1.9 m). A coarse
 //! far view (`o` → 0) differs by about 1.5 m rms, at most
 //! [`Ground::omitted_detail_bound`]`(0)` (26 m, a loose bound).
 //!
 //! What *is* drawn, exactly: [`Ground::surface`] at a given `o` is a vertex
 //! of that split octave, [`Ground::vertex`] one invocation of
 //! `terrain.warp`, and [`DrawnSurface`] the whole triangulated mesh of a
-//! view, from the same warp the renderer uploads; `tests/ground.rs` checks
+//! view, from the same warp the renderer uploads; `src/terrain/tests/ground.rs` checks
 //! that it matches the GPU's depth to within 1 cm.
 
 use glam::{DVec2, DVec3, DVec4};

@@ -22,3 +22,6 @@ pub mod wavelet_noise;
 pub mod zoom;
 
 pub use technique::{Terrain, TerrainFrame, TerrainTexturing};
+
+#[cfg(test)]
+mod tests;

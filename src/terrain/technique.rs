@@ -59,6 +59,8 @@ pub struct Terrain {
     /// Heap handles: sketch atlas (sampled), noise tile (sampled), layers (storage).
     handles: [u32; 3],
     views: Vec<TerrainViewState>,
+    /// The previous frame's prepared views, reused ([`Technique::recycle`]).
+    spare: Vec<TerrainViewFrame>,
 }
 
 /// What the terrain passes read this frame.
@@ -127,6 +129,7 @@ impl Terrain {
             maps,
             handles,
             views: Vec::new(),
+            spare: Vec::new(),
         })
     }
 
@@ -293,7 +296,8 @@ impl Technique for Terrain {
     /// Per view: sketch map, importance map and warp (§7.4.2) into the
     /// warp upload, the texturing constants, and the passes' push constants.
     fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<TerrainFrame> {
-        let mut views = Vec::with_capacity(self.views.len());
+        let mut views = std::mem::take(&mut self.spare);
+        views.clear();
         let settings = self.geometry.settings;
         self.plan_views(frame.views)?;
         for k in 0..self.views.len() {
@@ -346,5 +350,9 @@ impl Technique for Terrain {
             });
         }
         Ok(TerrainFrame { views })
+    }
+
+    fn recycle(&mut self, previous: TerrainFrame) {
+        self.spare = previous.views;
     }
 }

@@ -59,7 +59,7 @@
 //! after the first pass the columns are strongly bent (rows behind the eye
 //! stay uniform, rows in the frustum crowd into it), so `x` stops increasing
 //! along rows — 1600–3200 of the 16 129 quads of a 128² map fold over in
-//! our tests (`tests/warp.rs`), and the density also comes out worse. The
+//! our tests (`src/terrain/tests/warp.rs`), and the density also comes out worse. The
 //! default, [`ColumnImportance::RowDemand`], warps all columns alike by the
 //! demand of each row, `J = ∫ I² ds` along the row: an isotropic density
 //! `k·I` needs `k²∫I² ds` samples per unit width of the strip a row stands
@@ -71,7 +71,7 @@
 //! along every row of an axis-aligned map) carries over to the output and
 //! no quad can fold over; output rows stay straight. The price is
 //! that the second direction's density varies per row only; measured
-//! obtained/demanded densities are in the tests (`tests/warp.rs`).
+//! obtained/demanded densities are in the tests (`src/terrain/tests/warp.rs`).
 //!
 //! Which direction goes first matters: the first pass adapts per line, so it
 //! should run across the view (lateral), the shared pass along it

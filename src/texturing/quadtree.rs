@@ -368,30 +368,6 @@ impl Selector<'_> {
         let (lo, hi) = node.rect(self.extent);
         let box_min = lo.extend(f64::from(b.z_min));
         let box_max = hi.extend(f64::from(b.z_max));
-        let mut seen: Vec<Measure> = Vec::with_capacity(self.views.len());
-        for view in self.views {
-            let outside = |p: &DVec4| box_outside(p, box_min, box_max);
-            if view.frustum.is_some_and(|planes| planes.iter().any(outside)) {
-                continue;
-            }
-            let distance = view.eye.clamp(box_min, box_max).distance(view.eye).max(MIN_DISTANCE);
-            let per_metre = 1.0 / (view.pixel_footprint * distance);
-            seen.push(Measure {
-                distance,
-                needed: (hi - lo).max_element() * per_metre,
-                error_pixels: f64::from(b.geometric_error) * per_metre,
-            });
-        }
-        if seen.is_empty() {
-            return Ok(None);
-        }
-        let need = seen
-            .iter()
-            .map(|m| {
-                let texels = (m.needed + border2) / f64::from(settings.aim_texels);
-                texels.max(m.error_pixels / f64::from(settings.pixel_error))
-            })
-            .fold(0.0, f64::max);
         let largest = match node.level == settings.max_depth {
             true => settings.max_tile,
             false => settings.upper_tile(),
@@ -405,8 +381,30 @@ impl Selector<'_> {
                 fit(want)
             }
         };
-        let size = seen.iter().map(size_for).max().unwrap_or(settings.min_tile);
-        let distance = seen.iter().map(|m| m.distance).fold(f64::INFINITY, f64::min);
+        // Reduced view by view (no allocation per node): the neediest
+        // view's need and size, the nearest view's distance.
+        let (mut seen, mut need, mut size, mut distance) = (false, 0.0f64, settings.min_tile, f64::INFINITY);
+        for view in self.views {
+            let outside = |p: &DVec4| box_outside(p, box_min, box_max);
+            if view.frustum.is_some_and(|planes| planes.iter().any(outside)) {
+                continue;
+            }
+            let d = view.eye.clamp(box_min, box_max).distance(view.eye).max(MIN_DISTANCE);
+            let per_metre = 1.0 / (view.pixel_footprint * d);
+            let m = Measure {
+                distance: d,
+                needed: (hi - lo).max_element() * per_metre,
+                error_pixels: f64::from(b.geometric_error) * per_metre,
+            };
+            let texels = (m.needed + border2) / f64::from(settings.aim_texels);
+            need = need.max(texels.max(m.error_pixels / f64::from(settings.pixel_error)));
+            size = if seen { size.max(size_for(&m)) } else { size_for(&m) };
+            distance = distance.min(m.distance);
+            seen = true;
+        }
+        if !seen {
+            return Ok(None);
+        }
         let tile = NeededTile { node, size, distance };
         let split = need > 1.0 && node.level < settings.max_depth;
         Ok(Some((tile, split.then_some(need))))

@@ -6,6 +6,7 @@
 //! graph runs and kajiya's renderers' prepare step.
 
 use std::any::{type_name, Any, TypeId};
+use std::sync::Arc;
 
 use super::{Lighting, View, ViewIndex};
 use crate::error::{Error, Result};
@@ -18,7 +19,13 @@ pub struct Frame {
     pub index: u64,
     pub views: Vec<View>,
     pub lighting: Lighting,
+    /// Each technique's prepared data (`Option<T>`: None until prepared
+    /// this frame). A frame is reused frame after frame
+    /// ([`Frame::reset`]): the boxes stay, and each technique gets its
+    /// previous frame's data back to reuse ([`Technique::recycle`]).
     prepared: Vec<(TypeId, Box<dyn Any + Send + Sync>)>,
+    /// The profile stage name of each technique, made once.
+    stage_names: Vec<(&'static str, Arc<str>)>,
 }
 
 impl Frame {
@@ -29,7 +36,16 @@ impl Frame {
             views,
             lighting,
             prepared: Vec::new(),
+            stage_names: Vec::new(),
         }
+    }
+
+    /// Starts frame `index` of the same views (update their cameras in
+    /// [`Frame::views`]) with `lighting`: what was prepared becomes the
+    /// previous frame's, handed back to each technique as it prepares.
+    pub fn reset(&mut self, index: u64, lighting: Lighting) {
+        self.index = index;
+        self.lighting = lighting;
     }
 
     /// The view `index`.
@@ -39,11 +55,29 @@ impl Frame {
             .ok_or_else(|| Error::Graph(format!("view {index} is not in this frame")))
     }
 
-    /// Adds a technique's prepared data (replacing any of the same type).
+    /// Adds a technique's prepared data (replacing any of the same type,
+    /// in its box).
     pub fn insert<T: Any + Send + Sync>(&mut self, value: T) {
+        match self.slot::<T>() {
+            Some(slot) => *slot = Some(value),
+            None => self.prepared.push((TypeId::of::<T>(), Box::new(Some(value)))),
+        }
+    }
+
+    /// The box of `T`'s prepared data, if it has one.
+    fn slot<T: Any + Send + Sync>(&mut self) -> Option<&mut Option<T>> {
         let id = TypeId::of::<T>();
-        self.prepared.retain(|(t, _)| *t != id);
-        self.prepared.push((id, Box::new(value)));
+        (self.prepared.iter_mut().find(|(t, _)| *t == id)).and_then(|(_, v)| v.downcast_mut::<Option<T>>())
+    }
+
+    /// The profile stage name of `technique`.
+    fn stage_name(&mut self, technique: &'static str) -> Arc<str> {
+        if let Some((_, name)) = self.stage_names.iter().find(|(t, _)| *t == technique) {
+            return name.clone();
+        }
+        let name: Arc<str> = format!("prepare.{technique}").into();
+        self.stage_names.push((technique, name.clone()));
+        name
     }
 
     /// The prepared data of type `T`.
@@ -59,7 +93,10 @@ impl Frame {
         uploads: &mut UploadWriter<'_>,
         stages: &mut Vec<CpuStage>,
     ) -> Result<()> {
-        let name = format!("prepare.{}", technique.name());
+        let name = self.stage_name(technique.name());
+        if let Some(previous) = self.slot::<T::Prepared>().and_then(Option::take) {
+            technique.recycle(previous);
+        }
         let prepared = CpuStage::time(stages, &name, || {
             let mut ctx = FrameContext {
                 index: self.index,
@@ -99,7 +136,8 @@ fn find_prepared<T: Any>(prepared: &[(TypeId, Box<dyn Any + Send + Sync>)]) -> R
     prepared
         .iter()
         .find(|(t, _)| *t == TypeId::of::<T>())
-        .and_then(|(_, v)| v.downcast_ref::<T>())
+        .and_then(|(_, v)| v.downcast_ref::<Option<T>>())
+        .and_then(Option::as_ref)
         .ok_or_else(|| Error::Graph(format!("{} was not prepared for this frame", type_name::<T>())))
 }
 
@@ -112,4 +150,10 @@ pub trait Technique {
     fn name(&self) -> &'static str;
     /// The CPU work of a frame, before recording: plans, uploads, statistics.
     fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<Self::Prepared>;
+    /// Takes back the previous frame's prepared data before
+    /// [`Technique::prepare`], to reuse its memory (the frame path
+    /// allocates nothing in steady state); by default it is dropped.
+    fn recycle(&mut self, previous: Self::Prepared) {
+        drop(previous);
+    }
 }

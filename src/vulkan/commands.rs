@@ -40,43 +40,25 @@ impl CommandRecorder {
 
     /// One synchronization2 dependency for all the given transitions.
     pub(crate) fn barriers(&mut self, buffers: &[(&Buffer, Barrier)], images: &[(&Image, Barrier)]) {
+        let mut batch = BarrierBatch::default();
+        for (buffer, b) in buffers {
+            batch.buffer(self, buffer, b);
+        }
+        for (image, b) in images {
+            batch.image(self, image, b);
+        }
+        batch.flush(self);
+    }
+
+    /// Records `buffers` and `images` barriers as one dependency (the
+    /// caller batches them, without allocating: [`BarrierBatch`]).
+    fn pipeline_barrier(&mut self, buffers: &[vk::BufferMemoryBarrier2<'_>], images: &[vk::ImageMemoryBarrier2<'_>]) {
         if buffers.is_empty() && images.is_empty() {
             return;
         }
-        let buffer_barriers: Vec<_> = buffers
-            .iter()
-            .map(|(buffer, b)| {
-                vk::BufferMemoryBarrier2::default()
-                    .src_stage_mask(b.src_stages)
-                    .src_access_mask(b.src_access)
-                    .dst_stage_mask(b.dst_stages)
-                    .dst_access_mask(b.dst_access)
-                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .buffer(buffer.raw)
-                    .offset(0)
-                    .size(vk::WHOLE_SIZE)
-            })
-            .collect();
-        let image_barriers: Vec<_> = images
-            .iter()
-            .map(|(image, b)| {
-                vk::ImageMemoryBarrier2::default()
-                    .src_stage_mask(b.src_stages)
-                    .src_access_mask(b.src_access)
-                    .dst_stage_mask(b.dst_stages)
-                    .dst_access_mask(b.dst_access)
-                    .old_layout(b.old_layout)
-                    .new_layout(b.new_layout)
-                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .image(image.raw)
-                    .subresource_range(subresource_range(image.aspect()))
-            })
-            .collect();
         let dependency = vk::DependencyInfo::default()
-            .buffer_memory_barriers(&buffer_barriers)
-            .image_memory_barriers(&image_barriers);
+            .buffer_memory_barriers(buffers)
+            .image_memory_barriers(images);
         // SAFETY: the command buffer is recording; the resources are alive until the
         // frame completes (the graph or caller holds them).
         unsafe { self.device().cmd_pipeline_barrier2(self.cmd, &dependency) };
@@ -84,8 +66,17 @@ impl CommandRecorder {
 
     /// Opens a debug label (RenderDoc, Nsight, validation messages).
     pub fn begin_label(&mut self, name: &str, color: [f32; 4]) {
-        if let (Some(debug), Ok(name)) = (&self.ctx.shared.debug_device, std::ffi::CString::new(name)) {
-            let label = vk::DebugUtilsLabelEXT::default().label_name(&name).color(color);
+        if self.ctx.shared.debug_device.is_some() {
+            if let Ok(name) = std::ffi::CString::new(name) {
+                self.begin_label_c(&name, color);
+            }
+        }
+    }
+
+    /// [`CommandRecorder::begin_label`] of a C string (no allocation).
+    pub fn begin_label_c(&mut self, name: &std::ffi::CStr, color: [f32; 4]) {
+        if let Some(debug) = &self.ctx.shared.debug_device {
+            let label = vk::DebugUtilsLabelEXT::default().label_name(name).color(color);
             // SAFETY: recording command buffer; the label string outlives the call.
             unsafe { debug.cmd_begin_debug_utils_label(self.cmd, &label) };
         }
@@ -176,24 +167,34 @@ impl CommandRecorder {
             .map(|(i, _)| (i.desc().width, i.desc().height))
             .or(depth.map(|(i, _)| (i.desc().width, i.desc().height)))
             .unwrap_or((1, 1));
-        let color_infos: Vec<_> = colors
-            .iter()
-            .map(|(image, load)| {
-                let (op, clear) = match load {
-                    LoadOp::Clear(c) => (vk::AttachmentLoadOp::CLEAR, *c),
-                    LoadOp::Load => (vk::AttachmentLoadOp::LOAD, [0.0; 4]),
-                    LoadOp::DontCare => (vk::AttachmentLoadOp::DONT_CARE, [0.0; 4]),
-                };
-                vk::RenderingAttachmentInfo::default()
-                    .image_view(image.view)
-                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                    .load_op(op)
-                    .store_op(vk::AttachmentStoreOp::STORE)
-                    .clear_value(vk::ClearValue {
-                        color: vk::ClearColorValue { float32: clear },
-                    })
-            })
-            .collect();
+        // On the stack (no allocation per pass); more attachments than any
+        // device offers spill to the heap.
+        let color_info = |(image, load): &(&Image, LoadOp)| {
+            let (op, clear) = match load {
+                LoadOp::Clear(c) => (vk::AttachmentLoadOp::CLEAR, *c),
+                LoadOp::Load => (vk::AttachmentLoadOp::LOAD, [0.0; 4]),
+                LoadOp::DontCare => (vk::AttachmentLoadOp::DONT_CARE, [0.0; 4]),
+            };
+            vk::RenderingAttachmentInfo::default()
+                .image_view(image.view)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(op)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    color: vk::ClearColorValue { float32: clear },
+                })
+        };
+        let mut inline = [vk::RenderingAttachmentInfo::default(); 8];
+        let spilled: Vec<vk::RenderingAttachmentInfo<'_>>;
+        let color_infos: &[vk::RenderingAttachmentInfo<'_>] = if colors.len() <= inline.len() {
+            for (slot, color) in inline.iter_mut().zip(colors) {
+                *slot = color_info(color);
+            }
+            &inline[..colors.len()]
+        } else {
+            spilled = colors.iter().map(color_info).collect();
+            &spilled
+        };
         let depth_info = depth.map(|(image, clear)| {
             // A depth buffer the graph declared read-only is neither cleared nor stored.
             let read_only = image.state().layout == vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL;
@@ -228,7 +229,7 @@ impl CommandRecorder {
         let mut info = vk::RenderingInfo::default()
             .render_area(area)
             .layer_count(1)
-            .color_attachments(&color_infos);
+            .color_attachments(color_infos);
         if let Some(d) = depth_info.as_ref() {
             info = info.depth_attachment(d);
         }
@@ -398,5 +399,72 @@ impl Context {
         // SAFETY: the submission completed (or was never made), so the pool is idle.
         unsafe { device.destroy_command_pool(pool, None) };
         result
+    }
+}
+
+/// Barriers gathered on the stack and recorded as few dependencies as
+/// possible (one unless more than [`BarrierBatch::CAPACITY`] of a kind):
+/// the frame's barriers allocate nothing.
+pub(crate) struct BarrierBatch {
+    buffers: [vk::BufferMemoryBarrier2<'static>; BarrierBatch::CAPACITY],
+    images: [vk::ImageMemoryBarrier2<'static>; BarrierBatch::CAPACITY],
+    counts: (usize, usize),
+}
+
+impl Default for BarrierBatch {
+    fn default() -> Self {
+        BarrierBatch {
+            buffers: [vk::BufferMemoryBarrier2::default(); BarrierBatch::CAPACITY],
+            images: [vk::ImageMemoryBarrier2::default(); BarrierBatch::CAPACITY],
+            counts: (0, 0),
+        }
+    }
+}
+
+impl BarrierBatch {
+    pub(crate) const CAPACITY: usize = 32;
+
+    /// Adds a barrier of `buffer` (recording the batch first when full).
+    pub(crate) fn buffer(&mut self, cmd: &mut CommandRecorder, buffer: &Buffer, b: &Barrier) {
+        if self.counts.0 == Self::CAPACITY {
+            self.flush(cmd);
+        }
+        self.buffers[self.counts.0] = vk::BufferMemoryBarrier2::default()
+            .src_stage_mask(b.src_stages)
+            .src_access_mask(b.src_access)
+            .dst_stage_mask(b.dst_stages)
+            .dst_access_mask(b.dst_access)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .buffer(buffer.raw)
+            .offset(0)
+            .size(vk::WHOLE_SIZE);
+        self.counts.0 += 1;
+    }
+
+    /// Adds a barrier of `image` (recording the batch first when full).
+    pub(crate) fn image(&mut self, cmd: &mut CommandRecorder, image: &Image, b: &Barrier) {
+        if self.counts.1 == Self::CAPACITY {
+            self.flush(cmd);
+        }
+        self.images[self.counts.1] = vk::ImageMemoryBarrier2::default()
+            .src_stage_mask(b.src_stages)
+            .src_access_mask(b.src_access)
+            .dst_stage_mask(b.dst_stages)
+            .dst_access_mask(b.dst_access)
+            .old_layout(b.old_layout)
+            .new_layout(b.new_layout)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(image.raw)
+            .subresource_range(subresource_range(image.aspect()));
+        self.counts.1 += 1;
+    }
+
+    /// Records the gathered barriers as one dependency and empties the batch.
+    pub(crate) fn flush(&mut self, cmd: &mut CommandRecorder) {
+        let (b, i) = self.counts;
+        cmd.pipeline_barrier(&self.buffers[..b], &self.images[..i]);
+        self.counts = (0, 0);
     }
 }

@@ -555,6 +555,12 @@ impl Context {
                 .garbage
                 .lock()
                 .map_err(|_| Error::Device("garbage lock poisoned".into()))?;
+            if !list.iter().any(|(v, _)| *v <= done) {
+                // Nothing to destroy: leave the list (and its memory) alone.
+                drop(list);
+                self.shared.heap.recycle(done);
+                return Ok(());
+            }
             let (ready, waiting): (Vec<_>, Vec<_>) = list.drain(..).partition(|(v, _)| *v <= done);
             *list = waiting;
             ready.into_iter().map(|(_, g)| g).collect()

@@ -38,6 +38,9 @@ pub struct FrameRing {
     ctx: Context,
     slots: Vec<FrameSlot>,
     next_frame: u64,
+    /// Reused by every timestamp read (no allocation per frame).
+    ticks: Vec<u64>,
+    spare_timestamps: Vec<Vec<f64>>,
 }
 
 /// A frame being recorded.
@@ -86,6 +89,8 @@ impl FrameRing {
             ctx: ctx.clone(),
             slots,
             next_frame: 0,
+            ticks: Vec::new(),
+            spare_timestamps: Vec::new(),
         })
     }
 
@@ -94,28 +99,40 @@ impl FrameRing {
         &self.ctx
     }
 
-    fn read_timestamps(&self, slot: usize) -> Result<Option<CompletedFrame>> {
+    /// Gives back a completed frame's memory for the next timestamp read.
+    pub fn recycle(&mut self, completed: CompletedFrame) {
+        if self.spare_timestamps.len() < FRAMES_IN_FLIGHT {
+            self.spare_timestamps.push(completed.timestamps_ns);
+        }
+    }
+
+    fn read_timestamps(&mut self, slot: usize) -> Result<Option<CompletedFrame>> {
         let s = &self.slots[slot];
         if s.submitted == 0 || s.written_queries == 0 {
             return Ok(None);
         }
-        let mut ticks = vec![0u64; s.written_queries as usize];
+        let ticks = &mut self.ticks;
+        ticks.clear();
+        ticks.resize(s.written_queries as usize, 0);
         // SAFETY: the slot's submission completed (the caller waited), so every
         // query it wrote is available.
         unsafe {
             self.ctx.shared.device.get_query_pool_results(
                 s.queries,
                 0,
-                &mut ticks,
+                ticks,
                 vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
             )
         }
         .map_err(vk_err("vkGetQueryPoolResults"))?;
         let period = self.ctx.shared.limits.timestamp_period as f64;
         let first = ticks.iter().copied().min().unwrap_or(0);
+        let mut timestamps_ns = self.spare_timestamps.pop().unwrap_or_default();
+        timestamps_ns.clear();
+        timestamps_ns.extend(ticks.iter().map(|&t| (t.wrapping_sub(first)) as f64 * period));
         Ok(Some(CompletedFrame {
             frame: s.frame,
-            timestamps_ns: ticks.iter().map(|&t| (t.wrapping_sub(first)) as f64 * period).collect(),
+            timestamps_ns,
         }))
     }
 

@@ -248,6 +248,9 @@ impl DescriptorHeap {
     pub fn recycle(&self, completed: u64) {
         if let Ok(mut handles) = self.handles.lock() {
             for allocator in handles.iter_mut() {
+                if !allocator.pending.iter().any(|(after, _)| *after <= completed) {
+                    continue;
+                }
                 let (ready, waiting): (Vec<_>, Vec<_>) =
                     allocator.pending.drain(..).partition(|(after, _)| *after <= completed);
                 allocator.pending = waiting;

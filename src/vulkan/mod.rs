@@ -16,6 +16,7 @@ pub use ash::vk::{
     AccessFlags2, BufferUsageFlags, CompareOp, Format, ImageLayout, ImageUsageFlags, PipelineStageFlags2,
     PrimitiveTopology,
 };
+pub(crate) use commands::BarrierBatch;
 pub use commands::{CommandRecorder, LoadOp};
 pub use context::{Context, ContextOptions, DeviceInfo};
 pub use device_select::DeviceSelector;

@@ -70,8 +70,9 @@ impl ValidationReport {
         self.messages.lock().map(|m| m.clone()).unwrap_or_default()
     }
 
-    fn record(&self, severity: vk::DebugUtilsMessageSeverityFlagsEXT, text: String) {
-        if self.set_aside_bindless_hazards && is_descriptor_array_hazard(&text) {
+    /// Counts a message (allocating only for those kept: errors and warnings).
+    fn record(&self, severity: vk::DebugUtilsMessageSeverityFlagsEXT, text: &str) {
+        if self.set_aside_bindless_hazards && is_descriptor_array_hazard(text) {
             self.set_aside.fetch_add(1, Ordering::SeqCst);
             log::debug!("validation (set aside, layer bug #3450): {text}");
             return;
@@ -87,7 +88,7 @@ impl ValidationReport {
             return;
         }
         if let Ok(mut messages) = self.messages.lock() {
-            messages.push(text);
+            messages.push(text.to_string());
         }
     }
 }
@@ -133,12 +134,14 @@ unsafe extern "system" fn debug_callback(
             return vk::FALSE;
         }
         let report = &*(user_data as *const ValidationReport);
+        // Borrowed unless the message is not UTF-8: the layers' per-draw
+        // messages (INFO, the set-aside hazards) allocate nothing.
         let text = (*data)
             .message_as_c_str()
-            .map(|s| s.to_string_lossy().into_owned())
+            .map(|s| s.to_string_lossy())
             .unwrap_or_default();
         // Loader chatter ("Inserted device layer", ICD search) is INFO and not counted.
-        report.record(severity, text);
+        report.record(severity, &text);
     }
     vk::FALSE
 }
@@ -215,17 +218,17 @@ mod tests {
     #[test]
     fn old_layers_set_aside_only_descriptor_array_hazards() {
         let report = ValidationReport::for_layer(vk::make_api_version(0, 1, 3, 239));
-        report.record(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR, BINDLESS.into());
+        report.record(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR, BINDLESS);
         assert_eq!((report.errors(), report.set_aside()), (0, 1));
-        report.record(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR, ATTACHMENT.into());
+        report.record(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR, ATTACHMENT);
         assert_eq!((report.errors(), report.set_aside()), (1, 1));
     }
 
     #[test]
     fn fixed_layers_count_everything() {
         let report = ValidationReport::for_layer(BINDLESS_SYNCVAL_FIX);
-        report.record(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR, BINDLESS.into());
-        report.record(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING, "a warning".into());
+        report.record(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR, BINDLESS);
+        report.record(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING, "a warning");
         assert_eq!((report.errors(), report.warnings(), report.set_aside()), (1, 1, 0));
     }
 }

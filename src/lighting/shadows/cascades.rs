@@ -196,14 +196,15 @@ impl CascadePlan {
 
 /// View depths of the `n + 1` split planes over `[near, far]`.
 pub fn split_depths(near: f64, far: f64, n: u32, lambda: f64) -> Vec<f64> {
-    (0..=n)
-        .map(|i| {
-            let f = f64::from(i) / f64::from(n);
-            let log = near * (far / near).powf(f);
-            let uniform = near + (far - near) * f;
-            lambda * log + (1.0 - lambda) * uniform
-        })
-        .collect()
+    (0..=n).map(|i| split_depth(near, far, (i, n), lambda)).collect()
+}
+
+/// Split `i` of `n` of [`split_depths`].
+fn split_depth(near: f64, far: f64, (i, n): (u32, u32), lambda: f64) -> f64 {
+    let f = f64::from(i) / f64::from(n);
+    let log = near * (far / near).powf(f);
+    let uniform = near + (far - near) * f;
+    lambda * log + (1.0 - lambda) * uniform
 }
 
 /// Sun-space basis: x, y across the sun, z towards it; depends only on the sun.
@@ -237,6 +238,27 @@ pub fn plan_cascades(
     settings: &ShadowSettings,
     atlas: u32,
 ) -> Result<CascadePlan> {
+    let mut plan = CascadePlan {
+        cascades: Vec::new(),
+        sun: DVec3::Z,
+        basis: [DVec3::X, DVec3::Y, DVec3::Z],
+        atlas,
+        atlas_size: settings.atlas_size,
+        pcf_radius: settings.pcf_radius,
+    };
+    plan_cascades_into(&mut plan, (camera, aspect), sun, bounds, settings, atlas)?;
+    Ok(plan)
+}
+
+/// [`plan_cascades`] into `plan`, reusing its memory (no allocation).
+pub fn plan_cascades_into(
+    plan: &mut CascadePlan,
+    (camera, aspect): (&Camera, f64),
+    sun: Vec3,
+    bounds: SceneBounds,
+    settings: &ShadowSettings,
+    atlas: u32,
+) -> Result<()> {
     settings.validate()?;
     camera.validate()?;
     let sun = sun.as_dvec3();
@@ -246,7 +268,12 @@ pub fn plan_cascades(
     let sun = sun.normalize();
     let basis = sun_basis(sun);
     let far = camera.far.min(settings.max_distance).max(camera.near * 1.001);
-    let splits = split_depths(camera.near, far, settings.cascades, settings.lambda);
+    let n = settings.cascades.clamp(1, MAX_CASCADES as u32);
+    let mut split_array = [0.0; MAX_CASCADES + 1];
+    for (i, s) in split_array.iter_mut().enumerate().take(n as usize + 1) {
+        *s = split_depth(camera.near, far, (i as u32, n), settings.lambda);
+    }
+    let splits = &split_array[..n as usize + 1];
     let tan_y = (0.5 * camera.fov_y_deg.to_radians()).tan();
     let k = tan_y * (1.0 + aspect * aspect).sqrt();
     let quadrant = f64::from(settings.quadrant());
@@ -254,7 +281,8 @@ pub fn plan_cascades(
     let margin = 2.0 * f64::from(settings.pcf_radius) + 8.0;
     let forward = camera.forward();
     let top = bounds.corners().iter().map(|p| p.dot(sun)).fold(f64::MIN, f64::max);
-    let mut cascades = Vec::with_capacity(splits.len() - 1);
+    let mut cascades = std::mem::take(&mut plan.cascades);
+    cascades.clear();
     for (i, w) in splits.windows(2).enumerate() {
         let (c, r) = slice_sphere(w[0], w[1], k);
         // Quantised so the size does not flicker with rounding.
@@ -293,14 +321,15 @@ pub fn plan_cascades(
             depth: [back, front],
         });
     }
-    Ok(CascadePlan {
+    *plan = CascadePlan {
         cascades,
         sun,
         basis,
         atlas,
         atlas_size: settings.atlas_size,
         pcf_radius: settings.pcf_radius,
-    })
+    };
+    Ok(())
 }
 
 #[cfg(test)]

@@ -29,7 +29,7 @@ use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 
-pub use cascades::{plan_cascades, CascadePlan, SceneBounds, ShadowSettings};
+pub use cascades::{plan_cascades, plan_cascades_into, Cascade, CascadePlan, SceneBounds, ShadowSettings};
 
 use crate::error::{Error, Result};
 use crate::graph::{ImageAccess, ImageId, RenderGraph};
@@ -92,6 +92,8 @@ pub struct ShadowMaps {
     settings: ShadowSettings,
     bounds: SceneBounds,
     views: Vec<ShadowView>,
+    /// The previous frame's plans, reused ([`Technique::recycle`]).
+    spare: Vec<(ViewIndex, CascadePlan)>,
 }
 
 impl ShadowMaps {
@@ -109,6 +111,7 @@ impl ShadowMaps {
             settings,
             bounds,
             views: Vec::new(),
+            spare: Vec::new(),
         })
     }
 
@@ -196,6 +199,30 @@ impl ShadowMaps {
         }
         Ok(plan)
     }
+
+    /// [`ShadowMaps::plan`] into `plan`, reusing its memory.
+    fn plan_into(
+        &self,
+        plan: &mut CascadePlan,
+        (index, view): (ViewIndex, &View),
+        sun: glam::Vec3,
+        mode: ShadowMode,
+    ) -> Result<()> {
+        let target = self.target(index)?;
+        let camera = view.culling_camera();
+        plan_cascades_into(
+            plan,
+            (&camera, view.culling_aspect()),
+            sun,
+            self.bounds,
+            &self.settings,
+            target.handle,
+        )?;
+        if mode != ShadowMode::Cascaded {
+            plan.cascades.clear();
+        }
+        Ok(())
+    }
 }
 
 impl Technique for ShadowMaps {
@@ -208,16 +235,26 @@ impl Technique for ShadowMaps {
     /// Plans every declared view's cascades for the frame's sun.
     fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<ShadowFrame> {
         let sun = frame.lighting.sun_direction();
-        let mut views = Vec::with_capacity(self.views.len());
-        for v in &self.views {
+        let mut views = std::mem::take(&mut self.spare);
+        views.truncate(self.views.len());
+        for (k, v) in self.views.iter().enumerate() {
             let index = v.target.view;
             let view = frame
                 .views
                 .get(index)
                 .ok_or_else(|| Error::Graph(format!("shadows: the frame has no view {index}")))?;
-            views.push((index, self.plan(index, view, sun, frame.lighting.shadows)?));
+            if views.len() <= k {
+                views.push((index, self.plan(index, view, sun, frame.lighting.shadows)?));
+                continue;
+            }
+            views[k].0 = index;
+            self.plan_into(&mut views[k].1, (index, view), sun, frame.lighting.shadows)?;
         }
         Ok(ShadowFrame { views })
+    }
+
+    fn recycle(&mut self, previous: ShadowFrame) {
+        self.spare = previous.views;
     }
 }
 

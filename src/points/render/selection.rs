@@ -100,9 +100,34 @@ pub fn plan_frame(
     view_proj: DMat4,
     pixel: f64,
 ) -> FramePlan {
+    let mut plan = FramePlan::default();
+    plan_frame_into(&mut plan, scene, objects, (eye, view, view_proj), pixel);
+    plan
+}
+
+/// [`plan_frame`] into `plan`, reusing its memory (no allocation once its
+/// vectors have grown to a frame's size).
+pub fn plan_frame_into(
+    plan: &mut FramePlan,
+    scene: &PointScene,
+    objects: &[ObjectLayout],
+    (eye, view, view_proj): (DVec3, DMat4, DMat4),
+    pixel: f64,
+) {
     let planes = frustum_planes(view_proj);
-    let mut plan = FramePlan {
+    let (mut records, mut draws, mut triangle_draws) = (
+        std::mem::take(&mut plan.records),
+        std::mem::take(&mut plan.draws),
+        std::mem::take(&mut plan.triangle_draws),
+    );
+    records.clear();
+    draws.clear();
+    triangle_draws.clear();
+    *plan = FramePlan {
         instances: scene.instances.len(),
+        records,
+        draws,
+        triangle_draws,
         ..FramePlan::default()
     };
     for (index, inst) in scene.instances.iter().enumerate() {
@@ -121,19 +146,6 @@ pub fn plan_frame(
         }
         // r_lo in object units: the tree's intervals are in object units.
         let r_lo = ((((eye - centre).length() - radius) / scale).max(0.0)) as f32;
-        let ranges: Vec<(u32, usize)> = match &layout.clusters {
-            None => vec![(layout.first, tree.prefix_len(r_lo))],
-            Some(clustered) => {
-                let eye_object = model.inverse().transform_point3(eye).as_vec3();
-                clustered
-                    .clusters
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, c)| object.two_sided || !c.is_back_facing(eye_object, c.centre, c.radius))
-                    .map(|(k, c)| (layout.first + c.first, clustered.cluster_prefix_len(k, r_lo)))
-                    .collect()
-            }
-        };
         let model_view = (view * model).as_mat4().to_cols_array();
         let record = |first: u32, count: usize| GpuInstance {
             model_view,
@@ -147,7 +159,10 @@ pub fn plan_frame(
         };
         let first_record = plan.records.len() as u32;
         let mut drawn = false;
-        for (first, count) in ranges.into_iter().filter(|&(_, n)| n > 0) {
+        let mut push = |plan: &mut FramePlan, first: u32, count: usize| {
+            if count == 0 {
+                return;
+            }
             plan.draws.push(InstanceDraw {
                 record: plan.records.len() as u32,
                 count: count as u32,
@@ -155,6 +170,17 @@ pub fn plan_frame(
             plan.records.push(record(first, count));
             plan.prefix_splats += count as u64;
             drawn = true;
+        };
+        match &layout.clusters {
+            None => push(plan, layout.first, tree.prefix_len(r_lo)),
+            Some(clustered) => {
+                let eye_object = model.inverse().transform_point3(eye).as_vec3();
+                let visible = (clustered.clusters.iter().enumerate())
+                    .filter(|(_, c)| object.two_sided || !c.is_back_facing(eye_object, c.centre, c.radius));
+                for (k, c) in visible {
+                    push(plan, layout.first + c.first, clustered.cluster_prefix_len(k, r_lo));
+                }
+            }
         }
         let triangles = object.hybrid.as_ref().map_or(0, |h| h.prefix_len(r_lo, tree.epsilon));
         if triangles > 0 {
@@ -173,7 +199,6 @@ pub fn plan_frame(
             plan.list_splats += tree.nodes.len() as u64;
         }
     }
-    plan
 }
 
 #[cfg(test)]

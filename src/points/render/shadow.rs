@@ -27,8 +27,8 @@ use super::PointRenderer;
 use crate::error::{Error, Result};
 use crate::graph::{BufferAccess, BufferId, ImageAccess, RenderGraph, Stage, UploadRegion};
 use crate::lighting::shadows::{
-    plan_cascades, record_cascades, CascadePlan, SceneBounds, ShadowFrame, ShadowMaps, ShadowSettings, ShadowTarget,
-    SHADOW_FORMAT,
+    plan_cascades, plan_cascades_into, record_cascades, CascadePlan, SceneBounds, ShadowFrame, ShadowMaps,
+    ShadowSettings, ShadowTarget, SHADOW_FORMAT,
 };
 use crate::points::scene::PointScene;
 use crate::shaders;
@@ -94,6 +94,11 @@ pub struct PointShadows {
     settings: ShadowSettings,
     bounds: SceneBounds,
     views: Vec<ShadowView>,
+    /// Reused every frame (no allocation in steady state): the cascades
+    /// being planned, the caster records, and the previous frame's draws.
+    scratch_plan: Option<CascadePlan>,
+    records: Vec<ShadowInstance>,
+    spare: Vec<(ViewIndex, Vec<ShadowDraw>)>,
 }
 
 /// The box around every instance's bounding sphere, or None without instances.
@@ -126,6 +131,9 @@ impl PointShadows {
             settings: *shadows.settings(),
             bounds: shadows.bounds(),
             views: Vec::new(),
+            scratch_plan: None,
+            records: Vec::new(),
+            spare: Vec::new(),
         }
     }
 
@@ -209,10 +217,17 @@ impl PointShadows {
 
     /// The caster records of one view for `plan`, and its draws.
     /// (`pixel`: the view's pixel width at unit distance, for thinning.)
-    fn plan_view(&self, eye: DVec3, plan: &CascadePlan, pixel: f64) -> (Vec<ShadowInstance>, Vec<ShadowDraw>) {
-        let (mut records, mut draws) = (Vec::new(), Vec::new());
+    fn plan_view(
+        &self,
+        eye: DVec3,
+        plan: &CascadePlan,
+        pixel: f64,
+        (records, draws): (&mut Vec<ShadowInstance>, &mut Vec<ShadowDraw>),
+    ) {
+        records.clear();
+        draws.clear();
         if plan.count() == 0 {
-            return (records, draws);
+            return;
         }
         for (index, inst) in self.scene.instances.iter().enumerate() {
             let object = &self.scene.objects[inst.object];
@@ -227,14 +242,11 @@ impl PointShadows {
                 continue;
             }
             let r_lo = ((((eye - centre).length() - radius) / scale).max(0.0)) as f32;
-            let ranges: Vec<(u32, usize)> = match &layout.clusters {
-                None => vec![(layout.first, tree.prefix_len(r_lo))],
-                Some(c) => (c.clusters.iter().enumerate())
-                    .map(|(k, cl)| (layout.first + cl.first, c.cluster_prefix_len(k, r_lo)))
-                    .collect(),
-            };
             let model = model.as_mat4().to_cols_array();
-            for (first, count) in ranges.into_iter().filter(|&(_, n)| n > 0) {
+            let mut push = |first: u32, count: usize| {
+                if count == 0 {
+                    return;
+                }
                 draws.push(ShadowDraw {
                     record: records.len() as u32,
                     count: count as u32,
@@ -243,9 +255,16 @@ impl PointShadows {
                     model,
                     params: [scale as f32, f32::from_bits(first), f32::from_bits(count as u32), 0.0],
                 });
+            };
+            match &layout.clusters {
+                None => push(layout.first, tree.prefix_len(r_lo)),
+                Some(c) => {
+                    for (k, cl) in c.clusters.iter().enumerate() {
+                        push(layout.first + cl.first, c.cluster_prefix_len(k, r_lo));
+                    }
+                }
             }
         }
-        (records, draws)
     }
 }
 
@@ -259,26 +278,41 @@ impl Technique for PointShadows {
     /// Per view: the cascades (as [`ShadowMaps`] plans them), the instances
     /// that can cast into them and their prefixes, uploaded as records.
     fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<PointShadowFrame> {
-        let mut views = Vec::with_capacity(self.views.len());
-        for v in &self.views {
+        let mut views = std::mem::take(&mut self.spare);
+        views.truncate(self.views.len());
+        let mut records = std::mem::take(&mut self.records);
+        for (k, v) in self.views.iter().enumerate() {
             let view = frame
                 .views
                 .get(v.index)
                 .ok_or_else(|| Error::Graph(format!("points.shadow: the frame has no view {}", v.index)))?;
             let sun = frame.lighting.sun_direction();
-            let (records, draws) = if frame.lighting.shadows == ShadowMode::Cascaded {
-                let plan = plan_cascades(
-                    &view.culling_camera(),
-                    view.culling_aspect(),
-                    sun,
-                    self.bounds,
-                    &self.settings,
-                    0,
-                )?;
-                self.plan_view(view.camera.eye, &plan, 1.0 / view.intrinsics().fy)
-            } else {
-                (Vec::new(), Vec::new())
-            };
+            if views.len() <= k {
+                views.push((v.index, Vec::new()));
+            }
+            let (index, draws) = &mut views[k];
+            *index = v.index;
+            records.clear();
+            draws.clear();
+            if frame.lighting.shadows == ShadowMode::Cascaded {
+                let camera = view.culling_camera();
+                let (aspect, bounds) = (view.culling_aspect(), self.bounds);
+                let mut plan = match self.scratch_plan.take() {
+                    Some(mut plan) => {
+                        plan_cascades_into(&mut plan, (&camera, aspect), sun, bounds, &self.settings, 0)?;
+                        plan
+                    }
+                    None => plan_cascades(&camera, aspect, sun, bounds, &self.settings, 0)?,
+                };
+                self.plan_view(
+                    view.camera.eye,
+                    &plan,
+                    1.0 / view.intrinsics().fy,
+                    (&mut records, draws),
+                );
+                plan.cascades.clear();
+                self.scratch_plan = Some(plan);
+            }
             let header = ShadowHeader {
                 eye: view.camera.eye.as_vec3().extend(0.0).to_array(),
             };
@@ -288,8 +322,12 @@ impl Technique for PointShadows {
                     .uploads
                     .write_at(v.region, HEADER_BYTES, bytemuck::cast_slice(&records))?;
             }
-            views.push((v.index, draws));
         }
+        self.records = records;
         Ok(PointShadowFrame { views })
+    }
+
+    fn recycle(&mut self, previous: PointShadowFrame) {
+        self.spare = previous.views;
     }
 }

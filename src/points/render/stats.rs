@@ -71,6 +71,9 @@ impl PointFrameStats {
     }
 }
 
+/// The most frames of statistics kept until taken (the oldest are dropped).
+pub const STATS_HISTORY: usize = crate::graph::DEFAULT_PROFILE_HISTORY;
+
 /// Collects the statistics: the counter of a frame slot is read when the
 /// slot is recorded again (its previous frame has completed) or at the end.
 pub(crate) struct StatsLog {
@@ -85,14 +88,21 @@ impl StatsLog {
         StatsLog {
             counters,
             pending: [None; FRAMES_IN_FLIGHT],
-            done: Vec::new(),
+            // Reserved up front: recording frames allocates nothing.
+            done: Vec::with_capacity(STATS_HISTORY),
         }
     }
 
     /// Fills in the GPU counts of `stats` from its slot's counter.
     fn read(&self, slot: usize, stats: &mut PointFrameStats) -> Result<()> {
         if let Some(c) = &self.counters {
-            let words: Vec<u32> = bytemuck::pod_collect_to_vec(&c[slot].mapped()?[..COUNTER_BYTES]);
+            let bytes = c[slot].mapped()?;
+            let word = |k: usize| {
+                bytes
+                    .get(4 * k..4 * k + 4)
+                    .map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            };
+            let words = [word(0), word(1), word(2)];
             stats.interval_passed = Some(u64::from(words[0]));
             stats.drawn_splats = Some(u64::from(words[1]));
             stats.triangles_drawn = Some(u64::from(words[2]));
@@ -106,6 +116,9 @@ impl StatsLog {
         let slot = (stats.frame % FRAMES_IN_FLIGHT as u64) as usize;
         if let Some(mut previous) = self.pending[slot].take() {
             self.read(slot, &mut previous)?;
+            if self.done.len() >= STATS_HISTORY {
+                self.done.remove(0);
+            }
             self.done.push(previous);
         }
         if let Some(c) = &self.counters {
@@ -124,7 +137,7 @@ impl StatsLog {
                 self.done.push(s);
             }
         }
-        let mut out = std::mem::take(&mut self.done);
+        let mut out = std::mem::replace(&mut self.done, Vec::with_capacity(STATS_HISTORY));
         out.sort_by_key(|s| s.frame);
         Ok(out)
     }

@@ -9,7 +9,7 @@ use std::time::Instant;
 use super::gpu_layout::{frame_header, gaussian_table, pack_nodes, HEADER_BYTES, INSTANCE_BYTES};
 use super::object_space::ObjectSpaceResources;
 use super::passes::{declare_ewa, declare_opaque, PointBuffers, PointView};
-use super::selection::{plan_frame, FramePlan, ObjectLayout};
+use super::selection::{plan_frame_into, FramePlan, ObjectLayout};
 use super::single_pass::{check_backend, declare_single_pass};
 use super::stats::{PointFrameStats, StatsLog};
 use super::triangles::TriangleBuffer;
@@ -67,6 +67,8 @@ pub struct PointRenderer {
     buffers: Option<PointBuffers>,
     views: Vec<PointView>,
     stats: StatsLog,
+    /// The previous frame's plans, reused ([`Technique::recycle`]).
+    spare: Vec<PointViewFrame>,
 }
 
 impl PointRenderer {
@@ -156,6 +158,7 @@ impl PointRenderer {
             settings,
             scene,
             layouts,
+            spare: Vec::new(),
         })
     }
 
@@ -268,12 +271,13 @@ impl Technique for PointRenderer {
     /// statistics (the GPU counts of the slot's previous frame are read now).
     fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<PointsFrame> {
         let started = Instant::now();
-        let mut views = Vec::with_capacity(self.views.len());
+        let mut views = std::mem::take(&mut self.spare);
         let mut stats = PointFrameStats {
             frame: frame.index,
             ..PointFrameStats::default()
         };
-        for point_view in &self.views {
+        views.truncate(self.views.len());
+        for (k, point_view) in self.views.iter().enumerate() {
             let view = frame
                 .views
                 .get(point_view.index)
@@ -287,7 +291,18 @@ impl Technique for PointRenderer {
             );
             let view_proj = view.view_proj_f64();
             let pixel = 1.0 / view.intrinsics().fy;
-            let plan = plan_frame(&self.scene, &self.layouts, camera.eye, view_matrix, view_proj, pixel);
+            // The previous frame's plan of this view, reused in place.
+            if views.len() <= k {
+                views.push(PointViewFrame {
+                    view: point_view.index,
+                    plan: FramePlan::default(),
+                });
+            }
+            let slot = &mut views[k];
+            slot.view = point_view.index;
+            let eye_view = (camera.eye, view_matrix, view_proj);
+            plan_frame_into(&mut slot.plan, &self.scene, &self.layouts, eye_view, pixel);
+            let plan = &slot.plan;
             frame.uploads.write_pod(point_view.frame, &header)?;
             frame
                 .uploads
@@ -297,13 +312,13 @@ impl Technique for PointRenderer {
             stats.list_splats += plan.list_splats;
             stats.prefix_splats += plan.prefix_splats;
             stats.prefix_triangles += plan.prefix_triangles;
-            views.push(PointViewFrame {
-                view: point_view.index,
-                plan,
-            });
         }
         stats.cpu_ms = started.elapsed().as_secs_f64() * 1e3;
         self.stats.begin_frame(stats)?;
         Ok(PointsFrame { views })
+    }
+
+    fn recycle(&mut self, previous: PointsFrame) {
+        self.spare = previous.views;
     }
 }
