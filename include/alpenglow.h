@@ -130,8 +130,9 @@ typedef struct ag_settings {
    */
   uint32_t settle_frames;
   /**
-   * Frames that may be submitted and not yet read (the readback ring);
-   * 0: the library's default. Reserved: today's renderer keeps 2.
+   * Frames that may be submitted and not yet read: the readback ring's
+   * slots, 1 to 16; 0: the library's default (3). A ticket can be read
+   * until this many later frames were submitted.
    */
   uint32_t readback_slots;
 } ag_settings;
@@ -392,8 +393,8 @@ enum ag_status ag_renderer_submit(struct ag_renderer *renderer,
 
 /**
  * If the frame of `ticket` is done, copies its views `0..view_count` into
- * `views` and returns `AG_OK`; else returns `AG_NOT_READY` at once.
- * (This version waits for the GPU instead of answering `AG_NOT_READY`.)
+ * `views` and returns `AG_OK`; else returns `AG_NOT_READY` at once
+ * (never blocks).
  *
  * # Safety
  * As `ag_renderer_render` for `renderer` and `views`.

@@ -1,12 +1,11 @@
 //! The only file of the C layer that names alpenglow's Rust API.
 //!
 //! It uses the crate's front door (`alpenglow::{Scene, Renderer, Settings,
-//! Camera, …}`) and implements the non-blocking pair over the blocking
-//! `render` + `read`: a submitted frame is remembered by its
-//! [`FrameOutcome`], and polling or waiting reads it (blocking until the
-//! GPU is done). When the readback ring lands (`alpenglow::{Ticket,
-//! FrameData}`, `Renderer::{submit, try_read, wait}`), this file switches
-//! to it and the rest of the C layer stays as it is.
+//! Camera, …}`): the blocking `ag_renderer_render` renders a settled frame
+//! and reads it (`Renderer::read_view`); the non-blocking pair goes through
+//! the readback ring (`Renderer::{submit, try_read, wait}`, copying each
+//! requested output of the borrowed `FrameData` straight into the caller's
+//! buffer).
 
 use std::collections::VecDeque;
 use std::path::Path;
@@ -15,19 +14,14 @@ pub use alpenglow::Settings as RenderSettings;
 pub use alpenglow::{Camera, Context, ContextOptions, DeviceSelector, Error, FrameImages, Renderer, Scene};
 
 use alpenglow::glam::DVec3;
-use alpenglow::{FrameOutcome, HeightmapOptions, RowOrder};
+use alpenglow::{HeightmapOptions, RowOrder};
 
 use crate::status::{Failure, Outcome};
 
-/// Frames the renderer keeps in flight (its `FRAMES_IN_FLIGHT`, which the
-/// front door does not export): the only `settings.readback_slots` besides 0
-/// this version honours, until the readback ring lands.
-const FRAMES_IN_FLIGHT: usize = 2;
-
-/// How many submitted frames are remembered for `poll`/`wait`: more than
-/// the renderer keeps in flight, so that the renderer (not this list)
-/// decides when a frame was overwritten.
-const REMEMBERED_FRAMES: usize = 8;
+/// How many submitted tickets are remembered for `poll`/`wait`: more than
+/// the ring's most slots, so that the renderer (not this list) decides
+/// when a frame was overwritten.
+const REMEMBERED_FRAMES: usize = 32;
 
 /// A height field from a caller's row-major samples (row 0 at y = 0),
 /// checked: at least 2×2, `columns·rows` samples, spacing in range, every
@@ -96,8 +90,18 @@ pub fn camera_parts(camera: &Camera) -> ([f64; 3], [f64; 3], [f64; 3], f64, f64,
 }
 
 /// The renderer's settings from the C settings' values.
-pub fn render_settings(width: u32, height: u32, msaa: u32, terrain_detail: bool) -> RenderSettings {
+/// `readback_slots` 0 keeps the library's default ring size.
+pub fn render_settings(
+    width: u32,
+    height: u32,
+    msaa: u32,
+    terrain_detail: bool,
+    readback_slots: u32,
+) -> RenderSettings {
     let mut settings = RenderSettings::new(width, height);
+    if readback_slots != 0 {
+        settings.readback_slots = readback_slots as usize;
+    }
     settings.msaa = msaa;
     settings.terrain.detail = terrain_detail;
     settings
@@ -138,6 +142,20 @@ impl Output {
         }
     }
 
+    /// The library's output.
+    pub fn library(self) -> alpenglow::Output {
+        match self {
+            Output::Rgba8 => alpenglow::Output::Rgba8,
+            Output::Hdr => alpenglow::Output::Hdr,
+            Output::Depth => alpenglow::Output::Depth,
+            Output::Distance => alpenglow::Output::Distance,
+            Output::Normal => alpenglow::Output::Normal,
+            Output::Class => alpenglow::Output::Class,
+            Output::Instance => alpenglow::Output::Instance,
+            Output::Motion => alpenglow::Output::Motion,
+        }
+    }
+
     /// The name of the output's field in `ag_frame_buffers`.
     pub fn field(self) -> &'static str {
         match self {
@@ -173,11 +191,16 @@ impl ViewImages {
     }
 }
 
-/// A renderer and the frames submitted to it that may still be read.
+/// Where one view's outputs go: per output, in [`Output::ALL`] order, the
+/// caller's bytes (at least its size, checked by the caller) or None.
+pub type Destinations<'a> = [Option<&'a mut [u8]>; 8];
+
+/// A renderer and the tickets of the frames submitted to it.
 pub struct FramePipe {
     renderer: Renderer,
-    /// (ticket, frame), oldest first.
-    submitted: VecDeque<(u64, FrameOutcome)>,
+    /// (C ticket, the renderer's ticket), oldest first; the renderer decides
+    /// whether a ticket's frame is still readable.
+    submitted: VecDeque<(u64, alpenglow::Ticket)>,
 }
 
 impl FramePipe {
@@ -202,46 +225,71 @@ impl FramePipe {
         views: usize,
     ) -> Outcome<Vec<ViewImages>> {
         let frame = self.renderer.render_views_settled(cameras, settle_frames)?;
-        self.read(&frame, views)
+        (0..views)
+            .map(|k| Ok(ViewImages(self.renderer.read_view(&frame, k)?)))
+            .collect()
     }
 
-    /// Submits a frame of `cameras`; its ticket (never 0).
+    /// Submits a frame of `cameras` into the readback ring; its ticket (never 0).
     pub fn submit(&mut self, cameras: &[Camera]) -> Outcome<u64> {
-        let frame = self.renderer.render_views(cameras)?;
-        let ticket = frame.frame + 1;
+        let ticket = self.renderer.submit(cameras)?;
+        let id = ticket.frame() + 1;
         if self.submitted.len() == REMEMBERED_FRAMES {
             self.submitted.pop_front();
         }
-        self.submitted.push_back((ticket, frame));
-        Ok(ticket)
+        self.submitted.push_back((id, ticket));
+        Ok(id)
     }
 
-    /// The first `views` views of the frame of `ticket`, or None while the
-    /// GPU is still at work. Interim: blocks until the frame is done
-    /// (the blocking renderer has no completion query), so never None.
-    pub fn try_read(&mut self, ticket: u64, views: usize) -> Outcome<Option<Vec<ViewImages>>> {
-        self.wait(ticket, views).map(Some)
+    /// Copies the frame of `ticket` into `destinations` (one per view) if
+    /// the GPU is done with it (true), else leaves them alone (false); never blocks.
+    pub fn try_read(&mut self, ticket: u64, destinations: &mut [Destinations]) -> Outcome<bool> {
+        let ticket = self.ticket(ticket)?;
+        match self.renderer.try_read(ticket)? {
+            Some(frame) => copy_frame(&frame, destinations).map(|()| true),
+            None => Ok(false),
+        }
     }
 
-    /// Blocks until the frame of `ticket` is done and reads its first `views` views.
-    pub fn wait(&mut self, ticket: u64, views: usize) -> Outcome<Vec<ViewImages>> {
-        let frame = (self.submitted.iter())
-            .find(|(t, _)| *t == ticket)
-            .map(|(_, frame)| *frame)
+    /// Waits for the frame of `ticket` and copies it into `destinations`.
+    pub fn wait(&mut self, ticket: u64, destinations: &mut [Destinations]) -> Outcome {
+        let ticket = self.ticket(ticket)?;
+        let frame = self.renderer.wait(ticket)?;
+        copy_frame(&frame, destinations)
+    }
+
+    fn ticket(&self, ticket: u64) -> Outcome<alpenglow::Ticket> {
+        (self.submitted.iter())
+            .find(|(id, _)| *id == ticket)
+            .map(|(_, t)| *t)
             .ok_or_else(|| {
                 Failure::invalid(
                     "ticket",
                     format!("{ticket} was not submitted to this renderer or is too old to read"),
                 )
-            })?;
-        self.read(&frame, views)
+            })
     }
+}
 
-    fn read(&mut self, frame: &FrameOutcome, views: usize) -> Outcome<Vec<ViewImages>> {
-        (0..views)
-            .map(|k| Ok(ViewImages(self.renderer.read_view(frame, k)?)))
-            .collect()
+/// Copies view `k` of `frame` into `destinations[k]`, converting as the
+/// ring's `copy_into` does (f16 normals to f32, ids de-interleaved).
+fn copy_frame(frame: &alpenglow::FrameData<'_>, destinations: &mut [Destinations]) -> Outcome {
+    for (k, destination) in destinations.iter_mut().enumerate() {
+        let view = frame.view(k)?;
+        for (output, dst) in Output::ALL.into_iter().zip(destination.iter_mut()) {
+            if let Some(dst) = dst {
+                let bytes = view.width() as usize * view.height() as usize * output.pixel_bytes();
+                let dst = dst.get_mut(..bytes).ok_or_else(|| {
+                    Failure::new(
+                        crate::ag_status::AG_ERROR_INTERNAL,
+                        "a destination shorter than checked",
+                    )
+                })?;
+                view.copy_into(output.library(), dst)?;
+            }
+        }
     }
+    Ok(())
 }
 
 /// A context with `validation` on the device `device` ("NAME" or "INDEX";
@@ -277,18 +325,4 @@ pub fn default_camera(scene: &Scene) -> Camera {
 /// The name of the context's device.
 pub fn device_name(ctx: &Context) -> String {
     ctx.info().name.clone()
-}
-
-/// Refuses a readback ring size this version cannot honour (interim:
-/// the renderer keeps a fixed number of frames in flight).
-pub fn check_readback_slots(slots: u32) -> Outcome {
-    let fixed = FRAMES_IN_FLIGHT;
-    match slots as usize {
-        0 => Ok(()),
-        n if n == fixed => Ok(()),
-        n => Err(Failure::invalid(
-            "settings.readback_slots",
-            format!("{n}; this version keeps {fixed} frames in flight (0: the default)"),
-        )),
-    }
 }

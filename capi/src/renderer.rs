@@ -45,8 +45,13 @@ pub unsafe extern "C" fn ag_renderer_create(
             // SAFETY: not NULL; the caller guarantees a valid struct.
             false => *unsafe { arg(settings, "settings") }?,
         };
-        adapter::check_readback_slots(settings.readback_slots)?;
-        let rust = adapter::render_settings(settings.width, settings.height, settings.msaa, settings.terrain_detail);
+        let rust = adapter::render_settings(
+            settings.width,
+            settings.height,
+            settings.msaa,
+            settings.terrain_detail,
+            settings.readback_slots,
+        );
         let pipe = FramePipe::new(&ctx.ctx, &scene.scene, rust)?;
         let renderer = ag_renderer {
             sizes: pipe.view_sizes(),
@@ -168,8 +173,8 @@ pub unsafe extern "C" fn ag_renderer_submit(
 }
 
 /// If the frame of `ticket` is done, copies its views `0..view_count` into
-/// `views` and returns `AG_OK`; else returns `AG_NOT_READY` at once.
-/// (This version waits for the GPU instead of answering `AG_NOT_READY`.)
+/// `views` and returns `AG_OK`; else returns `AG_NOT_READY` at once
+/// (never blocks).
 ///
 /// # Safety
 /// As `ag_renderer_render` for `renderer` and `views`.
@@ -184,13 +189,11 @@ pub unsafe extern "C" fn ag_renderer_poll(
         // SAFETY: the caller's promises, passed on (no cameras).
         let (renderer, _, views) = unsafe { frame_args(renderer, std::ptr::null(), 0, views, view_count) }?;
         renderer.check_buffers(views)?;
-        match renderer.pipe.try_read(ticket, views.len())? {
-            None => Ok(ag_status::AG_NOT_READY),
-            Some(images) => {
-                // SAFETY: the buffers were checked; the caller guarantees they are writable.
-                unsafe { copy_out(&images, views) };
-                Ok(ag_status::AG_OK)
-            }
+        // SAFETY: the buffers were checked; the caller guarantees they are writable.
+        let mut destinations = unsafe { destinations(views) };
+        match renderer.pipe.try_read(ticket, &mut destinations)? {
+            false => Ok(ag_status::AG_NOT_READY),
+            true => Ok(ag_status::AG_OK),
         }
     })
 }
@@ -211,9 +214,9 @@ pub unsafe extern "C" fn ag_renderer_wait(
         // SAFETY: the caller's promises, passed on (no cameras).
         let (renderer, _, views) = unsafe { frame_args(renderer, std::ptr::null(), 0, views, view_count) }?;
         renderer.check_buffers(views)?;
-        let images = renderer.pipe.wait(ticket, views.len())?;
         // SAFETY: the buffers were checked; the caller guarantees they are writable.
-        unsafe { copy_out(&images, views) };
+        let mut destinations = unsafe { destinations(views) };
+        renderer.pipe.wait(ticket, &mut destinations)?;
         Ok(ag_status::AG_OK)
     })
 }
@@ -287,6 +290,22 @@ unsafe fn array<'a, T>(pointer: *const T, count: usize, parameter: &str) -> Outc
         // SAFETY: not NULL; the caller guarantees `count` readable elements.
         (false, _) => Ok(unsafe { std::slice::from_raw_parts(pointer, count) }),
     }
+}
+
+/// The caller's buffers of `views` as byte slices, per output in `Output::ALL` order.
+///
+/// # Safety
+/// Every non-NULL buffer of `views` is writable for its `bytes` and
+/// aliases nothing else for `'a`.
+unsafe fn destinations<'a>(views: &[ag_frame_buffers]) -> Vec<adapter::Destinations<'a>> {
+    let slice = |buffer: crate::types::ag_buffer| -> Option<&'a mut [u8]> {
+        // SAFETY: non-NULL buffers are writable for `bytes` and unaliased (caller's promise).
+        (!buffer.data.is_null())
+            .then(|| unsafe { std::slice::from_raw_parts_mut(buffer.data.cast::<u8>(), buffer.bytes) })
+    };
+    (views.iter())
+        .map(|buffers| Output::ALL.map(|output| slice(buffers.get(output))))
+        .collect()
 }
 
 /// Copies every wanted output of `images` into the caller's buffers.

@@ -88,8 +88,9 @@ pub struct ag_settings {
     /// `ag_renderer_render`: how many frames in a row may bring no texture
     /// tile closer before it gives up (the atlas settles in a few frames).
     pub settle_frames: u32,
-    /// Frames that may be submitted and not yet read (the readback ring);
-    /// 0: the library's default. Reserved: today's renderer keeps 2.
+    /// Frames that may be submitted and not yet read: the readback ring's
+    /// slots, 1 to 16; 0: the library's default (3). A ticket can be read
+    /// until this many later frames were submitted.
     pub readback_slots: u32,
 }
 
