@@ -226,6 +226,9 @@ pub use texturing::streaming::MAX_TILE_BUDGET;
 /// # Ok::<(), alpenglow::Error>(())
 /// ```
 pub use renderer::Rig;
+/// The views of a [`Rig`]: pose relative to the rig's camera (or fixed in
+/// the world), lens and distortion, size and clip planes.
+pub use view::rig::{RigLens, RigPose, RigView};
 pub use renderer::{check_view, validate_size, MAX_IMAGE_SIDE};
 pub use renderer::{ViewSpec, MAX_VIEWS};
 pub use view::camera_path::{CameraPath, Orbit, DEFAULT_START_ANGLE_DEG};

@@ -29,7 +29,7 @@ use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 
-pub use cascades::{plan_cascades, plan_cascades_into, Cascade, CascadePlan, SceneBounds, ShadowSettings};
+pub use cascades::{plan_cascades, plan_cascades_into, CascadePlan, SceneBounds, ShadowSettings};
 
 use crate::error::{Error, Result};
 use crate::graph::{ImageAccess, ImageId, RenderGraph};
