@@ -226,13 +226,13 @@ pub use texturing::streaming::MAX_TILE_BUDGET;
 /// # Ok::<(), alpenglow::Error>(())
 /// ```
 pub use renderer::Rig;
-/// The views of a [`Rig`]: pose relative to the rig's camera (or fixed in
-/// the world), lens and distortion, size and clip planes.
-pub use view::rig::{RigLens, RigPose, RigView};
 pub use renderer::{check_view, validate_size, MAX_IMAGE_SIDE};
 pub use renderer::{ViewSpec, MAX_VIEWS};
 pub use view::camera_path::{CameraPath, Orbit, DEFAULT_START_ANGLE_DEG};
 pub use view::lens::{Distortion, Intrinsics};
+/// The views of a [`Rig`]: pose relative to the rig's camera (or fixed in
+/// the world), lens and distortion, size and clip planes.
+pub use view::rig::{RigLens, RigPose, RigView};
 /// A pinhole camera: eye, target, up, vertical field of view, near and far
 /// planes (metres, +z up).
 ///
@@ -312,7 +312,7 @@ pub use renderer::FrameImages;
 /// # Ok(()) }
 /// ```
 pub use renderer::Ticket;
-pub use renderer::{Element, FrameData, Output, Outputs, Plane, ViewData};
+pub use renderer::{Element, FrameData, Output, Outputs, Plane, ViewData, MAX_READBACK_SLOTS};
 pub use texturing::stats::{TextureFrameStats, TextureSummary};
 /// The semantic classes of [`FrameImages::class`]: terrain with a known
 /// surface layer k is `CLASS_LAYER_BASE + k`.

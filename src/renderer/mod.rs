@@ -391,7 +391,7 @@ impl Renderer {
     }
 
     /// Keeps the profiles of at most `frames` frames (at least 1; default
-    /// [`crate::graph::DEFAULT_PROFILE_HISTORY`]) until
+    /// `DEFAULT_PROFILE_HISTORY`) until
     /// [`Renderer::finish`] takes them: older ones are dropped and their
     /// memory reused, so frames allocate nothing for their profiles once
     /// the history is full.

@@ -39,7 +39,7 @@ impl Ticket {
 impl Renderer {
     /// Prepares, records and submits a frame of every view (view `k`
     /// through `cameras[k]`) and returns its ticket. Blocks only while the
-    /// GPU is more than [`crate::vulkan::FRAMES_IN_FLIGHT`] frames behind.
+    /// GPU is more than `FRAMES_IN_FLIGHT` frames behind.
     pub fn submit(&mut self, cameras: &[Camera]) -> Result<Ticket> {
         let outcome = self.render_views(cameras)?;
         Ok(Ticket {
