@@ -27,15 +27,18 @@ mod tests {
         }
     }
 
-    /// The CLI and the front-door example are clients of the public API
-    /// only: neither reaches into `alpenglow::bench`.
+    /// Every client of the crate uses only the front door: the CLI, the
+    /// examples, the integration tests and the Python and C bindings never
+    /// reach into `alpenglow::bench` (only `benchmarks/` may; the private
+    /// modules the compiler already refuses).
     #[test]
-    fn the_cli_and_drive_do_not_use_bench() {
+    fn clients_use_only_the_front_door() {
         let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-        let mut files = vec![root.join("src/main.rs"), root.join("examples/drive.rs")];
-        for entry in std::fs::read_dir(root.join("src/cli")).unwrap() {
-            files.push(entry.unwrap().path());
+        let mut files = vec![root.join("src/main.rs")];
+        for folder in ["src/cli", "examples", "tests", "python/src", "capi/src", "capi/tests"] {
+            collect_rust_files(&root.join(folder), &mut files);
         }
+        assert!(files.len() > 40, "only {} client files found", files.len());
         for file in files {
             let text = std::fs::read_to_string(&file).unwrap();
             assert!(
@@ -43,6 +46,18 @@ mod tests {
                 "{} uses alpenglow::bench",
                 file.display()
             );
+        }
+    }
+
+    /// The `.rs` files under `folder`, recursively.
+    fn collect_rust_files(folder: &Path, files: &mut Vec<std::path::PathBuf>) {
+        for entry in std::fs::read_dir(folder).unwrap() {
+            let path = entry.unwrap().path();
+            match path.is_dir() {
+                true => collect_rust_files(&path, files),
+                false if path.extension().is_some_and(|e| e == "rs") => files.push(path),
+                false => {}
+            }
         }
     }
 }

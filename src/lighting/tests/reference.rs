@@ -4,7 +4,7 @@
 //! within three standard errors, with two bounces, the sun separate and in
 //! the environment, chunked dispatches and progressive frames; the maps are
 //! not recomputed while the lighting stays the same. Under validation and
-//! synchronization validation. Timings: `examples/lighting_bench.rs`.
+//! synchronization validation. Timings: `benchmarks/src/bin/lighting_bench.rs`.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};

@@ -1,5 +1,5 @@
-//! Helpers shared by the point-rendering benchmarks (`examples/splat_bench.rs`,
-//! `examples/splat_modes_bench.rs`), included with `#[path]`.
+//! Helpers shared by the point-rendering benchmarks (`splat_bench`,
+//! `splat_modes_bench`).
 
 use alpenglow::bench::ROOT_R_MAX;
 use alpenglow::tools::spt::SequentialPointTree;

@@ -1,5 +1,5 @@
 //! Benchmark of point rendering (dissertation §10.1.7, §10.2, §10.3):
-//! `cargo run --release --example splat_bench [-- --quick]`.
+//! `cargo run --release -p alpenglow-bench --bin splat_bench [-- --quick]`.
 //!
 //! 1. Table 10.3: frames and splats per second of each primitive in the
 //!    three passes of EWA splatting (and in the opaque mode), the text's set
@@ -27,9 +27,6 @@
 //! normalisation, or opaque; not `points.shadow`, the sun's shadow map);
 //! splats/s = splats drawn (the vertex stage's count) / that time.
 
-#[path = "support/points.rs"]
-mod support;
-
 use alpenglow::bench::{PointInstance, QUADRUPLICATION_EXTRA_BYTES_PER_SPLAT};
 use alpenglow::files::load_point_object;
 use alpenglow::tools::profile::median;
@@ -39,8 +36,8 @@ use alpenglow::{
     Renderer, Scene, Settings, SplatMode, SplatPrimitive, SplatSettings,
 };
 
+use alpenglow_bench::points::{all_leaves, camera_at};
 use glam::DVec3;
-use support::{all_leaves, camera_at};
 
 const SIDE: u32 = 512;
 /// Surfels sampled from the bunny mesh (each a leaf): the text's N = 101 685.
@@ -126,7 +123,7 @@ fn main() {
         spt,
         ..PointLoadOptions::default()
     };
-    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/models");
+    let models = alpenglow_bench::repo_root().join("tests/data/models");
     if hybrid_only {
         hybrid_against_points(&ctx, &options, &models, frames);
         return;

@@ -4,7 +4,7 @@
 //! benchmark rather than a test. Prints queries/s and candidate·taps/s of
 //! each, the GPU time per pass, and whether the choices agree.
 //!
-//! `cargo run --release --example synth_search_bench -- [QUERIES [SIDE [WINDOW [REPEATS]]]]`
+//! `cargo run --release -p alpenglow-bench --bin synth_search_bench -- [QUERIES [SIDE [WINDOW [REPEATS]]]]`
 //! (default 256 queries, a 134² exemplar = 16384 candidates of window 7,
 //! 5 repeats; without validation; figures in docs/PERFORMANCE.md).
 

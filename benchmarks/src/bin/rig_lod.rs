@@ -3,7 +3,7 @@
 //! renderer does) with one grid for the union of the views (a sketch map
 //! around the rig, importance by distance alone, no frustum factor):
 //!
-//! `cargo run --release --example rig_lod -- [--dem tests/data/jacksboro-fault.png] [--height 2]`
+//! `cargo run --release -p alpenglow-bench --bin rig_lod -- [--dem tests/data/jacksboro-fault.png] [--height 2]`
 //!
 //! For each view of a `ring6` rig at 640×480, it prints how many of the
 //! grid's quads land in the view and their median and 90th-percentile

@@ -8,7 +8,7 @@
 //! * `reference`: one frame of the Monte Carlo reference (§9.2) of 129² and
 //!   513² fields at 64 and 256 paths per texel, one bounce.
 //!
-//! `cargo run --release --example lighting_bench -- bake|reference`
+//! `cargo run --release -p alpenglow-bench --bin lighting_bench -- bake|reference`
 //! (without validation; figures in docs/PERFORMANCE.md).
 
 use std::time::Instant;

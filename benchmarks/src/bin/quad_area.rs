@@ -4,9 +4,8 @@
 //! for the default scene and the Jacksboro DEM. No GPU needed: the CPU
 //! replica of warp-and-zoom (`alpenglow::bench`).
 //!
-//! `cargo run --release --example quad_area`
+//! `cargo run --release -p alpenglow-bench --bin quad_area`
 
-use std::path::Path;
 
 use alpenglow::bench::{projected_quad_areas, zoom_positions, DebugScalar, LodFrame};
 use alpenglow::files::load_heightmap;
@@ -21,7 +20,7 @@ const SIDE: usize = 512;
 fn main() -> alpenglow::Result<()> {
     let default = Scene::default_terrain()?;
     let dem = Scene::new(load_heightmap(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/jacksboro-fault.png"),
+        &alpenglow_bench::repo_root().join("tests/data/jacksboro-fault.png"),
         &HeightmapOptions {
             scale: 1.0,
             offset: 0.0,

@@ -1,6 +1,6 @@
 //! Benchmark of single-pass splatting with a fuzzy depth test (dissertation
 //! §10.4) against the three-pass mode (§10.2), in the same run:
-//! `cargo run --release --example splat_modes_bench [-- --quick]`.
+//! `cargo run --release -p alpenglow-bench --bin splat_modes_bench [-- --quick]`.
 //!
 //! The bunny sampled into ~100k surfels, every leaf drawn (a flat list, two
 //! sided: every splat goes through the EWA set-up), in a 512² window, from a
@@ -14,9 +14,6 @@
 //! M splats/s, the time of each pass, and the image quality: mean FLIP of the
 //! single-pass image against the three-pass one (same frame, tone-mapped).
 
-#[path = "support/points.rs"]
-mod support;
-
 use alpenglow::files::load_point_object;
 use alpenglow::tools::profile::median;
 use alpenglow::tools::spt::epsilon_from_pixels;
@@ -25,7 +22,7 @@ use alpenglow::{
     Renderer, Scene, Settings, SplatBackend, SplatMode, SplatSettings,
 };
 
-use support::{all_leaves, camera_at};
+use alpenglow_bench::points::{all_leaves, camera_at};
 
 const SIDE: u32 = 512;
 
@@ -116,7 +113,7 @@ fn main() {
         },
         ..PointLoadOptions::default()
     };
-    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/models");
+    let models = alpenglow_bench::repo_root().join("tests/data/models");
     let bunny = load_point_object(&models.join("stanford-bunny.obj"), &options).expect("bunny");
     let mut points = PointScene::default();
     let leaves = PointObject::new("bunny leaves", all_leaves(&bunny.tree));

@@ -1,8 +1,8 @@
 //! Writes the binary seed files of the fuzz corpus (`tests/data/fuzz/`):
-//! `cargo run --example fuzz_corpus`. The text seeds are written by hand;
+//! `cargo run -p alpenglow-bench --bin fuzz_corpus`. The text seeds are written by hand;
 //! see `tests/data/fuzz/README.md`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use alpenglow::bench::{ClipLine, ClipLines, Surfel};
 use alpenglow::files::write_spt;
@@ -10,7 +10,7 @@ use alpenglow::tools::spt::{build_spt, SptOptions};
 use glam::Vec3;
 
 fn corpus(path: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz").join(path)
+    alpenglow_bench::repo_root().join("tests/data/fuzz").join(path)
 }
 
 fn main() {

@@ -1,5 +1,5 @@
 //! Benchmark of the simulator cameras' post passes (§3.3; src/post):
-//! `cargo run --release --example post_bench [-- WIDTH HEIGHT]` (default
+//! `cargo run --release -p alpenglow-bench --bin post_bench [-- WIDTH HEIGHT]` (default
 //! 640×360 output).
 //!
 //! One graph with the three passes on synthetic images of a view's five

@@ -1,7 +1,7 @@
 //! Benchmark of surface layers from a real image (§8.3;
 //! `alpenglow::tools::layers`) on the Rocky Mountain pair of
 //! `tests/data/real-world` (304 × 374 image, 152 × 187 DEM):
-//! `cargo run --release --example layers_bench [-- RUNS]` (default 5).
+//! `cargo run --release -p alpenglow-bench --bin layers_bench [-- RUNS]` (default 5).
 //!
 //! Prints the median CPU time of each step over the runs — the quantities
 //! at the pixels (B-spline altitude and slope), the modelled light (with
@@ -9,7 +9,6 @@
 //! the distribution functions, the tree, the calibration of the noise bias
 //! — and of the whole `build_layers`.
 
-use std::path::Path;
 use std::time::Instant;
 
 use alpenglow::bench::{calibrate, classify, distributions, shading, tree, Registration};
@@ -28,7 +27,7 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 
 fn main() -> alpenglow::Result<()> {
     let runs: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(5).max(1);
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/real-world");
+    let dir = alpenglow_bench::repo_root().join("tests/data/real-world");
     let options = HeightmapOptions {
         spacing: Some(DVec2::new(233.6, 234.3)),
         rows: RowOrder::NorthUp,

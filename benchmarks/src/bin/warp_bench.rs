@@ -1,6 +1,6 @@
 //! Micro-benchmark of the CPU geometry image warp (dissertation §7.4.2; the
 //! text: "we can do the warping on the CPU in a few milliseconds"):
-//! `cargo run --release --example warp_bench`.
+//! `cargo run --release -p alpenglow-bench --bin warp_bench`.
 //!
 //! Times `warp`, `warp_into` (buffers reused, the per-frame case) and, for
 //! reference, the per-column variant and `importance_map` on a 128² sketch map
