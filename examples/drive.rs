@@ -1,7 +1,7 @@
 //! A driving simulator's frame loop (issue 14, part 8): a car drives over
 //! the real Jacksboro DEM (`tests/data/jacksboro-fault.png`) at 25 m/s in
 //! fixed steps of 1/30 s, the driver's eye 1.7 m above the ground query
-//! ([`alpenglow::terrain::ground`]: the terrain as drawn, with its
+//! ([`alpenglow::Ground`]: the terrain as drawn, with its
 //! procedural detail, §7.4.3), looking along the path; every step renders
 //! through [`Renderer`].
 //!
@@ -13,13 +13,12 @@
 
 use std::time::Instant;
 
-use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
-use alpenglow::profile::{median, summarize};
-use alpenglow::renderer::{Camera, RenderSettings, Renderer, Rig, Scene, ViewSpec};
-use alpenglow::terrain::ground::Ground;
-use alpenglow::terrain::zoom::quantile;
-use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
-use glam::{DVec2, DVec3};
+use alpenglow::files::load_heightmap;
+use alpenglow::glam::{DVec2, DVec3};
+use alpenglow::tools::profile::{median, quantile, summarize};
+use alpenglow::{
+    Camera, Context, ContextOptions, DeviceSelector, Ground, HeightmapOptions, Renderer, Rig, Scene, Settings, ViewSpec,
+};
 
 /// Car speed (m/s) and the fixed step (s).
 const SPEED: f64 = 25.0;
@@ -158,10 +157,8 @@ fn run(args: &Args) -> alpenglow::Result<()> {
         Some(rig) => rig.specs((args.width, args.height))?,
         None => vec![ViewSpec::new(args.width, args.height)],
     };
-    let settings = RenderSettings {
-        readback: false,
-        ..RenderSettings::for_views(specs.clone())
-    };
+    let mut settings = Settings::for_views(specs.clone());
+    settings.readback = false;
     let ground = scene.ground(&settings.terrain)?;
     let started = Instant::now();
     let mut renderer = Renderer::new(&ctx, &scene, settings)?;

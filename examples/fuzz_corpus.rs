@@ -4,10 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
-use alpenglow::points::build::clip::{ClipLine, ClipLines};
-use alpenglow::points::build::spt::{build_spt, SptOptions};
-use alpenglow::points::build::spt_file::write_spt;
-use alpenglow::points::Surfel;
+use alpenglow::bench::{ClipLine, ClipLines, Surfel};
+use alpenglow::files::write_spt;
+use alpenglow::tools::spt::{build_spt, SptOptions};
 use glam::Vec3;
 
 fn corpus(path: &str) -> PathBuf {

@@ -1,5 +1,5 @@
 //! Benchmark of surface layers from a real image (§8.3;
-//! `alpenglow::texturing::from_image`) on the Rocky Mountain pair of
+//! `alpenglow::tools::layers`) on the Rocky Mountain pair of
 //! `tests/data/real-world` (304 × 374 image, 152 × 187 DEM):
 //! `cargo run --release --example layers_bench [-- RUNS]` (default 5).
 //!
@@ -12,12 +12,11 @@
 use std::path::Path;
 use std::time::Instant;
 
-use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions, RowOrder};
-use alpenglow::io::limits::InputLimits;
-use alpenglow::profile::median;
-use alpenglow::texturing::from_image::{
-    build_layers, calibrate, classify, distributions, load_rgb_image, shading, tree, FromImageOptions, Registration,
-};
+use alpenglow::bench::{calibrate, classify, distributions, shading, tree, Registration};
+use alpenglow::files::{load_heightmap, InputLimits};
+use alpenglow::tools::layers::{build_layers, load_rgb_image, FromImageOptions};
+use alpenglow::tools::profile::median;
+use alpenglow::{HeightmapOptions, RowOrder};
 use glam::DVec2;
 
 /// Milliseconds `f` takes, with its result.

@@ -13,13 +13,11 @@
 
 use std::time::Instant;
 
-use alpenglow::graph::RenderGraph;
-use alpenglow::io::heightmap::HeightField;
-use alpenglow::lighting::constants::LightingFrame;
-use alpenglow::lighting::reference::{MonteCarloReference, ReferenceSettings};
-use alpenglow::lighting::sky_light::{BakeSettings, SkyLightBake};
-use alpenglow::view::lighting::sun_direction;
-use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector, FrameRing};
+use alpenglow::bench::{
+    sun_direction, BakeSettings, FrameRing, LightingFrame, MonteCarloReference, ReferenceSettings, RenderGraph,
+    SkyLightBake,
+};
+use alpenglow::{Context, ContextOptions, DeviceSelector, HeightField};
 use bytemuck::Zeroable;
 use glam::DVec2;
 

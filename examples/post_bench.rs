@@ -14,15 +14,13 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use alpenglow::graph::{ImageId, ImageInfo, RenderGraph};
-use alpenglow::post::distortion::{source_intrinsics, BrownConrady, DistortedCamera, Intrinsics, LensDistortion};
-use alpenglow::post::motion_blur::{MotionBlur, MotionBlurImages, MotionBlurSettings};
-use alpenglow::post::resample::{ImageKind, ResampleImage};
-use alpenglow::post::resolve::{supersampled_size, Resolve, ResolveDesc, ResolveFilter};
-use alpenglow::profile::median;
-use alpenglow::vulkan::{
-    Context, ContextOptions, DeviceSelector, Format, FrameRing, Image, ImageDesc, ImageUsageFlags,
+use alpenglow::bench::{
+    source_intrinsics, supersampled_size, BrownConrady, DistortedCamera, Format, FrameRing, Image, ImageDesc, ImageId,
+    ImageInfo, ImageKind, ImageUsageFlags, Intrinsics, LensDistortion, MotionBlur, MotionBlurImages, RenderGraph,
+    ResampleImage, Resolve, ResolveDesc, ResolveFilter,
 };
+use alpenglow::tools::profile::median;
+use alpenglow::{Context, ContextOptions, DeviceSelector, MotionBlurSettings};
 
 const WARMUP: usize = 3;
 const FRAMES: usize = 20;

@@ -2,16 +2,16 @@
 //! §7.4, Fig. 7.9): the projected area of the output grid's quads in pixels
 //! (median, 90th percentile, and their ratio) at the same vertex count,
 //! for the default scene and the Jacksboro DEM. No GPU needed: the CPU
-//! replica of warp-and-zoom ([`alpenglow::terrain::zoom`]).
+//! replica of warp-and-zoom (`alpenglow::bench`).
 //!
 //! `cargo run --release --example quad_area`
 
 use std::path::Path;
 
-use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
-use alpenglow::renderer::{Camera, Scene};
-use alpenglow::terrain::lod::{DebugScalar, LodFrame, LodMode, LodSettings};
-use alpenglow::terrain::zoom::{projected_quad_areas, quantile, zoom_positions};
+use alpenglow::bench::{projected_quad_areas, zoom_positions, DebugScalar, LodFrame};
+use alpenglow::files::load_heightmap;
+use alpenglow::tools::profile::quantile;
+use alpenglow::{Camera, HeightmapOptions, LodMode, LodSettings, Scene};
 use glam::{DVec2, DVec3};
 
 const WIDTH: u32 = 1280;

@@ -7,9 +7,10 @@
 
 use std::time::Instant;
 
-use alpenglow::renderer::{Camera, FrameData, Output, Outputs, RenderSettings, Renderer, Scene};
-use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
-use glam::DVec3;
+use alpenglow::glam::DVec3;
+use alpenglow::{
+    Camera, Context, ContextOptions, DeviceSelector, FrameData, Output, Outputs, Renderer, Scene, Settings,
+};
 
 struct Options {
     width: u32,
@@ -31,7 +32,7 @@ fn options() -> alpenglow::Result<Options> {
         let number = |what: &str| {
             value
                 .parse()
-                .map_err(|_| alpenglow::error::Error::invalid(what, format!("'{value}' is not a number")))
+                .map_err(|_| alpenglow::Error::invalid(what, format!("'{value}' is not a number")))
         };
         match pair[0].as_str() {
             "--width" => o.width = number("--width")?,
@@ -39,12 +40,7 @@ fn options() -> alpenglow::Result<Options> {
             "--frames" => o.frames = number("--frames")?,
             "--outputs" if value == "all" => o.outputs = Outputs::ALL,
             "--outputs" => o.outputs = value.split(',').map(str::parse).collect::<alpenglow::Result<_>>()?,
-            other => {
-                return Err(alpenglow::error::Error::invalid(
-                    "option",
-                    format!("unknown option {other}"),
-                ))
-            }
+            other => return Err(alpenglow::Error::invalid("option", format!("unknown option {other}"))),
         }
     }
     Ok(o)
@@ -101,7 +97,7 @@ fn main() -> alpenglow::Result<()> {
     })?;
     let mut scene = Scene::default_terrain()?;
     scene.add_rocks(200)?;
-    let mut settings = RenderSettings::new(o.width, o.height);
+    let mut settings = Settings::new(o.width, o.height);
     settings.outputs = o.outputs;
     let mut renderer = Renderer::new(&ctx, &scene, settings)?;
     renderer.set_profile_history(8);

@@ -10,10 +10,11 @@
 
 use std::time::Instant;
 
-use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
-use alpenglow::profile::median;
-use alpenglow::renderer::{Camera, RenderSettings, Renderer, Rig, Scene, ViewSpec};
-use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
+use alpenglow::files::load_heightmap;
+use alpenglow::tools::profile::median;
+use alpenglow::{
+    Camera, Context, ContextOptions, DeviceSelector, HeightmapOptions, Renderer, Rig, Scene, Settings, ViewSpec,
+};
 use glam::{DVec2, DVec3};
 
 struct Options {
@@ -124,13 +125,13 @@ fn main() -> alpenglow::Result<()> {
         name: String::new(),
         ..spec.clone()
     };
-    let one = Renderer::new(&ctx, &scene, RenderSettings::for_views(vec![alone(&specs[0])]))?;
+    let one = Renderer::new(&ctx, &scene, Settings::for_views(vec![alone(&specs[0])]))?;
     report("one view alone", &mut vec![(one, vec![cameras[0]])])?;
-    let shared = Renderer::new(&ctx, &scene, RenderSettings::for_views(specs.clone()))?;
+    let shared = Renderer::new(&ctx, &scene, Settings::for_views(specs.clone()))?;
     report("ring6, one renderer", &mut vec![(shared, cameras.clone())])?;
     let mut separate = Vec::new();
     for (spec, camera) in specs.iter().zip(&cameras) {
-        let renderer = Renderer::new(&ctx, &scene, RenderSettings::for_views(vec![alone(spec)]))?;
+        let renderer = Renderer::new(&ctx, &scene, Settings::for_views(vec![alone(spec)]))?;
         separate.push((renderer, vec![*camera]));
     }
     report("ring6, six renderers", &mut separate)?;

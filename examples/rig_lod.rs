@@ -12,11 +12,10 @@
 
 use std::time::Instant;
 
-use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
-use alpenglow::renderer::{Camera, Rig, Scene};
-use alpenglow::terrain::lod::{DebugScalar, LodFrame, LodSettings};
-use alpenglow::terrain::sketch_map::SketchAlignment;
-use alpenglow::terrain::zoom::{projected_quad_areas, quantile, zoom_positions};
+use alpenglow::bench::{projected_quad_areas, zoom_positions, DebugScalar, LodFrame};
+use alpenglow::files::load_heightmap;
+use alpenglow::tools::profile::quantile;
+use alpenglow::{Camera, HeightmapOptions, LodSettings, Rig, Scene, SketchAlignment};
 use glam::{DVec2, DVec3};
 
 const GRID: usize = 512;

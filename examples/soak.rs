@@ -19,14 +19,11 @@
 
 use std::time::Instant;
 
-use alpenglow::lighting::shadows::ShadowSettings;
-use alpenglow::profile::{median, summarize, FrameProfile};
-use alpenglow::renderer::{RenderSettings, Renderer, Scene};
-use alpenglow::terrain::geometry_image::TerrainSettings;
-use alpenglow::terrain::zoom::quantile;
-use alpenglow::texturing::generation::TextureStreaming;
-use alpenglow::view::camera_path::{CameraPath, Orbit};
-use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
+use alpenglow::tools::profile::{median, quantile, summarize};
+use alpenglow::{
+    CameraPath, Context, ContextOptions, DeviceSelector, FrameProfile, Orbit, Renderer, Scene, Settings,
+    ShadowSettings, TerrainSettings, TextureStreaming,
+};
 use glam::DVec3;
 
 /// Frames between memory samples (and profile collection).
@@ -103,18 +100,16 @@ fn run(args: &Args) -> alpenglow::Result<()> {
         validation: false,
         device: DeviceSelector::Best,
     })?;
-    let settings = RenderSettings {
-        readback: false,
-        texture_streaming: evicting_streaming(args.width, args.height)?,
-        terrain: TerrainSettings {
-            grid_side: 128,
-            ..TerrainSettings::default()
-        },
-        shadows: ShadowSettings {
-            atlas_size: 512,
-            ..ShadowSettings::default()
-        },
-        ..RenderSettings::new(args.width, args.height)
+    let mut settings = Settings::new(args.width, args.height);
+    settings.readback = false;
+    settings.texture_streaming = evicting_streaming(args.width, args.height)?;
+    settings.terrain = TerrainSettings {
+        grid_side: 128,
+        ..TerrainSettings::default()
+    };
+    settings.shadows = ShadowSettings {
+        atlas_size: 512,
+        ..ShadowSettings::default()
     };
     let atlas_kib = settings.texture_streaming.atlas_bytes() / 1024;
     let mut renderer = Renderer::new(&ctx, &scene, settings)?;

@@ -30,15 +30,14 @@
 #[path = "support/points.rs"]
 mod support;
 
-use alpenglow::points::build::spt::epsilon_from_pixels;
-use alpenglow::points::render::object_space::QUADRUPLICATION_EXTRA_BYTES_PER_SPLAT;
-use alpenglow::points::render::{SplatMode, SplatPrimitive, SplatSettings};
-use alpenglow::points::scene::{
-    load_point_object, PointInstance, PointLoadOptions, PointObject, PointScene, PointTransform,
+use alpenglow::bench::{PointInstance, QUADRUPLICATION_EXTRA_BYTES_PER_SPLAT};
+use alpenglow::files::load_point_object;
+use alpenglow::tools::profile::median;
+use alpenglow::tools::spt::epsilon_from_pixels;
+use alpenglow::{
+    Camera, Context, ContextOptions, DeviceSelector, PointLoadOptions, PointObject, PointScene, PointTransform,
+    Renderer, Scene, Settings, SplatMode, SplatPrimitive, SplatSettings,
 };
-use alpenglow::profile::median;
-use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
-use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
 
 use glam::DVec3;
 use support::{all_leaves, camera_at};
@@ -69,11 +68,9 @@ struct Measured {
 }
 
 fn measure(ctx: &Context, scene: &Scene, camera: &Camera, points: SplatSettings, frames: usize) -> Measured {
-    let settings = RenderSettings {
-        readback: false,
-        points,
-        ..RenderSettings::new(SIDE, SIDE)
-    };
+    let mut settings = Settings::new(SIDE, SIDE);
+    settings.readback = false;
+    settings.points = points;
     let mut renderer = Renderer::new(ctx, scene, settings).expect("renderer");
     let warmup = 2;
     for _ in 0..warmup + frames {
@@ -120,7 +117,7 @@ fn main() {
     })
     .expect("Vulkan context");
     println!("device: {} ({})", ctx.info().name, ctx.info().driver_info);
-    let spt = alpenglow::points::build::spt::SptOptions {
+    let spt = alpenglow::tools::spt::SptOptions {
         epsilon: epsilon_from_pixels(1.0, 40f32.to_radians(), SIDE).unwrap(),
         ..Default::default()
     };
@@ -166,9 +163,7 @@ fn main() {
 
     println!("\n3. CPU selection per frame, default scene (300 rock instances):");
     let mut scene = Scene::default_terrain().expect("default terrain");
-    scene
-        .add_rocks(alpenglow::renderer::scene::DEFAULT_ROCKS.2)
-        .expect("rocks");
+    scene.add_rocks(alpenglow::DEFAULT_ROCKS.2).expect("rocks");
     let m = measure(&ctx, &scene, &scene.default_camera(), SplatSettings::default(), frames);
     println!(
         "median {:.3} ms per frame, {:.2} µs per instance",

@@ -17,12 +17,13 @@
 #[path = "support/points.rs"]
 mod support;
 
-use alpenglow::points::build::spt::epsilon_from_pixels;
-use alpenglow::points::render::{SplatBackend, SplatMode, SplatSettings};
-use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointObject, PointScene, PointTransform};
-use alpenglow::profile::median;
-use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
-use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
+use alpenglow::files::load_point_object;
+use alpenglow::tools::profile::median;
+use alpenglow::tools::spt::epsilon_from_pixels;
+use alpenglow::{
+    Camera, Context, ContextOptions, DeviceSelector, PointLoadOptions, PointObject, PointScene, PointTransform,
+    Renderer, Scene, Settings, SplatBackend, SplatMode, SplatSettings,
+};
 
 use support::{all_leaves, camera_at};
 
@@ -42,10 +43,8 @@ struct Measured {
 }
 
 fn measure(ctx: &Context, scene: &Scene, camera: &Camera, points: SplatSettings, frames: usize) -> Measured {
-    let settings = RenderSettings {
-        points,
-        ..RenderSettings::new(SIDE, SIDE)
-    };
+    let mut settings = Settings::new(SIDE, SIDE);
+    settings.points = points;
     let mut renderer = Renderer::new(ctx, scene, settings).expect("renderer");
     let warmup = 2;
     for _ in 0..warmup + frames - 1 {
@@ -56,7 +55,7 @@ fn measure(ctx: &Context, scene: &Scene, camera: &Camera, points: SplatSettings,
     let profiles = renderer.finish().expect("finish");
     let stats = renderer.take_point_stats().expect("stats");
     let timed = || profiles.iter().skip(warmup);
-    let points_passes = |p: &alpenglow::profile::FrameProfile| {
+    let points_passes = |p: &alpenglow::FrameProfile| {
         p.passes
             .iter()
             .filter(|p| p.name.starts_with("points.") && !p.name.starts_with("points.shadow"))
@@ -111,7 +110,7 @@ fn main() {
     );
     let options = PointLoadOptions {
         mesh_samples: 100_000,
-        spt: alpenglow::points::build::spt::SptOptions {
+        spt: alpenglow::tools::spt::SptOptions {
             epsilon: epsilon_from_pixels(1.0, 40f32.to_radians(), SIDE).unwrap(),
             ..Default::default()
         },

@@ -13,10 +13,9 @@
 use std::path::Path;
 use std::time::Instant;
 
-use alpenglow::io::heightmap::{load_heightmap, HeightField, HeightmapOptions};
-use alpenglow::synthesis::fill::{fill_holes_cpu, plan_hole_fill, FillParams};
-use alpenglow::synthesis::gpu::GpuSearch;
-use alpenglow::vulkan::{Context, ContextOptions};
+use alpenglow::files::load_heightmap;
+use alpenglow::tools::synth::{fill_holes_cpu, plan_hole_fill, FillParams, GpuSearch};
+use alpenglow::{Context, ContextOptions, HeightField, HeightmapOptions};
 use glam::DVec2;
 
 const SIDE: u32 = 1025;

@@ -11,10 +11,9 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use alpenglow::random::SplitMix64;
-use alpenglow::synthesis::gpu::GpuSearch;
-use alpenglow::synthesis::search::{CpuSearch, Exemplar, NeighbourhoodSearch, Query, SearchConfig};
-use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
+use alpenglow::bench::{Exemplar, NeighbourhoodSearch, Query, SearchConfig, SplitMix64};
+use alpenglow::tools::synth::{CpuSearch, GpuSearch};
+use alpenglow::{Context, ContextOptions, DeviceSelector};
 
 fn arg(i: usize, default: u32) -> u32 {
     std::env::args().nth(i).and_then(|a| a.parse().ok()).unwrap_or(default)

@@ -14,10 +14,8 @@
 
 use std::time::Instant;
 
-use alpenglow::points::vegetation::VegetationOptions;
-use alpenglow::profile::median;
-use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
-use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector};
+use alpenglow::tools::profile::median;
+use alpenglow::{Camera, Context, ContextOptions, DeviceSelector, Renderer, Scene, Settings, VegetationOptions};
 use glam::{DVec2, DVec3};
 
 /// The place with the most plants within 150 m (a 150 m grid's fullest cell).
@@ -94,10 +92,8 @@ fn main() {
     println!("| view | plants in view | prefix splats | splats drawn | triangles | points GPU ms | frame GPU ms | selection CPU ms |");
     println!("|---|---|---|---|---|---|---|---|");
     for (k, (name, camera)) in views.iter().enumerate() {
-        let settings = RenderSettings {
-            readback: png_dir.is_some(),
-            ..RenderSettings::new(width, height)
-        };
+        let mut settings = Settings::new(width, height);
+        settings.readback = png_dir.is_some();
         let mut renderer = Renderer::new(&ctx, &scene, settings).expect("renderer");
         let warmup = 2;
         let mut last = None;
@@ -107,7 +103,7 @@ fn main() {
         if let (Some(dir), Some(frame)) = (&png_dir, last) {
             let image = renderer.read(&frame).expect("read");
             let path = std::path::Path::new(dir).join(format!("vegetation-{k}.png"));
-            alpenglow::io::image_out::write_png_rgba8(&path, &image.rgba8, width, height).expect("png");
+            alpenglow::files::write_png_rgba8(&path, &image.rgba8, width, height).expect("png");
         }
         let profiles = renderer.finish().expect("finish");
         let stats = renderer.take_point_stats().expect("stats");

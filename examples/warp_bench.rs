@@ -12,12 +12,11 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use alpenglow::renderer::Scene;
-use alpenglow::terrain::importance::{importance_map, Backface, Frustum, ImportanceParams};
-use alpenglow::terrain::lod::{DebugScalar, LodFrame, LodSettings};
-use alpenglow::terrain::procedural::ProceduralTerrain;
-use alpenglow::terrain::sketch_map::{SketchAlignment, SketchMap};
-use alpenglow::terrain::warp::{warp, warp_into, warp_with, ColumnImportance, WarpOptions};
+use alpenglow::bench::{
+    importance_map, warp, warp_into, warp_with, Backface, ColumnImportance, DebugScalar, Frustum, ImportanceParams,
+    LodFrame, SketchMap, WarpOptions,
+};
+use alpenglow::{LodSettings, ProceduralTerrain, Scene, SketchAlignment};
 use glam::DVec3;
 
 const N: usize = 128;

@@ -165,7 +165,7 @@ impl MemoryLimits {
     }
 
     /// These limits with the device side capped by
-    /// [`DEVICE_MEMORY_ENV`] when it is set.
+    /// `DEVICE_MEMORY_ENV` when it is set.
     pub fn with_device_override(self) -> MemoryLimits {
         match env_mib(DEVICE_MEMORY_ENV) {
             Some(cap) => MemoryLimits {

@@ -81,6 +81,7 @@ pub const SHADOW_POINTS_VERT: SpirV = spirv!("lighting/shadow_points.vert");
 /// points.shadow: discards outside the splat's disc.
 pub const SHADOW_POINTS_FRAG: SpirV = spirv!("lighting/shadow_points.frag");
 /// shadow probe: `sun_visibility` at a list of points (tests and AOV checks of §9.5).
+#[cfg(test)]
 pub const SHADOW_PROBE: SpirV = spirv!("lighting/shadow_probe.comp");
 /// sky_light.horizon: horizon tracing of the height field and the sun horizon map (§9.5).
 pub const SKY_LIGHT_HORIZON: SpirV = spirv!("lighting/horizon.comp");

@@ -5,23 +5,19 @@
 
 mod common;
 
-use alpenglow::post::motion_blur::MotionBlurSettings;
-use alpenglow::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene, ViewSpec};
-use alpenglow::terrain::procedural::ProceduralTerrain;
-use alpenglow::view::lens::Distortion;
-use alpenglow::view::{Exposure, Intrinsics, Lighting};
-use alpenglow::vulkan::Context;
+use alpenglow::glam::DVec3;
+use alpenglow::{
+    Camera, Context, Distortion, Exposure, FrameImages, Intrinsics, Lighting, MotionBlurSettings, ProceduralTerrain,
+    Renderer, Scene, Settings, ViewSpec,
+};
 use common::{assert_validation_clean, dump_pngs, mean_flip, validated_context};
-use glam::{DVec2, DVec3};
 
 const W: u32 = 96;
 const H: u32 = 64;
 
 fn scene() -> Scene {
-    let field = ProceduralTerrain::default()
-        .try_generate(97, 97, DVec2::new(25.0, 25.0))
-        .expect("procedural terrain");
-    let mut scene = Scene::new(field);
+    let mut scene =
+        Scene::from_terrain(&ProceduralTerrain::default(), (97, 97), (25.0, 25.0)).expect("procedural terrain");
     scene.add_rocks(30).expect("rocks");
     scene
 }
@@ -46,9 +42,9 @@ fn render(
     scene: &Scene,
     spec: ViewSpec,
     cameras: &[Camera],
-    configure: impl Fn(&mut RenderSettings),
+    configure: impl Fn(&mut Settings),
 ) -> FrameImages {
-    let mut settings = RenderSettings::for_views(vec![spec]);
+    let mut settings = Settings::for_views(vec![spec]);
     settings.lighting = Some(Lighting {
         exposure: Exposure::Ev100(14.0),
         ..scene.default_lighting()
@@ -178,7 +174,7 @@ fn motion_blur_smears_a_moving_camera_and_leaves_a_still_one_sharp() {
             frame_interval_s: 1.0 / 30.0,
             ..MotionBlurSettings::default()
         };
-        let with = |s: &mut RenderSettings| s.motion_blur = Some(blur);
+        let with = |s: &mut Settings| s.motion_blur = Some(blur);
         let still = [camera(&scene, 1200.0), camera(&scene, 1200.0)];
         let sharp = render(&ctx, &scene, ViewSpec::new(W, H), &still, |_| {});
         let still_blurred = render(&ctx, &scene, ViewSpec::new(W, H), &still, with);

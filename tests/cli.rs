@@ -338,7 +338,7 @@ fn exr_has_colour_and_depth() {
         exr.as_os_str(),
     ]);
     assert_success("render --exr", &out);
-    let (w, h, channels) = alpenglow::io::image_out::read_exr_channels(&exr).unwrap();
+    let (w, h, channels) = alpenglow::files::read_exr_channels(&exr).unwrap();
     assert_eq!((w, h), (160, 90));
     let (w, h) = (w as usize, h as usize);
     let channel = |name: &str| -> &Vec<f32> {
@@ -363,7 +363,7 @@ fn exr_has_colour_and_depth() {
     }
 
     // The default scene's camera depends on its terrain only (no plants to build).
-    let camera = alpenglow::renderer::Scene::default_terrain().unwrap().default_camera();
+    let camera = alpenglow::Scene::default_terrain().unwrap().default_camera();
     let (near, far) = (camera.near as f32, camera.far as f32);
     let z = channel("Z");
     assert_eq!(z.len(), w * h);

@@ -1,4 +1,4 @@
-//! End-to-end tests of the memory model (`alpenglow::budget`): every count
+//! End-to-end tests of the memory model (`alpenglow::tools::budget`): every count
 //! that scales memory is checked before anything is allocated, and a count
 //! that does not fit is a one-line error naming the option the user wrote,
 //! the estimate and the limit, with no output written. The limits are

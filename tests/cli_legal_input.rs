@@ -167,11 +167,7 @@ fn errors_name_the_culprit() {
 
     let voids = dir.join("voids.exr");
     let nan = vec![f32::NAN; 16 * 16];
-    std::fs::write(
-        &voids,
-        alpenglow::io::image_out::encode_exr_height(&nan, 16, 16).unwrap(),
-    )
-    .unwrap();
+    std::fs::write(&voids, alpenglow::files::encode_exr_height(&nan, 16, 16).unwrap()).unwrap();
     let filled = dir.join("filled.exr");
     let out = run(&[
         "synth",

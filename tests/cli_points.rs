@@ -7,7 +7,7 @@ mod common;
 use common::cli::*;
 use common::data;
 
-use alpenglow::points::build::spt_file::read_spt;
+use alpenglow::files::read_spt;
 
 #[test]
 fn builds_the_bunny_into_a_readable_tree() {

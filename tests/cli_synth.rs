@@ -7,8 +7,8 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
-use alpenglow::io::image_out::{encode_exr_height, encode_png_gray16};
+use alpenglow::files::{encode_exr_height, encode_png_gray16, load_heightmap};
+use alpenglow::HeightmapOptions;
 use common::cli::*;
 
 const SIDE: u32 = 40;
@@ -19,7 +19,7 @@ fn crop(x0: u32, y0: u32) -> Vec<u16> {
     let full = load_heightmap(
         Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/jacksboro-fault.png")),
         &HeightmapOptions {
-            spacing: Some(glam::DVec2::ONE),
+            spacing: Some(alpenglow::glam::DVec2::ONE),
             ..HeightmapOptions::default()
         },
     )
@@ -36,7 +36,7 @@ fn write_png(path: &Path, values: &[u16], width: u32, height: u32) {
 /// Raw values of a greyscale PNG or the heights of an EXR.
 fn read(path: &Path) -> Vec<f32> {
     let opts = HeightmapOptions {
-        spacing: Some(glam::DVec2::ONE),
+        spacing: Some(alpenglow::glam::DVec2::ONE),
         ..HeightmapOptions::default()
     };
     load_heightmap(path, &opts).unwrap().heights

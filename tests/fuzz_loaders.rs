@@ -7,12 +7,11 @@ mod fuzz;
 
 use std::path::Path;
 
-use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
-use alpenglow::points::build::input::{load_points_file, PointInput};
-use alpenglow::points::build::spt_file::{read_spt, write_spt};
-use alpenglow::texturing::layers::{vegetation, Constraint, LayerTree, MAX_BLUR_RADII, MAX_HEIGHT_BLUR, MAX_SAMPLES};
-use alpenglow::view::camera_path::load_keyframes;
-use alpenglow::view::rig::Rig;
+use alpenglow::files::{load_heightmap, load_keyframes, load_points_file, read_spt, write_spt, PointInput};
+use alpenglow::tools::layers::{
+    Constraint, MAX_BLUR_RADII, MAX_HEIGHT_BLUR, MAX_SAMPLES, MAX_VEGETATION_DENSITY, MAX_VEGETATION_SCALE,
+};
+use alpenglow::{HeightmapOptions, LayerTree, Rig};
 use fuzz::mutate::{fix_png_crcs, reseal_spt, Kind};
 use fuzz::{fuzz, no_fixup, regressions, Outcome, Target};
 
@@ -94,10 +93,10 @@ fn layers(path: &Path) -> Outcome {
                 && constraints.into_iter().all(sampled_ok)
                 && l.height_blur.map_or(true, |r| r > 0.0 && r <= MAX_HEIGHT_BLUR)
                 && l.vegetation.iter().all(|v| {
-                    (0.0..=vegetation::MAX_DENSITY).contains(&v.density)
+                    (0.0..=MAX_VEGETATION_DENSITY).contains(&v.density)
                         && v.scale.0 > 0.0
                         && v.scale.0 <= v.scale.1
-                        && v.scale.1 <= vegetation::MAX_SCALE
+                        && v.scale.1 <= MAX_VEGETATION_SCALE
                 })
         });
     Ok(if ok {

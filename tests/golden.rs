@@ -21,16 +21,16 @@
 
 mod common;
 
-use alpenglow::io::image_out::write_png_rgba8;
-use alpenglow::points::render::{SplatMode, SplatSettings};
-use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointScene, PointTransform};
-use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
-use alpenglow::texturing::gpu_layout::TexturingMode;
+use alpenglow::files::{load_point_object, write_png_rgba8};
+use alpenglow::glam::DVec3;
+use alpenglow::{
+    Camera, Lighting, PointLoadOptions, PointScene, PointTransform, Renderer, Scene, Settings, SplatMode,
+    SplatSettings, SunPosition, TexturingMode,
+};
 use common::{
     assert_validation_clean, data, failure_dir, golden_dir, jacksboro_field, jacksboro_valley_camera, mean_flip,
     validated_context,
 };
-use glam::DVec3;
 
 const MEAN_FLIP_THRESHOLD: f32 = 0.02;
 const WIDTH: u32 = 256;
@@ -53,15 +53,9 @@ fn check_golden(name: &str, scene: &Scene, camera: &Camera) {
 fn check_golden_with(name: &str, scene: &Scene, camera: &Camera, points: SplatSettings, texturing: TexturingMode) {
     let (ctx, report) = validated_context();
     let frame = {
-        let settings = RenderSettings {
-            width: WIDTH,
-            height: HEIGHT,
-            readback: true,
-            terrain: Default::default(),
-            points,
-            texturing,
-            ..RenderSettings::new(WIDTH, HEIGHT)
-        };
+        let mut settings = Settings::new(WIDTH, HEIGHT);
+        settings.points = points;
+        settings.texturing = texturing;
         let mut renderer = Renderer::new(&ctx, scene, settings).expect("renderer");
         let frame = (renderer.render_settled(camera, SETTLE_FRAMES))
             .and_then(|f| renderer.read(&f))
@@ -165,7 +159,15 @@ fn bunny_scene() -> Scene {
     points.add(bunny, PointTransform::parse("r=90,0,0").expect("transform"));
     let mut scene = Scene::points_only(points);
     // Sun from behind the camera's left shoulder: the seen side is lit.
-    scene.sun_direction = alpenglow::view::lighting::sun_direction(40.0, 200.0);
+    let sun = SunPosition::Angles {
+        elevation_deg: 40.0,
+        azimuth_deg: 200.0,
+    };
+    scene.sun_direction = Lighting {
+        sun,
+        ..scene.default_lighting()
+    }
+    .sun_direction();
     scene
 }
 

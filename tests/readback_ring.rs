@@ -12,11 +12,9 @@ use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard};
 
-use alpenglow::renderer::{Camera, FrameData, Output, Outputs, RenderSettings, Renderer, Scene};
-use alpenglow::terrain::procedural::ProceduralTerrain;
-use alpenglow::vulkan::Context;
+use alpenglow::glam::{DVec2, DVec3};
+use alpenglow::{Camera, Context, FrameData, Output, Outputs, ProceduralTerrain, Renderer, Scene, Settings};
 use common::{assert_validation_clean, validated_context};
-use glam::{DVec2, DVec3};
 
 /// Counts heap allocations (alloc, alloc_zeroed, realloc) of every thread
 /// while [`COUNTING`] is set. With `ALPENGLOW_ALLOC_TRACE=N` in the
@@ -102,8 +100,8 @@ fn scene() -> Scene {
 /// `width`×`height` with a deterministic texture budget (tile counts, not
 /// measured GPU time), so which frame generates which tile does not
 /// depend on timings.
-fn settings(width: u32, height: u32) -> RenderSettings {
-    let mut settings = RenderSettings::new(width, height);
+fn settings(width: u32, height: u32) -> Settings {
+    let mut settings = Settings::new(width, height);
     settings.texture_streaming.budget.gpu_time = None;
     settings
 }

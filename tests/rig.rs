@@ -6,22 +6,20 @@
 
 mod common;
 
-use alpenglow::renderer::{Camera, FrameImages, RenderSettings, Renderer, Rig, Scene, ViewSpec};
-use alpenglow::terrain::procedural::ProceduralTerrain;
-use alpenglow::view::{Exposure, Intrinsics, Lighting};
-use alpenglow::vulkan::Context;
+use alpenglow::glam::DVec3;
+use alpenglow::{
+    Camera, Context, Exposure, FrameImages, Intrinsics, Lighting, ProceduralTerrain, Renderer, Rig, Scene, Settings,
+    ViewSpec,
+};
 use common::{assert_validation_clean, dump_pngs, mean_flip, validated_context};
-use glam::{DVec2, DVec3};
 
 /// Most frames a still view takes to settle its textures.
 const SETTLE: u32 = 64;
 
 /// A 2.5 km procedural terrain with a handful of rocks.
 fn scene() -> Scene {
-    let field = ProceduralTerrain::default()
-        .try_generate(129, 129, DVec2::new(20.0, 20.0))
-        .expect("procedural terrain");
-    let mut scene = Scene::new(field);
+    let mut scene =
+        Scene::from_terrain(&ProceduralTerrain::default(), (129, 129), (20.0, 20.0)).expect("procedural terrain");
     scene.add_rocks(40).expect("rocks");
     scene
 }
@@ -43,7 +41,7 @@ fn rig_camera(scene: &Scene) -> Camera {
 
 /// Renders `cameras` through views `specs` until settled; every view's images.
 fn render(ctx: &Context, scene: &Scene, specs: Vec<ViewSpec>, cameras: &[Camera]) -> (Vec<FrameImages>, Vec<String>) {
-    let mut settings = RenderSettings::for_views(specs);
+    let mut settings = Settings::for_views(specs);
     // A fixed exposure: views of one scene metered alike.
     settings.lighting = Some(Lighting {
         exposure: Exposure::Ev100(14.0),

@@ -1,25 +1,29 @@
 //! The renderer on a real device under validation and synchronization
 //! validation: render-to-vertex-buffer, frames in flight, readback,
-//! descriptor-heap handle reuse, device selection errors.
+//! determinism, device selection errors. (The render graph's and the
+//! descriptor heap's own tests are in `src/graph/tests/device.rs`.)
 
 mod common;
 
-use std::sync::Arc;
-
-use alpenglow::graph::{BufferAccess, BufferInfo, ImageAccess, ImageInfo, RenderGraph, Stage};
-use alpenglow::renderer::{Camera, RenderSettings, Renderer, Scene};
-use alpenglow::terrain::procedural::ProceduralTerrain;
-use alpenglow::vulkan::{
-    Buffer, BufferDesc, BufferUsageFlags, Context, ContextOptions, DeviceSelector, Format, FrameRing, MemoryLocation,
+use alpenglow::glam::DVec3;
+use alpenglow::{
+    Camera, Context, ContextOptions, DeviceSelector, ProceduralTerrain, Renderer, Scene, Settings, ShadowSettings,
+    TextureStreaming,
 };
 use common::{assert_validation_clean, validated_context};
-use glam::{DVec2, DVec3};
 
 fn small_scene() -> Scene {
-    let field = ProceduralTerrain::default()
-        .try_generate(65, 49, DVec2::new(40.0, 55.0))
-        .expect("procedural terrain");
-    Scene::new(field)
+    Scene::from_terrain(&ProceduralTerrain::default(), (65, 49), (40.0, 55.0)).expect("procedural terrain")
+}
+
+/// `width`×`height` with the default texture streaming and shadow settings
+/// (not the ones `Settings::new` sizes for the image).
+fn settings(width: u32, height: u32, readback: bool) -> Settings {
+    let mut settings = Settings::new(width, height);
+    settings.readback = readback;
+    settings.texture_streaming = TextureStreaming::default();
+    settings.shadows = ShadowSettings::default();
+    settings
 }
 
 #[test]
@@ -27,23 +31,7 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
     let (ctx, report) = validated_context();
     {
         let scene = small_scene();
-        let settings = RenderSettings {
-            width: 96,
-            height: 64,
-            views: Vec::new(),
-            msaa: 1,
-            motion_blur: None,
-            readback: true,
-            outputs: Default::default(),
-            readback_slots: 3,
-            terrain: Default::default(),
-            points: Default::default(),
-            texturing: Default::default(),
-            texture_streaming: Default::default(),
-            shadows: Default::default(),
-            cache_dir: None,
-            lighting: None,
-        };
+        let settings = settings(96, 64, true);
         let mut renderer = Renderer::new(&ctx, &scene, settings).expect("renderer");
         let layers = scene.layers.layers.iter().enumerate();
         let layer_passes = layers.map(|(i, l)| format!("texturing.layer{i}.{}", l.layer.name.replace(' ', "_")));
@@ -115,23 +103,7 @@ fn renders_are_deterministic() {
     let (ctx, report) = validated_context();
     {
         let scene = small_scene();
-        let settings = RenderSettings {
-            width: 80,
-            height: 48,
-            views: Vec::new(),
-            msaa: 1,
-            motion_blur: None,
-            readback: true,
-            outputs: Default::default(),
-            readback_slots: 3,
-            terrain: Default::default(),
-            points: Default::default(),
-            texturing: Default::default(),
-            texture_streaming: Default::default(),
-            shadows: Default::default(),
-            cache_dir: None,
-            lighting: None,
-        };
+        let settings = settings(80, 48, true);
         let camera = scene.default_camera();
         let mut first = Renderer::new(&ctx, &scene, settings.clone()).expect("renderer");
         let a = first.render(&camera).and_then(|f| first.read(&f)).expect("frame a");
@@ -157,100 +129,6 @@ fn renders_are_deterministic() {
 }
 
 #[test]
-fn graph_culls_unused_passes_and_writes_a_storage_buffer_drawn_by_the_next_pass() {
-    let (ctx, report) = validated_context();
-    {
-        let mut graph: RenderGraph<()> = RenderGraph::new();
-        let target = Arc::new(
-            Buffer::new(
-                &ctx,
-                BufferDesc {
-                    name: "result".into(),
-                    size: 256,
-                    usage: BufferUsageFlags::TRANSFER_DST | BufferUsageFlags::TRANSFER_SRC,
-                    location: MemoryLocation::GpuToCpu,
-                },
-            )
-            .unwrap(),
-        );
-        let scratch = graph.create_buffer(
-            "scratch",
-            BufferInfo {
-                size: 256,
-                location: MemoryLocation::GpuOnly,
-            },
-        );
-        let unused = graph.create_image("unused", ImageInfo::new(8, 8, Format::R8G8B8A8_UNORM));
-        let result = graph.import_buffer(target.clone());
-        graph
-            .pass("never used")
-            .read(scratch, BufferAccess::StorageRead(Stage::Compute))
-            .write(unused, ImageAccess::StorageWrite(Stage::Compute))
-            .record(|_, _| panic!("a culled pass must not record"));
-        graph
-            .pass("copy")
-            .transfer()
-            .read(scratch, BufferAccess::TransferSrc)
-            .write(result, BufferAccess::TransferDst)
-            .record(move |pass, _| {
-                let (src, dst) = (pass.buffer(scratch)?, pass.buffer(result)?);
-                pass.cmd().copy_buffer(src, dst, 256);
-                Ok(())
-            });
-        graph.read_back(result);
-        let mut baked = graph.bake(&ctx).expect("bake");
-        assert_eq!(baked.pass_names(), ["copy"]);
-        assert_eq!(baked.culled_passes(), ["never used"]);
-        assert!(baked.image(unused).is_none(), "a culled transient is not created");
-        let mut frames = FrameRing::new(&ctx).unwrap();
-        for _ in 0..3 {
-            baked.execute(&mut frames, &(), &[]).unwrap();
-        }
-        baked.finish(&mut frames).unwrap();
-        assert_eq!(baked.take_profiles().len(), 3);
-    }
-    drop(ctx);
-    assert_validation_clean(&report);
-}
-
-#[test]
-fn heap_handles_are_reused_only_after_the_gpu_is_done() {
-    let (ctx, report) = validated_context();
-    {
-        let storage = |name: &str| {
-            Buffer::new(
-                &ctx,
-                BufferDesc {
-                    name: name.into(),
-                    size: 64,
-                    usage: BufferUsageFlags::STORAGE_BUFFER,
-                    location: MemoryLocation::GpuOnly,
-                },
-            )
-            .unwrap()
-        };
-        let first = storage("first");
-        let handle = first.storage_handle().expect("storage buffers get a heap handle");
-        drop(first);
-        let second = storage("second");
-        assert_ne!(
-            second.storage_handle(),
-            Some(handle),
-            "released handle reused before the GPU finished"
-        );
-        ctx.wait_idle().unwrap();
-        let third = storage("third");
-        assert_eq!(
-            third.storage_handle(),
-            Some(handle),
-            "released handle recycled once the GPU is done"
-        );
-    }
-    drop(ctx);
-    assert_validation_clean(&report);
-}
-
-#[test]
 fn missing_devices_and_bad_cameras_are_clear_errors() {
     for selector in [
         DeviceSelector::Name("no-such-gpu-xyz".into()),
@@ -268,28 +146,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
     let (ctx, report) = validated_context();
     {
         let scene = small_scene();
-        let mut renderer = Renderer::new(
-            &ctx,
-            &scene,
-            RenderSettings {
-                width: 16,
-                height: 16,
-                views: Vec::new(),
-                msaa: 1,
-                motion_blur: None,
-                readback: true,
-                outputs: Default::default(),
-                readback_slots: 3,
-                terrain: Default::default(),
-                points: Default::default(),
-                texturing: Default::default(),
-                texture_streaming: Default::default(),
-                shadows: Default::default(),
-                cache_dir: None,
-                lighting: None,
-            },
-        )
-        .unwrap();
+        let mut renderer = Renderer::new(&ctx, &scene, settings(16, 16, true)).unwrap();
         let bad = Camera {
             eye: DVec3::ONE,
             target: DVec3::ONE,
@@ -300,28 +157,7 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
             .unwrap_err()
             .to_string()
             .contains("eye equals target"));
-        assert!(Renderer::new(
-            &ctx,
-            &scene,
-            RenderSettings {
-                width: 0,
-                height: 16,
-                views: Vec::new(),
-                msaa: 1,
-                motion_blur: None,
-                readback: false,
-                outputs: Default::default(),
-                readback_slots: 3,
-                terrain: Default::default(),
-                points: Default::default(),
-                texturing: Default::default(),
-                texture_streaming: Default::default(),
-                shadows: Default::default(),
-                cache_dir: None,
-                lighting: None,
-            }
-        )
-        .is_err());
+        assert!(Renderer::new(&ctx, &scene, settings(0, 16, false)).is_err());
     }
     drop(ctx);
     assert_validation_clean(&report);
@@ -333,5 +169,4 @@ fn missing_devices_and_bad_cameras_are_clear_errors() {
 fn renderer_is_send() {
     fn assert_send<T: Send>() {}
     assert_send::<Renderer>();
-    assert_send::<alpenglow::graph::BakedGraph<alpenglow::view::Frame>>();
 }

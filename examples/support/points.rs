@@ -1,8 +1,9 @@
 //! Helpers shared by the point-rendering benchmarks (`examples/splat_bench.rs`,
 //! `examples/splat_modes_bench.rs`), included with `#[path]`.
 
-use alpenglow::points::build::spt::{SequentialPointTree, ROOT_R_MAX};
-use alpenglow::renderer::Camera;
+use alpenglow::bench::ROOT_R_MAX;
+use alpenglow::tools::spt::SequentialPointTree;
+use alpenglow::Camera;
 use glam::DVec3;
 
 /// The leaves of `tree` as a flat list drawn at every distance.

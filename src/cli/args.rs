@@ -7,7 +7,7 @@ use glam::DVec3;
 
 use crate::cli::orbit::parse_orbit;
 use crate::cli::terrain_spec::TerrainSpec;
-use alpenglow::view::camera_path::Orbit;
+use alpenglow::Orbit;
 
 /// alpenglow: a Vulkan renderer for large outdoor scenes.
 #[derive(Parser, Debug)]
@@ -364,7 +364,7 @@ pub struct TerrainArgs {
         default_value_t = 32,
         value_name = "TILES",
         help_heading = "Texturing",
-        value_parser = clap::value_parser!(u32).range(1..=i64::from(alpenglow::texturing::streaming::MAX_TILE_BUDGET))
+        value_parser = clap::value_parser!(u32).range(1..=i64::from(alpenglow::MAX_TILE_BUDGET))
     )]
     pub tile_budget: u32,
     /// Tile counts only, no pacing of tile generation by measured GPU time
@@ -518,7 +518,7 @@ pub struct SptBuildArgs {
     pub rows: u32,
     /// Longest estimated build accepted, in hours: a build estimated to
     /// take longer is refused before it samples (README, "Command line").
-    #[arg(long = "max-hours", default_value_t = alpenglow::budget::DEFAULT_MAX_HOURS, value_name = "HOURS", value_parser = parse_hours)]
+    #[arg(long = "max-hours", default_value_t = alpenglow::tools::budget::DEFAULT_MAX_HOURS, value_name = "HOURS", value_parser = parse_hours)]
     pub max_hours: f64,
 }
 
@@ -557,13 +557,13 @@ pub(super) fn parse_spacing(s: &str) -> Result<(f64, f64), String> {
         [dx, dy] => (*dx, *dy),
         _ => return Err(format!("'{s}' is not DX or DX,DY")),
     };
-    alpenglow::io::heightmap::check_spacing(glam::DVec2::new(dx, dy)).map_err(|m| format!("'{s}': {m}"))?;
+    alpenglow::files::check_spacing(glam::DVec2::new(dx, dy)).map_err(|m| format!("'{s}': {m}"))?;
     Ok((dx, dy))
 }
 
 /// `NAME=FILE` of `--input-map`.
 pub(super) fn parse_input_map(s: &str) -> Result<(usize, PathBuf), String> {
-    let names = alpenglow::texturing::layers::INPUT_NAMES;
+    let names = alpenglow::tools::layers::INPUT_NAMES;
     let (name, file) = s.split_once('=').ok_or_else(|| format!("'{s}': expected NAME=FILE"))?;
     let k = (names.iter().position(|n| *n == name))
         .ok_or_else(|| format!("'{name}': the input maps are {}", names.join(", ")))?;
@@ -586,10 +586,10 @@ pub(super) fn parse_height_scale(s: &str) -> Result<f32, String> {
 }
 
 /// `--height-offset`: metres within the heights' range (±1000 km,
-/// [`alpenglow::io::heightmap::MAX_ABS_HEIGHT`]); beyond, every height of a
+/// [`alpenglow::files::MAX_ABS_HEIGHT`]); beyond, every height of a
 /// file or an output would be out of range.
 pub(super) fn parse_height_offset(s: &str) -> Result<f32, String> {
-    let limit = alpenglow::io::heightmap::MAX_ABS_HEIGHT;
+    let limit = alpenglow::files::MAX_ABS_HEIGHT;
     match s.trim().parse::<f32>() {
         Ok(v) if v.is_finite() && v.abs() <= limit => Ok(v),
         Ok(v) => Err(format!("{v} m is not within ±{limit} m")),

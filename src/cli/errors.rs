@@ -147,10 +147,10 @@ pub fn error_line(e: &anyhow::Error) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use alpenglow::points::render::SplatSettings;
-    use alpenglow::points::scene::PointTransform;
-    use alpenglow::renderer::Camera;
-    use alpenglow::view::camera_path::Orbit;
+    use alpenglow::Camera;
+    use alpenglow::Orbit;
+    use alpenglow::PointTransform;
+    use alpenglow::SplatSettings;
     use anyhow::Context as _;
     use glam::DVec3;
 
@@ -233,10 +233,7 @@ mod tests {
                 .unwrap_err(),
                 "invalid --epsilon: ",
             ),
-            (
-                alpenglow::renderer::validate_size(0, 32).unwrap_err(),
-                "invalid --width: ",
-            ),
+            (alpenglow::validate_size(0, 32).unwrap_err(), "invalid --width: "),
         ];
         for (e, start) in cases {
             let line = line(e);

@@ -1,11 +1,11 @@
 //! The EXR of a rendered frame: linear `R,G,B,A`, view-space depth `Z`,
 //! the lighting AOVs, `W` with points, and the simulator AOVs
-//! (`alpenglow::view::aov`): `distance`, `N.X, N.Y, N.Z`, `class` and
+//! (see [`alpenglow::FrameImages`]): `distance`, `N.X, N.Y, N.Z`, `class` and
 //! `instance` (32-bit unsigned integer channels, exact), `motion.X`,
 //! `motion.Y`.
 
-use alpenglow::io::image_out::{encode_exr_samples, ExrSamples};
-use alpenglow::renderer::FrameImages;
+use alpenglow::files::{encode_exr_samples, ExrSamples};
+use alpenglow::FrameImages;
 
 /// Every other value of `values` from the `k`-th of each group of `n`.
 fn channel(values: &[f32], n: usize, k: usize) -> Vec<f32> {

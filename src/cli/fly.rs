@@ -6,7 +6,7 @@
 //! Frames go into a hidden staging sibling of the output directory
 //! (`.DIR.partial-PID-N`), renamed into place together with `--json` and
 //! `--trace` when every frame was written (one output transaction,
-//! `alpenglow::io::atomic::OutputTransaction`): on any error no partial
+//! `alpenglow::files::OutputTransaction`): on any error no partial
 //! sequence is left behind, and a run that was killed leaves a staging
 //! folder that the next run in that directory removes.
 //!
@@ -26,10 +26,9 @@ use super::lighting;
 use anyhow::{bail, Context as _, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use alpenglow::io::image_out::write_png_rgba8;
-use alpenglow::profile::{chrome_trace, median, summarize};
-use alpenglow::renderer::{Camera, FrameImages, Rig, Scene};
-use alpenglow::view::camera_path::{load_keyframes, CameraPath, Orbit};
+use alpenglow::files::{load_keyframes, write_png_rgba8};
+use alpenglow::tools::profile::{chrome_trace, median, summarize};
+use alpenglow::{Camera, CameraPath, FrameImages, Orbit, Rig, Scene};
 
 use super::args::FlyArgs;
 use super::{
@@ -139,7 +138,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
                     write_png_rgba8(&path("png"), &images.rgba8, images.width, images.height)?;
                     if args.exr {
                         let bytes = super::exr::encode_frame_exr(images)?;
-                        alpenglow::io::atomic::write_bytes_atomically(&path("exr"), &bytes)?;
+                        alpenglow::files::write_bytes_atomically(&path("exr"), &bytes)?;
                     }
                 }
             }

@@ -1,6 +1,6 @@
 //! `alpenglow layers from-image`: a surface-layer tree estimated from a
 //! real colour image registered to a height map (dissertation §8.3; see
-//! `alpenglow::texturing::from_image`).
+//! `alpenglow::tools::layers`).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -10,12 +10,11 @@ use anyhow::{bail, Result};
 use clap::{Args, Subcommand};
 use glam::DVec2;
 
-use alpenglow::io::heightmap::{load_heightmap, HeightField, HeightmapOptions, RowOrder};
-use alpenglow::io::limits::InputLimits;
-use alpenglow::texturing::from_image::{
-    build_layers, load_rgb_image, ClassCount, FromImageOptions, PixelStatus, MAX_CLASSES,
+use alpenglow::files::{load_heightmap, InputLimits};
+use alpenglow::tools::layers::{
+    build_layers, load_rgb_image, ClassCount, FromImageOptions, PixelStatus, INPUT_NAMES, MAX_CLASSES,
 };
-use alpenglow::texturing::layers::INPUT_NAMES;
+use alpenglow::{HeightField, HeightmapOptions, RowOrder};
 
 use super::args::{parse_input_map, parse_spacing, RowsArg};
 use super::outputs::Outputs;
@@ -188,7 +187,7 @@ fn from_image(args: FromImageArgs) -> Result<ExitCode> {
     if let Some(path) = &args.class_map {
         let c = &generated.classification;
         let colours: Vec<[u8; 3]> = (c.classes.iter())
-            .map(|class| alpenglow::texturing::reference::srgb8(class.linear))
+            .map(|class| alpenglow::tools::layers::srgb8(class.linear))
             .collect();
         let rgba: Vec<u8> = (c.labels.iter().zip(&c.status))
             .flat_map(|(&l, &s)| {

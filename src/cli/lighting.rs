@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 
-use alpenglow::lighting::solar::{parse_date, parse_time, solar_position, Clock, SkyPreset};
-use alpenglow::view::{Exposure, Lighting, ShadowMode, SkyLightMode, SkyModel, SunPosition};
+use alpenglow::tools::solar::{parse_date, parse_time, solar_position, Clock, SkyPreset};
+use alpenglow::{Exposure, Lighting, ShadowMode, SkyLightMode, SkyModel, SunPosition};
 
 #[derive(Args, Debug, Clone, Default)]
 #[command(next_help_heading = "Lighting")]
@@ -122,16 +122,16 @@ pub fn default_cache_dir(
 
 /// A renderer, with a progress bar while the sky-light transfer bakes.
 pub fn renderer(
-    ctx: &alpenglow::vulkan::Context,
-    scene: &alpenglow::renderer::Scene,
-    settings: alpenglow::renderer::RenderSettings,
-) -> alpenglow::Result<alpenglow::renderer::Renderer> {
+    ctx: &alpenglow::Context,
+    scene: &alpenglow::Scene,
+    settings: alpenglow::Settings,
+) -> alpenglow::Result<alpenglow::Renderer> {
     let bar = indicatif::ProgressBar::new(1000);
     bar.set_style(
         indicatif::ProgressStyle::with_template("sky-light bake {bar:40} {percent:>3}% {elapsed}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let renderer = alpenglow::renderer::Renderer::with_progress(ctx, scene, settings, &mut |f| {
+    let renderer = alpenglow::Renderer::with_progress(ctx, scene, settings, &mut |f| {
         bar.set_position((f.clamp(0.0, 1.0) * 1000.0) as u64)
     });
     bar.finish_and_clear();

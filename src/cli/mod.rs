@@ -23,14 +23,13 @@ use std::process::ExitCode;
 use anyhow::{anyhow, bail, Result};
 use glam::DVec2;
 
-use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
-use alpenglow::profile::{chrome_trace, profile_json, summarize, FrameProfile};
-use alpenglow::renderer::{validate_size, Camera, RenderSettings, Scene, ViewSpec};
-use alpenglow::terrain::geometry_image::{TerrainSettings, TerrainView};
-use alpenglow::terrain::lod::{ImportanceFactors, LodMode, LodSettings};
-use alpenglow::terrain::sketch_map::SketchAlignment;
-use alpenglow::texturing::stats::TextureSummary;
-use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector, ValidationReport};
+use alpenglow::files::load_heightmap;
+use alpenglow::tools::profile::{chrome_trace, profile_json, summarize};
+use alpenglow::{
+    validate_size, Camera, Context, ContextOptions, DeviceSelector, FrameProfile, HeightmapOptions, ImportanceFactors,
+    LodMode, LodSettings, Scene, Settings, SketchAlignment, TerrainSettings, TerrainView, TextureSummary,
+    TexturingMode, ValidationReport, ViewSpec,
+};
 pub use errors::error_line;
 
 use outputs::Outputs;
@@ -135,7 +134,7 @@ fn check_validation(report: Option<std::sync::Arc<ValidationReport>>) -> Result<
 /// Warns when `--input-map NAME=FILE` has no effect: no layer of the tree
 /// constrains input `k`, or classic texturing uses no layer tree.
 fn warn_unused_input_map(args: &SceneArgs, scene: &Scene, k: usize) {
-    let name = alpenglow::texturing::layers::INPUT_NAMES[k];
+    let name = alpenglow::tools::layers::INPUT_NAMES[k];
     let tree = match &args.terrain.layers {
         Some(path) => format!("the layer tree {}", path.display()),
         None => "the built-in layer tree".to_string(),
@@ -153,10 +152,10 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
     let mut scene = load_terrain(args)?;
     points::add_points(&args.points, &mut scene, builtin)?;
     if let Some(path) = &args.terrain.layers {
-        scene.layers = alpenglow::texturing::layers::LayerTree::load(path)?;
+        scene.layers = alpenglow::LayerTree::load(path)?;
     }
     for (k, path) in &args.terrain.input_maps {
-        let name = alpenglow::texturing::layers::INPUT_NAMES[*k];
+        let name = alpenglow::tools::layers::INPUT_NAMES[*k];
         if scene.input_maps[*k].is_some() {
             bail!("--input-map {name} is given twice");
         }
@@ -174,7 +173,7 @@ fn load_scene(args: &SceneArgs) -> Result<Scene> {
 }
 
 /// The rig of the scene arguments and the views a frame renders.
-pub(crate) fn views(args: &SceneArgs) -> Result<(Option<alpenglow::renderer::Rig>, Vec<ViewSpec>)> {
+pub(crate) fn views(args: &SceneArgs) -> Result<(Option<alpenglow::Rig>, Vec<ViewSpec>)> {
     let rig = args.camera.rig(args.width)?;
     let specs = args
         .camera
@@ -183,41 +182,35 @@ pub(crate) fn views(args: &SceneArgs) -> Result<(Option<alpenglow::renderer::Rig
 }
 
 /// Render settings of the scene arguments for the views `views`.
-fn render_settings(args: &SceneArgs, scene: &Scene, views: &[ViewSpec], readback: bool) -> Result<RenderSettings> {
+fn render_settings(args: &SceneArgs, scene: &Scene, views: &[ViewSpec], readback: bool) -> Result<Settings> {
     let lighting = lighting::lighting(&args.lighting, scene.default_lighting())?;
     lighting.validate()?;
-    Ok(RenderSettings {
-        width: args.width,
-        height: args.height,
-        views: views.to_vec(),
-        msaa: args.camera.msaa,
-        motion_blur: args.camera.motion_blur()?,
-        readback,
-        terrain: terrain_settings(&args.terrain, &args.debug)?,
-        points: points::splat_settings(&args.points, args.fov_y, args.height)?,
-        texturing: match args.terrain.texturing {
-            args::TexturingArg::Classic => alpenglow::texturing::gpu_layout::TexturingMode::Classic,
-            args::TexturingArg::Direct => alpenglow::texturing::gpu_layout::TexturingMode::Direct,
-            args::TexturingArg::Atlas => alpenglow::texturing::gpu_layout::TexturingMode::Atlas,
-        },
-        texture_streaming: texture_streaming(args, views)?,
-        lighting: Some(lighting),
-        // Only a terrain is baked: no cache (nor a warning about it) without one.
-        cache_dir: scene
-            .draw_terrain
-            .then(|| lighting::cache_dir(&args.lighting))
-            .flatten(),
-        ..RenderSettings::new(args.width, args.height)
-    })
+    let mut settings = Settings::new(args.width, args.height);
+    settings.views = views.to_vec();
+    settings.msaa = args.camera.msaa;
+    settings.motion_blur = args.camera.motion_blur()?;
+    settings.readback = readback;
+    settings.terrain = terrain_settings(&args.terrain, &args.debug)?;
+    settings.points = points::splat_settings(&args.points, args.fov_y, args.height)?;
+    settings.texturing = match args.terrain.texturing {
+        args::TexturingArg::Classic => TexturingMode::Classic,
+        args::TexturingArg::Direct => TexturingMode::Direct,
+        args::TexturingArg::Atlas => TexturingMode::Atlas,
+    };
+    settings.texture_streaming = texture_streaming(args, views)?;
+    settings.lighting = Some(lighting);
+    // Only a terrain is baked: no cache (nor a warning about it) without one.
+    settings.cache_dir = scene
+        .draw_terrain
+        .then(|| lighting::cache_dir(&args.lighting))
+        .flatten();
+    Ok(settings)
 }
 
 /// Atlas streaming for `views` with the tile budget of the arguments.
-fn texture_streaming(
-    args: &SceneArgs,
-    views: &[ViewSpec],
-) -> Result<alpenglow::texturing::generation::TextureStreaming> {
+fn texture_streaming(args: &SceneArgs, views: &[ViewSpec]) -> Result<alpenglow::TextureStreaming> {
     let sizes: Vec<(u32, u32)> = views.iter().map(|v| (v.width, v.height)).collect();
-    let mut streaming = alpenglow::texturing::generation::TextureStreaming::for_views(&sizes);
+    let mut streaming = alpenglow::TextureStreaming::for_views(&sizes);
     if args.terrain.no_tile_pacing {
         streaming.budget.gpu_time = None;
     }
@@ -237,8 +230,8 @@ fn load_terrain(args: &SceneArgs) -> Result<Scene> {
                     offset: args.height_offset,
                     spacing: args.spacing.map(|(dx, dy)| DVec2::new(dx, dy)),
                     rows: match args.terrain.rows {
-                        args::RowsArg::NorthUp => alpenglow::io::heightmap::RowOrder::NorthUp,
-                        args::RowsArg::SouthUp => alpenglow::io::heightmap::RowOrder::SouthUp,
+                        args::RowsArg::NorthUp => alpenglow::RowOrder::NorthUp,
+                        args::RowsArg::SouthUp => alpenglow::RowOrder::SouthUp,
                     },
                     limits: input_limits(&args.terrain),
                 },
@@ -250,8 +243,8 @@ fn load_terrain(args: &SceneArgs) -> Result<Scene> {
 }
 
 /// The input limits of `--max-input-mb`.
-fn input_limits(args: &TerrainArgs) -> alpenglow::io::limits::InputLimits {
-    alpenglow::io::limits::InputLimits::with_max_file_mib(args.max_input_mb)
+fn input_limits(args: &TerrainArgs) -> alpenglow::files::InputLimits {
+    alpenglow::files::InputLimits::with_max_file_mib(args.max_input_mb)
 }
 
 fn terrain_settings(args: &TerrainArgs, debug: &TerrainDebugArgs) -> Result<TerrainSettings> {
@@ -458,7 +451,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
         frame.median_gpu_ms,
         frame.median_cpu_ms
     );
-    let interval_median = alpenglow::profile::median(intervals.iter().copied());
+    let interval_median = alpenglow::tools::profile::median(intervals.iter().copied());
     let interval_max = intervals.iter().copied().fold(0.0, f64::max);
     println!("  frame interval   median {interval_median:>8.3} ms wall (max {interval_max:.3}), 2 frames in flight");
     for p in &passes {
@@ -469,7 +462,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     }
     if let Some(stats) = point_stats.last() {
         println!("  {}", stats.summary());
-        let cpu = alpenglow::profile::median(point_stats.iter().map(|s| s.cpu_ms));
+        let cpu = alpenglow::tools::profile::median(point_stats.iter().map(|s| s.cpu_ms));
         println!(
             "  points CPU selection median {cpu:.3} ms per frame ({:.4} ms per instance)",
             cpu / stats.instances.max(1) as f64
@@ -504,10 +497,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
 
 /// Prints the texture streaming summary of `stats` with the GPU times of
 /// `profiles`; None (and nothing printed) without the atlas.
-fn report_textures(
-    stats: &[alpenglow::texturing::stats::TextureFrameStats],
-    profiles: &[FrameProfile],
-) -> Option<TextureSummary> {
+fn report_textures(stats: &[alpenglow::TextureFrameStats], profiles: &[FrameProfile]) -> Option<TextureSummary> {
     let summary = (!stats.is_empty()).then(|| TextureSummary::new(stats, profiles))?;
     println!("  {}", summary.line());
     if let Some(line) = summary.per_pass_line() {
@@ -530,9 +520,9 @@ fn info(args: DeviceArgs) -> Result<ExitCode> {
     println!("max image:   {} px per side", i.max_image_dimension_2d);
     println!(
         "memory:      {} device heap{}, at most {} in one allocation",
-        alpenglow::budget::format_bytes(i.memory_heap_bytes),
+        alpenglow::tools::budget::format_bytes(i.memory_heap_bytes),
         if i.memory_budget { " (VK_EXT_memory_budget)" } else { "" },
-        alpenglow::budget::format_bytes(i.max_allocation_bytes)
+        alpenglow::tools::budget::format_bytes(i.max_allocation_bytes)
     );
     println!(
         "validation:  {}",

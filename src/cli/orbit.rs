@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use alpenglow::view::camera_path::{Orbit, DEFAULT_START_ANGLE_DEG};
+use alpenglow::{Orbit, DEFAULT_START_ANGLE_DEG};
 
 use super::errors::describe;
 

@@ -7,8 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 
-use alpenglow::io::atomic::OutputTransaction;
-use alpenglow::io::image_out::ImageFormat;
+use alpenglow::files::{ImageFormat, OutputTransaction};
 
 /// The outputs of one command.
 #[derive(Default)]

@@ -4,13 +4,12 @@
 
 use anyhow::{bail, Context as _, Result};
 
-use alpenglow::budget::MemoryLimits;
-use alpenglow::points::build::sampling::{sampling_footprint, SamplingMethod};
-use alpenglow::points::build::spt::epsilon_from_pixels;
-use alpenglow::points::render::{SplatBackend, SplatMode, SplatPrimitive, SplatSettings};
-use alpenglow::points::scene::{load_point_object, PointLoadOptions, PointTransform};
-use alpenglow::points::vegetation::VegetationOptions;
-use alpenglow::renderer::Scene;
+use alpenglow::files::load_point_object;
+use alpenglow::tools::budget::MemoryLimits;
+use alpenglow::tools::spt::{epsilon_from_pixels, sampling_footprint, SamplingMethod};
+use alpenglow::{
+    PointLoadOptions, PointTransform, Scene, SplatBackend, SplatMode, SplatPrimitive, SplatSettings, VegetationOptions,
+};
 
 use super::args::{PointArgs, SplatArg, SplatBackendArg, SplatPrimitiveArg, VegetationArg};
 

@@ -9,8 +9,7 @@ use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 use glam::{DMat4, DQuat};
 
-use alpenglow::renderer::{Camera, Rig, ViewSpec};
-use alpenglow::view::lens::{Distortion, Intrinsics};
+use alpenglow::{Camera, Distortion, Intrinsics, Rig, ViewSpec};
 
 /// The placeholder of a view's name in output paths.
 pub const VIEW_PATTERN: &str = "{view}";
@@ -88,7 +87,7 @@ impl CameraArgs {
                 // A rig file's views are checked here, so that their errors
                 // name the file and the view, not --distortion.
                 for spec in &specs {
-                    alpenglow::renderer::check_view(spec).map_err(|e| match (&self.rig, &e) {
+                    alpenglow::check_view(spec).map_err(|e| match (&self.rig, &e) {
                         (Some(path), alpenglow::Error::InvalidArgument { message, .. }) => {
                             anyhow::anyhow!("{}: view '{}': {message}", path.display(), spec.name)
                         }
@@ -115,14 +114,14 @@ impl CameraArgs {
     }
 
     /// The motion blur of --shutter and --fps (None for a shutter of 0).
-    pub fn motion_blur(&self) -> Result<Option<alpenglow::post::motion_blur::MotionBlurSettings>> {
+    pub fn motion_blur(&self) -> Result<Option<alpenglow::MotionBlurSettings>> {
         if !(self.fps.is_finite() && self.fps > 0.0 && self.fps <= 1000.0) {
             bail!("invalid --fps {}: must be in (0, 1000]", self.fps);
         }
         if self.shutter == 0.0 {
             return Ok(None);
         }
-        let settings = alpenglow::post::motion_blur::MotionBlurSettings {
+        let settings = alpenglow::MotionBlurSettings {
             shutter_s: self.shutter,
             frame_interval_s: 1.0 / self.fps,
             ..Default::default()

@@ -3,7 +3,7 @@
 //! sequential point tree (§10.1) → versioned SPT file, with a progress bar.
 //!
 //! Every option and the input are checked, and the build's time and memory
-//! estimated ([`alpenglow::points::build::plan`]), before anything is
+//! estimated ([`alpenglow::tools::spt::plan_build`]), before anything is
 //! sampled: a bad option or file is a one-line error within milliseconds.
 
 use std::path::Path;
@@ -12,14 +12,13 @@ use std::time::Instant;
 
 use anyhow::Result;
 
-use alpenglow::budget::MemoryLimits;
-use alpenglow::error::Error;
-use alpenglow::points::build::estimate::complete_cloud;
-use alpenglow::points::build::input::{load_points_file, PointInput};
-use alpenglow::points::build::plan::plan_build;
-use alpenglow::points::build::sampling::{sample_mesh_reporting, SamplingMethod, SamplingOptions};
-use alpenglow::points::build::spt::{build_spt, epsilon_from_pixels, SptOptions};
-use alpenglow::points::build::spt_file::write_spt;
+use alpenglow::files::{load_points_file, write_spt, PointInput};
+use alpenglow::tools::budget::MemoryLimits;
+use alpenglow::tools::spt::{
+    build_spt, complete_cloud, epsilon_from_pixels, plan_build, sample_mesh_reporting, SamplingMethod, SamplingOptions,
+    SptOptions,
+};
+use alpenglow::Error;
 
 use super::args::{SamplingArg, SptBuildArgs};
 use super::progress;

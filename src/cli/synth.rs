@@ -1,20 +1,18 @@
 //! `alpenglow synth fill` and `alpenglow synth transition`: height-field
 //! synthesis by non-parametric sampling (dissertation §7.3;
-//! `alpenglow::synthesis`).
+//! `alpenglow::tools::synth`).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-use alpenglow::budget::MemoryLimits;
-use alpenglow::io::heightmap::{load_heightmap, load_heightmap_with_voids, HeightField, HeightmapOptions, RowOrder};
-use alpenglow::io::image_out::{encode_exr_height, encode_png_gray16};
-use alpenglow::synthesis::cost::{GrowthCost, SearchDevice};
-use alpenglow::synthesis::fill::{check_hole_fill, plan_hole_fill, FillParams, Growth};
-use alpenglow::synthesis::gpu::GpuSearch;
-use alpenglow::synthesis::search::CpuSearch;
-use alpenglow::synthesis::transition::{band_of, check_fields, plan_transition, Axis, TransitionParams};
-use alpenglow::vulkan::Context;
+use alpenglow::files::{encode_exr_height, encode_png_gray16, load_heightmap, load_heightmap_with_voids};
+use alpenglow::tools::budget::MemoryLimits;
+use alpenglow::tools::synth::{
+    band_of, check_fields, check_hole_fill, plan_hole_fill, plan_transition, Axis, CpuSearch, FillParams, GpuSearch,
+    Growth, GrowthCost, SearchDevice, TransitionParams,
+};
+use alpenglow::{Context, HeightField, HeightmapOptions, RowOrder};
 use anyhow::{bail, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use glam::DVec2;
@@ -94,7 +92,7 @@ pub struct GrowArgs {
     pub search: SearchArg,
     /// Longest estimated run accepted, in hours: a growth estimated to
     /// take longer is refused before it starts (README, "Height-field synthesis").
-    #[arg(long = "max-hours", default_value_t = alpenglow::budget::DEFAULT_MAX_HOURS, value_name = "HOURS", value_parser = parse_hours)]
+    #[arg(long = "max-hours", default_value_t = alpenglow::tools::budget::DEFAULT_MAX_HOURS, value_name = "HOURS", value_parser = parse_hours)]
     pub max_hours: f64,
     #[command(flatten)]
     pub device: crate::cli::args::DeviceArgs,
@@ -183,7 +181,7 @@ fn heightmap_options(args: &HeightArgs) -> HeightmapOptions {
             RowsArg::NorthUp => RowOrder::NorthUp,
             RowsArg::SouthUp => RowOrder::SouthUp,
         },
-        limits: alpenglow::io::limits::InputLimits::with_max_file_mib(args.max_input_mb),
+        limits: alpenglow::files::InputLimits::with_max_file_mib(args.max_input_mb),
     }
 }
 
@@ -401,7 +399,7 @@ fn grow_with(growth: Growth, search: Search) -> Result<HeightField> {
 /// The bytes of `field` written to `out` (by extension) with the height
 /// mapping and row order of `args`.
 fn encode_field(out: &Path, field: &HeightField, args: &HeightArgs) -> alpenglow::Result<Vec<u8>> {
-    use alpenglow::error::Error;
+    use alpenglow::Error;
     let (w, h) = (field.columns as usize, field.rows as usize);
     let (scale, offset) = (f64::from(args.height_scale), f64::from(args.height_offset));
     let flip = args.rows == RowsArg::NorthUp;

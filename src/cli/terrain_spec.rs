@@ -17,9 +17,7 @@ use std::str::FromStr;
 
 use glam::DVec2;
 
-use alpenglow::error::{Error, Result};
-use alpenglow::io::heightmap::HeightField;
-use alpenglow::terrain::procedural::{ProceduralTerrain, TerrainModel};
+use alpenglow::{Error, HeightField, ProceduralTerrain, Result, TerrainModel};
 
 /// The prefix every spec starts with.
 pub const PREFIX: &str = "procedural:";
@@ -79,7 +77,7 @@ impl Default for TerrainSpec {
 impl TerrainSpec {
     /// Checks the terrain parameters ([`ProceduralTerrain::validate`]), the
     /// grid size ([`MIN_SIZE`]..=[`MAX_SIZE`] per side) and the spacing
-    /// (the height field's range, [`alpenglow::io::heightmap::check_spacing`]).
+    /// (the height field's range, [`alpenglow::files::check_spacing`]).
     pub fn validate(&self) -> Result<()> {
         self.terrain.validate()?;
         for (what, v) in [("columns", self.columns), ("rows", self.rows)] {
@@ -90,8 +88,7 @@ impl TerrainSpec {
                 ));
             }
         }
-        alpenglow::io::heightmap::check_spacing(self.spacing)
-            .map_err(|m| Error::invalid("spacing= of the terrain", m))?;
+        alpenglow::files::check_spacing(self.spacing).map_err(|m| Error::invalid("spacing= of the terrain", m))?;
         Ok(())
     }
 

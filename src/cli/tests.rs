@@ -56,7 +56,8 @@ fn numeric_options_take_any_hyphen_value() {
 /// whether or not a height map is read.
 #[test]
 fn height_mapping_errors_name_the_flags() {
-    use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
+    use alpenglow::files::load_heightmap;
+    use alpenglow::HeightmapOptions;
     for (opts, start) in [
         (
             HeightmapOptions {

@@ -34,7 +34,9 @@ mod uploads;
 
 use std::sync::Arc;
 
-pub use access::{derive_barrier, Access, Stage};
+#[cfg(test)]
+pub use access::derive_barrier;
+pub use access::{Access, Stage};
 pub use bake::{BakedGraph, DEFAULT_PROFILE_HISTORY};
 pub use execute::{CpuStage, FrameOutcome, PassContext};
 pub use typed::{BufferAccess, BufferId, ImageAccess, ImageId, Resource};
@@ -344,3 +346,6 @@ impl<P: 'static> PassBuilder<'_, P> {
         self.graph.passes.push(self.decl);
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -207,7 +207,7 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) ->
     })
 }
 
-/// Writes `bytes` to `path` atomically (see [`write_atomically`]).
+/// Writes `bytes` to `path` atomically (see `write_atomically`).
 pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     write_atomically(path, |tmp| {
         std::fs::write(tmp, bytes).map_err(|e| {

@@ -245,9 +245,9 @@ const EXR_MAGIC: &[u8] = &[0x76, 0x2f, 0x31, 0x01];
 ///   values are the stored floats (half, float or uint). Deep data is
 ///   rejected.
 /// * **GeoTIFF** or plain TIFF, one sample per pixel (see
-///   [`crate::io::geotiff`]): spacing and orientation from the
+///   `crate::io::geotiff`): spacing and orientation from the
 ///   georeferencing.
-/// * **SRTM `.hgt`** (see [`crate::io::hgt`]): spacing from the file's size
+/// * **SRTM `.hgt`** (see `crate::io::hgt`): spacing from the file's size
 ///   and the latitude in its name; voids are an error.
 ///
 /// Rows: see the module documentation. Spacing: `opts.spacing`, else the

@@ -137,7 +137,7 @@ pub fn encode_jpeg_rgba8(rgba: &[u8], width: u32, height: u32) -> Result<Vec<u8>
 pub enum ImageFormat {
     /// `.png`: lossless, with alpha.
     Png,
-    /// `.jpg` or `.jpeg`: quality [`JPEG_QUALITY`], no alpha.
+    /// `.jpg` or `.jpeg`: quality `JPEG_QUALITY`, no alpha.
     Jpeg,
 }
 

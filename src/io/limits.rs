@@ -86,7 +86,7 @@ impl InputLimits {
     }
 
     /// [`InputLimits::check_image`], then the memory model
-    /// ([`crate::budget`]): the image decoded at `bytes_per_pixel` plus 4 B
+    /// (`crate::budget`): the image decoded at `bytes_per_pixel` plus 4 B
     /// a sample as kept, against the host's available memory.
     pub fn check_image_fits(&self, width: u64, height: u64, bytes_per_pixel: u64) -> Result<(), String> {
         self.check_image(width, height, bytes_per_pixel)?;

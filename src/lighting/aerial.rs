@@ -47,10 +47,14 @@
 //! the definition of turbidity (eq. 6.8): τ_M ≈ (T − 1)·τ_R. The Mie phase is
 //! Henyey–Greenstein with g = [`MIE_G`].
 
-use glam::{Vec2, Vec3};
+#[cfg(test)]
+use glam::Vec2;
+use glam::Vec3;
 
 use super::constants::LightingFrame;
-use super::preetham::{check_turbidity, COS_THETA_MIN};
+use super::preetham::check_turbidity;
+#[cfg(test)]
+use super::preetham::COS_THETA_MIN;
 use crate::error::Result;
 
 /// Representative wavelengths (nm) of R, G, B.
@@ -67,6 +71,7 @@ pub const AEROSOL_OPTICAL_LENGTH_M: f32 = 1250.0;
 pub const SCALE_HEIGHTS_M: (f32, f32) = (8_400.0, AEROSOL_OPTICAL_LENGTH_M);
 /// `sin` of the top of the horizon band (10°) the distant radiance is read
 /// from; the bottom is `preetham::COS_THETA_MIN` (≈ 0.57°).
+#[cfg(test)]
 pub const HORIZON_BAND_SIN: f32 = 0.173_648_18;
 
 /// Sea-level Rayleigh scattering coefficient (1/m) at `lambda_nm`:
@@ -87,11 +92,13 @@ pub fn mie_coefficient(lambda_nm: f32, t: f32) -> f32 {
 }
 
 /// Rayleigh phase function `3/(16π)(1 + cos²θ)` (1/sr).
+#[cfg(test)]
 pub fn rayleigh_phase(cos_theta: f32) -> f32 {
     3.0 / (16.0 * std::f32::consts::PI) * (1.0 + cos_theta * cos_theta)
 }
 
 /// Henyey–Greenstein phase `(1 − g²)/(4π(1 + g² − 2g cos θ)^(3/2))` (eq. 6.7).
+#[cfg(test)]
 pub fn henyey_greenstein(cos_theta: f32, g: f32) -> f32 {
     (1.0 - g * g) / (4.0 * std::f32::consts::PI * (1.0 + g * g - 2.0 * g * cos_theta).powf(1.5))
 }
@@ -119,6 +126,7 @@ impl AerialCoefficients {
     }
 
     /// β = β_R + β_M.
+    #[cfg(test)]
     pub fn extinction(&self) -> Vec3 {
         self.rayleigh + self.mie
     }
@@ -126,6 +134,7 @@ impl AerialCoefficients {
     /// The single-scattering radiance of an infinitely long ray,
     /// `L_∞ = E_sun·β(θ)/β`, for sun irradiance `e_sun` and the cosine of
     /// the angle between the view ray and the sun.
+    #[cfg(test)]
     pub fn single_scattering(&self, e_sun: Vec3, cos_theta: f32) -> Vec3 {
         let cos_theta = cos_theta.clamp(-1.0, 1.0);
         let angular = self.rayleigh * rayleigh_phase(cos_theta) + self.mie * henyey_greenstein(cos_theta, self.g);
@@ -146,6 +155,7 @@ impl AerialCoefficients {
 /// `L = L₀·e^(−τ) + (1 − e^(−τ))·L_∞`: radiance `l0` seen through air of
 /// optical depth `tau` ([`optical_depth`]) whose infinitely long ray has
 /// radiance `l_inf`. CPU twin of the GLSL `aerial_perspective`.
+#[cfg(test)]
 pub fn aerial_perspective(l0: Vec3, tau: Vec3, l_inf: Vec3) -> Vec3 {
     let t = (-tau.max(Vec3::ZERO)).exp();
     l0 * t + (Vec3::ONE - t) * l_inf
@@ -157,6 +167,7 @@ pub fn aerial_perspective(l0: Vec3, tau: Vec3, l_inf: Vec3) -> Vec3 {
 /// `e^(−z̄/h)` for a level ray. Heights below the ground count as the
 /// ground; `h ≤ 0` means constant density (1). Twin of
 /// `aerial_mean_density`.
+#[cfg(test)]
 pub fn mean_density(z0: f32, z1: f32, h: f32) -> f32 {
     if h.is_nan() || h <= 0.0 {
         return 1.0;
@@ -173,6 +184,7 @@ pub fn mean_density(z0: f32, z1: f32, h: f32) -> f32 {
 /// Optical depth τ (per channel) of `s` metres of air between heights
 /// `z0` and `z1` above the ground: the ground coefficients scaled by the
 /// mean density of their components (`scale_heights`: Rayleigh, Mie, m).
+#[cfg(test)]
 pub fn optical_depth(coefficients: &AerialCoefficients, s: f32, z0: f32, z1: f32, scale_heights: (f32, f32)) -> Vec3 {
     let rho_r = mean_density(z0, z1, scale_heights.0);
     let rho_m = mean_density(z0, z1, scale_heights.1);
@@ -182,6 +194,7 @@ pub fn optical_depth(coefficients: &AerialCoefficients, s: f32, z0: f32, z1: f32
 /// The direction the distant radiance is read from: `d` (any length) with
 /// its elevation clamped into the horizon band, azimuth kept (straight up or
 /// down: north). Twin of `aerial_sky_direction` (aerial_perspective.glsl).
+#[cfg(test)]
 pub fn horizon_band_direction(d: Vec3) -> Vec3 {
     let d = d.normalize_or(Vec3::Y);
     let z = d.z.clamp(COS_THETA_MIN, HORIZON_BAND_SIN);
@@ -193,6 +206,7 @@ pub fn horizon_band_direction(d: Vec3) -> Vec3 {
 /// `L_∞` of the renderer: `sky` (a sky model's radiance along a direction)
 /// in the horizon band along `view`; where the sky gives nothing (all
 /// zero), single scattering of `e_sun` from the unit direction `sun`.
+#[cfg(test)]
 pub fn distant_radiance(
     sky: impl Fn(Vec3) -> Vec3,
     coefficients: &AerialCoefficients,

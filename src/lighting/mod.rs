@@ -15,3 +15,6 @@ pub mod sky;
 pub mod sky_light;
 pub mod solar;
 pub mod technique;
+
+#[cfg(test)]
+mod tests;

@@ -37,10 +37,13 @@ use super::solar::transmitted_sun;
 use crate::error::{Error, Result};
 
 /// Smallest `cos θ` (view zenith angle) the Perez formula is evaluated at.
+#[cfg(test)]
 pub const COS_THETA_MIN: f32 = 0.01;
 /// Fraction of the horizon radiance left for directions well below it.
+#[cfg(test)]
 pub const GROUND_FLOOR: f32 = 0.3;
 /// `sin` of the depression below the horizon where the darkening is complete.
+#[cfg(test)]
 pub const GROUND_FADE: f32 = 0.2;
 /// Zenith luminance (cd/m²) once the sun is [`TWILIGHT_END_DEG`] below the
 /// horizon (end of civil twilight).
@@ -130,6 +133,7 @@ pub fn zenith_chromaticity_formula(theta_s: f32, t: f32) -> (f32, f32) {
 
 /// CIE xyY → linear sRGB (IEC 61966-2-1, D65); components may be negative
 /// for colours outside the gamut.
+#[cfg(test)]
 pub fn xyy_to_linear_srgb(luminance: f32, x: f32, y: f32) -> Vec3 {
     let y = y.max(1e-4);
     let xyz = Vec3::new(x / y * luminance, luminance, (1.0 - x - y) / y * luminance);
@@ -141,6 +145,7 @@ pub fn xyy_to_linear_srgb(luminance: f32, x: f32, y: f32) -> Vec3 {
 }
 
 /// Luminance (cd/m² for this crate's radiance) of a linear sRGB colour.
+#[cfg(test)]
 pub fn luminance(rgb: Vec3) -> f32 {
     rgb.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
@@ -152,6 +157,7 @@ fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
 
 /// The factor below-horizon directions are darkened by (1 above it); the
 /// GPU twin is `preetham_ground_factor`.
+#[cfg(test)]
 pub fn ground_factor(dir_z: f32) -> f32 {
     1.0 - (1.0 - GROUND_FLOOR) * smoothstep(0.0, GROUND_FADE, -dir_z)
 }
@@ -220,31 +226,32 @@ impl PreethamSky {
     }
 
     /// The unit vector towards the sun.
+    #[cfg(test)]
     pub fn sun(&self) -> Vec3 {
         self.sun
     }
 
-    pub fn turbidity(&self) -> f32 {
-        self.turbidity
-    }
-
     /// Y_z (cd/m²), after the twilight fade.
+    #[cfg(test)]
     pub fn zenith_luminance(&self) -> f32 {
         self.zenith.x
     }
 
     /// (x_z, y_z).
+    #[cfg(test)]
     pub fn zenith_chromaticity(&self) -> (f32, f32) {
         (self.zenith.y, self.zenith.z)
     }
 
     /// Perez A..E (x, y, z for Y, x, y).
+    #[cfg(test)]
     pub fn coefficients(&self) -> &[Vec3; 5] {
         &self.coefficients
     }
 
     /// `(Y, x, y)` along unit `dir` after the view clamp, before the
     /// below-horizon darkening.
+    #[cfg(test)]
     pub fn luminance_chromaticity(&self, dir: Vec3) -> Vec3 {
         let dir = dir.normalize_or(Vec3::Z);
         let cos_theta = dir.z.max(COS_THETA_MIN);
@@ -254,6 +261,7 @@ impl PreethamSky {
 
     /// Sky radiance along `dir` (+Z up) without the sun disc: linear sRGB,
     /// luminance in cd/m². CPU twin of `preetham_sky` (sky_preetham.glsl).
+    #[cfg(test)]
     pub fn radiance(&self, dir: Vec3) -> Vec3 {
         let dir = dir.normalize_or(Vec3::Z);
         let yxy = self.luminance_chromaticity(dir);

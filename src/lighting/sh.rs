@@ -21,14 +21,17 @@
 
 use std::f64::consts::PI;
 
+#[cfg(test)]
 use glam::DVec3;
 
 /// Bands supported (l < 5).
 pub const MAX_BANDS: usize = 5;
 /// Coefficients of [`MAX_BANDS`] bands.
+#[cfg(test)]
 pub const MAX_COEFFICIENTS: usize = MAX_BANDS * MAX_BANDS;
 
 /// Index of `y_l^m`: `l(l+1) + m`.
+#[cfg(test)]
 pub const fn index(l: usize, m: i32) -> usize {
     ((l * (l + 1)) as i32 + m) as usize
 }
@@ -67,12 +70,14 @@ pub fn legendre_reduced(l: usize, m: usize, z: f64) -> f64 {
 }
 
 /// The associated Legendre function `P_l^m(z)` of the definition.
+#[cfg(test)]
 pub fn legendre(l: usize, m: usize, z: f64) -> f64 {
     legendre_reduced(l, m, z) * (1.0 - z * z).max(0.0).powf(m as f64 * 0.5)
 }
 
 /// Evaluates the first `bands²` basis functions at unit direction `dir` into
 /// `out` (which must hold at least `bands²` values; extra entries are left).
+#[cfg(test)]
 pub fn basis(dir: DVec3, bands: usize, out: &mut [f64]) {
     let bands = bands.min(MAX_BANDS);
     // (re, im) of (x + i y)^m = sin^m θ (cos mφ, sin mφ).
@@ -102,6 +107,7 @@ pub fn basis(dir: DVec3, bands: usize, out: &mut [f64]) {
 }
 
 /// The basis at `dir` as an array (all 25 functions).
+#[cfg(test)]
 pub fn basis_all(dir: DVec3) -> [f64; MAX_COEFFICIENTS] {
     let mut y = [0.0; MAX_COEFFICIENTS];
     basis(dir, MAX_BANDS, &mut y);
@@ -109,12 +115,14 @@ pub fn basis_all(dir: DVec3) -> [f64; MAX_COEFFICIENTS] {
 }
 
 /// Reconstruction `Σ c_i y_i(dir)` of a band-limited function.
+#[cfg(test)]
 pub fn evaluate(coefficients: &[f64], dir: DVec3) -> f64 {
     let y = basis_all(dir);
     coefficients.iter().zip(y).map(|(c, y)| c * y).sum()
 }
 
 /// Gauss–Legendre nodes and weights of `n` points on [−1, 1].
+#[cfg(test)]
 pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
     let n = n.max(1);
     (0..n)
@@ -146,6 +154,7 @@ pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
 /// Projection `c_i = ∫ f y_i dω` of `f` onto `bands` bands: Gauss–Legendre
 /// in z (`n` nodes) × `2n` equally spaced azimuths, exact for polynomials
 /// of degree < 2n.
+#[cfg(test)]
 pub fn project(f: impl Fn(DVec3) -> f64, bands: usize, n: usize) -> Vec<f64> {
     let bands = bands.min(MAX_BANDS);
     let mut c = vec![0.0; bands * bands];
@@ -169,6 +178,7 @@ pub fn project(f: impl Fn(DVec3) -> f64, bands: usize, n: usize) -> Vec<f64> {
 /// `Â_l`: the clamped cosine `max(0, n·ω)` convolved with band `l`
 /// (Ramamoorthi and Hanrahan 2001): `∫ max(0, n·ω) y_l^m(ω) dω = Â_l y_l^m(n)`.
 /// π, 2π/3, π/4, 0, −π/24, … (0 for odd l > 1).
+#[cfg(test)]
 pub fn clamped_cosine_band(l: usize) -> f64 {
     match l {
         0 => PI,
@@ -184,6 +194,7 @@ pub fn clamped_cosine_band(l: usize) -> f64 {
 
 /// The SH projection of the clamped cosine lobe `max(0, n·ω)` (bands²
 /// coefficients).
+#[cfg(test)]
 pub fn clamped_cosine(n: DVec3, bands: usize) -> Vec<f64> {
     let y = basis_all(n);
     (0..bands.min(MAX_BANDS) * bands.min(MAX_BANDS))
@@ -192,12 +203,14 @@ pub fn clamped_cosine(n: DVec3, bands: usize) -> Vec<f64> {
 }
 
 /// The band `l` of coefficient `i`.
+#[cfg(test)]
 pub fn band_of(i: usize) -> usize {
     (i as f64).sqrt() as usize
 }
 
 /// Irradiance `E(n) = ∫ L(ω) max(0, n·ω) dω` at normal `n` from the
 /// projected radiance `L` (clamped-cosine convolution).
+#[cfg(test)]
 pub fn irradiance(radiance: &[f64], n: DVec3) -> f64 {
     let y = basis_all(n);
     radiance

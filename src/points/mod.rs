@@ -27,7 +27,7 @@ pub struct Surfel {
     /// sRGB colour.
     pub color: [u8; 3],
     /// Clip lines for sharp features (§10.2.4), in the tangent frame
-    /// [`build::clip::tangent_frame`] of `normal`; [`ClipLines::NONE`] for none.
+    /// `build::clip::tangent_frame` of `normal`; [`ClipLines::NONE`] for none.
     pub clip: ClipLines,
 }
 
@@ -53,3 +53,6 @@ pub struct PointCloud {
     /// Per-point clip lines (§10.2.4), when the file had them.
     pub clip: Option<Vec<ClipLines>>,
 }
+
+#[cfg(test)]
+mod tests;

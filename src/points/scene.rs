@@ -107,7 +107,7 @@ pub struct PointObject {
     pub name: String,
     /// Its semantic class (scan unless made a rock).
     pub class: PointClass,
-    /// The splat list (for a hybrid object, with the floors of [`HybridMesh::point_tree`]).
+    /// The splat list (for a hybrid object, with the floors of `HybridMesh::point_tree`).
     pub tree: Arc<SequentialPointTree>,
     /// The triangles drawn where they are large in the image.
     pub hybrid: Option<Arc<HybridMesh>>,
@@ -116,7 +116,7 @@ pub struct PointObject {
     /// [`crate::points::render::SplatSettings::two_sided`] says.
     pub two_sided: bool,
     /// Thin its instances stochastically where they are smaller than a few
-    /// pixels ([`crate::points::render::selection`]): for the many small
+    /// pixels (`crate::points::render::selection`): for the many small
     /// copies of vegetation.
     pub thinning: bool,
 }

@@ -36,7 +36,7 @@ pub struct VegetationOptions {
     pub seed: u64,
     /// Prototypes per plant model (≥ 1).
     pub variants: usize,
-    /// Surfels per prototype as a fraction of [`PlantModel::default_samples`] (> 0).
+    /// Surfels per prototype as a fraction of `PlantModel::default_samples` (> 0).
     pub samples: f64,
     /// Keep the triangles of leaves and blades for hybrid rendering (§10.1.8).
     pub hybrid: bool,
@@ -48,7 +48,7 @@ pub struct VegetationOptions {
 
 impl Default for VegetationOptions {
     /// Density 1, three variants per model at full sampling, hybrid, at
-    /// most [`DEFAULT_MAX_PLANTS`], trees for a one-pixel error at 50° and
+    /// most `DEFAULT_MAX_PLANTS`, trees for a one-pixel error at 50° and
     /// 720 rows.
     fn default() -> Self {
         VegetationOptions {
@@ -91,7 +91,7 @@ impl VegetationOptions {
     }
 }
 
-/// What [`plant_scene`] made, for logs and benchmarks.
+/// What `plant_scene` made, for logs and benchmarks.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct VegetationReport {
     /// Plants per model.

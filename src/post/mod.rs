@@ -10,3 +10,6 @@ pub mod motion_blur;
 pub mod resample;
 pub mod resolve;
 pub mod tonemap;
+
+#[cfg(test)]
+mod tests;

@@ -36,7 +36,9 @@ use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 
-use super::resample::{add_weighted, check_size, Plane};
+use super::resample::check_size;
+#[cfg(test)]
+use super::resample::{add_weighted, Plane};
 use crate::error::{Error, Result};
 use crate::graph::{ImageAccess, ImageId, RenderGraph, Stage};
 use crate::shaders;
@@ -202,6 +204,7 @@ impl MotionBlur {
 
 /// The CPU twin of `post.motion_blur` (what the GPU must match to f32
 /// rounding): radiance, depth (x) and motion (x, y) as float planes of one size.
+#[cfg(test)]
 pub fn motion_blur_cpu(
     radiance: &Plane<[f32; 4]>,
     depth: &Plane<[f32; 4]>,

@@ -187,14 +187,17 @@ pub(crate) fn declare_pass<P: 'static, T: Pod>(
 /// texels, rows top to bottom. Float images are `Plane<[f32; 4]>` whatever
 /// their format (what `texelFetch` returns: missing channels 0, 0, 1).
 #[derive(Clone, Debug, PartialEq)]
+#[cfg(test)]
 pub struct Plane<T> {
     pub width: u32,
     pub height: u32,
     pub texels: Vec<T>,
 }
 
+#[cfg(test)]
 impl<T: Copy> Plane<T> {
     /// A plane of `f(x, y)`.
+    #[cfg(test)]
     pub fn from_fn(width: u32, height: u32, f: impl Fn(u32, u32) -> T) -> Plane<T> {
         let texels = (0..height)
             .flat_map(|y| (0..width).map(move |x| (x, y)))
@@ -207,6 +210,7 @@ impl<T: Copy> Plane<T> {
     }
 
     /// Checks that the plane has a size and a texel per pixel; errors name `parameter`.
+    #[cfg(test)]
     pub fn check(&self, parameter: &str) -> Result<()> {
         check_size(parameter, (self.width, self.height))?;
         if self.texels.len() != self.width as usize * self.height as usize {
@@ -219,6 +223,7 @@ impl<T: Copy> Plane<T> {
     }
 
     /// The texel at (`x`, `y`), clamped to the edge (of a checked plane).
+    #[cfg(test)]
     pub fn at(&self, x: i64, y: i64) -> T {
         let x = x.clamp(0, i64::from(self.width) - 1) as usize;
         let y = y.clamp(0, i64::from(self.height) - 1) as usize;
@@ -227,6 +232,7 @@ impl<T: Copy> Plane<T> {
 }
 
 /// `sum + w·c`, channel by channel.
+#[cfg(test)]
 pub(crate) fn add_weighted(sum: &mut [f32; 4], w: f32, c: [f32; 4]) {
     for (s, c) in sum.iter_mut().zip(c) {
         *s += w * c;
@@ -236,6 +242,7 @@ pub(crate) fn add_weighted(sum: &mut [f32; 4], w: f32, c: [f32; 4]) {
 /// Bilinear interpolation at `q` in texel coordinates (texel k's centre at
 /// k), clamped to the edge, skipping taps of weight 0: the twin of
 /// `bilinear` in `glsl/include/resample.glsl`.
+#[cfg(test)]
 pub fn bilinear(plane: &Plane<[f32; 4]>, q: [f32; 2]) -> [f32; 4] {
     let q = [
         q[0].clamp(-1.0, plane.width as f32),

@@ -32,7 +32,9 @@ use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 
-use super::resample::{add_weighted, check_images, check_size, declare_pass, ImageKind, Plane, ResampleImage};
+#[cfg(test)]
+use super::resample::{add_weighted, ImageKind, Plane};
+use super::resample::{check_images, check_size, declare_pass, ResampleImage};
 use crate::error::{Error, Result};
 use crate::graph::RenderGraph;
 use crate::shaders;
@@ -183,6 +185,7 @@ impl Resolve {
 
 /// The first and last source texel of target pixel `i` along one axis
 /// (`s` source pixels per target pixel, `n` source texels).
+#[cfg(test)]
 fn taps(i: u32, s: f32, n: u32, filter: ResolveFilter) -> (i64, i64) {
     let (first, last) = match filter {
         ResolveFilter::Tent => {
@@ -195,6 +198,7 @@ fn taps(i: u32, s: f32, n: u32, filter: ResolveFilter) -> (i64, i64) {
 }
 
 /// The weight of source texel `k` for target pixel `i` along one axis.
+#[cfg(test)]
 fn weight(k: i64, i: u32, s: f32, filter: ResolveFilter) -> f32 {
     match filter {
         ResolveFilter::Tent => {
@@ -210,12 +214,14 @@ fn weight(k: i64, i: u32, s: f32, filter: ResolveFilter) -> f32 {
 
 /// The source texel whose centre is nearest target pixel `i`'s centre
 /// along an axis of `target` → `source` texels (ties to the larger index).
+#[cfg(test)]
 pub fn nearest_source_texel(i: u32, target: u32, source: u32) -> u32 {
     (((2 * u64::from(i) + 1) * u64::from(source)) / (2 * u64::from(target))) as u32
 }
 
 /// The CPU twin of `post.resolve` for a float image of `kind` (what the GPU
 /// must match to f32 rounding); errors as [`Resolve::declare`]'s.
+#[cfg(test)]
 pub fn resolve_cpu(
     source: &Plane<[f32; 4]>,
     target_size: (u32, u32),
@@ -261,6 +267,7 @@ pub fn resolve_cpu(
 }
 
 /// The CPU twin of `post.resolve` for an Exact image of any texel type.
+#[cfg(test)]
 pub fn resolve_exact_cpu<T: Copy>(source: &Plane<T>, (width, height): (u32, u32)) -> Result<Plane<T>> {
     ResolveDesc {
         source_size: (source.width, source.height),

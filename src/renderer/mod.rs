@@ -73,6 +73,7 @@ pub const MAX_READBACK_SLOTS: usize = 16;
 /// Output size (or the views of a rig), whether frames are read back to
 /// the host, and every technique's settings.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct RenderSettings {
     /// The image size of a single view (ignored when `views` is set).
     pub width: u32,
@@ -660,3 +661,6 @@ fn warped_terrain(
     }
     Ok(terrain)
 }
+
+#[cfg(test)]
+mod tests;

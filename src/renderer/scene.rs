@@ -10,7 +10,9 @@ use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
 use crate::points::build::plants::scatter::{scatter, ScatterRule};
 use crate::points::build::spt::{epsilon_from_pixels, SptOptions};
-use crate::points::scene::{scatter_rocks, PointInstance, PointScene};
+#[cfg(test)]
+use crate::points::scene::PointInstance;
+use crate::points::scene::{scatter_rocks, PointScene};
 use crate::points::vegetation::{plant_scene, VegetationOptions, VegetationReport};
 use crate::terrain::geometry_image::TerrainSettings;
 use crate::terrain::ground::Ground;
@@ -25,6 +27,7 @@ pub const DEFAULT_ROCKS: (usize, usize, usize) = (4, 4000, 300);
 
 /// Host bytes of the point instance itself: the instance (72 B) twice (a
 /// growing vector doubles) and the per-frame selection entry (16 B).
+#[cfg(test)]
 pub const INSTANCE_HOST_BYTES: u64 = 2 * std::mem::size_of::<PointInstance>() as u64 + 16;
 
 /// Host bytes per point instance (boulder or plant) at the peak of a
@@ -119,7 +122,7 @@ impl Scene {
     /// trees built for a one-pixel error at 50° and 720 rows.
     ///
     /// Errors, before anything is built, when `count` boulders do not fit
-    /// the host's memory ([`rocks_footprint`]); the parameter is `rocks`.
+    /// the host's memory (`rocks_footprint`); the parameter is `rocks`.
     pub fn add_rocks(&mut self, count: usize) -> Result<()> {
         MemoryLimits::host_only().check("rocks", &format!("{count} boulders"), rocks_footprint(count))?;
         let spt = SptOptions {
@@ -133,9 +136,9 @@ impl Scene {
     }
 
     /// Plants of the layer tree's `vegetation` tables (§8.2 layers,
-    /// chapter 10 point trees; [`crate::points::vegetation`]): scattered
+    /// chapter 10 point trees; `crate::points::vegetation`): scattered
     /// over the terrain where their layer shows, as the CPU twin of the
-    /// layer evaluation ([`ReferenceSurface`], full detail, the default
+    /// layer evaluation (`ReferenceSurface`, full detail, the default
     /// terrain noise seed) says, standing on [`Scene::ground`] with the
     /// default terrain settings. Set the layers and input maps first.
     /// Warns when the cap thinned them.
@@ -219,7 +222,7 @@ impl Scene {
 
     /// Height (metres) of the ground at world `(x, y)` as the terrain is
     /// drawn with the default [`TerrainSettings`]: the B-spline with its
-    /// procedural detail at the finest level ([`crate::terrain::ground`]
+    /// procedural detail at the finest level (`crate::terrain::ground`
     /// says how far a drawn view may differ). Errors, naming the point,
     /// outside the terrain. Each call builds the noise tile (a few
     /// milliseconds; a query on a built [`Ground`] takes about a

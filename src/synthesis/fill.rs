@@ -18,7 +18,7 @@
 //! is what showed as speckle and as a scar where two fronts meet. On the
 //! test DEM the offset raised the share of boundary gradients within the
 //! field's 99th percentile from 95.8 % to 97.6 % and lowered the curvature
-//! KS statistic from 0.122 to 0.103 (`tests/synthesis_fill.rs`). Filled
+//! KS statistic from 0.122 to 0.103 (`src/synthesis/tests/fill.rs`). Filled
 //! samples then count as known for later queries; candidates always come
 //! from the original known samples.
 //!
@@ -66,7 +66,7 @@ impl Default for FillParams {
     /// seed 1, waves of at most 256 samples, at most 16384 candidates.
     ///
     /// λ = 0.25 favours continuous heights over matching slopes: on the
-    /// holes of `tests/synthesis_fill.rs` (Jacksboro DEM, 2048
+    /// holes of `src/synthesis/tests/fill.rs` (Jacksboro DEM, 2048
     /// candidates) it gave KS statistics of 0.12 (slope) and 0.15
     /// (curvature) and 95.5% of the boundary slopes within the field's
     /// 99th percentile, against 0.15, 0.15 and 94.6% with λ = 1.
@@ -411,7 +411,7 @@ impl FillOrder {
 
 /// The checks of [`plan_hole_fill`] that need no allocation: the mask's
 /// size, the parameters, and at least one known sample. Callers run them
-/// before estimating the cost ([`crate::synthesis::cost`]), so that a bad
+/// before estimating the cost (`crate::synthesis::cost`), so that a bad
 /// input is reported as such rather than as an absurd cost.
 pub fn check_hole_fill(field: &HeightField, unknown: &[bool], params: &FillParams) -> Result<()> {
     check_mask(field, unknown, "mask")?;
@@ -427,7 +427,7 @@ pub fn check_hole_fill(field: &HeightField, unknown: &[bool], params: &FillParam
 
 /// Prepares filling the `unknown` samples of `field` (`true`: unknown,
 /// row-major) from its own known windows (module docs of
-/// [`crate::synthesis::exemplar`]).
+/// `crate::synthesis::exemplar`).
 ///
 /// Errors (one line, naming the parameter): a mask of another size, bad
 /// [`FillParams`], a mask that marks every sample, no fully known window.

@@ -165,7 +165,7 @@ pub struct GpuSearch {
 }
 
 impl GpuSearch {
-    /// The search of `exemplar` by `config` with [`GpuSearchLimits::default`].
+    /// The search of `exemplar` by `config` with `GpuSearchLimits::default`.
     pub fn new(ctx: &Context, exemplar: Arc<Exemplar>, config: SearchConfig) -> Result<GpuSearch> {
         GpuSearch::with_limits(ctx, exemplar, config, GpuSearchLimits::default())
     }

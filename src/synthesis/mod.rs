@@ -16,3 +16,6 @@ pub mod fill;
 pub mod gpu;
 pub mod search;
 pub mod transition;
+
+#[cfg(test)]
+mod tests;

@@ -101,7 +101,7 @@ pub trait NeighbourhoodSearch {
 
     /// [`NeighbourhoodSearch::choose`], calling `progress` with the number
     /// of queries answered so far while it works (a long wave is not
-    /// silent: [`CpuSearch`] reports about every [`PROGRESS_INTERVAL`], the
+    /// silent: [`CpuSearch`] reports about every `PROGRESS_INTERVAL`, the
     /// GPU search after each batch). By default it reports once at the end.
     fn choose_reporting(&mut self, queries: &[Query], progress: &mut dyn FnMut(usize)) -> Result<Vec<Choice>> {
         let choices = self.choose(queries)?;
@@ -257,7 +257,7 @@ impl NeighbourhoodSearch for CpuSearch {
     }
 
     /// The workers count the queries they answered; this thread waits for
-    /// them and reports the count every [`PROGRESS_INTERVAL`].
+    /// them and reports the count every `PROGRESS_INTERVAL`.
     fn choose_reporting(&mut self, queries: &[Query], progress: &mut dyn FnMut(usize)) -> Result<Vec<Choice>> {
         check(&self.exemplar, &self.config, queries)?;
         let threads = std::thread::available_parallelism()

@@ -88,7 +88,7 @@ impl Band {
 
 /// The band between two `columns`×`rows` fields of `spacing` (module
 /// docs), checked against their size; nothing is allocated, so callers can
-/// estimate the growth's cost ([`crate::synthesis::cost`]) first.
+/// estimate the growth's cost (`crate::synthesis::cost`) first.
 pub fn band_of(columns: u32, rows: u32, spacing: glam::DVec2, params: &TransitionParams) -> Result<Band> {
     let (length, spacing) = match params.axis {
         Axis::X => (columns, spacing.x),
@@ -192,7 +192,7 @@ impl Transition {
 }
 
 /// Prepares growing the transition between `a` and `b`: the growth of the
-/// residual's band and the [`Transition`] that turns the grown residual
+/// residual's band and the `Transition` that turns the grown residual
 /// into the joined field.
 ///
 /// The band is grown on the residual over a smooth base, not on absolute

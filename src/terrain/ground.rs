@@ -37,14 +37,14 @@
 //! wide, so even there `o` is only 4–5 (octaves 5–8, 0.49 … 0.08 m in
 //! amplitude, are bump-mapped): 3 m above the ground, the drawn ground
 //! within 30 m differs from [`Ground::height`] by 0.15 m rms, 0.43 m at
-//! most (`tests/ground.rs`; the vertices' bound there is 1.9 m). A coarse
+//! most (`src/terrain/tests/ground.rs`; the vertices' bound there is 1.9 m). A coarse
 //! far view (`o` → 0) differs by about 1.5 m rms, at most
 //! [`Ground::omitted_detail_bound`]`(0)` (26 m, a loose bound).
 //!
 //! What *is* drawn, exactly: [`Ground::surface`] at a given `o` is a vertex
 //! of that split octave, [`Ground::vertex`] one invocation of
 //! `terrain.warp`, and [`DrawnSurface`] the whole triangulated mesh of a
-//! view, from the same warp the renderer uploads; `tests/ground.rs` checks
+//! view, from the same warp the renderer uploads; `src/terrain/tests/ground.rs` checks
 //! that it matches the GPU's depth to within 1 cm.
 
 use glam::{DVec2, DVec3, DVec4};
@@ -249,6 +249,7 @@ impl<'a> Ground<'a> {
 
 /// A point of the drawn mesh: its height and the triangle it lies in.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg(test)]
 pub struct DrawnPoint {
     /// Height of the triangulated surface (metres).
     pub height: f64,
@@ -261,6 +262,7 @@ pub struct DrawnPoint {
 /// The triangulated mesh a view draws: the `side×side` geometry image of
 /// `terrain.warp` over a warped sketch map, with the grid's triangles
 /// ([`crate::terrain::geometry_image::grid_indices`]).
+#[cfg(test)]
 pub struct DrawnSurface<'g, 'a> {
     ground: &'g Ground<'a>,
     warped: &'g [DVec3],
@@ -271,9 +273,11 @@ pub struct DrawnSurface<'g, 'a> {
     cells: Vec<[f64; 4]>,
 }
 
+#[cfg(test)]
 impl<'g, 'a> DrawnSurface<'g, 'a> {
     /// The mesh of `warped` (`n×n`, `n ≥ 2`) zoomed to `side×side`
     /// vertices (`side ≥ 2`).
+    #[cfg(test)]
     pub fn new(ground: &'g Ground<'a>, warped: &'g [DVec3], n: usize, side: usize) -> Result<Self> {
         if n < 2 || warped.len() != n * n || side < 2 {
             return Err(Error::invalid(
@@ -301,6 +305,7 @@ impl<'g, 'a> DrawnSurface<'g, 'a> {
 
     /// The drawn surface above world `xy`; None where the mesh does not
     /// reach (outside the view's sketch region).
+    #[cfg(test)]
     pub fn at(&self, xy: DVec2) -> Option<DrawnPoint> {
         let m = self.n - 1;
         let scale = m as f64 / (self.side - 1) as f64;
@@ -329,6 +334,7 @@ impl<'g, 'a> DrawnSurface<'g, 'a> {
     /// The point above `xy` if it lies in one of the two triangles of grid
     /// quad `(i, j)` (`grid_indices`' split: `(i, j), (i+1, j), (i, j+1)`
     /// and `(i+1, j), (i+1, j+1), (i, j+1)`).
+    #[cfg(test)]
     fn in_quad(&self, xy: DVec2, i: usize, j: usize) -> Option<DrawnPoint> {
         let extent = self.ground.field.extent();
         let at = |a: usize, b: usize| zoom_xy(self.warped, self.n, self.side, extent, a, b);

@@ -232,7 +232,7 @@ pub fn grid_normals(geometry: &[DVec3], n: usize) -> Result<Vec<DVec3>> {
 /// finite and > 0.
 ///
 /// `geometry` holds the texels' world positions `(x, y, h)`. Normals for
-/// `S_b` come from [`grid_normals`]. Non-finite intermediate values count
+/// `S_b` come from `grid_normals`. Non-finite intermediate values count
 /// as 0 and are then lifted to the floor. Errors on a wrong texel count,
 /// a surface bound of the wrong length, non-finite `eye`, or parameters out
 /// of range; never panics.

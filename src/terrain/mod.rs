@@ -11,6 +11,7 @@ pub mod ground;
 pub mod importance;
 pub mod lod;
 pub mod procedural;
+#[cfg(test)]
 pub mod raycast;
 pub mod shading;
 pub mod shadow;
@@ -20,4 +21,7 @@ pub mod warp;
 pub mod wavelet_noise;
 pub mod zoom;
 
-pub use technique::{Terrain, TerrainFrame, TerrainTexturing, TerrainViewFrame};
+pub use technique::{Terrain, TerrainFrame, TerrainTexturing};
+
+#[cfg(test)]
+mod tests;

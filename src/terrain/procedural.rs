@@ -157,7 +157,7 @@ pub struct ProceduralTerrain {
     pub model: TerrainModel,
     /// Noise seed.
     pub seed: u64,
-    /// Number of octaves `n` (at most [`MAX_OCTAVES`] are used).
+    /// Number of octaves `n` (at most `MAX_OCTAVES` are used).
     pub octaves: u32,
     /// Lacunarity `L`: frequency ratio of successive octaves.
     pub lacunarity: f64,
@@ -193,7 +193,7 @@ impl Default for ProceduralTerrain {
 }
 
 impl ProceduralTerrain {
-    /// Checks the parameters: 1 ≤ octaves ≤ [`MAX_OCTAVES`],
+    /// Checks the parameters: 1 ≤ octaves ≤ `MAX_OCTAVES`,
     /// 1 < lacunarity ≤ 16, all numbers finite, base wavelength > 0.
     pub fn validate(&self) -> Result<()> {
         let bad = |what: &str, msg: String| Err(Error::invalid(format!("terrain {what}"), msg));
@@ -320,7 +320,7 @@ impl ProceduralTerrain {
     }
 
     /// Samples the terrain on a grid: sample (c, r) is `height(c·dx, r·dy)`
-    /// (the height-field convention of [`crate::io::heightmap`]). Rows are
+    /// (the height-field convention of `crate::io::heightmap`). Rows are
     /// computed in parallel on scoped threads; each sample depends only on
     /// its coordinates, so the result is identical for any thread count.
     /// Non-finite values (only possible with parameters that

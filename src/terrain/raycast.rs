@@ -353,11 +353,6 @@ impl<'a> Raycaster<'a> {
         })
     }
 
-    /// The height field this caster was built for.
-    pub fn field(&self) -> &'a HeightField {
-        self.field
-    }
-
     /// Same as [`raycast`] on this caster's field (bit-identical result),
     /// with empty-space skipping.
     pub fn raycast(&self, origin: DVec3, dir: DVec3, max_t: f64) -> Option<f64> {

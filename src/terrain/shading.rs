@@ -26,6 +26,7 @@ use crate::vulkan::{
 /// ([`crate::texturing::layers::DEFAULT_LAYERS`]) their class reports:
 /// (name, layer index), in the order of `CLASSIC_LAYER` in
 /// `glsl/terrain/draw.frag`, which hard-codes the indices.
+#[cfg(test)]
 pub const CLASSIC_LAYERS: [(&str, u32); 4] = [("grass", 1), ("dry grass", 3), ("rock", 0), ("snow", 6)];
 
 /// Push constants of `terrain.draw` (`glsl/include/terrain_draw.glsl`).

@@ -18,7 +18,7 @@
 //! follow the lateral frustum edges for every view direction; with an
 //! axis-aligned map ([`SketchAlignment::Axes`], the text's choice) diagonal
 //! views lose about a fifth of the texels within the wanted density band
-//! (`tests/warp.rs`). A rotated frame's clipped rectangle may still reach
+//! (`src/terrain/tests/warp.rs`). A rotated frame's clipped rectangle may still reach
 //! beyond the terrain at its corners: those texels get zero importance
 //! through the surface bound ([`SketchMap::outside`]) and the GPU clamps
 //! warped positions onto the terrain, so such samples collapse onto its
@@ -171,7 +171,7 @@ pub struct SketchMap {
     pub n: usize,
     pub region: SketchRegion,
     /// World `(x, y, h)` per texel, row-major; heights are the cubic
-    /// B-spline of the atlas ([`sample_bspline`]), clamped at its edges.
+    /// B-spline of the atlas (`sample_bspline`), clamped at its edges.
     pub geometry: Vec<DVec3>,
     /// Texels outside the terrain's rectangle (possible at the corners of a
     /// view-aligned region).

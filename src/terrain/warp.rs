@@ -59,7 +59,7 @@
 //! after the first pass the columns are strongly bent (rows behind the eye
 //! stay uniform, rows in the frustum crowd into it), so `x` stops increasing
 //! along rows — 1600–3200 of the 16 129 quads of a 128² map fold over in
-//! our tests (`tests/warp.rs`), and the density also comes out worse. The
+//! our tests (`src/terrain/tests/warp.rs`), and the density also comes out worse. The
 //! default, [`ColumnImportance::RowDemand`], warps all columns alike by the
 //! demand of each row, `J = ∫ I² ds` along the row: an isotropic density
 //! `k·I` needs `k²∫I² ds` samples per unit width of the strip a row stands
@@ -71,7 +71,7 @@
 //! along every row of an axis-aligned map) carries over to the output and
 //! no quad can fold over; output rows stay straight. The price is
 //! that the second direction's density varies per row only; measured
-//! obtained/demanded densities are in the tests (`tests/warp.rs`).
+//! obtained/demanded densities are in the tests (`src/terrain/tests/warp.rs`).
 //!
 //! Which direction goes first matters: the first pass adapts per line, so it
 //! should run across the view (lateral), the shared pass along it
@@ -81,12 +81,16 @@ use std::ops::{Add, Mul, Sub};
 
 use glam::{DVec2, DVec3, DVec4};
 
-use crate::error::{Error, Result};
+#[cfg(test)]
+use crate::error::Error;
+use crate::error::Result;
 use crate::terrain::importance::check_grid;
 
 mod density;
 
-pub use density::{density_ratio, fraction_within, histogram, DensityRatio, Histogram};
+pub use density::density_ratio;
+#[cfg(test)]
+pub use density::{fraction_within, histogram};
 
 /// Smallest warped segment length as a fraction of the mean segment length.
 pub const MIN_SEGMENT_FRACTION: f64 = 1e-6;
@@ -282,6 +286,7 @@ impl<T: Sample> Walk<'_, T> {
 /// Index of element `k` of line `l` in an `n×n` image: `(n, l, k) → index`.
 type LineIndex = fn(usize, usize, usize) -> usize;
 
+#[cfg(test)]
 fn check_line(what: &str, p: usize, importance: usize, out: usize) -> Result<()> {
     if p < 2 || importance != p || out != p {
         return Err(Error::invalid(
@@ -295,11 +300,13 @@ fn check_line(what: &str, p: usize, importance: usize, out: usize) -> Result<()>
 /// Warps one row (or column) `p` with per-sample `importance` into `out`
 /// with the box filter (the text's Fig. 7.11, corrected; see the module
 /// documentation). Errors unless all three have the same length ≥ 2.
+#[cfg(test)]
 pub fn warp_row(p: &[DVec3], importance: &[f64], out: &mut [DVec3]) -> Result<()> {
     warp_row_with(p, importance, out, WarpFilter::Box)
 }
 
 /// [`warp_row`] with a choice of resampling filter.
+#[cfg(test)]
 pub fn warp_row_with(p: &[DVec3], importance: &[f64], out: &mut [DVec3], filter: WarpFilter) -> Result<()> {
     check_line("warp line", p.len(), importance.len(), out.len())?;
     let line: Vec<DVec4> = p.iter().zip(importance).map(|(q, &i)| q.extend(i)).collect();

@@ -58,6 +58,7 @@ use crate::error::{Error, Result};
 use crate::random::SplitMix64;
 
 /// Default tile size (texels per side), as in the paper.
+#[cfg(test)]
 pub const TILE: usize = 128;
 
 /// Root mean square of a tile after normalisation (step 4 of the module
@@ -219,6 +220,7 @@ fn tile_ok(tile: &[f32], n: usize) -> bool {
 ///
 /// Returns NaN when `tile.len() != n·n` or `n == 0`, or for non-finite
 /// coordinates.
+#[cfg(test)]
 pub fn evaluate(tile: &[f32], n: usize, x: f64, y: f64) -> f64 {
     if !tile_ok(tile, n) {
         return f64::NAN;

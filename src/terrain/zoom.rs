@@ -4,7 +4,7 @@
 //! warped against uniform meshes (`docs/PERFORMANCE.md`). The GPU pass
 //! (`glsl/terrain/warp.comp`) performs the same bilinear interpolation of
 //! `Φ` and the same cubic B-spline ([`sample_bspline`]); the depth test in
-//! `tests/terrain.rs` checks that they agree.
+//! `src/terrain/tests/terrain.rs` checks that they agree.
 
 use glam::{DVec2, DVec3};
 

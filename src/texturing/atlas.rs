@@ -49,7 +49,9 @@
 use std::collections::{HashMap, HashSet};
 
 use crate::error::Result;
-pub use crate::texturing::atlas_settings::{AtlasSettings, MAX_TILE_SIZES};
+pub use crate::texturing::atlas_settings::AtlasSettings;
+#[cfg(test)]
+pub use crate::texturing::atlas_settings::MAX_TILE_SIZES;
 pub use crate::texturing::pacing::GpuTimeBudget;
 use crate::texturing::quadtree::{NeededTile, NodeId};
 
@@ -285,12 +287,8 @@ impl TileCache {
         }
     }
 
-    /// Resident tiles in all layers.
-    pub fn resident(&self) -> usize {
-        self.index.len()
-    }
-
     /// GPU memory of all atlas textures at `bytes_per_texel`.
+    #[cfg(test)]
     pub fn memory_bytes(&self, bytes_per_texel: u64) -> u64 {
         let textures = self.settings.texture_tile_sizes().len() as u64;
         let texels = u64::from(self.settings.size).pow(2) * textures;

@@ -39,6 +39,7 @@ pub fn dominant_layer(coverage: &[f32]) -> Option<usize> {
 /// The dominant layer as the shaders track it along the walk: the running
 /// best's share scaled by every later layer's `1 − C`, a later layer taking
 /// over when its own coverage is larger.
+#[cfg(test)]
 pub fn dominant_layer_running(coverage: &[f32]) -> Option<usize> {
     let (mut best, mut share) = (None, 0.0f32);
     for (k, &c) in coverage.iter().enumerate() {

@@ -43,6 +43,7 @@ pub struct Coarsening {
 
 impl Coarsening {
     /// Whether the selection was changed.
+    #[cfg(test)]
     pub fn any(&self) -> bool {
         self.halved + self.merged > 0
     }

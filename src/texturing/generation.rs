@@ -38,12 +38,14 @@ use crate::texturing::atlas::{TileCache, TilePlan};
 use crate::texturing::fit::{select_to_fit, Coarsening};
 use crate::texturing::input_maps::InputMaps;
 use crate::texturing::layers::LayerTree;
-use crate::texturing::pacing::{GenerationPacer, GpuTimeBudget};
+use crate::texturing::pacing::GenerationPacer;
+#[cfg(test)]
+use crate::texturing::pacing::GpuTimeBudget;
 use crate::texturing::page_table::PageTable;
 use crate::texturing::passes::{add_atlas_readback, base_push, GenerationPasses};
 use crate::texturing::quadtree::{HeightBounds, NeededTile, NodeId, View};
 pub use crate::texturing::stats::TextureFrameStats;
-pub use crate::texturing::streaming::{TextureStreaming, MAX_ATLAS_TEXTURES, MAX_VIEWS};
+pub use crate::texturing::streaming::{TextureStreaming, MAX_VIEWS};
 use crate::view::{frustum_planes, Frame, FrameContext, Technique};
 use crate::vulkan::{Buffer, Context, Format, Image, ImageDesc, ImageUsageFlags, MemoryLocation};
 
@@ -307,6 +309,7 @@ impl TextureAtlas {
 
     /// Sets the budget's GPU time per frame (a simulator's frame time may
     /// change at run time); errors on a value that is not finite and positive.
+    #[cfg(test)]
     pub fn set_gpu_time(&mut self, gpu_time: Option<GpuTimeBudget>) -> Result<()> {
         if let Some(t) = gpu_time.filter(|t| !t.is_valid()) {
             return Err(Error::invalid(
@@ -326,6 +329,7 @@ impl TextureAtlas {
     }
 
     /// The measured generation cost: GPU milliseconds per texel, once known.
+    #[cfg(test)]
     pub fn gpu_ms_per_texel(&self) -> Option<f64> {
         self.pacer.ms_per_texel()
     }

@@ -81,7 +81,9 @@ pub const DEFAULT_LAYERS: &str = include_str!("default_layers.toml");
 pub mod constraint;
 pub mod vegetation;
 use constraint::ConstraintFile;
-pub use constraint::{Constraint, Hat, SampledFunction, MAX_HAT_VALUE, MAX_SAMPLES};
+#[cfg(test)]
+pub use constraint::Hat;
+pub use constraint::{Constraint, SampledFunction, MAX_SAMPLES};
 pub use vegetation::Vegetation;
 use vegetation::VegetationFile;
 
@@ -222,7 +224,7 @@ fn line_of(text: &str, at: usize) -> usize {
 }
 
 impl LayerTree {
-    /// The built-in tree ([`DEFAULT_LAYERS`]).
+    /// The built-in tree (`DEFAULT_LAYERS`).
     pub fn default_tree() -> LayerTree {
         // The built-in file is tested to parse.
         LayerTree::parse(DEFAULT_LAYERS, "built-in layers").unwrap_or_else(|_| LayerTree { layers: Vec::new() })
@@ -415,12 +417,7 @@ pub struct Surface {
     pub coverage: Vec<f32>,
 }
 
-impl Surface {
-    /// Unit normal of the final height.
-    pub fn normal(&self) -> Vec3 {
-        Vec3::new(-self.gradient.x as f32, -self.gradient.y as f32, 1.0).normalize()
-    }
-}
+impl Surface {}
 
 /// Noise of a layer at a point: `(layer index, world xy, wavelength)` →
 /// value in about [−1, 1] and its gradient. `coverage` selects N (true) or

@@ -45,3 +45,6 @@ pub mod quadtree;
 pub mod reference;
 pub mod stats;
 pub mod streaming;
+
+#[cfg(test)]
+mod tests;

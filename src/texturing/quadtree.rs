@@ -212,6 +212,7 @@ pub struct NodeBounds {
 
 /// The leaves the view needs, by the rules in the module documentation:
 /// [`select_tiles_for_views`] of one view.
+#[cfg(test)]
 pub fn select_tiles(
     extent: DVec2,
     view: &View,

@@ -72,7 +72,7 @@ impl TextureStreaming {
     }
 
     /// Streaming for frames of `views` (width, height) served by one atlas
-    /// within [`DEFAULT_ATLAS_BYTES`]: [`TextureStreaming::for_views_within`]
+    /// within `DEFAULT_ATLAS_BYTES`: [`TextureStreaming::for_views_within`]
     /// (which cannot fail at that limit).
     pub fn for_views(views: &[(u32, u32)]) -> TextureStreaming {
         let atlas = atlas_for(views, DEFAULT_ATLAS_BYTES).unwrap_or_else(|_| minimal_atlas());
@@ -83,7 +83,7 @@ impl TextureStreaming {
     /// 16² to 128², and only the finest nodes (level 12) get up to 256²
     /// (§8.2.4); the atlas sized from the views (module documentation) in
     /// at most `max_bytes`; at most 32 tiles of 128² generated per frame,
-    /// and at most [`DEFAULT_FRAME_SHARE`] of the frame's GPU time. Errors
+    /// and at most `DEFAULT_FRAME_SHARE` of the frame's GPU time. Errors
     /// when `max_bytes` is below [`TextureStreaming::min_atlas_bytes`].
     pub fn for_views_within(views: &[(u32, u32)], max_bytes: u64) -> Result<TextureStreaming> {
         Ok(TextureStreaming::with_atlas(atlas_for(views, max_bytes)?))
@@ -108,7 +108,7 @@ impl TextureStreaming {
     }
 
     /// The most tiles of the aim size one frame may generate:
-    /// [`MAX_DISPATCH_TEXELS`] over the aim size's texels.
+    /// `MAX_DISPATCH_TEXELS` over the aim size's texels.
     pub fn max_tile_budget(&self) -> u32 {
         let aim = u64::from(self.quadtree.aim_texels.next_power_of_two()).pow(2);
         (MAX_DISPATCH_TEXELS / aim).min(u64::from(u32::MAX)) as u32

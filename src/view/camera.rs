@@ -46,10 +46,10 @@ pub struct Camera {
 
 impl Camera {
     /// Checks that the camera describes a view: finite values, eye and
-    /// target within ±[`MAX_COORDINATE`] metres, eye ≠ target, up not zero
+    /// target within ±`MAX_COORDINATE` metres, eye ≠ target, up not zero
     /// or parallel to the view direction, 0 < fov < 180, and
-    /// [`MIN_NEAR`] ≤ near < far ≤ [`MAX_FAR`] with far / near ≤
-    /// [`MAX_DEPTH_RATIO`] (the depth buffer's precision).
+    /// `MIN_NEAR` ≤ near < far ≤ `MAX_FAR` with far / near ≤
+    /// `MAX_DEPTH_RATIO` (the depth buffer's precision).
     pub fn validate(&self) -> Result<()> {
         for (name, v) in [
             ("camera.eye", self.eye),
@@ -139,19 +139,19 @@ impl Camera {
     /// point, looking at the centre, with clip planes that hold the whole
     /// terrain. Valid ([`Camera::validate`]) for the box of every legal
     /// height field (sides of at least a millimetre, heights within
-    /// ±10⁶ m; [`crate::io::heightmap`]), however thin, flat, steep or large:
+    /// ±10⁶ m; `crate::io::heightmap`), however thin, flat, steep or large:
     ///
-    /// * the view is at most [`MAX_OVERVIEW_ELEVATION_DEG`] from the
+    /// * the view is at most `MAX_OVERVIEW_ELEVATION_DEG` from the
     ///   horizontal, so a terrain far higher than wide is seen from the side,
     ///   not straight down along `up`;
     /// * the eye is at least 10⁻⁸ of the target's distance from the origin
     ///   away from the target, so the two differ at their magnitude;
-    /// * eye and target are clamped to ±[`MAX_COORDINATE`] (a terrain
+    /// * eye and target are clamped to ±`MAX_COORDINATE` (a terrain
     ///   larger than that is shown in part);
     /// * near is at most half the eye's distance to the terrain (a
     ///   millimetre terrain is not clipped away), far reaches its farthest
-    ///   corner, both within [`MIN_NEAR`], [`MAX_FAR`] and
-    ///   [`MAX_DEPTH_RATIO`].
+    ///   corner, both within `MIN_NEAR`, `MAX_FAR` and
+    ///   `MAX_DEPTH_RATIO`.
     ///
     /// For ordinary terrains (wider than high, within the limits) this is
     /// the camera of earlier versions unchanged.

@@ -89,7 +89,7 @@ impl Orbit {
     /// 60 % of its half-size, 0.08 of its size above the highest point.
     /// Valid ([`Orbit::validate`]) for the box of every legal height field:
     /// centre, radius and height are kept within half of
-    /// [`MAX_COORDINATE`] (a larger terrain is circled in part), and the
+    /// `MAX_COORDINATE` (a larger terrain is circled in part), and the
     /// radius is at least a fifth of the height (a terrain far higher than
     /// wide is circled, not looked at from straight above), and the eye
     /// stays apart from the centre at the centre's magnitude.
@@ -119,8 +119,8 @@ impl Orbit {
 
     /// Checks that all numbers are finite, the radius is positive, and
     /// every camera on the orbit is valid ([`Camera::validate`] with up
-    /// +Z): the eye within ±[`MAX_COORDINATE`], not straight above the
-    /// centre (radius at least [`MIN_ORBIT_SLOPE`] of the distance) and not
+    /// +Z): the eye within ±`MAX_COORDINATE`, not straight above the
+    /// centre (radius at least `MIN_ORBIT_SLOPE` of the distance) and not
     /// on it.
     pub fn validate(&self) -> Result<()> {
         let finite = self.centre.is_finite()

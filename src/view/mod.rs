@@ -24,7 +24,9 @@ pub use camera::{frustum_planes, Camera};
 pub use frame::{Frame, FrameContext, Technique};
 pub use lens::Intrinsics;
 pub use lighting::{Exposure, Lighting, ShadowMode, SkyLightMode, SkyModel, SunPosition};
-pub use targets::{LightingInputs, SceneTargets, TargetFormats, LIGHTING_CONSTANTS_BYTES};
+#[cfg(test)]
+pub use targets::LIGHTING_CONSTANTS_BYTES;
+pub use targets::{SceneTargets, TargetFormats};
 
 use glam::{DMat4, Mat4, Vec3};
 

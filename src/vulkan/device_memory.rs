@@ -70,7 +70,7 @@ pub(crate) fn query(instance: &ash::Instance, physical: vk::PhysicalDevice, budg
 }
 
 impl Context {
-    /// What this machine and device can take ([`crate::budget`]): the
+    /// What this machine and device can take (`crate::budget`): the
     /// host's available memory, the largest device-local heap (its
     /// `VK_EXT_memory_budget` budget where offered) and the largest single
     /// allocation, capped by `ALPENGLOW_DEVICE_MEMORY_MB` when set.

@@ -21,16 +21,6 @@ use crate::error::{Error, Result};
 /// Bytes of push constants every pipeline may use.
 pub const PUSH_CONSTANT_BYTES: u32 = 128;
 
-/// The fixed samplers, by heap index.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u32)]
-pub enum SamplerKind {
-    LinearClamp = 0,
-    NearestClamp = 1,
-    LinearRepeat = 2,
-    NearestRepeat = 3,
-}
-
 /// The descriptor arrays of the heap.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HeapKind {

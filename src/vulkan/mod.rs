@@ -18,11 +18,10 @@ pub use ash::vk::{
 };
 pub(crate) use commands::BarrierBatch;
 pub use commands::{CommandRecorder, LoadOp};
-pub use context::{Context, ContextOptions, DeviceInfo, OptionalFeatures};
-pub use device_select::{DeviceSelector, REQUIRED_FEATURES};
-pub use frames::{CompletedFrame, FrameRing, RecordingFrame, FRAMES_IN_FLIGHT};
-pub use heap::{SamplerKind, PUSH_CONSTANT_BYTES};
-pub use image::{is_depth_format, Image, ImageDesc, MemoryBlock};
+pub use context::{Context, ContextOptions, DeviceInfo};
+pub use device_select::DeviceSelector;
+pub use frames::{CompletedFrame, FrameRing, FRAMES_IN_FLIGHT};
+pub use image::{Image, ImageDesc, MemoryBlock};
 pub use memory::{AccessState, Barrier, Buffer, BufferDesc, MemoryLocation};
 pub use pipeline::{Blend, ComputePipeline, GraphicsPipeline, GraphicsPipelineDesc, SpirV, VertexAttribute};
 pub use validation::ValidationReport;

@@ -29,7 +29,7 @@ pub const BINDLESS_SYNCVAL_FIX: u32 = ash::vk::make_api_version(0, 1, 3, 268);
 impl ValidationReport {
     /// A report for a validation layer whose spec version is `layer_version`.
     ///
-    /// Layers before [`BINDLESS_SYNCVAL_FIX`] treat every descriptor of a bound
+    /// Layers before `BINDLESS_SYNCVAL_FIX` treat every descriptor of a bound
     /// runtime array as accessed by every draw and dispatch, so a bindless heap
     /// produces hazards on resources the shader never touches. Those reports
     /// (and only those: they name a descriptor binding and index) are counted

@@ -16,7 +16,7 @@ impl Fixtures {
     /// Writes a 33×33 DEM (16-bit PNG), a mask with a 5×5 hole and a
     /// 33×33 colour image into `dir`.
     pub fn create(dir: &Path) -> Fixtures {
-        use alpenglow::io::image_out::{encode_png_gray16, encode_png_rgba8};
+        use alpenglow::files::{encode_png_gray16, encode_png_rgba8};
         std::fs::create_dir_all(dir).unwrap();
         let side = 33u32;
         let at = |i: u32| (f64::from(i % side), f64::from(i / side));

@@ -263,7 +263,8 @@ fn check_outputs(case: &Case) -> Result<(), String> {
 }
 
 fn check_output(case: &Case, output: &Output) -> Result<(), String> {
-    use alpenglow::io::heightmap::{load_heightmap, HeightmapOptions};
+    use alpenglow::files::load_heightmap;
+    use alpenglow::HeightmapOptions;
     let fail = |p: &Path, why: String| Err(format!("{}: {why}", p.display()));
     match output {
         Output::Png(p) => match image::open(p) {
@@ -295,7 +296,7 @@ fn check_output(case: &Case, output: &Output) -> Result<(), String> {
             }
             Ok(())
         }
-        Output::Spt(p) => match alpenglow::points::build::spt_file::read_spt(p) {
+        Output::Spt(p) => match alpenglow::files::read_spt(p) {
             Ok(_) => Ok(()),
             Err(e) => fail(p, format!("does not load: {e}")),
         },
@@ -306,7 +307,7 @@ fn check_output(case: &Case, output: &Output) -> Result<(), String> {
                 at.and_then(|i| case.args.get(i + 1)?.parse().ok()).unwrap_or(default)
             };
             let opts = HeightmapOptions {
-                spacing: Some(glam::DVec2::ONE),
+                spacing: Some(alpenglow::glam::DVec2::ONE),
                 scale: given("--height-scale", 1.0),
                 offset: given("--height-offset", 0.0),
                 ..HeightmapOptions::default()
@@ -319,7 +320,7 @@ fn check_output(case: &Case, output: &Output) -> Result<(), String> {
         }
         Output::Layers(p) => {
             let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
-            match alpenglow::texturing::layers::LayerTree::parse(&text, "written") {
+            match alpenglow::LayerTree::parse(&text, "written") {
                 Ok(_) => Ok(()),
                 Err(e) => fail(p, format!("does not parse: {e}")),
             }

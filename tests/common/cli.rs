@@ -161,15 +161,7 @@ pub fn dem_with_hole(dir: &Path, side: u32, hole: u32) -> (PathBuf, PathBuf) {
     let holes: Vec<u16> = (0..side * side)
         .map(|i| if inside(i % side) && inside(i / side) { 255 } else { 0 })
         .collect();
-    std::fs::write(
-        &dem,
-        alpenglow::io::image_out::encode_png_gray16(&values, side, side).unwrap(),
-    )
-    .unwrap();
-    std::fs::write(
-        &mask,
-        alpenglow::io::image_out::encode_png_gray16(&holes, side, side).unwrap(),
-    )
-    .unwrap();
+    std::fs::write(&dem, alpenglow::files::encode_png_gray16(&values, side, side).unwrap()).unwrap();
+    std::fs::write(&mask, alpenglow::files::encode_png_gray16(&holes, side, side).unwrap()).unwrap();
     (dem, mask)
 }

@@ -6,8 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use alpenglow::io::heightmap::{load_heightmap, HeightField, HeightmapOptions};
-use alpenglow::vulkan::{Context, ContextOptions, DeviceSelector, ValidationReport};
+use alpenglow::files::load_heightmap;
+use alpenglow::{Context, ContextOptions, DeviceSelector, HeightField, HeightmapOptions, ValidationReport};
 
 /// A context with validation and synchronization validation on.
 pub fn validated_context() -> (Context, Arc<ValidationReport>) {
@@ -47,7 +47,7 @@ pub fn jacksboro_field() -> HeightField {
     let options = HeightmapOptions {
         scale: 1.0,
         offset: 0.0,
-        spacing: Some(glam::DVec2::new(74.4, 92.6)),
+        spacing: Some(alpenglow::glam::DVec2::new(74.4, 92.6)),
         ..Default::default()
     };
     load_heightmap(&data("jacksboro-fault.png"), &options).expect("real DEM")
@@ -55,11 +55,11 @@ pub fn jacksboro_field() -> HeightField {
 
 /// Along the valley of the Jacksboro fault, from its south-western part
 /// towards the north-east, a few hundred metres above the valley floor.
-pub fn jacksboro_valley_camera() -> alpenglow::renderer::Camera {
-    alpenglow::renderer::Camera {
-        eye: glam::DVec3::new(13600.0, 9600.0, 750.0),
-        target: glam::DVec3::new(18500.0, 21500.0, 350.0),
-        up: glam::DVec3::Z,
+pub fn jacksboro_valley_camera() -> alpenglow::Camera {
+    alpenglow::Camera {
+        eye: alpenglow::glam::DVec3::new(13600.0, 9600.0, 750.0),
+        target: alpenglow::glam::DVec3::new(18500.0, 21500.0, 350.0),
+        up: alpenglow::glam::DVec3::Z,
         fov_y_deg: 50.0,
         near: 5.0,
         far: 100000.0,
@@ -88,11 +88,8 @@ pub fn mean_flip(reference_rgba: &[u8], test_rgba: &[u8], width: u32, height: u3
     let mean = nv_flip::FlipPool::from_image(&error).mean();
     (mean, heatmap)
 }
-pub mod atlas;
 #[cfg(feature = "cli")]
 pub mod cli;
-pub mod plane;
-pub mod points;
 
 /// With `ALPENGLOW_DUMP=DIR` (an existing folder), writes each named RGBA8
 /// image as `DIR/<n>-<name>.png`, n the number of entries already there,
@@ -104,7 +101,7 @@ pub fn dump_pngs(images: &[(&str, &[u8])], width: u32, height: u32) {
     let dir = Path::new(&dir);
     let n = std::fs::read_dir(dir).map(|d| d.count()).unwrap_or(0);
     for (name, rgba) in images {
-        let _ = alpenglow::io::image_out::write_png_rgba8(&dir.join(format!("{n}-{name}.png")), rgba, width, height);
+        let _ = alpenglow::files::write_png_rgba8(&dir.join(format!("{n}-{name}.png")), rgba, width, height);
     }
 }
 

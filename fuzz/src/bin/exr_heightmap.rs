@@ -3,7 +3,7 @@
 fn main() {
     afl::fuzz!(|data: &[u8]| {
         alpenglow_fuzz::run(data, "exr", |p| {
-            alpenglow::io::heightmap::load_heightmap(p, &alpenglow::io::heightmap::HeightmapOptions::default())
+            alpenglow::files::load_heightmap(p, &alpenglow::HeightmapOptions::default())
         });
     });
 }

@@ -2,6 +2,6 @@
 
 fn main() {
     afl::fuzz!(|data: &[u8]| {
-        alpenglow_fuzz::run(data, "toml", alpenglow::view::camera_path::load_keyframes);
+        alpenglow_fuzz::run(data, "toml", alpenglow::files::load_keyframes);
     });
 }

@@ -2,6 +2,6 @@
 
 fn main() {
     afl::fuzz!(|data: &[u8]| {
-        alpenglow_fuzz::run(data, "toml", alpenglow::texturing::layers::LayerTree::load);
+        alpenglow_fuzz::run(data, "toml", alpenglow::LayerTree::load);
     });
 }

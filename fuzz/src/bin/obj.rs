@@ -2,6 +2,6 @@
 
 fn main() {
     afl::fuzz!(|data: &[u8]| {
-        alpenglow_fuzz::run(data, "obj", alpenglow::points::build::input::load_points_file);
+        alpenglow_fuzz::run(data, "obj", alpenglow::files::load_points_file);
     });
 }

@@ -2,6 +2,6 @@
 
 fn main() {
     afl::fuzz!(|data: &[u8]| {
-        alpenglow_fuzz::run(data, "ply", alpenglow::points::build::input::load_points_file);
+        alpenglow_fuzz::run(data, "ply", alpenglow::files::load_points_file);
     });
 }

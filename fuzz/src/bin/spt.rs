@@ -2,6 +2,6 @@
 
 fn main() {
     afl::fuzz!(|data: &[u8]| {
-        alpenglow_fuzz::run(data, "spt", alpenglow::points::build::spt_file::read_spt);
+        alpenglow_fuzz::run(data, "spt", alpenglow::files::read_spt);
     });
 }

@@ -19,7 +19,7 @@ use crate::io::one_line;
 ///    name), and what is at the path now is absent or a regular file (an
 ///    empty real directory for a folder output) — symbolic links, FIFOs,
 ///    sockets and device nodes are never replaced. Adding a path also
-///    cleans up after killed runs in its directory ([`super::clean_stale`]).
+///    cleans up after killed runs in its directory (`super::clean_stale`).
 /// 2. [`OutputTransaction::stage`] writes each output to a hidden temporary
 ///    sibling (`.NAME.tmp-PID-N`; a folder is filled in `.NAME.partial-PID-N`).
 /// 3. [`OutputTransaction::commit`] flushes every temporary to the disk,
@@ -28,7 +28,7 @@ use crate::io::one_line;
 ///    targets aside (`.NAME.bak-PID-N`), renames every temporary into
 ///    place, removes the journals (the commit point: the journal of the
 ///    first output's directory) and then the backups, flushing the
-///    directories between these steps (the order and why: [`super`]). When
+///    directories between these steps (the order and why: `super`). When
 ///    a rename fails, every target is restored from its backup and the new
 ///    files are removed, so a failure never deletes what was there before.
 ///

@@ -42,9 +42,8 @@ mod parameters;
 mod passes;
 mod twin;
 
-pub use parameters::{mie_extinction_for_turbidity, solar_irradiance, sun_solid_angle, AtmosphereParameters};
-pub use passes::{AtmosphereLuts, LutSizes, PhysicalAtmosphere};
-pub use twin::{
-    distance_to_top, hits_ground, optical_depth_to_top, sky_view_angles, sky_view_unit, sun_transmittance,
-    transmittance_lut_r_mu, transmittance_lut_unit, transmittance_to_top, TWIN_STEPS,
-};
+pub use parameters::AtmosphereParameters;
+pub use passes::{LutSizes, PhysicalAtmosphere};
+pub use twin::sun_transmittance;
+#[cfg(test)]
+pub use twin::{transmittance_lut_r_mu, transmittance_to_top};

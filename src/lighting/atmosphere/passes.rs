@@ -175,21 +175,6 @@ impl PhysicalAtmosphere {
         })
     }
 
-    /// The tables' sizes.
-    pub fn sizes(&self) -> LutSizes {
-        self.sizes
-    }
-
-    /// The parameters the tables were created with.
-    pub fn parameters(&self) -> &AtmosphereParameters {
-        &self.params
-    }
-
-    /// How many views have a sky-view table.
-    pub fn view_count(&self) -> usize {
-        self.sky_views.len()
-    }
-
     /// Writes the tables' sampled handles into `frame.atmosphere` (x
     /// transmittance, y multiple scattering, z view `view`'s sky view) and,
     /// as f32 bits in `atmosphere.w`, the camera altitude above the ground

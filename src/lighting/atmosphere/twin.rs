@@ -75,6 +75,7 @@ pub fn sun_transmittance(p: &AtmosphereParameters, altitude_m: f32, sun_dir: Vec
 /// x_r = j / (H − 1)). Bruneton's mapping: x_r is the distance to the
 /// horizon, x_mu the distance to the top between its minimum and maximum,
 /// so every row spans zenith (x_mu = 0) to horizon (x_mu = 1).
+#[cfg(test)]
 pub fn transmittance_lut_r_mu(p: &AtmosphereParameters, x_mu: f64, x_r: f64) -> (f64, f64) {
     let (bottom, top) = (f64::from(p.bottom_radius), f64::from(p.top_radius));
     let h = (top * top - bottom * bottom).sqrt();
@@ -92,6 +93,7 @@ pub fn transmittance_lut_r_mu(p: &AtmosphereParameters, x_mu: f64, x_r: f64) -> 
 
 /// Inverse of [`transmittance_lut_r_mu`]: unit coordinates (x_mu, x_r) of
 /// (r, μ) for a direction above the horizon.
+#[cfg(test)]
 pub fn transmittance_lut_unit(p: &AtmosphereParameters, r: f64, mu: f64) -> (f64, f64) {
     let (bottom, top) = (f64::from(p.bottom_radius), f64::from(p.top_radius));
     let h = (top * top - bottom * bottom).sqrt();
@@ -112,6 +114,7 @@ pub fn transmittance_lut_unit(p: &AtmosphereParameters, r: f64, mu: f64) -> (f64
 /// mapping of Hillaire 2020 §5.3, θ = θ_h (1 − (1 − 2y)²) above the horizon
 /// (y < 1/2), θ_h + β (2y − 1)² below it, cos β = √(r² − R²) / r,
 /// θ_h = π − β.
+#[cfg(test)]
 pub fn sky_view_angles(p: &AtmosphereParameters, r: f64, x: f64, y: f64) -> (f64, f64) {
     let beta = sky_view_beta(p, r);
     let horizon = std::f64::consts::PI - beta;
@@ -126,6 +129,7 @@ pub fn sky_view_angles(p: &AtmosphereParameters, r: f64, x: f64, y: f64) -> (f64
 }
 
 /// Inverse of [`sky_view_angles`] (`atmosphere_sky_view_unit` in the GLSL).
+#[cfg(test)]
 pub fn sky_view_unit(p: &AtmosphereParameters, r: f64, phi: f64, theta: f64) -> (f64, f64) {
     let beta = sky_view_beta(p, r);
     let horizon = std::f64::consts::PI - beta;
@@ -139,6 +143,7 @@ pub fn sky_view_unit(p: &AtmosphereParameters, r: f64, phi: f64, theta: f64) -> 
 }
 
 /// β: the angle between the nadir and the horizon seen from radius `r`.
+#[cfg(test)]
 fn sky_view_beta(p: &AtmosphereParameters, r: f64) -> f64 {
     let bottom = f64::from(p.bottom_radius);
     ((r * r - bottom * bottom).max(0.0).sqrt() / r).clamp(-1.0, 1.0).acos()

@@ -80,11 +80,6 @@ impl<'a> CpuReference<'a> {
         })
     }
 
-    /// The exact ray caster.
-    pub fn tracer(&self) -> &HeightFieldTracer<'a> {
-        &self.tracer
-    }
-
     /// Whether the ray from `p` (lifted) along `dir` escapes.
     fn escapes(&self, p: DVec3, dir: Vec3) -> bool {
         self.tracer.trace(p + DVec3::Z * self.offset, dir.as_dvec3()).is_none()

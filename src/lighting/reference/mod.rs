@@ -69,20 +69,27 @@
 //! [`MonteCarloReference`]) and the CPU twin ([`CpuReference`]) draw the same
 //! random numbers, so they agree far within the Monte Carlo error.
 
+#[cfg(test)]
 mod cpu;
 mod gpu;
 mod pyramid;
+#[cfg(test)]
 pub mod sampling;
+#[cfg(test)]
 mod trace;
 
 #[cfg(test)]
 mod tests;
 
-pub use cpu::{CpuReference, SunInput, TexelEstimate};
-pub use gpu::{MonteCarloReference, ReferenceImages, ReferenceProgress};
-pub use pyramid::field_buffer_words;
-pub use trace::{HeightFieldTracer, TraceHit};
+#[cfg(test)]
+pub use cpu::{CpuReference, SunInput};
+pub use gpu::MonteCarloReference;
+#[cfg(test)]
+pub use gpu::ReferenceProgress;
+#[cfg(test)]
+pub use trace::HeightFieldTracer;
 
+#[cfg(test)]
 use glam::Vec3;
 
 use crate::error::{Error, Result};
@@ -200,6 +207,7 @@ pub fn ray_offset(field: &HeightField) -> f32 {
 
 /// The direction an escaping ray sees the sky in: `dir` with a negative Z
 /// clamped to the horizon (renormalised); straight down becomes the zenith.
+#[cfg(test)]
 pub fn horizon_clamp(dir: Vec3) -> Vec3 {
     let d = Vec3::new(dir.x, dir.y, dir.z.max(0.0));
     let len = d.length();

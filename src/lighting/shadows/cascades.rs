@@ -195,6 +195,7 @@ impl CascadePlan {
 }
 
 /// View depths of the `n + 1` split planes over `[near, far]`.
+#[cfg(test)]
 pub fn split_depths(near: f64, far: f64, n: u32, lambda: f64) -> Vec<f64> {
     (0..=n).map(|i| split_depth(near, far, (i, n), lambda)).collect()
 }

@@ -29,7 +29,7 @@ use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 
-pub use cascades::{plan_cascades, plan_cascades_into, Cascade, CascadePlan, SceneBounds, ShadowSettings};
+pub use cascades::{plan_cascades, plan_cascades_into, CascadePlan, SceneBounds, ShadowSettings};
 
 use crate::error::{Error, Result};
 use crate::graph::{ImageAccess, ImageId, RenderGraph};
@@ -123,11 +123,6 @@ impl ShadowMaps {
     /// The box holding every caster.
     pub fn bounds(&self) -> SceneBounds {
         self.bounds
-    }
-
-    /// Replaces the casters' bounds (e.g. after objects were added).
-    pub fn set_bounds(&mut self, bounds: SceneBounds) {
-        self.bounds = bounds;
     }
 
     /// Creates view `index`'s atlas, imports it and declares `shadow.clear`

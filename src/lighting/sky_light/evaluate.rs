@@ -123,6 +123,7 @@ impl SkyLight {
     }
 
     /// The bake.
+    #[cfg(test)]
     pub fn bake(&self) -> &SkyLightBake {
         &self.bake
     }

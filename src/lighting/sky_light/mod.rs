@@ -33,8 +33,7 @@ pub mod horizon;
 mod tables;
 
 pub use bake::{BakeSettings, SkyLightBake};
-pub use cache::{BakeData, BakeKey};
-pub use evaluate::{SkyLight, SkyLightIds};
+pub use evaluate::SkyLight;
 
 /// Sky patches per side baked (the 4×4 patches merge 2×2 of them).
 pub const PATCHES_PER_SIDE: u32 = 8;

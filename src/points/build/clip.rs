@@ -311,11 +311,13 @@ impl Creases {
     }
 
     /// Number of crease edges.
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.edges.len()
     }
 
     /// Whether the mesh has no crease.
+    #[cfg(test)]
     pub fn is_empty(&self) -> bool {
         self.edges.is_empty()
     }

@@ -315,6 +315,7 @@ impl ClusteredTree {
     /// front)`, `all` summed over every cluster (the tree's prefix length)
     /// and `front` over the clusters that are not back-facing with their own
     /// bounding spheres (module docs).
+    #[cfg(test)]
     pub fn prefix_points(&self, eye_object: Vec3, r_lo: f32) -> (usize, usize) {
         let (mut all, mut front) = (0, 0);
         for (k, c) in self.clusters.iter().enumerate() {

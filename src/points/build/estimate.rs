@@ -62,6 +62,7 @@ pub const DEFAULT_COLOR: [u8; 3] = [128, 128, 128];
 /// §10.1).
 ///
 /// Errors on empty or non-finite input and on `k` out of range.
+#[cfg(test)]
 pub fn estimate_normals(positions: &[Vec3], k: usize) -> Result<Vec<Vec3>> {
     validate_positions(positions)?;
     check_normal_k(positions.len(), k)?;
@@ -76,6 +77,7 @@ pub fn estimate_normals(positions: &[Vec3], k: usize) -> Result<Vec<Vec3>> {
 ///
 /// Errors on empty or non-finite input, on `k` out of range and when all
 /// points coincide.
+#[cfg(test)]
 pub fn estimate_radii(positions: &[Vec3], k: usize) -> Result<Vec<f32>> {
     validate_positions(positions)?;
     check_radius_k(positions.len(), k)?;
@@ -84,9 +86,9 @@ pub fn estimate_radii(positions: &[Vec3], k: usize) -> Result<Vec<f32>> {
 }
 
 /// Surfels for a point cloud, filling what the file lacked (§10.1): normals by
-/// [`estimate_normals`] with k = [`DEFAULT_NORMAL_K`], radii by
-/// [`estimate_radii`] with k = [`DEFAULT_RADIUS_K`], colour
-/// [`DEFAULT_COLOR`]. Both k are lowered for clouds too small for them.
+/// `estimate_normals` with k = `DEFAULT_NORMAL_K`, radii by
+/// `estimate_radii` with k = `DEFAULT_RADIUS_K`, colour
+/// `DEFAULT_COLOR`. Both k are lowered for clouds too small for them.
 ///
 /// Given normals are normalised; zero or non-finite ones are replaced by a
 /// PCA normal turned towards the given normals of its neighbours. Given radii

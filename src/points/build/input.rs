@@ -74,6 +74,7 @@ use ply_rs_bw::ply::{Property, PropertyAccess, PropertyAccessResult};
 use super::clip::{ClipLine, ClipLines};
 use crate::error::{Error, Result};
 use crate::points::{PointCloud, TriangleMesh};
+#[cfg(test)]
 pub use header::MAX_PLY_ELEMENTS;
 use header::{check_ply_header, check_ply_limits, payload_len};
 

@@ -105,7 +105,7 @@ impl SamplingMethod {
     }
 }
 
-/// Parameters of [`sample_mesh`].
+/// Parameters of `sample_mesh`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SamplingOptions {
     /// Number of surfels to produce (> 0), exactly.
@@ -116,8 +116,8 @@ pub struct SamplingOptions {
 }
 
 /// Host memory sampling `count` surfels with `method` needs at its peak
-/// ([`crate::budget`]): `count` × [`bytes_per_sample`] (about 550 B a
-/// surfel for blue noise, which holds [`BLUE_NOISE_CANDIDATES`] candidates a
+/// (`crate::budget`): `count` × `bytes_per_sample` (about 550 B a
+/// surfel for blue noise, which holds `BLUE_NOISE_CANDIDATES` candidates a
 /// surfel). The point tree built from the surfels is counted by
 /// `crate::points::build::plan`.
 pub fn sampling_footprint(count: usize, method: SamplingMethod) -> crate::budget::Footprint {
@@ -135,8 +135,8 @@ pub fn sample_mesh(mesh: &TriangleMesh, options: &SamplingOptions) -> Result<Vec
     Ok(sample_mesh_traced(mesh, options)?.0)
 }
 
-/// [`sample_mesh`], reporting the fraction done (0 first, 1 last, about
-/// every [`PROGRESS_STEP`] candidates of blue-noise elimination in between).
+/// `sample_mesh`, reporting the fraction done (0 first, 1 last, about
+/// every `PROGRESS_STEP` candidates of blue-noise elimination in between).
 pub fn sample_mesh_reporting(
     mesh: &TriangleMesh,
     options: &SamplingOptions,

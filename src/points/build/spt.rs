@@ -212,7 +212,7 @@ pub struct SptOptions {
     pub epsilon: f32,
     /// Most surfels an octree cell may hold before it is split (≥ 1; default 1).
     pub leaf_size: usize,
-    /// Deepest octree level (≤ [`MAX_DEPTH_LIMIT`]); cells there are not split
+    /// Deepest octree level (≤ `MAX_DEPTH_LIMIT`); cells there are not split
     /// further whatever their count (duplicate points end up there).
     pub max_depth: u32,
     /// Children colour difference (largest per-channel range, 8-bit sRGB code

@@ -48,7 +48,6 @@ use super::clip::{ClipLine, ClipLines};
 use super::spt::{SequentialPointTree, SptNode};
 use crate::error::{Error, Result};
 use validate::validate;
-pub use validate::{MAX_SPT_COORDINATE, MAX_SPT_LENGTH};
 
 mod validate;
 

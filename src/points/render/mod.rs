@@ -32,7 +32,7 @@ mod technique;
 mod triangles;
 
 pub use stats::PointFrameStats;
-pub use technique::{PointRenderer, PointViewFrame, PointsFrame};
+pub use technique::{PointRenderer, PointsFrame};
 
 use crate::error::{Error, Result};
 

@@ -89,23 +89,9 @@ pub struct FramePlan {
     pub prefix_triangles: u64,
 }
 
-/// Plans a frame: `view` world → camera, `view_proj` world → clip,
-/// `pixel` the width of a pixel at unit distance (1/f_y, for thinning),
-/// `objects[o]` where object o's list is.
-pub fn plan_frame(
-    scene: &PointScene,
-    objects: &[ObjectLayout],
-    eye: DVec3,
-    view: DMat4,
-    view_proj: DMat4,
-    pixel: f64,
-) -> FramePlan {
-    let mut plan = FramePlan::default();
-    plan_frame_into(&mut plan, scene, objects, (eye, view, view_proj), pixel);
-    plan
-}
-
-/// [`plan_frame`] into `plan`, reusing its memory (no allocation once its
+/// Plans a frame into `plan`: `view` world → camera, `view_proj` world →
+/// clip, `pixel` the width of a pixel at unit distance (1/f_y, for
+/// thinning), `objects[o]` where object o's list is; reusing its memory (no allocation once its
 /// vectors have grown to a frame's size).
 pub fn plan_frame_into(
     plan: &mut FramePlan,

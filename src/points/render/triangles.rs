@@ -3,7 +3,7 @@
 //! list, and per pass a pipeline (`glsl/points/hybrid.vert` with the pass's
 //! fragment stage) that draws each instance's CPU prefix by vertex pulling.
 //! The vertex stage does the exact test `r < s/ε`; the CPU prefix comes from
-//! [`super::selection::plan_frame`].
+//! [`super::selection::plan_frame_into`].
 
 use std::sync::Arc;
 

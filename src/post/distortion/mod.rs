@@ -20,8 +20,12 @@ use bytemuck::{Pod, Zeroable};
 
 pub use lens::{source_intrinsics, source_map, BrownConrady, DistortedCamera, Intrinsics, SourceMap, SourceView};
 
-use super::resample::{bilinear, check_images, declare_pass, ImageKind, Plane, ResampleImage};
-use crate::error::{Error, Result};
+#[cfg(test)]
+use super::resample::{bilinear, ImageKind, Plane};
+use super::resample::{check_images, declare_pass, ResampleImage};
+#[cfg(test)]
+use crate::error::Error;
+use crate::error::Result;
 use crate::graph::RenderGraph;
 use crate::shaders;
 use crate::view::pass_name;
@@ -75,6 +79,7 @@ impl MotionLens {
 
     /// The displacement `m` (source pixels) at source position `q`, in
     /// output pixels: the twin of `carry_motion` in the shader.
+    #[cfg(test)]
     fn carry(&self, m: [f32; 2], q: [f32; 2]) -> [f32; 2] {
         let [k1, k2, k3, p1] = self.radial;
         let p2 = self.p2;
@@ -169,12 +174,14 @@ impl LensDistortion {
 }
 
 /// The nearest texel to source position `q`.
+#[cfg(test)]
 fn nearest(q: [f32; 2]) -> (i64, i64) {
     ((q[0] + 0.5).floor() as i64, (q[1] + 0.5).floor() as i64)
 }
 
 /// The CPU twin of `post.distortion` for a float image of `kind`, sampled
 /// where `distortion`'s map says (what the GPU must match to f32 rounding).
+#[cfg(test)]
 pub fn distortion_cpu(
     distortion: &LensDistortionCpu,
     source: &Plane<[f32; 4]>,
@@ -199,6 +206,7 @@ pub fn distortion_cpu(
 }
 
 /// A map with a position per pixel, a source with a texel per pixel.
+#[cfg(test)]
 fn check_planes<T: Copy>(map: &SourceMap, source: &Plane<T>) -> Result<()> {
     source.check("distortion source")?;
     if map.positions.len() != map.width as usize * map.height as usize {
@@ -211,6 +219,7 @@ fn check_planes<T: Copy>(map: &SourceMap, source: &Plane<T>) -> Result<()> {
 }
 
 /// The CPU twin of `post.distortion` for an Exact image of any texel type.
+#[cfg(test)]
 pub fn distortion_exact_cpu<T: Copy>(map: &SourceMap, source: &Plane<T>) -> Result<Plane<T>> {
     check_planes(map, source)?;
     Ok(Plane::from_fn(map.width, map.height, |i, j| {

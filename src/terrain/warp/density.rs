@@ -1,6 +1,7 @@
 //! Obtained over demanded sample density of a warped geometry image
 //! (dissertation §7.4.2, Fig. 7.12), and a small histogram helper.
 
+#[cfg(test)]
 use std::fmt;
 
 use glam::{DMat2, DVec2, DVec3};
@@ -84,6 +85,7 @@ pub fn density_ratio(warped: &[DVec3], sketch: &[DVec3], importance: &[f64], n: 
 /// A histogram over fixed bin edges: bin `k` counts values in
 /// `[edges[k], edges[k + 1])`.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg(test)]
 pub struct Histogram {
     /// Ascending bin edges (at least two).
     pub edges: Vec<f64>,
@@ -99,6 +101,7 @@ pub struct Histogram {
 
 /// Counts `values` into the bins given by ascending `edges` (fewer than
 /// two edges: everything is counted as below/above/NaN only).
+#[cfg(test)]
 pub fn histogram(values: &[f64], edges: &[f64]) -> Histogram {
     let bins = edges.len().saturating_sub(1);
     let mut h = Histogram {
@@ -125,6 +128,7 @@ pub fn histogram(values: &[f64], edges: &[f64]) -> Histogram {
 }
 
 /// Fraction of `values` in the closed interval `[lo, hi]` (0 if empty).
+#[cfg(test)]
 pub fn fraction_within(values: &[f64], lo: f64, hi: f64) -> f64 {
     if values.is_empty() {
         return 0.0;
@@ -132,6 +136,7 @@ pub fn fraction_within(values: &[f64], lo: f64, hi: f64) -> f64 {
     values.iter().filter(|&&v| v >= lo && v <= hi).count() as f64 / values.len() as f64
 }
 
+#[cfg(test)]
 impl fmt::Display for Histogram {
     /// One line per bin: range, count, percentage and a bar.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

@@ -9,9 +9,9 @@
 //! simple heuristic; here each level-1 layer's coverage-noise bias c_S
 //! (with n_S in proportion) is scaled, a few fixed-point steps, until the
 //! share of the terrain where it is the dominant layer
-//! ([`crate::texturing::dominant`]) matches its class's share of the image
+//! (`crate::texturing::dominant`) matches its class's share of the image
 //! — c_S acts as the class's prior. The prediction is the CPU twin of the
-//! renderer ([`crate::texturing::reference`]) at every [`STRIDE`]-th pixel
+//! renderer (`crate::texturing::reference`) at every [`STRIDE`]-th pixel
 //! of every [`STRIDE`]-th row of the class map.
 
 use glam::DVec2;
@@ -79,7 +79,7 @@ fn worst_error(fractions: &[f64], targets: &[f64]) -> f64 {
 /// predicted fractions of the final layers.
 ///
 /// Each layer's c_S is bisected in log space within a bracket that starts
-/// at [`BIAS_RANGE`]: too much area lowers the bracket's top, too little
+/// at `BIAS_RANGE`: too much area lowers the bracket's top, too little
 /// raises its bottom. All layers move at once, so the others' steps shift
 /// each layer's answer a little; the brackets widen by 3 % a step to
 /// follow. Dominance is nearly a threshold in c_S (the clamped histograms

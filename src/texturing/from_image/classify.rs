@@ -1,6 +1,6 @@
 //! Classification of the image's pixels into surface types (§8.3,
 //! "Surface Type Classification"): RGB and HSV together, near-grey pixels
-//! in reserved classes, the chromatic ones clustered by [`super::kmeans`]
+//! in reserved classes, the chromatic ones clustered by `super::kmeans`
 //! in the hue–saturation histogram.
 //!
 //! Decisions where the text leaves room:

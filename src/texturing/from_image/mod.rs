@@ -44,7 +44,7 @@ use image::RgbImage;
 use crate::error::{Error, Result};
 use crate::io::heightmap::{HeightField, RowOrder};
 
-pub use classify::{ClassKind, PixelStatus};
+pub use classify::PixelStatus;
 pub use tree::GeneratedLayers;
 
 /// Most classes k-means may find (`--classes`).
@@ -57,7 +57,7 @@ pub const AUTO_CLASSES: std::ops::RangeInclusive<usize> = 2..=6;
 pub enum ClassCount {
     /// Exactly k (1..=[`MAX_CLASSES`]).
     Fixed(usize),
-    /// The k of [`AUTO_CLASSES`] with the largest silhouette ([`kmeans`]).
+    /// The k of `AUTO_CLASSES` with the largest silhouette (`kmeans`).
     Auto,
 }
 
@@ -85,7 +85,7 @@ pub struct FromImageOptions {
     /// ([`calibrate`]).
     pub calibrate: bool,
     /// Weight of the shade-normalised value in the clustering space
-    /// ([`kmeans`]); 0: hue and saturation alone.
+    /// (`kmeans`); 0: hue and saturation alone.
     pub value_weight: f64,
 }
 

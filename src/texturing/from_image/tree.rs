@@ -1,6 +1,6 @@
 //! The surface-layer hierarchy of the estimated classes (§8.3, "Surface
 //! Layer Hierarchy"), written in the layer tree's TOML format
-//! ([`crate::texturing::layers`]).
+//! (`crate::texturing::layers`).
 //!
 //! Decisions (the text's simple heuristic, its "fixed values for further
 //! surface parameters" chosen here):

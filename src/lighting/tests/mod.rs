@@ -1,0 +1,9 @@
+//! White-box tests of the lighting technique against its CPU twins, under validation.
+//! (Moved from `tests/` in issue 26: integration tests use only the front door.)
+
+mod atmosphere;
+mod figures;
+mod reference;
+mod shadows;
+mod sky_light;
+mod twins;

@@ -1,0 +1,5 @@
+//! White-box tests of terrain synthesis: hole filling and the GPU neighbourhood search.
+//! (Moved from `tests/` in issue 26: integration tests use only the front door.)
+
+mod fill;
+mod gpu;
