@@ -31,7 +31,9 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
     let (ctx, report) = validated_context();
     {
         let scene = small_scene();
-        let settings = settings(96, 64, true);
+        let mut settings = settings(96, 64, true);
+        // Two readback slots: the frame two renders back is overwritten.
+        settings.readback_slots = 2;
         let mut renderer = Renderer::new(&ctx, &scene, settings).expect("renderer");
         let layers = scene.layers.layers.iter().enumerate();
         let layer_passes = layers.map(|(i, l)| format!("texturing.layer{i}.{}", l.layer.name.replace(' ', "_")));
