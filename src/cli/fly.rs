@@ -126,6 +126,8 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     let profiles = {
         let settings = render_settings(&args.scene, &scene, &specs, staging.is_some())?;
         let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
+        // Every frame's profile is reported (the history is bounded by default).
+        renderer.set_profile_history(args.frames as usize);
         let bar = ProgressBar::new(u64::from(args.frames));
         bar.set_style(
             ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} frames {msg}")

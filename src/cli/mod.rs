@@ -416,6 +416,8 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     let profiles = {
         let settings = render_settings(&args.scene, &scene, &specs, false)?;
         let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
+        // Every frame's profile is reported (the history is bounded by default).
+        renderer.set_profile_history((args.warmup + args.frames + MAX_SETTLE_FRAMES) as usize);
         // A still view: first every texture tile (untimed), then warm-up and timed frames.
         settle_frames = renderer.render_views_settled(&cameras, MAX_SETTLE_FRAMES)?.frame + 1;
         let mut last = std::time::Instant::now();

@@ -6,7 +6,6 @@
 //!
 //! `cargo run --release -p alpenglow-bench --bin quad_area`
 
-
 use alpenglow::bench::{projected_quad_areas, zoom_positions, DebugScalar, LodFrame};
 use alpenglow::files::load_heightmap;
 use alpenglow::tools::profile::quantile;
