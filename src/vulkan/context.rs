@@ -207,8 +207,8 @@ fn open_device(
         device_info = device_info.push_next(&mut interlock);
     }
     // SAFETY: the features were checked as supported by `inspect`; pointers are to locals.
-    let device = unsafe { instance.create_device(candidate.physical, &device_info, None) }
-        .map_err(vk_err("vkCreateDevice"))?;
+    let device =
+        unsafe { instance.create_device(candidate.physical, &device_info, None) }.map_err(vk_err("vkCreateDevice"))?;
     Ok((candidate, device, optional, memory_budget))
 }
 
