@@ -56,7 +56,12 @@ impl Sky {
 
     /// Declares `sky` for view `index`: writes its radiance, view depth,
     /// lighting AOVs, normal and ids.
-    pub fn declare(&self, graph: &mut RenderGraph<Frame>, (index, view): (ViewIndex, &View), targets: &SceneTargets) {
+    pub fn declare<S: 'static>(
+        &self,
+        graph: &mut RenderGraph<Frame<S>>,
+        (index, view): (ViewIndex, &View),
+        targets: &SceneTargets,
+    ) {
         let pipeline = self.pipeline.clone();
         let (radiance, view_depth, visibility) = (targets.radiance, targets.view_depth, targets.visibility);
         let (normal, ids) = (targets.normal, targets.ids);

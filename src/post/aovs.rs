@@ -125,9 +125,9 @@ impl Aovs {
 
     /// Declares `aovs` for view `index`: reads its view depth, writes its
     /// motion and distance.
-    pub fn declare(
+    pub fn declare<S: 'static>(
         &mut self,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         (index, view): (ViewIndex, &View),
         targets: &SceneTargets,
     ) {
@@ -169,6 +169,7 @@ impl Aovs {
 
 impl Technique for Aovs {
     type Prepared = AovsFrame;
+    type Needs<'a> = ();
 
     fn name(&self) -> &'static str {
         "aovs"
@@ -176,7 +177,7 @@ impl Technique for Aovs {
 
     /// Per view: the constants from this frame's camera and the previous
     /// frame's transform, then this frame's transform kept for the next.
-    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<AovsFrame> {
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, (): ()) -> Result<AovsFrame> {
         let mut with_motion = std::mem::take(&mut self.spare);
         with_motion.clear();
         for (view, previous) in self.views.iter().zip(&mut self.previous) {

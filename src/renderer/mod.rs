@@ -45,23 +45,24 @@ use view_chain::ViewChain;
 
 use crate::error::{Error, Result};
 use crate::graph::{BakedGraph, CpuStage, FrameOutcome, RenderGraph};
-use crate::lighting::shadows::ShadowSettings;
+use crate::lighting::shadows::{ShadowFrame, ShadowSettings};
 use crate::lighting::sky::Sky;
-use crate::lighting::technique::SceneLighting;
-use crate::points::render::{PointFrameStats, PointRenderer, SplatSettings};
-use crate::post::aovs::Aovs;
+use crate::lighting::technique::{PreparedLighting, SceneLighting};
+use crate::points::render::shadow::PointShadowFrame;
+use crate::points::render::{PointFrameStats, PointRenderer, PointsFrame, SplatSettings};
+use crate::post::aovs::{Aovs, AovsFrame};
 use crate::post::exposure::ExposureMeter;
 use crate::post::motion_blur::{MotionBlur, MotionBlurSettings};
 use crate::post::resolve::Resolve;
 use crate::post::tonemap::Tonemap;
 use crate::profile::FrameProfile;
 use crate::terrain::geometry_image::TerrainSettings;
-use crate::terrain::{Terrain, TerrainTexturing};
-use crate::texturing::generation::{TextureAtlas, TextureFrameStats, TextureStreaming};
+use crate::terrain::{Terrain, TerrainFrame, TerrainTexturing};
+use crate::texturing::generation::{TextureAtlas, TextureFrame, TextureFrameStats, TextureStreaming};
 use crate::texturing::gpu_layout::TexturingMode;
 use crate::texturing::page_table::PageTable;
 use crate::view::rig::validate_views;
-use crate::view::{Frame, Lighting, SceneTargets, View};
+use crate::view::{frame_slots, Frame, FrameLighting, Lighting, SceneTargets, View};
 use crate::vulkan::{Context, FrameRing, FRAMES_IN_FLIGHT};
 
 /// The default [`RenderSettings::readback_slots`]: one frame being read,
@@ -160,6 +161,23 @@ impl RenderSettings {
     }
 }
 
+frame_slots! {
+    /// What the renderer's techniques prepare each frame, one slot each:
+    /// what a pass body reads with `frame.prepared::<T>()`.
+    pub(crate) struct Slots {
+        shadows: ShadowFrame,
+        point_shadows: PointShadowFrame,
+        lighting: PreparedLighting,
+        terrain: TerrainFrame,
+        texturing: TextureFrame,
+        points: PointsFrame,
+        aovs: AovsFrame,
+    }
+}
+
+/// A renderer's frame.
+pub(crate) type RenderFrame = Frame<Slots>;
+
 /// The techniques of a scene, each with its persistent state.
 /// (The sky and tone mapping prepare nothing: their passes own their pipelines.)
 struct Techniques {
@@ -176,7 +194,7 @@ struct Techniques {
 pub struct Renderer {
     ctx: Context,
     frames: FrameRing,
-    graph: BakedGraph<Frame>,
+    graph: BakedGraph<RenderFrame>,
     /// The output images.
     views: Vec<ViewSpec>,
     /// What the techniques render for each (supersampled, undistorted).
@@ -188,9 +206,10 @@ pub struct Renderer {
     /// Identifies the renderer's tickets.
     id: u64,
     /// The last frame and its CPU stages, reused by the next.
-    frame: Option<Frame>,
+    frame: Option<RenderFrame>,
     stages: Vec<CpuStage>,
-    lighting: Lighting,
+    /// The lighting of the next frames, validated when set.
+    lighting: FrameLighting,
     /// Frames rendered so far.
     frames_rendered: u64,
     techniques: Techniques,
@@ -245,23 +264,22 @@ impl Renderer {
             .collect::<Result<_>>()?;
         // The views the graph is declared for; every frame brings their cameras.
         let views: Vec<View> = (chains.iter()).map(|c| c.render.view(scene.default_camera())).collect();
-        let lighting = settings.lighting.unwrap_or_else(|| scene.default_lighting());
-        lighting.validate()?;
-        let mut targets: Vec<SceneTargets> = (views.iter())
-            .map(|v| SceneTargets::declare(&mut graph, v, points_present))
+        let lighting = FrameLighting::new(settings.lighting.unwrap_or_else(|| scene.default_lighting()))?;
+        // What the renderer is built with (later lightings keep it).
+        let setup = lighting.setup();
+        let regions: Vec<_> = (views.iter())
+            .map(|v| SceneLighting::declare_constants(&mut graph, v))
             .collect();
-        let mut scene_lighting = lighting::scene_lighting(scene, &targets);
-        lighting::declare_atmosphere(
-            ctx,
-            &mut graph,
-            (&views, &lighting),
-            (&mut targets, &mut scene_lighting),
-        )?;
+        let mut targets: Vec<SceneTargets> = (views.iter().zip(&regions))
+            .map(|(v, &region)| SceneTargets::declare(&mut graph, v, points_present, region))
+            .collect();
+        let mut scene_lighting = lighting::scene_lighting(scene, regions);
+        lighting::declare_atmosphere(ctx, &mut graph, (&views, &setup), (&mut targets, &mut scene_lighting))?;
         if scene.draw_terrain {
             lighting::declare_sky_light(
                 ctx,
                 &mut graph,
-                (scene, &lighting),
+                (scene, &setup),
                 (&mut targets, &mut scene_lighting),
                 settings.cache_dir.as_deref(),
                 progress,
@@ -366,7 +384,7 @@ impl Renderer {
 
     /// The lighting of the next frames.
     pub fn lighting(&self) -> &Lighting {
-        &self.lighting
+        self.lighting.lighting()
     }
 
     /// Sets the lighting of the next frames (sun, sky model, exposure,
@@ -374,8 +392,7 @@ impl Renderer {
     /// frame is recorded. The renderer must have been built with the parts
     /// the lighting uses (see [`RenderSettings::lighting`]).
     pub fn set_lighting(&mut self, lighting: Lighting) -> Result<()> {
-        lighting.validate()?;
-        self.lighting = lighting;
+        self.lighting = FrameLighting::new(lighting)?;
         Ok(())
     }
 
@@ -456,28 +473,33 @@ impl Renderer {
     }
 
     /// Every technique's prepare, then the graph records and submits `frame`.
-    fn prepare_and_execute(&mut self, frame: &mut Frame, stages: &mut Vec<CpuStage>) -> Result<FrameOutcome> {
+    /// The order is the data's: the lighting needs the shadows' cascades
+    /// (its constants carry them), so it takes what their prepare returned.
+    fn prepare_and_execute(&mut self, frame: &mut RenderFrame, stages: &mut Vec<CpuStage>) -> Result<FrameOutcome> {
         let mut uploads = self.graph.uploads(frame.index);
         let t = &mut self.techniques;
-        if let Some(shadows) = &mut t.shadows {
-            frame.prepare(&mut shadows.maps, &mut uploads, stages)?;
-            if let Some(points) = &mut shadows.points {
-                frame.prepare(points, &mut uploads, stages)?;
+        let mut shadows = None;
+        if let Some(s) = &mut t.shadows {
+            shadows = Some(frame.prepare(&mut s.maps, (), &mut uploads, stages)?);
+            if let Some(points) = &mut s.points {
+                frame.prepare_into(points, (), &mut uploads, stages)?;
             }
         }
-        // After the shadows: the constants carry their cascades.
-        frame.prepare(&mut t.lighting, &mut uploads, stages)?;
+        frame.prepare_into(&mut t.lighting, shadows.as_ref(), &mut uploads, stages)?;
+        if let Some(shadows) = shadows {
+            frame.insert(shadows);
+        }
         if let Some(terrain) = &mut t.terrain {
-            frame.prepare(terrain, &mut uploads, stages)?;
+            frame.prepare_into(terrain, (), &mut uploads, stages)?;
         }
         if let Some(atlas) = &mut t.atlas {
             atlas.observe_profiles(self.graph.profiles());
-            frame.prepare(atlas, &mut uploads, stages)?;
+            frame.prepare_into(atlas, (), &mut uploads, stages)?;
         }
         if let Some(points) = &mut t.points {
-            frame.prepare(points, &mut uploads, stages)?;
+            frame.prepare_into(points, (), &mut uploads, stages)?;
         }
-        frame.prepare(&mut t.aovs, &mut uploads, stages)?;
+        frame.prepare_into(&mut t.aovs, (), &mut uploads, stages)?;
         self.graph.execute(&mut self.frames, frame, stages)
     }
 
@@ -644,7 +666,7 @@ fn streaming_for(settings: &RenderSettings, chains: &[ViewChain]) -> TextureStre
 /// The terrain of `scene` with every view's `terrain.warp` declared.
 fn warped_terrain(
     ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
+    graph: &mut RenderGraph<RenderFrame>,
     scene: &Scene,
     settings: &RenderSettings,
     views: &[View],

@@ -19,7 +19,7 @@ use crate::texturing::generation::{AtlasBindings, GenerationInputs};
 use crate::texturing::gpu_layout::{pack_layers, TexturingFrame, TexturingMode};
 use crate::texturing::input_maps::InputMaps;
 use crate::texturing::layers::LayerTree;
-use crate::view::{pass_name, Frame, FrameContext, SceneTargets, Technique, View, ViewIndex};
+use crate::view::{pass_name, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex};
 use crate::vulkan::{Buffer, BufferUsageFlags, Context, Image};
 
 /// How `terrain.draw` colours the surface (§7.4.3 or §8.2).
@@ -93,9 +93,9 @@ fn heap_handle(image_or_buffer: Option<u32>, what: &str) -> Result<u32> {
 impl Terrain {
     /// Uploads the height field, the noise tile, the surface layers and
     /// their input maps, and imports them into `graph`.
-    pub fn new(
+    pub fn new<S: Provides<TerrainFrame> + 'static>(
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         field: Arc<HeightField>,
         settings: TerrainSettings,
         texturing: &TerrainTexturing,
@@ -146,10 +146,10 @@ impl Terrain {
     }
 
     /// Declares `terrain.warp` of view `index`, with its geometry image.
-    pub fn declare_warp(
+    pub fn declare_warp<S: Provides<TerrainFrame> + 'static>(
         &mut self,
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         (index, view): (ViewIndex, &View),
     ) -> Result<()> {
         let vertex_buffer = self.geometry.vertex_buffer(ctx, &view.name)?;
@@ -187,10 +187,10 @@ impl Terrain {
 
     /// Declares `terrain.draw` of view `index` into `targets`, textured from
     /// `atlas` when given (after [`Terrain::declare_warp`] of that view).
-    pub fn declare_draw(
+    pub fn declare_draw<S: Provides<TerrainFrame> + 'static>(
         &mut self,
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         (index, view): (ViewIndex, &View),
         targets: &SceneTargets,
         atlas: Option<&AtlasBindings>,
@@ -288,6 +288,7 @@ impl Terrain {
 
 impl Technique for Terrain {
     type Prepared = TerrainFrame;
+    type Needs<'a> = ();
 
     fn name(&self) -> &'static str {
         "terrain"
@@ -295,7 +296,7 @@ impl Technique for Terrain {
 
     /// Per view: sketch map, importance map and warp (§7.4.2) into the
     /// warp upload, the texturing constants, and the passes' push constants.
-    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<TerrainFrame> {
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, (): ()) -> Result<TerrainFrame> {
         let mut views = std::mem::take(&mut self.spare);
         views.clear();
         let settings = self.geometry.settings;

@@ -77,13 +77,15 @@ pub struct ShadowFrame {
 }
 
 impl ShadowFrame {
-    /// The cascades of view `index`.
+    /// The cascades of view `index` (at `views[index]` when the views were
+    /// declared in order, as the renderer does).
     pub fn view(&self, index: ViewIndex) -> Result<&CascadePlan> {
-        self.views
-            .iter()
-            .find(|(v, _)| *v == index)
-            .map(|(_, p)| p)
-            .ok_or_else(|| Error::Graph(format!("shadows: view {index} was not prepared")))
+        match self.views.get(index) {
+            Some((v, plan)) if *v == index => Ok(plan),
+            _ => (self.views.iter().find(|(v, _)| *v == index))
+                .map(|(_, p)| p)
+                .ok_or_else(|| Error::Graph(format!("shadows: view {index} was not prepared"))),
+        }
     }
 }
 
@@ -127,10 +129,10 @@ impl ShadowMaps {
 
     /// Creates view `index`'s atlas, imports it and declares `shadow.clear`
     /// (clears it to depth 1 each frame). Declare before the caster passes.
-    pub fn declare_view(
+    pub fn declare_view<S: 'static>(
         &mut self,
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         (index, view): (ViewIndex, &View),
     ) -> Result<ShadowTarget> {
         if self.views.iter().any(|v| v.target.view == index) {
@@ -227,14 +229,15 @@ impl ShadowMaps {
 
 impl Technique for ShadowMaps {
     type Prepared = ShadowFrame;
+    type Needs<'a> = ();
 
     fn name(&self) -> &'static str {
         "shadows"
     }
 
     /// Plans every declared view's cascades for the frame's sun.
-    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<ShadowFrame> {
-        let sun = frame.lighting.sun_direction();
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, (): ()) -> Result<ShadowFrame> {
+        let sun = frame.lighting.sun;
         let mut views = std::mem::take(&mut self.spare);
         views.truncate(self.views.len());
         for (k, v) in self.views.iter().enumerate() {

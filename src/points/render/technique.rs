@@ -18,7 +18,7 @@ use crate::error::{Error, Result};
 use crate::graph::RenderGraph;
 use crate::points::build::clusters::{cluster_normals, CLUSTER_COUNT};
 use crate::points::scene::PointScene;
-use crate::view::{pass_name, Frame, FrameContext, SceneTargets, Technique, View, ViewIndex};
+use crate::view::{pass_name, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex};
 use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Context, MemoryLocation};
 
 /// What the points passes read this frame: each view's plan.
@@ -167,10 +167,10 @@ impl PointRenderer {
     /// `points.normalize` for EWA splats, `points.single_pass*` for
     /// single-pass splats (§10.4), or `points.opaque`.
     /// `clear_depth`: no terrain drew into the depth buffer.
-    pub fn declare(
+    pub fn declare<S: Provides<PointsFrame> + 'static>(
         &mut self,
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         (index, view): (ViewIndex, &View),
         targets: &SceneTargets,
         clear_depth: bool,
@@ -261,6 +261,7 @@ impl PointRenderer {
 
 impl Technique for PointRenderer {
     type Prepared = PointsFrame;
+    type Needs<'a> = ();
 
     fn name(&self) -> &'static str {
         "points"
@@ -269,7 +270,7 @@ impl Technique for PointRenderer {
     /// Per view: the prefix of every visible instance and its record
     /// (object→camera in f64), uploaded with the view's header; the frame's
     /// statistics (the GPU counts of the slot's previous frame are read now).
-    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<PointsFrame> {
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, (): ()) -> Result<PointsFrame> {
         let started = Instant::now();
         let mut views = std::mem::take(&mut self.spare);
         let mut stats = PointFrameStats {
