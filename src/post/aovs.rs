@@ -29,7 +29,7 @@ use glam::DMat4;
 use crate::error::{Error, Result};
 use crate::graph::{BufferAccess, ImageAccess, RenderGraph, Stage, UploadRegion};
 use crate::shaders;
-use crate::view::{pass_name, Frame, FrameContext, SceneTargets, TargetFormats, Technique, View, ViewIndex};
+use crate::view::{pass_name, Declare, Frame, FrameContext, SceneTargets, TargetFormats, Technique, View, ViewIndex};
 use crate::vulkan::{Context, GraphicsPipeline, GraphicsPipelineDesc, LoadOp};
 
 /// Per-view constants of `aovs` (`AovConstants` in glsl/post/aovs.frag).
@@ -164,6 +164,23 @@ impl Aovs {
     /// (a cut, or a camera that jumped).
     pub fn reset(&mut self) {
         self.previous.iter_mut().for_each(|p| *p = None);
+    }
+}
+
+/// `aovs` of a view: its targets in, nothing out.
+impl<S: 'static> Declare<S> for Aovs {
+    type Inputs<'a> = &'a SceneTargets;
+    type Outputs = ();
+
+    fn declare(
+        &mut self,
+        _: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: (ViewIndex, &View),
+        targets: &SceneTargets,
+    ) -> Result<()> {
+        Aovs::declare(self, graph, view, targets);
+        Ok(())
     }
 }
 

@@ -62,7 +62,7 @@ use crate::texturing::generation::{TextureAtlas, TextureFrame, TextureFrameStats
 use crate::texturing::gpu_layout::TexturingMode;
 use crate::texturing::page_table::PageTable;
 use crate::view::rig::validate_views;
-use crate::view::{frame_slots, Frame, FrameLighting, Lighting, SceneTargets, View};
+use crate::view::{declare_views, frame_slots, Frame, FrameLighting, Lighting, LightingSetup, SceneTargets, View};
 use crate::vulkan::{Context, FrameRing, FRAMES_IN_FLIGHT};
 
 /// The default [`RenderSettings::readback_slots`]: one frame being read,
@@ -265,98 +265,24 @@ impl Renderer {
         // The views the graph is declared for; every frame brings their cameras.
         let views: Vec<View> = (chains.iter()).map(|c| c.render.view(scene.default_camera())).collect();
         let lighting = FrameLighting::new(settings.lighting.unwrap_or_else(|| scene.default_lighting()))?;
-        // What the renderer is built with (later lightings keep it).
-        let setup = lighting.setup();
-        let regions: Vec<_> = (views.iter())
-            .map(|v| SceneLighting::declare_constants(&mut graph, v))
-            .collect();
-        let mut targets: Vec<SceneTargets> = (views.iter().zip(&regions))
-            .map(|(v, &region)| SceneTargets::declare(&mut graph, v, points_present, region))
-            .collect();
-        let mut scene_lighting = lighting::scene_lighting(scene, regions);
-        lighting::declare_atmosphere(ctx, &mut graph, (&views, &setup), (&mut targets, &mut scene_lighting))?;
-        if scene.draw_terrain {
-            lighting::declare_sky_light(
-                ctx,
-                &mut graph,
-                (scene, &setup),
-                (&mut targets, &mut scene_lighting),
-                settings.cache_dir.as_deref(),
-                progress,
-            )?;
-        }
-        let sky = Sky::new(ctx, &targets[0].formats)?;
-        for (k, view) in views.iter().enumerate() {
-            sky.declare(&mut graph, (k, view), &targets[k]);
-        }
-        let mut terrain = match scene.draw_terrain {
-            true => Some(warped_terrain(ctx, &mut graph, scene, &settings, &views)?),
-            false => None,
+        let wiring = Wiring {
+            ctx,
+            scene,
+            settings: &settings,
+            views: &views,
         };
-        let mut points = match points_present {
-            true => Some(PointRenderer::new(ctx, &scene.points, settings.points)?),
-            false => None,
+        let (techniques, targets) = wiring.declare(&mut graph, &chains, lighting.setup(), progress)?;
+        let outputs = match settings.readback {
+            true => settings.outputs,
+            false => Outputs::NONE,
         };
-        // The atlas's generation passes before the shadow casters: validation
-        // layers before 1.3.268 count their dispatches as writing every buffer
-        // of the heap, the geometry image included, so the casters' barrier
-        // must come after them.
-        let atlas = match (&terrain, settings.texturing) {
-            (Some(terrain), TexturingMode::Atlas) => Some(TextureAtlas::declare(
-                ctx,
-                &mut graph,
-                terrain.generation_inputs(&scene.layers),
-                streaming_for(&settings, &chains),
-            )?),
-            _ => None,
-        };
-        let shadows = lighting::declare_shadows(
+        let readback = declare_outputs(
             ctx,
             &mut graph,
-            (&views, &mut targets),
-            (terrain.as_ref(), points.as_ref()),
-            settings.shadows,
+            (&views, &targets, &chains),
+            &settings,
+            (outputs, slots),
         )?;
-        // Every view's draws before any view's post-processing dispatches:
-        // validation layers before 1.3.268 count a dispatch as writing every
-        // buffer of the heap, the other views' geometry images included.
-        for (k, (view, targets)) in views.iter().zip(&targets).enumerate() {
-            if let Some(terrain) = &mut terrain {
-                let atlas = atlas.as_ref().map(|a| a.bindings());
-                terrain.declare_draw(ctx, &mut graph, (k, view), targets, atlas)?;
-            }
-        }
-        for (k, (view, targets)) in views.iter().zip(&targets).enumerate() {
-            if let Some(points) = &mut points {
-                points.declare(ctx, &mut graph, (k, view), targets, !scene.draw_terrain)?;
-            }
-        }
-        let mut aovs = Aovs::new(ctx, &targets[0].formats)?;
-        for (k, (view, targets)) in views.iter().zip(&targets).enumerate() {
-            aovs.declare(&mut graph, (k, view), targets);
-        }
-        let exposure = ExposureMeter::new(ctx)?;
-        let tonemap = Tonemap::new(ctx)?;
-        let resolve = Resolve::new(ctx)?;
-        let blur = match settings.motion_blur {
-            Some(s) if s.shutter_s > 0.0 => Some((MotionBlur::new(ctx)?, s)),
-            _ => None,
-        };
-        let mut readback = Vec::new();
-        for ((view, rendered), chain) in views.iter().zip(&targets).zip(&chains) {
-            let blur = blur.as_ref().map(|(b, s)| (b, *s));
-            let targets = chain.declare(&mut graph, rendered, (&resolve, blur))?;
-            let exposure = exposure.declare(&mut graph, view, &targets);
-            tonemap.declare(&mut graph, view, &targets, exposure);
-            let outputs = match settings.readback {
-                true => settings.outputs,
-                false => Outputs::NONE,
-            };
-            match Readback::declare(ctx, &mut graph, view, &targets, (outputs, slots))? {
-                Some(rb) => readback.push(rb),
-                None => graph.keep(targets.display),
-            }
-        }
         let graph = graph.bake(ctx)?;
         Ok(Renderer {
             ctx: ctx.clone(),
@@ -371,14 +297,7 @@ impl Renderer {
             render_specs: chains.into_iter().map(|c| c.render).collect(),
             lighting,
             frames_rendered: 0,
-            techniques: Techniques {
-                lighting: scene_lighting,
-                shadows,
-                terrain,
-                atlas,
-                points,
-                aovs,
-            },
+            techniques,
         })
     }
 
@@ -632,6 +551,130 @@ impl Renderer {
             None => Ok(Vec::new()),
         }
     }
+}
+
+/// What the techniques are declared for.
+struct Wiring<'a> {
+    ctx: &'a Context,
+    scene: &'a Scene,
+    settings: &'a RenderSettings,
+    views: &'a [View],
+}
+
+impl Wiring<'_> {
+    /// The wiring list: every technique's passes of every view, in
+    /// execution order (the graph runs passes in the order declared); a
+    /// technique's inputs are what earlier ones returned. Beyond what the
+    /// data orders, two edges are kept for validation layers before
+    /// 1.3.268, which count a dispatch as writing every buffer of the heap
+    /// (the geometry images included), marked "Edge" below. Adding a
+    /// technique: its folder, a slot in [`Slots`], one line here (and its
+    /// prepare in [`Renderer::prepare_and_execute`]).
+    fn declare(
+        &self,
+        graph: &mut RenderGraph<RenderFrame>,
+        chains: &[ViewChain],
+        setup: LightingSetup,
+        progress: &mut dyn FnMut(f32),
+    ) -> Result<(Techniques, Vec<SceneTargets>)> {
+        let (ctx, scene, settings, views) = (self.ctx, self.scene, self.settings, self.views);
+        let points_present = !scene.points.is_empty();
+        // The lighting declares each view's constants; the targets carry them.
+        let regions: Vec<_> = (views.iter())
+            .map(|v| SceneLighting::declare_constants(graph, v))
+            .collect();
+        let mut targets: Vec<SceneTargets> = (views.iter().zip(&regions))
+            .map(|(v, &region)| SceneTargets::declare(graph, v, points_present, region))
+            .collect();
+        let mut scene_lighting = lighting::scene_lighting(scene, regions);
+        // The lighting's lookup tables and maps first: every shading pass reads them.
+        lighting::declare_atmosphere(ctx, graph, (views, &setup), (&mut targets, &mut scene_lighting))?;
+        if scene.draw_terrain {
+            let parts = (&mut targets[..], &mut scene_lighting);
+            lighting::declare_sky_light(
+                ctx,
+                graph,
+                (scene, &setup),
+                parts,
+                settings.cache_dir.as_deref(),
+                progress,
+            )?;
+        }
+        declare_views(&mut Sky::new(ctx, &targets[0].formats)?, ctx, graph, views, &targets)?;
+        let mut terrain = match scene.draw_terrain {
+            true => Some(warped_terrain(ctx, graph, scene, settings, views)?),
+            false => None,
+        };
+        let mut points = match points_present {
+            true => Some(PointRenderer::new(ctx, &scene.points, settings.points)?),
+            false => None,
+        };
+        // Edge: the atlas's generation passes before the shadow casters
+        // (whose barrier on the geometry image must come after them).
+        let atlas = match (&terrain, settings.texturing) {
+            (Some(terrain), TexturingMode::Atlas) => Some(TextureAtlas::declare(
+                ctx,
+                graph,
+                terrain.generation_inputs(&scene.layers),
+                streaming_for(settings, chains),
+            )?),
+            _ => None,
+        };
+        let casters = (terrain.as_ref(), points.as_ref());
+        let shadows = lighting::declare_shadows(ctx, graph, (views, &mut targets), casters, settings.shadows)?;
+        // Edge: every view's draws before any view's post-processing
+        // dispatches (the other views' geometry images).
+        if let Some(terrain) = &mut terrain {
+            let atlas = atlas.as_ref().map(|a| a.bindings());
+            declare_views(terrain, ctx, graph, views, targets.iter().map(|t| (t, atlas)))?;
+        }
+        if let Some(points) = &mut points {
+            let clear_depth = !scene.draw_terrain;
+            declare_views(points, ctx, graph, views, targets.iter().map(|t| (t, clear_depth)))?;
+        }
+        let mut aovs = Aovs::new(ctx, &targets[0].formats)?;
+        declare_views(&mut aovs, ctx, graph, views, &targets)?;
+        let techniques = Techniques {
+            lighting: scene_lighting,
+            shadows,
+            terrain,
+            atlas,
+            points,
+            aovs,
+        };
+        Ok((techniques, targets))
+    }
+}
+
+/// Each view's post chain (resolve, distortion, motion blur), exposure,
+/// tone mapping and readback of `outputs` into `slots` slots (none read
+/// back: the display image is kept).
+fn declare_outputs(
+    ctx: &Context,
+    graph: &mut RenderGraph<RenderFrame>,
+    (views, targets, chains): (&[View], &[SceneTargets], &[ViewChain]),
+    settings: &RenderSettings,
+    (outputs, slots): (Outputs, usize),
+) -> Result<Vec<Readback>> {
+    let exposure = ExposureMeter::new(ctx)?;
+    let tonemap = Tonemap::new(ctx)?;
+    let resolve = Resolve::new(ctx)?;
+    let blur = match settings.motion_blur {
+        Some(s) if s.shutter_s > 0.0 => Some((MotionBlur::new(ctx)?, s)),
+        _ => None,
+    };
+    let mut readback = Vec::new();
+    for ((view, rendered), chain) in views.iter().zip(targets).zip(chains) {
+        let blur = blur.as_ref().map(|(b, s)| (b, *s));
+        let targets = chain.declare(graph, rendered, (&resolve, blur))?;
+        let exposure = exposure.declare(graph, view, &targets);
+        tonemap.declare(graph, view, &targets, exposure);
+        match Readback::declare(ctx, graph, view, &targets, (outputs, slots))? {
+            Some(rb) => readback.push(rb),
+            None => graph.keep(targets.display),
+        }
+    }
+    Ok(readback)
 }
 
 /// The view `spec` renders through `camera`, without allocating (the

@@ -19,7 +19,7 @@ use crate::texturing::generation::{AtlasBindings, GenerationInputs};
 use crate::texturing::gpu_layout::{pack_layers, TexturingFrame, TexturingMode};
 use crate::texturing::input_maps::InputMaps;
 use crate::texturing::layers::LayerTree;
-use crate::view::{pass_name, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex};
+use crate::view::{pass_name, Declare, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex};
 use crate::vulkan::{Buffer, BufferUsageFlags, Context, Image};
 
 /// How `terrain.draw` colours the surface (§7.4.3 or §8.2).
@@ -283,6 +283,23 @@ impl Terrain {
                     .unwrap_or_else(|_| Err(Error::Graph("terrain: a view's LOD thread panicked".into())))
             })
         })
+    }
+}
+
+/// `terrain.draw` of a view (after its `terrain.warp`): its targets and the
+/// texture atlas's bindings (None: texturing in the draw) in, nothing out.
+impl<S: Provides<TerrainFrame> + 'static> Declare<S> for Terrain {
+    type Inputs<'a> = (&'a SceneTargets, Option<&'a AtlasBindings>);
+    type Outputs = ();
+
+    fn declare(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: (ViewIndex, &View),
+        (targets, atlas): Self::Inputs<'_>,
+    ) -> Result<()> {
+        self.declare_draw(ctx, graph, view, targets, atlas)
     }
 }
 

@@ -18,7 +18,8 @@ use std::sync::Arc;
 
 use super::{FrameLighting, View, ViewIndex};
 use crate::error::{Error, Result};
-use crate::graph::{CpuStage, UploadWriter};
+use crate::graph::{CpuStage, RenderGraph, UploadWriter};
+use crate::vulkan::Context;
 
 /// A frame slot struct holds a `T` (one technique's prepared data): what
 /// [`Frame::prepared`] reads. Implemented by [`frame_slots!`].
@@ -194,7 +195,7 @@ pub struct FrameContext<'a, 'u> {
 }
 
 /// A technique: persistent GPU state, passes declared once into the frame
-/// graph, and a per-frame CPU step that prepares what those
+/// graph ([`Declare`]), and a per-frame CPU step that prepares what those
 /// passes read, from the frame and what it needs of the other techniques'
 /// prepared data.
 pub trait Technique {
@@ -213,4 +214,43 @@ pub trait Technique {
     fn recycle(&mut self, previous: Self::Prepared) {
         drop(previous);
     }
+}
+
+/// Declaring a technique's passes of one view into the frame graph: what
+/// they read that other techniques declared comes in (`Inputs`: the view's
+/// targets, a shadow atlas), what they write that others read goes out
+/// (`Outputs`). `S` is the frame's slot struct; an impl bounds it by the
+/// prepared data its passes read (`S: Provides<TerrainFrame>`), so a graph
+/// whose frame lacks it does not compile.
+pub trait Declare<S> {
+    type Inputs<'a>;
+    type Outputs;
+    /// Declares the passes of view `index` (`view`).
+    fn declare(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: (ViewIndex, &View),
+        inputs: Self::Inputs<'_>,
+    ) -> Result<Self::Outputs>;
+}
+
+/// Declares `technique`'s passes of every view, view `k` with the `k`-th
+/// of `inputs`; returns each view's outputs.
+pub fn declare_views<'a, S, T: Declare<S>>(
+    technique: &mut T,
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame<S>>,
+    views: &[View],
+    inputs: impl IntoIterator<Item = T::Inputs<'a>>,
+) -> Result<Vec<T::Outputs>> {
+    let mut inputs = inputs.into_iter();
+    let mut outputs = Vec::with_capacity(views.len());
+    for (k, view) in views.iter().enumerate() {
+        let input = inputs
+            .next()
+            .ok_or_else(|| Error::Graph(format!("view {k} has no inputs to declare with")))?;
+        outputs.push(technique.declare(ctx, graph, (k, view), input)?);
+    }
+    Ok(outputs)
 }

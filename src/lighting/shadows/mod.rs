@@ -33,7 +33,7 @@ pub use cascades::{plan_cascades, plan_cascades_into, CascadePlan, SceneBounds, 
 
 use crate::error::{Error, Result};
 use crate::graph::{ImageAccess, ImageId, RenderGraph};
-use crate::view::{pass_name, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
+use crate::view::{pass_name, Declare, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
 use crate::vulkan::{CommandRecorder, Context, Format, Image, ImageDesc, ImageUsageFlags};
 
 /// The depth format of shadow atlases.
@@ -224,6 +224,23 @@ impl ShadowMaps {
             plan.cascades.clear();
         }
         Ok(())
+    }
+}
+
+/// `shadow.clear` of a view: nothing in, the view's atlas out (the casters
+/// draw into it, the shading passes sample it).
+impl<S: 'static> Declare<S> for ShadowMaps {
+    type Inputs<'a> = ();
+    type Outputs = ShadowTarget;
+
+    fn declare(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: (ViewIndex, &View),
+        (): (),
+    ) -> Result<ShadowTarget> {
+        self.declare_view(ctx, graph, view)
     }
 }
 

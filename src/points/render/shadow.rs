@@ -32,7 +32,7 @@ use crate::lighting::shadows::{
 };
 use crate::points::scene::PointScene;
 use crate::shaders;
-use crate::view::{pass_name, Frame, FrameContext, Provides, ShadowMode, Technique, View, ViewIndex};
+use crate::view::{pass_name, Declare, Frame, FrameContext, Provides, ShadowMode, Technique, View, ViewIndex};
 use crate::vulkan::{Blend, Buffer, CompareOp, Context, GraphicsPipeline, GraphicsPipelineDesc, PrimitiveTopology};
 
 /// Header of a view's shadow records (`ShadowPoints` in shadow_points.vert).
@@ -265,6 +265,22 @@ impl PointShadows {
                 }
             }
         }
+    }
+}
+
+/// `points.shadow` of a view: its shadow atlas in, nothing out.
+impl<S: Provides<ShadowFrame> + Provides<PointShadowFrame> + 'static> Declare<S> for PointShadows {
+    type Inputs<'a> = ShadowTarget;
+    type Outputs = ();
+
+    fn declare(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: (ViewIndex, &View),
+        target: ShadowTarget,
+    ) -> Result<()> {
+        PointShadows::declare(self, ctx, graph, view, target)
     }
 }
 

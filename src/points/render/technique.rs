@@ -18,7 +18,7 @@ use crate::error::{Error, Result};
 use crate::graph::RenderGraph;
 use crate::points::build::clusters::{cluster_normals, CLUSTER_COUNT};
 use crate::points::scene::PointScene;
-use crate::view::{pass_name, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex};
+use crate::view::{pass_name, Declare, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex};
 use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Context, MemoryLocation};
 
 /// What the points passes read this frame: each view's plan.
@@ -256,6 +256,23 @@ impl PointRenderer {
     /// frames completed).
     pub fn take_stats(&mut self) -> Result<Vec<PointFrameStats>> {
         self.stats.take_all_completed()
+    }
+}
+
+/// The points passes of a view: its targets (W required) and whether
+/// they clear the depth buffer (no terrain drew into it) in, nothing out.
+impl<S: Provides<PointsFrame> + 'static> Declare<S> for PointRenderer {
+    type Inputs<'a> = (&'a SceneTargets, bool);
+    type Outputs = ();
+
+    fn declare(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: (ViewIndex, &View),
+        (targets, clear_depth): Self::Inputs<'_>,
+    ) -> Result<()> {
+        PointRenderer::declare(self, ctx, graph, view, targets, clear_depth)
     }
 }
 
