@@ -19,7 +19,9 @@ use crate::terrain::geometry_image::{declare_warp_pass, GeometryImage, TerrainSe
 use crate::terrain::lod::LodFrame;
 use crate::terrain::shading::{declare_draw_pass, DrawPass, TerrainDrawPush};
 use crate::texturing::generation::{AtlasBindings, GenerationInputs};
-use crate::view::{pass_name, Declare, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex};
+use crate::view::{
+    pass_name, per_view, Declare, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex,
+};
 use crate::vulkan::{Buffer, BufferUsageFlags, Context, Image};
 
 /// How `terrain.draw` colours the surface (§7.4.3 or §8.2).
@@ -79,9 +81,7 @@ pub struct TerrainViewFrame {
 impl TerrainFrame {
     /// The prepared data of view `index`.
     pub fn view(&self, index: ViewIndex) -> Result<&TerrainViewFrame> {
-        self.views
-            .iter()
-            .find(|v| v.view == index)
+        per_view(&self.views, index, |v| v.view)
             .ok_or_else(|| Error::Graph(format!("terrain: view {index} was not prepared")))
     }
 }

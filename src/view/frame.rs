@@ -194,6 +194,16 @@ pub struct FrameContext<'a, 'u> {
     pub uploads: &'a mut UploadWriter<'u>,
 }
 
+/// The entry of view `index` in a technique's per-view prepared data
+/// (`view_of` reads an entry's view): at `items[index]` when the views
+/// were declared in order, as the renderer declares them, else searched.
+pub fn per_view<T>(items: &[T], index: ViewIndex, view_of: impl Fn(&T) -> ViewIndex) -> Option<&T> {
+    match items.get(index) {
+        Some(item) if view_of(item) == index => Some(item),
+        _ => items.iter().find(|item| view_of(item) == index),
+    }
+}
+
 /// A technique: persistent GPU state, passes declared once into the frame
 /// graph ([`Declare`]), and a per-frame CPU step that prepares what those
 /// passes read, from the frame and what it needs of the other techniques'

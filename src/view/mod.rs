@@ -23,7 +23,7 @@ mod targets;
 
 pub use camera::{frustum_planes, Camera};
 pub(crate) use frame::frame_slots;
-pub use frame::{declare_views, Declare, Frame, FrameContext, Provides, Technique};
+pub use frame::{declare_views, per_view, Declare, Frame, FrameContext, Provides, Technique};
 pub use lens::Intrinsics;
 pub use lighting::{Exposure, FrameLighting, Lighting, LightingSetup, ShadowMode, SkyLightMode, SkyModel, SunPosition};
 pub use targets::{SceneTargets, TargetFormats};

@@ -33,7 +33,7 @@ pub use cascades::{plan_cascades, plan_cascades_into, CascadePlan, SceneBounds, 
 
 use crate::error::{Error, Result};
 use crate::graph::{ImageAccess, ImageId, RenderGraph};
-use crate::view::{pass_name, Declare, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
+use crate::view::{pass_name, per_view, Declare, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
 use crate::vulkan::{CommandRecorder, Context, Format, Image, ImageDesc, ImageUsageFlags};
 
 /// The depth format of shadow atlases.
@@ -80,12 +80,9 @@ impl ShadowFrame {
     /// The cascades of view `index` (at `views[index]` when the views were
     /// declared in order, as the renderer does).
     pub fn view(&self, index: ViewIndex) -> Result<&CascadePlan> {
-        match self.views.get(index) {
-            Some((v, plan)) if *v == index => Ok(plan),
-            _ => (self.views.iter().find(|(v, _)| *v == index))
-                .map(|(_, p)| p)
-                .ok_or_else(|| Error::Graph(format!("shadows: view {index} was not prepared"))),
-        }
+        per_view(&self.views, index, |(v, _)| *v)
+            .map(|(_, p)| p)
+            .ok_or_else(|| Error::Graph(format!("shadows: view {index} was not prepared")))
     }
 }
 

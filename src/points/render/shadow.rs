@@ -32,7 +32,9 @@ use crate::lighting::shadows::{
 };
 use crate::points::scene::PointScene;
 use crate::shaders;
-use crate::view::{pass_name, Declare, Frame, FrameContext, Provides, ShadowMode, Technique, View, ViewIndex};
+use crate::view::{
+    pass_name, per_view, Declare, Frame, FrameContext, Provides, ShadowMode, Technique, View, ViewIndex,
+};
 use crate::vulkan::{Blend, Buffer, CompareOp, Context, GraphicsPipeline, GraphicsPipelineDesc, PrimitiveTopology};
 
 /// Header of a view's shadow records (`ShadowPoints` in shadow_points.vert).
@@ -71,9 +73,7 @@ pub struct PointShadowFrame {
 
 impl PointShadowFrame {
     fn view(&self, index: ViewIndex) -> Result<&[ShadowDraw]> {
-        self.views
-            .iter()
-            .find(|(v, _)| *v == index)
+        per_view(&self.views, index, |(v, _)| *v)
             .map(|(_, d)| d.as_slice())
             .ok_or_else(|| Error::Graph(format!("points.shadow: view {index} was not prepared")))
     }

@@ -18,7 +18,9 @@ use crate::error::{Error, Result};
 use crate::graph::RenderGraph;
 use crate::points::build::clusters::{cluster_normals, CLUSTER_COUNT};
 use crate::points::scene::PointScene;
-use crate::view::{pass_name, Declare, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex};
+use crate::view::{
+    pass_name, per_view, Declare, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex,
+};
 use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Context, MemoryLocation};
 
 /// What the points passes read this frame: each view's plan.
@@ -35,9 +37,7 @@ pub struct PointViewFrame {
 impl PointsFrame {
     /// The prepared plan of view `index`.
     pub fn view(&self, index: ViewIndex) -> Result<&PointViewFrame> {
-        self.views
-            .iter()
-            .find(|v| v.view == index)
+        per_view(&self.views, index, |v| v.view)
             .ok_or_else(|| Error::Graph(format!("points: view {index} was not prepared")))
     }
 }
