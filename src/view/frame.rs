@@ -264,3 +264,34 @@ pub fn declare_views<'a, S, T: Declare<S>>(
     }
     Ok(outputs)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    frame_slots! {
+        struct Slots {
+            numbers: Vec<u32>,
+            name: String,
+        }
+    }
+
+    #[test]
+    fn slots_hold_what_was_inserted_and_nothing_else() {
+        let mut frame = Frame::<Slots>::new(0, Vec::new(), FrameLighting::default());
+        let missing = frame.prepared::<String>().expect_err("nothing prepared");
+        assert!(missing.to_string().contains("String was not prepared"), "{missing}");
+        frame.insert(vec![1u32, 2]);
+        assert_eq!(frame.prepared::<Vec<u32>>().expect("numbers"), &[1, 2]);
+        assert!(frame.prepared::<String>().is_err());
+    }
+
+    #[test]
+    fn per_view_data_is_found_in_or_out_of_order() {
+        let in_order = [(0, 'a'), (1, 'b')];
+        assert_eq!(per_view(&in_order, 1, |e| e.0), Some(&(1, 'b')));
+        let shuffled = [(1, 'b'), (0, 'a')];
+        assert_eq!(per_view(&shuffled, 0, |e| e.0), Some(&(0, 'a')));
+        assert_eq!(per_view(&shuffled, 2, |e| e.0), None);
+    }
+}
