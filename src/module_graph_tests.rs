@@ -393,18 +393,6 @@ fn child_file(src: &Path, parent: &Path, decl: &ModDecl) -> PathBuf {
     }
 }
 
-/// The `.rs` files under `folder`, recursively.
-fn rust_files(folder: &Path, files: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(folder).unwrap() {
-        let path = entry.unwrap().path();
-        match path.is_dir() {
-            true => rust_files(&path, files),
-            false if path.extension().is_some_and(|e| e == "rs") => files.push(path),
-            false => {}
-        }
-    }
-}
-
 /// Edges between top-level modules: importer → (imported → files).
 type Graph = BTreeMap<String, BTreeMap<String, BTreeSet<String>>>;
 
@@ -529,7 +517,7 @@ fn the_walk_reaches_every_library_file() {
     assert!(top.iter().any(|t| t == "terrain") && top.iter().any(|t| t == "surface"));
     let reached: BTreeSet<&PathBuf> = files.iter().map(|f| &f.path).collect();
     let mut all = Vec::new();
-    rust_files(&src, &mut all);
+    crate::test_support::rust_files(&src, &mut all);
     let binary = [src.join("main.rs"), src.join("lib.rs")];
     let missed: Vec<&PathBuf> = all
         .iter()
