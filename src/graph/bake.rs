@@ -342,27 +342,18 @@ fn plan_aliasing<P>(
     Ok((alias_of, blocks))
 }
 
-pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<BakedGraph<P>> {
-    validate(&graph)?;
-    let serial = graph.serial;
-    let live = live_passes(&graph);
-    let mut image_usage = vec![ImageUsageFlags::empty(); graph.resources.len()];
-    let mut buffer_usage = vec![BufferUsageFlags::empty(); graph.resources.len()];
-    for (pass, _) in graph.passes.iter().zip(&live).filter(|(_, l)| **l) {
-        for (r, a) in &pass.uses {
-            image_usage[r.0] |= a.image_usage();
-            buffer_usage[r.0] |= a.buffer_usage();
-        }
-    }
-    let (alias_of, blocks) = plan_aliasing(&graph, &live, &image_usage, ctx)?;
-    let uploads = match graph.upload_arena {
-        Some(_) => Some(UploadArena::new(ctx, &graph.upload_regions)?),
-        None => None,
-    };
-    let mut physical = Vec::with_capacity(graph.resources.len());
-    let mut imported = Vec::with_capacity(graph.resources.len());
-    for (i, decl) in graph.resources.into_iter().enumerate() {
-        imported.push(decl.is_imported());
+/// The physical resources: transients created (aliased into `blocks`
+/// where planned) with the usage their accesses need, imports checked for
+/// it, the upload arena's buffers.
+fn create_physical(
+    ctx: &Context,
+    resources: Vec<ResourceDecl>,
+    (image_usage, buffer_usage): (&[ImageUsageFlags], &[BufferUsageFlags]),
+    blocks: &[Option<Arc<MemoryBlock>>],
+    uploads: Option<&UploadArena>,
+) -> Result<Vec<Physical>> {
+    let mut physical = Vec::with_capacity(resources.len());
+    for (i, decl) in resources.into_iter().enumerate() {
         let p = match decl {
             ResourceDecl::TransientImage { name, info } => {
                 if image_usage[i].is_empty() {
@@ -416,13 +407,36 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
                 }
                 Physical::Buffer(buffers)
             }
-            ResourceDecl::Uploads => match &uploads {
+            ResourceDecl::Uploads => match uploads {
                 Some(u) => Physical::Buffer(u.buffers.clone()),
                 None => Physical::Unused,
             },
         };
         physical.push(p);
     }
+    Ok(physical)
+}
+
+pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<BakedGraph<P>> {
+    validate(&graph)?;
+    let serial = graph.serial;
+    let live = live_passes(&graph);
+    let mut image_usage = vec![ImageUsageFlags::empty(); graph.resources.len()];
+    let mut buffer_usage = vec![BufferUsageFlags::empty(); graph.resources.len()];
+    for (pass, _) in graph.passes.iter().zip(&live).filter(|(_, l)| **l) {
+        for (r, a) in &pass.uses {
+            image_usage[r.0] |= a.image_usage();
+            buffer_usage[r.0] |= a.buffer_usage();
+        }
+    }
+    let (alias_of, blocks) = plan_aliasing(&graph, &live, &image_usage, ctx)?;
+    let uploads = match graph.upload_arena {
+        Some(_) => Some(UploadArena::new(ctx, &graph.upload_regions)?),
+        None => None,
+    };
+    let imported = graph.resources.iter().map(ResourceDecl::is_imported).collect();
+    let usage = (image_usage.as_slice(), buffer_usage.as_slice());
+    let physical = create_physical(ctx, graph.resources, usage, &blocks, uploads.as_ref())?;
     let mut passes = Vec::new();
     let mut culled = Vec::new();
     for (decl, alive) in graph.passes.into_iter().zip(live) {

@@ -245,31 +245,7 @@ impl GraphicsPipeline {
             .depth_test_enable(desc.depth_test)
             .depth_write_enable(desc.depth_write)
             .depth_compare_op(desc.depth_compare);
-        let attachment = match desc.blend {
-            Blend::None => vk::PipelineColorBlendAttachmentState::default(),
-            Blend::Additive => vk::PipelineColorBlendAttachmentState::default()
-                .blend_enable(true)
-                .src_color_blend_factor(vk::BlendFactor::ONE)
-                .dst_color_blend_factor(vk::BlendFactor::ONE)
-                .color_blend_op(vk::BlendOp::ADD)
-                .src_alpha_blend_factor(vk::BlendFactor::ONE)
-                .dst_alpha_blend_factor(vk::BlendFactor::ONE)
-                .alpha_blend_op(vk::BlendOp::ADD),
-            Blend::PremultipliedOver => vk::PipelineColorBlendAttachmentState::default()
-                .blend_enable(true)
-                .src_color_blend_factor(vk::BlendFactor::ONE)
-                .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-                .color_blend_op(vk::BlendOp::ADD)
-                .src_alpha_blend_factor(vk::BlendFactor::ONE)
-                .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-                .alpha_blend_op(vk::BlendOp::ADD),
-        }
-        .color_write_mask(vk::ColorComponentFlags::RGBA);
-        // Integer attachments (ids) cannot blend: they are always replaced.
-        let replace = vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA);
-        let attachments: Vec<_> = (desc.color_formats.iter())
-            .map(|&f| if is_integer_format(f) { replace } else { attachment })
-            .collect();
+        let attachments = blend_attachments(desc);
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
@@ -321,6 +297,36 @@ impl GraphicsPipeline {
     pub fn depth_format(&self) -> Option<vk::Format> {
         self.depth_format
     }
+}
+
+/// The colour blend state of each of `desc`'s attachments: its blend
+/// mode, except on integer attachments (ids), which cannot blend and are
+/// always replaced.
+fn blend_attachments(desc: &GraphicsPipelineDesc) -> Vec<vk::PipelineColorBlendAttachmentState> {
+    let attachment = match desc.blend {
+        Blend::None => vk::PipelineColorBlendAttachmentState::default(),
+        Blend::Additive => vk::PipelineColorBlendAttachmentState::default()
+            .blend_enable(true)
+            .src_color_blend_factor(vk::BlendFactor::ONE)
+            .dst_color_blend_factor(vk::BlendFactor::ONE)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+            .alpha_blend_op(vk::BlendOp::ADD),
+        Blend::PremultipliedOver => vk::PipelineColorBlendAttachmentState::default()
+            .blend_enable(true)
+            .src_color_blend_factor(vk::BlendFactor::ONE)
+            .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+            .alpha_blend_op(vk::BlendOp::ADD),
+    }
+    .color_write_mask(vk::ColorComponentFlags::RGBA);
+    let replace = vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA);
+    (desc.color_formats.iter())
+        .map(|&f| if is_integer_format(f) { replace } else { attachment })
+        .collect()
 }
 
 impl Drop for GraphicsPipeline {
