@@ -58,11 +58,12 @@
 //! Layers, bottom up (each uses only the ones below it): `vulkan` (the
 //! only `unsafe` code) → `graph` (render graph: passes declare reads and
 //! writes; baking derives barriers) → `view` (cameras, views, the frame's
-//! shared targets and uploads) → the techniques (`terrain`, `synthesis`,
-//! `texturing`, `lighting`, `points`, `post`) → `renderer` (composition:
-//! scenes, frames, outputs) → the CLI (binary only). `io`, `budget` (the
-//! memory model), `profile`, `random`, `shaders` and `error` are leaves
-//! every layer may use. Every module but `vulkan` is
+//! shared targets and uploads) → `surface` (what the techniques share: the
+//! ground surface and the surface material) → the techniques (`terrain`,
+//! `synthesis`, `texturing`, `lighting`, `points`, `post`) → `renderer`
+//! (composition: scenes, frames, outputs) → the CLI (binary only). `io`,
+//! `budget` (the memory model), `profile`, `random`, `shaders` and `error`
+//! are leaves every layer may use. Every module but `vulkan` is
 //! `#[forbid(unsafe_code)]`.
 
 #[forbid(unsafe_code)]
@@ -107,6 +108,12 @@ pub(crate) mod test_support;
 
 #[forbid(unsafe_code)]
 mod front;
+
+/// The layering of the crate checked from its `use` lines: no cycle between
+/// top-level modules, no technique above the renderer.
+#[cfg(test)]
+#[forbid(unsafe_code)]
+mod module_graph_tests;
 
 #[doc(hidden)]
 #[forbid(unsafe_code)]

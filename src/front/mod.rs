@@ -36,7 +36,7 @@ mod tests {
         let root = Path::new(env!("CARGO_MANIFEST_DIR"));
         let mut files = vec![root.join("src/main.rs")];
         for folder in ["src/cli", "examples", "tests", "python/src", "capi/src", "capi/tests"] {
-            collect_rust_files(&root.join(folder), &mut files);
+            crate::test_support::rust_files(&root.join(folder), &mut files);
         }
         assert!(files.len() > 40, "only {} client files found", files.len());
         for file in files {
@@ -46,18 +46,6 @@ mod tests {
                 "{} uses alpenglow::bench",
                 file.display()
             );
-        }
-    }
-
-    /// The `.rs` files under `folder`, recursively.
-    fn collect_rust_files(folder: &Path, files: &mut Vec<std::path::PathBuf>) {
-        for entry in std::fs::read_dir(folder).unwrap() {
-            let path = entry.unwrap().path();
-            match path.is_dir() {
-                true => collect_rust_files(&path, files),
-                false if path.extension().is_some_and(|e| e == "rs") => files.push(path),
-                false => {}
-            }
         }
     }
 }

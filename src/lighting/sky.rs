@@ -10,7 +10,7 @@ use bytemuck::{Pod, Zeroable};
 use crate::error::Result;
 use crate::graph::{ImageAccess, RenderGraph, Stage};
 use crate::shaders;
-use crate::view::{pass_name, Frame, SceneTargets, TargetFormats, View, ViewIndex};
+use crate::view::{pass_name, Declare, Frame, SceneTargets, TargetFormats, View, ViewIndex};
 use crate::vulkan::{Context, GraphicsPipeline, GraphicsPipelineDesc, LoadOp};
 
 /// Push constants of `sky` (`glsl/lighting/sky.frag`): the view ray basis
@@ -56,7 +56,12 @@ impl Sky {
 
     /// Declares `sky` for view `index`: writes its radiance, view depth,
     /// lighting AOVs, normal and ids.
-    pub fn declare(&self, graph: &mut RenderGraph<Frame>, (index, view): (ViewIndex, &View), targets: &SceneTargets) {
+    pub fn declare<S: 'static>(
+        &self,
+        graph: &mut RenderGraph<Frame<S>>,
+        (index, view): (ViewIndex, &View),
+        targets: &SceneTargets,
+    ) {
         let pipeline = self.pipeline.clone();
         let (radiance, view_depth, visibility) = (targets.radiance, targets.view_depth, targets.visibility);
         let (normal, ids) = (targets.normal, targets.ids);
@@ -98,5 +103,22 @@ impl Sky {
                 cmd.end_rendering();
                 Ok(())
             });
+    }
+}
+
+/// `sky` of a view: its targets in, nothing out.
+impl<S: 'static> Declare<S> for Sky {
+    type Inputs<'a> = &'a SceneTargets;
+    type Outputs = ();
+
+    fn declare(
+        &mut self,
+        _: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: (ViewIndex, &View),
+        targets: &SceneTargets,
+    ) -> Result<()> {
+        Sky::declare(self, graph, view, targets);
+        Ok(())
     }
 }

@@ -1,9 +1,10 @@
 //! The lighting technique (§6.3, §9): its prepare step turns the frame's
-//! [`Lighting`] request into each view's [`LightingFrame`] constants (sun,
+//! [`FrameLighting`] into each view's [`LightingFrame`] constants (sun,
 //! sky model coefficients, aerial perspective, cascades, map handles) in the
-//! view's upload region ([`crate::view::LightingInputs::constants`]), which
+//! view's upload region ([`SceneLighting::declare_constants`]), which
 //! every shading pass reads; the lighting passes (lookup tables, shadow
-//! casters, sky light) are declared by its parts.
+//! casters, sky light) are declared by its parts. It needs the frame's
+//! shadow cascades ([`ShadowFrame`]) when the scene has shadow casters.
 
 use glam::Vec3;
 
@@ -15,8 +16,8 @@ use super::reference::MonteCarloReference;
 use super::shadows::ShadowFrame;
 use super::sky_light::SkyLight;
 use crate::error::{Error, Result};
-use crate::graph::UploadRegion;
-use crate::view::{FrameContext, Lighting, ShadowMode, SkyLightMode, SkyModel, Technique};
+use crate::graph::{RenderGraph, UploadRegion};
+use crate::view::{pass_name, FrameContext, FrameLighting, ShadowMode, SkyLightMode, SkyModel, Technique, View};
 
 /// What the height field contributes to the constants.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,12 +64,20 @@ impl SceneLighting {
         }
     }
 
-    /// The constants of one view (without view-dependent parts): the
-    /// Preetham sky's coefficients and the transmitted sun (§6.3), the
-    /// aerial perspective's scattering coefficients (§9.1), the modes.
-    fn constants(&self, lighting: &Lighting) -> Result<LightingFrame> {
+    /// Declares the upload region of `view`'s lighting constants (one
+    /// [`LightingFrame`]), which its [`crate::view::SceneTargets`] carry.
+    pub fn declare_constants<P: 'static>(graph: &mut RenderGraph<P>, view: &View) -> UploadRegion {
+        let bytes = std::mem::size_of::<LightingFrame>() as u64;
+        graph.upload_region(&pass_name("lighting", &view.name), bytes)
+    }
+
+    /// The constants every view shares (the frame's, without view-dependent
+    /// parts): the Preetham sky's coefficients and the transmitted sun
+    /// (§6.3), the aerial perspective's scattering coefficients (§9.1), the
+    /// modes.
+    fn constants(&self, lighting: &FrameLighting) -> Result<LightingFrame> {
         let mut f = LightingFrame::zeroed_frame();
-        let sun = lighting.sun_direction();
+        let sun = lighting.sun;
         PreethamSky::new(sun, lighting.turbidity)?.fill(&mut f);
         f.mie[3] = self.field.ground;
         match lighting.sky {
@@ -135,21 +144,23 @@ impl LightingFrame {
 
 impl Technique for SceneLighting {
     type Prepared = PreparedLighting;
+    /// The shadow cascades of every view (None: no shadow casters).
+    type Needs<'a> = Option<&'a ShadowFrame>;
 
     fn name(&self) -> &'static str {
         "lighting"
     }
 
-    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<PreparedLighting> {
-        frame.lighting.validate()?;
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, shadows: Option<&ShadowFrame>) -> Result<PreparedLighting> {
         let mut views = std::mem::take(&mut self.spare);
         views.clear();
+        let shared = self.constants(frame.lighting)?;
         for (k, view) in frame.views.iter().enumerate() {
-            let mut constants = self.constants(frame.lighting)?;
+            let mut constants = shared;
             if let Some(atmosphere) = &self.atmosphere {
                 atmosphere.fill_handles(k, view.camera.eye.z, &mut constants)?;
             }
-            if let Ok(shadows) = frame.prepared::<ShadowFrame>() {
+            if let Some(shadows) = shadows {
                 shadows.view(k)?.fill(&mut constants);
             }
             if let Some(sky_light) = &self.sky_light {

@@ -29,7 +29,7 @@ use glam::DMat4;
 use crate::error::{Error, Result};
 use crate::graph::{BufferAccess, ImageAccess, RenderGraph, Stage, UploadRegion};
 use crate::shaders;
-use crate::view::{pass_name, Frame, FrameContext, SceneTargets, TargetFormats, Technique, View, ViewIndex};
+use crate::view::{pass_name, Declare, Frame, FrameContext, SceneTargets, TargetFormats, Technique, View, ViewIndex};
 use crate::vulkan::{Context, GraphicsPipeline, GraphicsPipelineDesc, LoadOp};
 
 /// Per-view constants of `aovs` (`AovConstants` in glsl/post/aovs.frag).
@@ -125,9 +125,9 @@ impl Aovs {
 
     /// Declares `aovs` for view `index`: reads its view depth, writes its
     /// motion and distance.
-    pub fn declare(
+    pub fn declare<S: 'static>(
         &mut self,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         (index, view): (ViewIndex, &View),
         targets: &SceneTargets,
     ) {
@@ -167,8 +167,26 @@ impl Aovs {
     }
 }
 
+/// `aovs` of a view: its targets in, nothing out.
+impl<S: 'static> Declare<S> for Aovs {
+    type Inputs<'a> = &'a SceneTargets;
+    type Outputs = ();
+
+    fn declare(
+        &mut self,
+        _: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: (ViewIndex, &View),
+        targets: &SceneTargets,
+    ) -> Result<()> {
+        Aovs::declare(self, graph, view, targets);
+        Ok(())
+    }
+}
+
 impl Technique for Aovs {
     type Prepared = AovsFrame;
+    type Needs<'a> = ();
 
     fn name(&self) -> &'static str {
         "aovs"
@@ -176,7 +194,7 @@ impl Technique for Aovs {
 
     /// Per view: the constants from this frame's camera and the previous
     /// frame's transform, then this frame's transform kept for the next.
-    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<AovsFrame> {
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, (): ()) -> Result<AovsFrame> {
         let mut with_motion = std::mem::take(&mut self.spare);
         with_motion.clear();
         for (view, previous) in self.views.iter().zip(&mut self.previous) {

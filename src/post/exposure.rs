@@ -56,7 +56,12 @@ impl ExposureMeter {
 
     /// Declares `exposure.meter` for `view`: reads its radiance, writes and
     /// returns the view's exposure buffer (read by `tonemap`).
-    pub fn declare(&self, graph: &mut RenderGraph<Frame>, view: &View, targets: &SceneTargets) -> BufferId {
+    pub fn declare<S: 'static>(
+        &self,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: &View,
+        targets: &SceneTargets,
+    ) -> BufferId {
         let exposure = graph.create_buffer(
             &pass_name("exposure", &view.name),
             BufferInfo {

@@ -41,7 +41,13 @@ impl Tonemap {
 
     /// Declares `tonemap` for `view`: its radiance, exposed by `exposure`,
     /// into its display image.
-    pub fn declare(&self, graph: &mut RenderGraph<Frame>, view: &View, targets: &SceneTargets, exposure: BufferId) {
+    pub fn declare<S: 'static>(
+        &self,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: &View,
+        targets: &SceneTargets,
+        exposure: BufferId,
+    ) {
         let pipeline = self.pipeline.clone();
         let (radiance, display, width, height) = (targets.radiance, targets.display, targets.width, targets.height);
         graph

@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use crate::error::Result;
-use crate::graph::RenderGraph;
+use crate::graph::{RenderGraph, UploadRegion};
 use crate::lighting::atmosphere::{AtmosphereParameters, LutSizes, PhysicalAtmosphere};
 use crate::lighting::reference::{MonteCarloReference, ReferenceSettings};
 use crate::lighting::shadows::{ShadowMaps, ShadowSettings};
@@ -15,11 +15,10 @@ use crate::lighting::technique::{FieldInfo, SceneLighting};
 use crate::points::render::shadow::PointShadows;
 use crate::points::render::PointRenderer;
 use crate::terrain::Terrain;
-use crate::view::{Frame, SceneTargets, View};
-use crate::view::{Lighting, SkyLightMode};
+use crate::view::{LightingSetup, SceneTargets, View};
 use crate::vulkan::Context;
 
-use super::Scene;
+use super::{RenderFrame, Scene};
 
 /// The sun's shadow maps and their point casters.
 pub(super) struct SunShadows {
@@ -27,13 +26,14 @@ pub(super) struct SunShadows {
     pub points: Option<PointShadows>,
 }
 
-/// The scene's lighting technique, writing every view's lighting constants.
-pub(super) fn scene_lighting(scene: &Scene, targets: &[SceneTargets]) -> SceneLighting {
+/// The scene's lighting technique, writing every view's lighting constants
+/// into `regions` ([`SceneLighting::declare_constants`]).
+pub(super) fn scene_lighting(scene: &Scene, regions: Vec<UploadRegion>) -> SceneLighting {
     let field = &scene.heights;
     let extent = field.extent();
     let (lo, _) = scene.height_range();
     SceneLighting::new(
-        targets.iter().map(|t| t.lighting.constants).collect(),
+        regions,
         FieldInfo {
             extent: [extent.x as f32, extent.y as f32],
             texels: [
@@ -51,7 +51,7 @@ pub(super) fn scene_lighting(scene: &Scene, targets: &[SceneTargets]) -> SceneLi
 /// casters.
 pub(super) fn declare_shadows(
     ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
+    graph: &mut RenderGraph<RenderFrame>,
     (views, targets): (&[View], &mut [SceneTargets]),
     (terrain, points): (Option<&Terrain>, Option<&PointRenderer>),
     settings: ShadowSettings,
@@ -84,8 +84,8 @@ pub(super) fn declare_shadows(
 /// adds their maps to what the view's shading passes read.
 pub(super) fn declare_sky_light(
     ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
-    (scene, lighting): (&Scene, &Lighting),
+    graph: &mut RenderGraph<RenderFrame>,
+    (scene, lighting): (&Scene, &LightingSetup),
     (targets, scene_lighting): (&mut [SceneTargets], &mut SceneLighting),
     cache: Option<&Path>,
     progress: &mut dyn FnMut(f32),
@@ -95,7 +95,7 @@ pub(super) fn declare_sky_light(
     let bake = SkyLightBake::bake(
         ctx,
         &scene.heights,
-        &BakeSettings::from_lighting(lighting),
+        &BakeSettings::from_setup(lighting),
         cache,
         progress,
     )?;
@@ -106,7 +106,7 @@ pub(super) fn declare_sky_light(
         t.lighting.buffers.push(ids.environment);
     }
     scene_lighting.sky_light = Some(sky_light);
-    if lighting.sky_light == SkyLightMode::Reference {
+    if lighting.reference {
         let [targets] = targets else {
             return Err(crate::error::Error::invalid(
                 "lighting.sky_light",
@@ -115,7 +115,7 @@ pub(super) fn declare_sky_light(
         };
         let settings = ReferenceSettings {
             bounces: lighting.bounces,
-            bounce_albedo: lighting.albedo_override.unwrap_or(0.3),
+            bounce_albedo: lighting.bounce_albedo,
             ..ReferenceSettings::default()
         };
         let reference = MonteCarloReference::new(ctx, &scene.heights, settings)?;
@@ -134,8 +134,8 @@ pub(super) fn declare_sky_light(
 /// first, read by every pass that evaluates the sky.
 pub(super) fn declare_atmosphere(
     ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
-    (views, lighting): (&[View], &Lighting),
+    graph: &mut RenderGraph<RenderFrame>,
+    (views, lighting): (&[View], &LightingSetup),
     (targets, scene_lighting): (&mut [SceneTargets], &mut SceneLighting),
 ) -> Result<()> {
     let params = AtmosphereParameters::for_turbidity(lighting.turbidity)?;

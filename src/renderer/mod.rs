@@ -45,11 +45,12 @@ use view_chain::ViewChain;
 
 use crate::error::{Error, Result};
 use crate::graph::{BakedGraph, CpuStage, FrameOutcome, RenderGraph};
-use crate::lighting::shadows::ShadowSettings;
+use crate::lighting::shadows::{ShadowFrame, ShadowSettings};
 use crate::lighting::sky::Sky;
-use crate::lighting::technique::SceneLighting;
-use crate::points::render::{PointFrameStats, PointRenderer, SplatSettings};
-use crate::post::aovs::Aovs;
+use crate::lighting::technique::{PreparedLighting, SceneLighting};
+use crate::points::render::shadow::PointShadowFrame;
+use crate::points::render::{PointFrameStats, PointRenderer, PointsFrame, SplatSettings};
+use crate::post::aovs::{Aovs, AovsFrame};
 use crate::post::exposure::ExposureMeter;
 use crate::post::motion_blur::{MotionBlur, MotionBlurSettings};
 use crate::post::resolve::Resolve;
@@ -57,11 +58,11 @@ use crate::post::tonemap::Tonemap;
 use crate::profile::FrameProfile;
 use crate::surface::gpu_layout::TexturingMode;
 use crate::terrain::geometry_image::TerrainSettings;
-use crate::terrain::{Terrain, TerrainTexturing};
-use crate::texturing::generation::{TextureAtlas, TextureFrameStats, TextureStreaming};
+use crate::terrain::{Terrain, TerrainFrame, TerrainTexturing};
+use crate::texturing::generation::{TextureAtlas, TextureFrame, TextureFrameStats, TextureStreaming};
 use crate::texturing::page_table::PageTable;
 use crate::view::rig::validate_views;
-use crate::view::{Frame, Lighting, SceneTargets, View};
+use crate::view::{declare_views, frame_slots, Frame, FrameLighting, Lighting, LightingSetup, SceneTargets, View};
 use crate::vulkan::{Context, FrameRing, FRAMES_IN_FLIGHT};
 
 /// The default [`RenderSettings::readback_slots`]: one frame being read,
@@ -160,6 +161,23 @@ impl RenderSettings {
     }
 }
 
+frame_slots! {
+    /// What the renderer's techniques prepare each frame, one slot each:
+    /// what a pass body reads with `frame.prepared::<T>()`.
+    pub(crate) struct Slots {
+        shadows: ShadowFrame,
+        point_shadows: PointShadowFrame,
+        lighting: PreparedLighting,
+        terrain: TerrainFrame,
+        texturing: TextureFrame,
+        points: PointsFrame,
+        aovs: AovsFrame,
+    }
+}
+
+/// A renderer's frame.
+pub(crate) type RenderFrame = Frame<Slots>;
+
 /// The techniques of a scene, each with its persistent state.
 /// (The sky and tone mapping prepare nothing: their passes own their pipelines.)
 struct Techniques {
@@ -176,7 +194,7 @@ struct Techniques {
 pub struct Renderer {
     ctx: Context,
     frames: FrameRing,
-    graph: BakedGraph<Frame>,
+    graph: BakedGraph<RenderFrame>,
     /// The output images.
     views: Vec<ViewSpec>,
     /// What the techniques render for each (supersampled, undistorted).
@@ -188,9 +206,10 @@ pub struct Renderer {
     /// Identifies the renderer's tickets.
     id: u64,
     /// The last frame and its CPU stages, reused by the next.
-    frame: Option<Frame>,
+    frame: Option<RenderFrame>,
     stages: Vec<CpuStage>,
-    lighting: Lighting,
+    /// The lighting of the next frames, validated when set.
+    lighting: FrameLighting,
     /// Frames rendered so far.
     frames_rendered: u64,
     techniques: Techniques,
@@ -245,100 +264,25 @@ impl Renderer {
             .collect::<Result<_>>()?;
         // The views the graph is declared for; every frame brings their cameras.
         let views: Vec<View> = (chains.iter()).map(|c| c.render.view(scene.default_camera())).collect();
-        let lighting = settings.lighting.unwrap_or_else(|| scene.default_lighting());
-        lighting.validate()?;
-        let mut targets: Vec<SceneTargets> = (views.iter())
-            .map(|v| SceneTargets::declare(&mut graph, v, points_present))
-            .collect();
-        let mut scene_lighting = lighting::scene_lighting(scene, &targets);
-        lighting::declare_atmosphere(
+        let lighting = FrameLighting::new(settings.lighting.unwrap_or_else(|| scene.default_lighting()))?;
+        let wiring = Wiring {
+            ctx,
+            scene,
+            settings: &settings,
+            views: &views,
+        };
+        let (techniques, targets) = wiring.declare(&mut graph, &chains, lighting.setup(), progress)?;
+        let outputs = match settings.readback {
+            true => settings.outputs,
+            false => Outputs::NONE,
+        };
+        let readback = declare_outputs(
             ctx,
             &mut graph,
-            (&views, &lighting),
-            (&mut targets, &mut scene_lighting),
+            (&views, &targets, &chains),
+            &settings,
+            (outputs, slots),
         )?;
-        if scene.draw_terrain {
-            lighting::declare_sky_light(
-                ctx,
-                &mut graph,
-                (scene, &lighting),
-                (&mut targets, &mut scene_lighting),
-                settings.cache_dir.as_deref(),
-                progress,
-            )?;
-        }
-        let sky = Sky::new(ctx, &targets[0].formats)?;
-        for (k, view) in views.iter().enumerate() {
-            sky.declare(&mut graph, (k, view), &targets[k]);
-        }
-        let mut terrain = match scene.draw_terrain {
-            true => Some(warped_terrain(ctx, &mut graph, scene, &settings, &views)?),
-            false => None,
-        };
-        let mut points = match points_present {
-            true => Some(PointRenderer::new(ctx, &scene.points, settings.points)?),
-            false => None,
-        };
-        // The atlas's generation passes before the shadow casters: validation
-        // layers before 1.3.268 count their dispatches as writing every buffer
-        // of the heap, the geometry image included, so the casters' barrier
-        // must come after them.
-        let atlas = match (&terrain, settings.texturing) {
-            (Some(terrain), TexturingMode::Atlas) => Some(TextureAtlas::declare(
-                ctx,
-                &mut graph,
-                terrain.generation_inputs(&scene.layers),
-                streaming_for(&settings, &chains),
-            )?),
-            _ => None,
-        };
-        let shadows = lighting::declare_shadows(
-            ctx,
-            &mut graph,
-            (&views, &mut targets),
-            (terrain.as_ref(), points.as_ref()),
-            settings.shadows,
-        )?;
-        // Every view's draws before any view's post-processing dispatches:
-        // validation layers before 1.3.268 count a dispatch as writing every
-        // buffer of the heap, the other views' geometry images included.
-        for (k, (view, targets)) in views.iter().zip(&targets).enumerate() {
-            if let Some(terrain) = &mut terrain {
-                let atlas = atlas.as_ref().map(|a| a.bindings());
-                terrain.declare_draw(ctx, &mut graph, (k, view), targets, atlas)?;
-            }
-        }
-        for (k, (view, targets)) in views.iter().zip(&targets).enumerate() {
-            if let Some(points) = &mut points {
-                points.declare(ctx, &mut graph, (k, view), targets, !scene.draw_terrain)?;
-            }
-        }
-        let mut aovs = Aovs::new(ctx, &targets[0].formats)?;
-        for (k, (view, targets)) in views.iter().zip(&targets).enumerate() {
-            aovs.declare(&mut graph, (k, view), targets);
-        }
-        let exposure = ExposureMeter::new(ctx)?;
-        let tonemap = Tonemap::new(ctx)?;
-        let resolve = Resolve::new(ctx)?;
-        let blur = match settings.motion_blur {
-            Some(s) if s.shutter_s > 0.0 => Some((MotionBlur::new(ctx)?, s)),
-            _ => None,
-        };
-        let mut readback = Vec::new();
-        for ((view, rendered), chain) in views.iter().zip(&targets).zip(&chains) {
-            let blur = blur.as_ref().map(|(b, s)| (b, *s));
-            let targets = chain.declare(&mut graph, rendered, (&resolve, blur))?;
-            let exposure = exposure.declare(&mut graph, view, &targets);
-            tonemap.declare(&mut graph, view, &targets, exposure);
-            let outputs = match settings.readback {
-                true => settings.outputs,
-                false => Outputs::NONE,
-            };
-            match Readback::declare(ctx, &mut graph, view, &targets, (outputs, slots))? {
-                Some(rb) => readback.push(rb),
-                None => graph.keep(targets.display),
-            }
-        }
         let graph = graph.bake(ctx)?;
         Ok(Renderer {
             ctx: ctx.clone(),
@@ -353,20 +297,13 @@ impl Renderer {
             render_specs: chains.into_iter().map(|c| c.render).collect(),
             lighting,
             frames_rendered: 0,
-            techniques: Techniques {
-                lighting: scene_lighting,
-                shadows,
-                terrain,
-                atlas,
-                points,
-                aovs,
-            },
+            techniques,
         })
     }
 
     /// The lighting of the next frames.
     pub fn lighting(&self) -> &Lighting {
-        &self.lighting
+        self.lighting.lighting()
     }
 
     /// Sets the lighting of the next frames (sun, sky model, exposure,
@@ -374,8 +311,7 @@ impl Renderer {
     /// frame is recorded. The renderer must have been built with the parts
     /// the lighting uses (see [`RenderSettings::lighting`]).
     pub fn set_lighting(&mut self, lighting: Lighting) -> Result<()> {
-        lighting.validate()?;
-        self.lighting = lighting;
+        self.lighting = FrameLighting::new(lighting)?;
         Ok(())
     }
 
@@ -456,28 +392,33 @@ impl Renderer {
     }
 
     /// Every technique's prepare, then the graph records and submits `frame`.
-    fn prepare_and_execute(&mut self, frame: &mut Frame, stages: &mut Vec<CpuStage>) -> Result<FrameOutcome> {
+    /// The order is the data's: the lighting needs the shadows' cascades
+    /// (its constants carry them), so it takes what their prepare returned.
+    fn prepare_and_execute(&mut self, frame: &mut RenderFrame, stages: &mut Vec<CpuStage>) -> Result<FrameOutcome> {
         let mut uploads = self.graph.uploads(frame.index);
         let t = &mut self.techniques;
-        if let Some(shadows) = &mut t.shadows {
-            frame.prepare(&mut shadows.maps, &mut uploads, stages)?;
-            if let Some(points) = &mut shadows.points {
-                frame.prepare(points, &mut uploads, stages)?;
+        let mut shadows = None;
+        if let Some(s) = &mut t.shadows {
+            shadows = Some(frame.prepare(&mut s.maps, (), &mut uploads, stages)?);
+            if let Some(points) = &mut s.points {
+                frame.prepare_into(points, (), &mut uploads, stages)?;
             }
         }
-        // After the shadows: the constants carry their cascades.
-        frame.prepare(&mut t.lighting, &mut uploads, stages)?;
+        frame.prepare_into(&mut t.lighting, shadows.as_ref(), &mut uploads, stages)?;
+        if let Some(shadows) = shadows {
+            frame.insert(shadows);
+        }
         if let Some(terrain) = &mut t.terrain {
-            frame.prepare(terrain, &mut uploads, stages)?;
+            frame.prepare_into(terrain, (), &mut uploads, stages)?;
         }
         if let Some(atlas) = &mut t.atlas {
             atlas.observe_profiles(self.graph.profiles());
-            frame.prepare(atlas, &mut uploads, stages)?;
+            frame.prepare_into(atlas, (), &mut uploads, stages)?;
         }
         if let Some(points) = &mut t.points {
-            frame.prepare(points, &mut uploads, stages)?;
+            frame.prepare_into(points, (), &mut uploads, stages)?;
         }
-        frame.prepare(&mut t.aovs, &mut uploads, stages)?;
+        frame.prepare_into(&mut t.aovs, (), &mut uploads, stages)?;
         self.graph.execute(&mut self.frames, frame, stages)
     }
 
@@ -612,6 +553,130 @@ impl Renderer {
     }
 }
 
+/// What the techniques are declared for.
+struct Wiring<'a> {
+    ctx: &'a Context,
+    scene: &'a Scene,
+    settings: &'a RenderSettings,
+    views: &'a [View],
+}
+
+impl Wiring<'_> {
+    /// The wiring list: every technique's passes of every view, in
+    /// execution order (the graph runs passes in the order declared); a
+    /// technique's inputs are what earlier ones returned. Beyond what the
+    /// data orders, two edges are kept for validation layers before
+    /// 1.3.268, which count a dispatch as writing every buffer of the heap
+    /// (the geometry images included), marked "Edge" below. Adding a
+    /// technique: its folder, a slot in [`Slots`], one line here (and its
+    /// prepare in [`Renderer::prepare_and_execute`]).
+    fn declare(
+        &self,
+        graph: &mut RenderGraph<RenderFrame>,
+        chains: &[ViewChain],
+        setup: LightingSetup,
+        progress: &mut dyn FnMut(f32),
+    ) -> Result<(Techniques, Vec<SceneTargets>)> {
+        let (ctx, scene, settings, views) = (self.ctx, self.scene, self.settings, self.views);
+        let points_present = !scene.points.is_empty();
+        // The lighting declares each view's constants; the targets carry them.
+        let regions: Vec<_> = (views.iter())
+            .map(|v| SceneLighting::declare_constants(graph, v))
+            .collect();
+        let mut targets: Vec<SceneTargets> = (views.iter().zip(&regions))
+            .map(|(v, &region)| SceneTargets::declare(graph, v, points_present, region))
+            .collect();
+        let mut scene_lighting = lighting::scene_lighting(scene, regions);
+        // The lighting's lookup tables and maps first: every shading pass reads them.
+        lighting::declare_atmosphere(ctx, graph, (views, &setup), (&mut targets, &mut scene_lighting))?;
+        if scene.draw_terrain {
+            let parts = (&mut targets[..], &mut scene_lighting);
+            lighting::declare_sky_light(
+                ctx,
+                graph,
+                (scene, &setup),
+                parts,
+                settings.cache_dir.as_deref(),
+                progress,
+            )?;
+        }
+        declare_views(&mut Sky::new(ctx, &targets[0].formats)?, ctx, graph, views, &targets)?;
+        let mut terrain = match scene.draw_terrain {
+            true => Some(warped_terrain(ctx, graph, scene, settings, views)?),
+            false => None,
+        };
+        let mut points = match points_present {
+            true => Some(PointRenderer::new(ctx, &scene.points, settings.points)?),
+            false => None,
+        };
+        // Edge: the atlas's generation passes before the shadow casters
+        // (whose barrier on the geometry image must come after them).
+        let atlas = match (&terrain, settings.texturing) {
+            (Some(terrain), TexturingMode::Atlas) => Some(TextureAtlas::declare(
+                ctx,
+                graph,
+                terrain.generation_inputs(&scene.layers),
+                streaming_for(settings, chains),
+            )?),
+            _ => None,
+        };
+        let casters = (terrain.as_ref(), points.as_ref());
+        let shadows = lighting::declare_shadows(ctx, graph, (views, &mut targets), casters, settings.shadows)?;
+        // Edge: every view's draws before any view's post-processing
+        // dispatches (the other views' geometry images).
+        if let Some(terrain) = &mut terrain {
+            let atlas = atlas.as_ref().map(|a| a.bindings());
+            declare_views(terrain, ctx, graph, views, targets.iter().map(|t| (t, atlas)))?;
+        }
+        if let Some(points) = &mut points {
+            let clear_depth = !scene.draw_terrain;
+            declare_views(points, ctx, graph, views, targets.iter().map(|t| (t, clear_depth)))?;
+        }
+        let mut aovs = Aovs::new(ctx, &targets[0].formats)?;
+        declare_views(&mut aovs, ctx, graph, views, &targets)?;
+        let techniques = Techniques {
+            lighting: scene_lighting,
+            shadows,
+            terrain,
+            atlas,
+            points,
+            aovs,
+        };
+        Ok((techniques, targets))
+    }
+}
+
+/// Each view's post chain (resolve, distortion, motion blur), exposure,
+/// tone mapping and readback of `outputs` into `slots` slots (none read
+/// back: the display image is kept).
+fn declare_outputs(
+    ctx: &Context,
+    graph: &mut RenderGraph<RenderFrame>,
+    (views, targets, chains): (&[View], &[SceneTargets], &[ViewChain]),
+    settings: &RenderSettings,
+    (outputs, slots): (Outputs, usize),
+) -> Result<Vec<Readback>> {
+    let exposure = ExposureMeter::new(ctx)?;
+    let tonemap = Tonemap::new(ctx)?;
+    let resolve = Resolve::new(ctx)?;
+    let blur = match settings.motion_blur {
+        Some(s) if s.shutter_s > 0.0 => Some((MotionBlur::new(ctx)?, s)),
+        _ => None,
+    };
+    let mut readback = Vec::new();
+    for ((view, rendered), chain) in views.iter().zip(targets).zip(chains) {
+        let blur = blur.as_ref().map(|(b, s)| (b, *s));
+        let targets = chain.declare(graph, rendered, (&resolve, blur))?;
+        let exposure = exposure.declare(graph, view, &targets);
+        tonemap.declare(graph, view, &targets, exposure);
+        match Readback::declare(ctx, graph, view, &targets, (outputs, slots))? {
+            Some(rb) => readback.push(rb),
+            None => graph.keep(targets.display),
+        }
+    }
+    Ok(readback)
+}
+
 /// The view `spec` renders through `camera`, without allocating (the
 /// name stays empty: only the size and intrinsics are checked with it).
 fn view_of(spec: &ViewSpec, camera: &Camera) -> View {
@@ -644,7 +709,7 @@ fn streaming_for(settings: &RenderSettings, chains: &[ViewChain]) -> TextureStre
 /// The terrain of `scene` with every view's `terrain.warp` declared.
 fn warped_terrain(
     ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
+    graph: &mut RenderGraph<RenderFrame>,
     scene: &Scene,
     settings: &RenderSettings,
     views: &[View],

@@ -122,9 +122,9 @@ impl Readback {
     /// Declares the view's `readback` pass copying `outputs` of `targets`
     /// into `slots` host buffers each; returns None (and declares nothing)
     /// when there is nothing to copy.
-    pub(super) fn declare(
+    pub(super) fn declare<S: 'static>(
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         view: &View,
         targets: &SceneTargets,
         (outputs, slots): (Outputs, usize),

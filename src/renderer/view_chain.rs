@@ -13,7 +13,7 @@ use crate::post::motion_blur::{MotionBlur, MotionBlurImages, MotionBlurSettings}
 use crate::post::resample::{ImageKind, ResampleImage};
 use crate::post::resolve::{supersampled_size, Resolve, ResolveDesc, ResolveFilter};
 use crate::view::rig::ViewSpec;
-use crate::view::{pass_name, Frame, Intrinsics, SceneTargets};
+use crate::view::{pass_name, Intrinsics, SceneTargets};
 use crate::vulkan::Context;
 
 fn to_post(k: Intrinsics) -> distortion::Intrinsics {
@@ -120,9 +120,9 @@ impl ViewChain {
     /// Declares the view's post chain from `rendered` (the render spec's
     /// targets) and returns the targets the exposure, tone mapping and
     /// readback use (`rendered` itself when there is nothing to do).
-    pub fn declare(
+    pub fn declare<P: 'static>(
         &self,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<P>,
         rendered: &SceneTargets,
         (resolve, blur): (&Resolve, Option<(&MotionBlur, MotionBlurSettings)>),
     ) -> Result<SceneTargets> {
@@ -132,9 +132,11 @@ impl ViewChain {
             n => format!("{n}.{what}"),
         };
         let weight = rendered.weight.is_some();
+        // The lighting inputs stay the rendered targets'.
+        let lit = &rendered.lighting;
         let mut current = rendered.clone();
         if self.source != (self.render.width, self.render.height) {
-            let next = SceneTargets::declare_named(graph, &stage("resolved"), self.source, weight);
+            let next = SceneTargets::declare_named(graph, &stage("resolved"), self.source, weight, lit.clone());
             let desc = ResolveDesc {
                 source_size: (current.width, current.height),
                 target_size: self.source,
@@ -145,7 +147,7 @@ impl ViewChain {
         }
         if let Some(lens) = &self.distortion {
             let size = (self.output.width, self.output.height);
-            let next = SceneTargets::declare_named(graph, &stage("distorted"), size, weight);
+            let next = SceneTargets::declare_named(graph, &stage("distorted"), size, weight, lit.clone());
             lens.declare(graph, name, &resampled(&current, &next))?;
             current = next;
         }
@@ -166,8 +168,6 @@ impl ViewChain {
             blur.declare(graph, name, &images, &settings)?;
             current.radiance = output;
         }
-        // The lighting inputs stay the rendered targets'.
-        current.lighting = rendered.lighting.clone();
         Ok(current)
     }
 }

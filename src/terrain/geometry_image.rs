@@ -22,7 +22,8 @@ use crate::io::heightmap::HeightField;
 use crate::shaders;
 use crate::surface::wavelet_noise::{self, NOISE_TILE};
 use crate::terrain::lod::{DebugScalar, LodSettings};
-use crate::view::{pass_name, Frame, ViewIndex};
+use crate::terrain::TerrainFrame;
+use crate::view::{pass_name, Frame, Provides, ViewIndex};
 use crate::vulkan::{
     Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, Format, Image, ImageDesc, ImageUsageFlags,
     MemoryLocation,
@@ -301,7 +302,12 @@ pub struct WarpPass {
 /// prepared warp of the sketch map, bilinearly to N×N, heights re-sampled
 /// from the atlas, detail displacement, normals; into the vertex buffer.
 /// Its push constants come from the view's [`crate::terrain::TerrainFrame`].
-pub fn declare_warp_pass(ctx: &Context, graph: &mut RenderGraph<Frame>, name: &str, pass: WarpPass) -> Result<()> {
+pub fn declare_warp_pass<S: Provides<TerrainFrame> + 'static>(
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame<S>>,
+    name: &str,
+    pass: WarpPass,
+) -> Result<()> {
     let pipeline = ComputePipeline::new(ctx, shaders::TERRAIN_WARP)?;
     graph
         .pass(name)

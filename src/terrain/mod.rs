@@ -3,7 +3,10 @@
 //! [`importance`] → [`warp`] (combined per frame by [`lod`], in
 //! [`Terrain`]'s `prepare`) → [`geometry_image`] (`terrain.warp`) →
 //! [`shading`] (`terrain.draw`); [`technique`] ties them into the frame.
-//! [`ground`] is the CPU twin of the drawn surface, for height queries.
+//! [`ground`] is the CPU twin of the drawn surface, for height queries. The
+//! cubic B-spline and the wavelet noise of the detail octaves are shared
+//! with the other techniques (`crate::surface::bspline`,
+//! `crate::surface::wavelet_noise`).
 
 pub mod geometry_image;
 pub mod ground;

@@ -15,8 +15,9 @@ use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, RenderGraph, St
 use crate::shaders;
 use crate::surface::input_maps::InputMaps;
 use crate::terrain::geometry_image::VERTEX_STRIDE;
+use crate::terrain::TerrainFrame;
 use crate::texturing::generation::AtlasBindings;
-use crate::view::{Frame, SceneTargets, ViewIndex};
+use crate::view::{Frame, Provides, SceneTargets, ViewIndex};
 use crate::vulkan::{
     Blend, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, PrimitiveTopology,
     VertexAttribute,
@@ -103,9 +104,9 @@ fn pipeline(ctx: &Context, targets: &SceneTargets) -> Result<GraphicsPipeline> {
 /// Declares `terrain.draw` for one view into its radiance and view depth
 /// (loaded: the sky pass wrote them) with its depth buffer (cleared). Its
 /// push constants come from the view's [`crate::terrain::TerrainFrame`].
-pub fn declare_draw_pass(
+pub fn declare_draw_pass<S: Provides<TerrainFrame> + 'static>(
     ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
+    graph: &mut RenderGraph<Frame<S>>,
     name: &str,
     pass: DrawPass,
     targets: &SceneTargets,

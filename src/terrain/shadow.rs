@@ -16,7 +16,7 @@ use crate::error::Result;
 use crate::graph::{BufferAccess, ImageAccess, RenderGraph};
 use crate::lighting::shadows::{record_cascades, SceneBounds, ShadowFrame, ShadowTarget, SHADOW_FORMAT};
 use crate::shaders;
-use crate::view::{pass_name, Frame, View, ViewIndex};
+use crate::view::{pass_name, Frame, Provides, View, ViewIndex};
 use crate::vulkan::{
     CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, PrimitiveTopology, VertexAttribute,
 };
@@ -67,10 +67,10 @@ impl Terrain {
     /// Declares `terrain.shadow` of view `index` into its atlas `target`
     /// (after `terrain.warp` of that view and `shadow.clear`; the cascades
     /// come from the frame's [`ShadowFrame`]).
-    pub fn declare_shadow(
+    pub fn declare_shadow<S: Provides<ShadowFrame> + 'static>(
         &self,
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         (index, view): (ViewIndex, &View),
         target: ShadowTarget,
     ) -> Result<()> {

@@ -19,7 +19,9 @@ use crate::terrain::geometry_image::{declare_warp_pass, GeometryImage, TerrainSe
 use crate::terrain::lod::LodFrame;
 use crate::terrain::shading::{declare_draw_pass, DrawPass, TerrainDrawPush};
 use crate::texturing::generation::{AtlasBindings, GenerationInputs};
-use crate::view::{pass_name, Frame, FrameContext, SceneTargets, Technique, View, ViewIndex};
+use crate::view::{
+    pass_name, per_view, Declare, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex,
+};
 use crate::vulkan::{Buffer, BufferUsageFlags, Context, Image};
 
 /// How `terrain.draw` colours the surface (§7.4.3 or §8.2).
@@ -79,9 +81,7 @@ pub struct TerrainViewFrame {
 impl TerrainFrame {
     /// The prepared data of view `index`.
     pub fn view(&self, index: ViewIndex) -> Result<&TerrainViewFrame> {
-        self.views
-            .iter()
-            .find(|v| v.view == index)
+        per_view(&self.views, index, |v| v.view)
             .ok_or_else(|| Error::Graph(format!("terrain: view {index} was not prepared")))
     }
 }
@@ -93,9 +93,9 @@ fn heap_handle(image_or_buffer: Option<u32>, what: &str) -> Result<u32> {
 impl Terrain {
     /// Uploads the height field, the noise tile, the surface layers and
     /// their input maps, and imports them into `graph`.
-    pub fn new(
+    pub fn new<S: Provides<TerrainFrame> + 'static>(
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         field: Arc<HeightField>,
         settings: TerrainSettings,
         texturing: &TerrainTexturing,
@@ -146,10 +146,10 @@ impl Terrain {
     }
 
     /// Declares `terrain.warp` of view `index`, with its geometry image.
-    pub fn declare_warp(
+    pub fn declare_warp<S: Provides<TerrainFrame> + 'static>(
         &mut self,
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         (index, view): (ViewIndex, &View),
     ) -> Result<()> {
         let vertex_buffer = self.geometry.vertex_buffer(ctx, &view.name)?;
@@ -187,10 +187,10 @@ impl Terrain {
 
     /// Declares `terrain.draw` of view `index` into `targets`, textured from
     /// `atlas` when given (after [`Terrain::declare_warp`] of that view).
-    pub fn declare_draw(
+    pub fn declare_draw<S: Provides<TerrainFrame> + 'static>(
         &mut self,
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         (index, view): (ViewIndex, &View),
         targets: &SceneTargets,
         atlas: Option<&AtlasBindings>,
@@ -286,8 +286,26 @@ impl Terrain {
     }
 }
 
+/// `terrain.draw` of a view (after its `terrain.warp`): its targets and the
+/// texture atlas's bindings (None: texturing in the draw) in, nothing out.
+impl<S: Provides<TerrainFrame> + 'static> Declare<S> for Terrain {
+    type Inputs<'a> = (&'a SceneTargets, Option<&'a AtlasBindings>);
+    type Outputs = ();
+
+    fn declare(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: (ViewIndex, &View),
+        (targets, atlas): Self::Inputs<'_>,
+    ) -> Result<()> {
+        self.declare_draw(ctx, graph, view, targets, atlas)
+    }
+}
+
 impl Technique for Terrain {
     type Prepared = TerrainFrame;
+    type Needs<'a> = ();
 
     fn name(&self) -> &'static str {
         "terrain"
@@ -295,7 +313,7 @@ impl Technique for Terrain {
 
     /// Per view: sketch map, importance map and warp (§7.4.2) into the
     /// warp upload, the texturing constants, and the passes' push constants.
-    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<TerrainFrame> {
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, (): ()) -> Result<TerrainFrame> {
         let mut views = std::mem::take(&mut self.spare);
         views.clear();
         let settings = self.geometry.settings;

@@ -46,7 +46,7 @@ use crate::texturing::passes::{add_atlas_readback, base_push, GenerationPasses};
 use crate::texturing::quadtree::{HeightBounds, NeededTile, NodeId, View};
 pub use crate::texturing::stats::TextureFrameStats;
 pub use crate::texturing::streaming::{TextureStreaming, MAX_VIEWS};
-use crate::view::{frustum_planes, Frame, FrameContext, Technique};
+use crate::view::{frustum_planes, Frame, FrameContext, Provides, Technique};
 use crate::vulkan::{Buffer, Context, Format, Image, ImageDesc, ImageUsageFlags, MemoryLocation};
 
 /// Bytes of one texel's state in the scratch buffer (`TexelState`).
@@ -170,9 +170,9 @@ pub struct GenerationInputs<'a> {
 type AtlasTexture = (ImageId, Arc<Image>);
 
 /// The atlas textures, imported into `graph`: (colour, normal) per texture.
-fn atlas_textures(
+fn atlas_textures<S: Provides<TextureFrame> + 'static>(
     ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
+    graph: &mut RenderGraph<Frame<S>>,
     streaming: &TextureStreaming,
 ) -> Result<Vec<[AtlasTexture; 2]>> {
     let readback_usage = match streaming.readback {
@@ -209,9 +209,9 @@ impl TextureAtlas {
     /// Creates the atlas and declares `texturing.upsample`, one
     /// `texturing.layer*` pass per layer and `texturing.finish` (module
     /// documentation), and `texturing.readback` when asked for.
-    pub fn declare(
+    pub fn declare<S: Provides<TextureFrame> + 'static>(
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         inputs: GenerationInputs,
         streaming: TextureStreaming,
     ) -> Result<TextureAtlas> {
@@ -394,6 +394,7 @@ pub fn quadtree_view(view: &crate::view::View) -> View {
 
 impl Technique for TextureAtlas {
     type Prepared = TextureFrame;
+    type Needs<'a> = ();
 
     fn name(&self) -> &'static str {
         "texturing"
@@ -403,7 +404,7 @@ impl Technique for TextureAtlas {
     /// documentation, step 1) and uploads its jobs and the page table every
     /// view samples. A frame whose plan cannot be generated forgets the
     /// cache, so that no tile stays marked resident without being generated.
-    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<TextureFrame> {
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, (): ()) -> Result<TextureFrame> {
         let start = std::time::Instant::now();
         if !(1..=MAX_VIEWS).contains(&frame.views.len()) {
             return Err(Error::invalid(

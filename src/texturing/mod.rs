@@ -3,11 +3,11 @@
 //! chosen per frame from a quadtree over the height field and reused from
 //! frame to frame. Files follow the pipeline of §8.2:
 //!
-//! * [`layers`]: the surface-layer tree (TOML file, built-in default), hat
-//!   functions and coverage, the CPU reference evaluation;
-//! * [`input_maps`]: rainfall, radiation and temperature maps registered
-//!   to the height field; [`blurred_height`]: the blurred height fields
-//!   `height_blur` layers read (snow in furrows);
+//! * the surface material it evaluates is shared with the terrain and the
+//!   vegetation, in `crate::surface`: the layer tree (`surface::layers`),
+//!   its input maps and blurred height fields (`surface::input_maps`,
+//!   `surface::blurred_height`), the layers buffer (`surface::gpu_layout`)
+//!   and the dominant layer of a point (`surface::dominant`, the class AOV);
 //! * [`quadtree`]: per frame, the nodes the views need and their tile
 //!   sizes, one partition for all views; [`bounds`]: the height field's
 //!   per-node bounds it measures;
@@ -24,8 +24,7 @@
 //!   frame's views;
 //! * [`stats`]: streaming statistics per frame and over a run;
 //! * [`from_image`]: surface layers estimated from a real image (§8.3);
-//! * [`reference`]: the CPU twin of the shaders' evaluation, for tests;
-//! * [`dominant`]: the dominant layer of a point (the class AOV).
+//! * [`reference`]: the CPU twin of the shaders' evaluation, for tests.
 
 pub mod atlas;
 pub mod atlas_settings;

@@ -14,7 +14,7 @@ use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, RenderGraph, St
 use crate::io::heightmap::HeightField;
 use crate::shaders;
 use crate::texturing::generation::{GenerationInputs, TextureFrame, GROUP};
-use crate::view::Frame;
+use crate::view::{Frame, Provides};
 use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, MemoryLocation};
 
 /// Push constants of every `texturing.*` pass (`Push` in
@@ -61,7 +61,12 @@ pub(crate) struct GenerationPasses {
 
 impl GenerationPasses {
     /// `texturing.upsample`: the base surface at every dirty texel.
-    pub fn declare_upsample(&self, ctx: &Context, graph: &mut RenderGraph<Frame>, heights: ImageId) -> Result<()> {
+    pub fn declare_upsample<S: Provides<TextureFrame> + 'static>(
+        &self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        heights: ImageId,
+    ) -> Result<()> {
         let pipeline = ComputePipeline::new(ctx, shaders::TEXTURING_UPSAMPLE)?;
         let (jobs, scratch, base_push) = (self.jobs, self.scratch, self.base_push);
         graph
@@ -82,10 +87,10 @@ impl GenerationPasses {
     }
 
     /// `texturing.layer<i>.<name>`: one layer over every dirty texel.
-    pub fn declare_layers(
+    pub fn declare_layers<S: Provides<TextureFrame> + 'static>(
         &self,
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         inputs: &GenerationInputs,
     ) -> Result<()> {
         let layer_pipeline = Arc::new(ComputePipeline::new(ctx, shaders::TEXTURING_LAYER)?);
@@ -136,7 +141,12 @@ impl GenerationPasses {
     }
 
     /// `texturing.finish`: colour and normal into the atlas.
-    pub fn declare_finish(&self, ctx: &Context, graph: &mut RenderGraph<Frame>, images: &[ImageId]) -> Result<()> {
+    pub fn declare_finish<S: Provides<TextureFrame> + 'static>(
+        &self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        images: &[ImageId],
+    ) -> Result<()> {
         let pipeline = ComputePipeline::new(ctx, shaders::TEXTURING_FINISH)?;
         let (jobs, scratch, base_push) = (self.jobs, self.scratch, self.base_push);
         let mut pass = graph
@@ -160,9 +170,9 @@ impl GenerationPasses {
 }
 
 /// `texturing.readback`: every colour texture into host buffers.
-pub(crate) fn add_atlas_readback(
+pub(crate) fn add_atlas_readback<S: Provides<TextureFrame> + 'static>(
     ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
+    graph: &mut RenderGraph<Frame<S>>,
     colors: &[(ImageId, u32)],
     atlas_size: u32,
 ) -> Result<Vec<Vec<Arc<Buffer>>>> {

@@ -1,49 +1,98 @@
 //! The frame: prepare, then record. Before a frame is recorded, every
 //! technique's [`Technique::prepare`] does its CPU work (LOD, tile and point
 //! planning) for the frame's views and returns its prepared data, which goes
-//! into the [`Frame`]; the passes' recording closures then only read it
-//! (`Fn`, no locks), in the manner of Granite's `refresh()` before the
-//! graph runs and kajiya's renderers' prepare step.
+//! into its typed slot of the [`Frame`]; the passes' recording closures then
+//! only read it (`Fn`, no locks), in the manner of Granite's `refresh()`
+//! before the graph runs and kajiya's renderers' prepare step.
+//!
+//! The slots are a plain struct the renderer defines ([`frame_slots!`]), one
+//! `Option<T>` per technique's prepared type, with a [`Provides<T>`] impl
+//! each: a pass body reads `frame.prepared::<T>()?` and compiles only where
+//! its graph's frame provides `T` (no `TypeId`, no boxes). A technique that
+//! reads another's prepared data says so in [`Technique::Needs`], and gets
+//! it as an argument of its prepare: the renderer hands it the value the
+//! other technique returned, so preparing them in the wrong order does not
+//! compile.
 
-use std::any::{type_name, Any, TypeId};
 use std::sync::Arc;
 
-use super::{Lighting, View, ViewIndex};
+use super::{FrameLighting, View, ViewIndex};
 use crate::error::{Error, Result};
-use crate::graph::{CpuStage, UploadWriter};
+use crate::graph::{CpuStage, RenderGraph, UploadWriter};
+use crate::vulkan::Context;
+
+/// A frame slot struct holds a `T` (one technique's prepared data): what
+/// [`Frame::prepared`] reads. Implemented by [`frame_slots!`].
+pub trait Provides<T> {
+    /// The slot (None until prepared this frame).
+    fn slot(&self) -> &Option<T>;
+    fn slot_mut(&mut self) -> &mut Option<T>;
+}
+
+/// Defines a frame slot struct: one `Option` field per prepared type, and
+/// its [`Provides`] impls. Each type appears once.
+///
+/// ```ignore
+/// frame_slots! {
+///     /// What the renderer's techniques prepare.
+///     pub(crate) struct Slots { shadows: ShadowFrame, terrain: TerrainFrame }
+/// }
+/// ```
+macro_rules! frame_slots {
+    ($(#[$meta:meta])* $vis:vis struct $name:ident { $($field:ident: $ty:ty),* $(,)? }) => {
+        $(#[$meta])*
+        #[derive(Default)]
+        $vis struct $name {
+            $($field: Option<$ty>,)*
+        }
+        $(
+            impl $crate::view::Provides<$ty> for $name {
+                fn slot(&self) -> &Option<$ty> {
+                    &self.$field
+                }
+                fn slot_mut(&mut self) -> &mut Option<$ty> {
+                    &mut self.$field
+                }
+            }
+        )*
+    };
+}
+pub(crate) use frame_slots;
 
 /// Everything a frame's passes read: its views, its lighting and each
-/// technique's prepared data.
-pub struct Frame {
+/// technique's prepared data, in the slot struct `S`.
+pub struct Frame<S> {
     /// Frame number (0, 1, 2, …).
     pub index: u64,
     pub views: Vec<View>,
-    pub lighting: Lighting,
-    /// Each technique's prepared data (`Option<T>`: None until prepared
-    /// this frame). A frame is reused frame after frame
-    /// ([`Frame::reset`]): the boxes stay, and each technique gets its
-    /// previous frame's data back to reuse ([`Technique::recycle`]).
-    prepared: Vec<(TypeId, Box<dyn Any + Send + Sync>)>,
+    pub lighting: FrameLighting,
+    /// Each technique's prepared data (None until prepared this frame).
+    /// A frame is reused frame after frame ([`Frame::reset`]): each
+    /// technique gets its previous frame's data back to reuse
+    /// ([`Technique::recycle`]).
+    slots: S,
     /// The profile stage name of each technique, made once.
     stage_names: Vec<(&'static str, Arc<str>)>,
 }
 
-impl Frame {
+impl<S: Default> Frame<S> {
     /// A frame of `views` with nothing prepared yet.
-    pub fn new(index: u64, views: Vec<View>, lighting: Lighting) -> Frame {
+    pub fn new(index: u64, views: Vec<View>, lighting: FrameLighting) -> Frame<S> {
         Frame {
             index,
             views,
             lighting,
-            prepared: Vec::new(),
+            slots: S::default(),
             stage_names: Vec::new(),
         }
     }
+}
 
+impl<S> Frame<S> {
     /// Starts frame `index` of the same views (update their cameras in
     /// [`Frame::views`]) with `lighting`: what was prepared becomes the
     /// previous frame's, handed back to each technique as it prepares.
-    pub fn reset(&mut self, index: u64, lighting: Lighting) {
+    pub fn reset(&mut self, index: u64, lighting: FrameLighting) {
         self.index = index;
         self.lighting = lighting;
     }
@@ -55,19 +104,27 @@ impl Frame {
             .ok_or_else(|| Error::Graph(format!("view {index} is not in this frame")))
     }
 
-    /// Adds a technique's prepared data (replacing any of the same type,
-    /// in its box).
-    pub fn insert<T: Any + Send + Sync>(&mut self, value: T) {
-        match self.slot::<T>() {
-            Some(slot) => *slot = Some(value),
-            None => self.prepared.push((TypeId::of::<T>(), Box::new(Some(value)))),
-        }
+    /// Puts a technique's prepared data into its slot (what
+    /// [`Frame::prepare`] returned, once the techniques that need it have
+    /// prepared).
+    pub fn insert<T>(&mut self, value: T)
+    where
+        S: Provides<T>,
+    {
+        *self.slots.slot_mut() = Some(value);
     }
 
-    /// The box of `T`'s prepared data, if it has one.
-    fn slot<T: Any + Send + Sync>(&mut self) -> Option<&mut Option<T>> {
-        let id = TypeId::of::<T>();
-        (self.prepared.iter_mut().find(|(t, _)| *t == id)).and_then(|(_, v)| v.downcast_mut::<Option<T>>())
+    /// The prepared data of type `T`.
+    pub fn prepared<T>(&self) -> Result<&T>
+    where
+        S: Provides<T>,
+    {
+        self.slots.slot().as_ref().ok_or_else(|| {
+            Error::Graph(format!(
+                "{} was not prepared for this frame",
+                std::any::type_name::<T>()
+            ))
+        })
     }
 
     /// The profile stage name of `technique`.
@@ -80,33 +137,48 @@ impl Frame {
         name
     }
 
-    /// The prepared data of type `T`.
-    pub fn prepared<T: Any>(&self) -> Result<&T> {
-        find_prepared(&self.prepared)
-    }
-
-    /// Runs `technique`'s prepare step as the profile stage
-    /// `prepare.<name>` and adds its result to the frame.
+    /// Runs `technique`'s prepare step with what it needs of the others
+    /// as the profile stage `prepare.<name>` and returns its prepared data
+    /// (hand it to the techniques that need it, then [`Frame::insert`] it).
+    /// Its slot is emptied first (the previous frame's data goes back to
+    /// the technique), so a pass never reads a previous frame's data.
     pub fn prepare<T: Technique>(
         &mut self,
         technique: &mut T,
+        needs: T::Needs<'_>,
         uploads: &mut UploadWriter<'_>,
         stages: &mut Vec<CpuStage>,
-    ) -> Result<()> {
+    ) -> Result<T::Prepared>
+    where
+        S: Provides<T::Prepared>,
+    {
         let name = self.stage_name(technique.name());
-        if let Some(previous) = self.slot::<T::Prepared>().and_then(Option::take) {
+        if let Some(previous) = self.slots.slot_mut().take() {
             technique.recycle(previous);
         }
-        let prepared = CpuStage::time(stages, &name, || {
+        CpuStage::time(stages, &name, || {
             let mut ctx = FrameContext {
                 index: self.index,
                 views: &self.views,
                 lighting: &self.lighting,
                 uploads,
-                earlier: &self.prepared,
             };
-            technique.prepare(&mut ctx)
-        })?;
+            technique.prepare(&mut ctx, needs)
+        })
+    }
+
+    /// [`Frame::prepare`] of a technique that no other needs, into its slot.
+    pub fn prepare_into<T: Technique>(
+        &mut self,
+        technique: &mut T,
+        needs: T::Needs<'_>,
+        uploads: &mut UploadWriter<'_>,
+        stages: &mut Vec<CpuStage>,
+    ) -> Result<()>
+    where
+        S: Provides<T::Prepared>,
+    {
+        let prepared = self.prepare(technique, needs, uploads, stages)?;
         self.insert(prepared);
         Ok(())
     }
@@ -118,42 +190,108 @@ impl Frame {
 pub struct FrameContext<'a, 'u> {
     pub index: u64,
     pub views: &'a [View],
-    pub lighting: &'a Lighting,
+    pub lighting: &'a FrameLighting,
     pub uploads: &'a mut UploadWriter<'u>,
-    /// What the techniques prepared before this one.
-    earlier: &'a [(TypeId, Box<dyn Any + Send + Sync>)],
 }
 
-impl FrameContext<'_, '_> {
-    /// The prepared data of type `T` of a technique prepared earlier this
-    /// frame (the lighting reads the shadow cascades' plan).
-    pub fn prepared<T: Any>(&self) -> Result<&T> {
-        find_prepared(self.earlier)
+/// The entry of view `index` in a technique's per-view prepared data
+/// (`view_of` reads an entry's view): at `items[index]` when the views
+/// were declared in order, as the renderer declares them, else searched.
+pub fn per_view<T>(items: &[T], index: ViewIndex, view_of: impl Fn(&T) -> ViewIndex) -> Option<&T> {
+    match items.get(index) {
+        Some(item) if view_of(item) == index => Some(item),
+        _ => items.iter().find(|item| view_of(item) == index),
     }
 }
 
-fn find_prepared<T: Any>(prepared: &[(TypeId, Box<dyn Any + Send + Sync>)]) -> Result<&T> {
-    prepared
-        .iter()
-        .find(|(t, _)| *t == TypeId::of::<T>())
-        .and_then(|(_, v)| v.downcast_ref::<Option<T>>())
-        .and_then(Option::as_ref)
-        .ok_or_else(|| Error::Graph(format!("{} was not prepared for this frame", type_name::<T>())))
-}
-
 /// A technique: persistent GPU state, passes declared once into the frame
-/// graph, and a per-frame CPU step that prepares what those passes read.
+/// graph ([`Declare`]), and a per-frame CPU step that prepares what those
+/// passes read, from the frame and what it needs of the other techniques'
+/// prepared data.
 pub trait Technique {
     /// What the technique's passes read this frame.
-    type Prepared: Any + Send + Sync;
+    type Prepared: Send + Sync + 'static;
+    /// What its prepare reads of other techniques' prepared data this
+    /// frame (`()`: nothing), e.g. `&'a ShadowFrame`.
+    type Needs<'a>;
     /// Short name; the profile stage is `prepare.<name>`.
     fn name(&self) -> &'static str;
     /// The CPU work of a frame, before recording: plans, uploads, statistics.
-    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<Self::Prepared>;
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, needs: Self::Needs<'_>) -> Result<Self::Prepared>;
     /// Takes back the previous frame's prepared data before
     /// [`Technique::prepare`], to reuse its memory (the frame path
     /// allocates nothing in steady state); by default it is dropped.
     fn recycle(&mut self, previous: Self::Prepared) {
         drop(previous);
+    }
+}
+
+/// Declaring a technique's passes of one view into the frame graph: what
+/// they read that other techniques declared comes in (`Inputs`: the view's
+/// targets, a shadow atlas), what they write that others read goes out
+/// (`Outputs`). `S` is the frame's slot struct; an impl bounds it by the
+/// prepared data its passes read (`S: Provides<TerrainFrame>`), so a graph
+/// whose frame lacks it does not compile.
+pub trait Declare<S> {
+    type Inputs<'a>;
+    type Outputs;
+    /// Declares the passes of view `index` (`view`).
+    fn declare(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: (ViewIndex, &View),
+        inputs: Self::Inputs<'_>,
+    ) -> Result<Self::Outputs>;
+}
+
+/// Declares `technique`'s passes of every view, view `k` with the `k`-th
+/// of `inputs`; returns each view's outputs.
+pub fn declare_views<'a, S, T: Declare<S>>(
+    technique: &mut T,
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame<S>>,
+    views: &[View],
+    inputs: impl IntoIterator<Item = T::Inputs<'a>>,
+) -> Result<Vec<T::Outputs>> {
+    let mut inputs = inputs.into_iter();
+    let mut outputs = Vec::with_capacity(views.len());
+    for (k, view) in views.iter().enumerate() {
+        let input = inputs
+            .next()
+            .ok_or_else(|| Error::Graph(format!("view {k} has no inputs to declare with")))?;
+        outputs.push(technique.declare(ctx, graph, (k, view), input)?);
+    }
+    Ok(outputs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    frame_slots! {
+        struct Slots {
+            numbers: Vec<u32>,
+            name: String,
+        }
+    }
+
+    #[test]
+    fn slots_hold_what_was_inserted_and_nothing_else() {
+        let mut frame = Frame::<Slots>::new(0, Vec::new(), FrameLighting::default());
+        let missing = frame.prepared::<String>().expect_err("nothing prepared");
+        assert!(missing.to_string().contains("String was not prepared"), "{missing}");
+        frame.insert(vec![1u32, 2]);
+        assert_eq!(frame.prepared::<Vec<u32>>().expect("numbers"), &[1, 2]);
+        assert!(frame.prepared::<String>().is_err());
+    }
+
+    #[test]
+    fn per_view_data_is_found_in_or_out_of_order() {
+        let in_order = [(0, 'a'), (1, 'b')];
+        assert_eq!(per_view(&in_order, 1, |e| e.0), Some(&(1, 'b')));
+        let shuffled = [(1, 'b'), (0, 'a')];
+        assert_eq!(per_view(&shuffled, 0, |e| e.0), Some(&(0, 'a')));
+        assert_eq!(per_view(&shuffled, 2, |e| e.0), None);
     }
 }

@@ -3,6 +3,13 @@
 //! a simulator changes the time of day between frames. The lighting
 //! technique (`crate::lighting`) turns it into the per-view GPU constants
 //! every shading pass reads (`glsl/include/lighting.glsl`).
+//!
+//! A [`Lighting`] is two things: what the renderer is built with
+//! ([`LightingSetup`]: the sky-light bake, the atmosphere's lookup tables,
+//! whether the Monte Carlo reference exists; changing it needs a new
+//! renderer) and what each frame lights with ([`FrameLighting`]: the
+//! lighting validated once, when it is set, with its derived values — the
+//! sun's direction — computed once, for every technique's prepare).
 
 use glam::Vec3;
 
@@ -211,6 +218,81 @@ impl Lighting {
             return Err(Error::invalid("lighting.snow_line", "NaN"));
         }
         Ok(())
+    }
+}
+
+/// What of a [`Lighting`] the renderer is built with: the sky-light bake's
+/// parameters, the physical atmosphere's lookup tables and whether the
+/// Monte Carlo reference is built. Later lightings keep these.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightingSetup {
+    /// The aerosols of the atmosphere's lookup tables.
+    pub turbidity: f32,
+    /// SH bands of the sky-light transfer: 3 or 5.
+    pub sh_bands: u32,
+    /// Interreflection bounces of the bake and the reference (0–2).
+    pub bounces: u32,
+    /// Albedo of those bounces.
+    pub bounce_albedo: f32,
+    /// Build the Monte Carlo reference ([`SkyLightMode::Reference`]).
+    pub reference: bool,
+}
+
+/// The lighting of a frame: a validated [`Lighting`] (read its fields
+/// through `Deref`) and the values derived from it, computed once when it
+/// is made rather than in each technique's prepare.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameLighting {
+    lighting: Lighting,
+    /// Unit vector towards the sun.
+    pub sun: Vec3,
+}
+
+impl FrameLighting {
+    /// Validates `lighting` (the error names the parameter out of range)
+    /// and derives the sun's direction.
+    pub fn new(lighting: Lighting) -> Result<FrameLighting> {
+        lighting.validate()?;
+        Ok(FrameLighting {
+            sun: lighting.sun_direction(),
+            lighting,
+        })
+    }
+
+    /// The lighting as requested.
+    pub fn lighting(&self) -> &Lighting {
+        &self.lighting
+    }
+}
+
+impl Default for FrameLighting {
+    fn default() -> Self {
+        let lighting = Lighting::default();
+        FrameLighting {
+            sun: lighting.sun_direction(),
+            lighting,
+        }
+    }
+}
+
+impl std::ops::Deref for FrameLighting {
+    type Target = Lighting;
+
+    fn deref(&self) -> &Lighting {
+        &self.lighting
+    }
+}
+
+impl Lighting {
+    /// What of this lighting the renderer is built with.
+    pub fn setup(&self) -> LightingSetup {
+        LightingSetup {
+            turbidity: self.turbidity,
+            sh_bands: self.sh_bands,
+            bounces: self.bounces,
+            bounce_albedo: self.albedo_override.unwrap_or(0.3),
+            reference: self.sky_light == SkyLightMode::Reference,
+        }
     }
 }
 

@@ -9,7 +9,8 @@
 //! * [`Frame`]: the frame's views, its lighting, and every technique's
 //!   prepared data ([`Frame::prepared`]), which the passes' recording closures
 //!   read.
-//! * [`Technique`]: the prepare step every technique implements.
+//! * [`Technique`]: the prepare step every technique implements, with what
+//!   it needs of the others' prepared data.
 
 pub mod aov;
 pub mod camera;
@@ -21,11 +22,10 @@ pub mod rig;
 mod targets;
 
 pub use camera::{frustum_planes, Camera};
-pub use frame::{Frame, FrameContext, Technique};
+pub(crate) use frame::frame_slots;
+pub use frame::{declare_views, per_view, Declare, Frame, FrameContext, Provides, Technique};
 pub use lens::Intrinsics;
-pub use lighting::{Exposure, Lighting, ShadowMode, SkyLightMode, SkyModel, SunPosition};
-#[cfg(test)]
-pub use targets::LIGHTING_CONSTANTS_BYTES;
+pub use lighting::{Exposure, FrameLighting, Lighting, LightingSetup, ShadowMode, SkyLightMode, SkyModel, SunPosition};
 pub use targets::{SceneTargets, TargetFormats};
 
 use glam::{DMat4, Mat4, Vec3};

@@ -8,9 +8,6 @@ use crate::graph::{
 };
 use crate::vulkan::Format;
 
-/// Bytes of one view's lighting constants (`crate::lighting::constants::LightingFrame`).
-pub const LIGHTING_CONSTANTS_BYTES: u64 = 592;
-
 /// Formats of the scene targets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TargetFormats {
@@ -118,22 +115,35 @@ pub struct SceneTargets {
 }
 
 impl SceneTargets {
-    /// Declares the targets of `view` (and W when `weight`).
-    pub fn declare<P: 'static>(graph: &mut RenderGraph<P>, view: &View, weight: bool) -> SceneTargets {
-        SceneTargets::declare_named(graph, &view.name, (view.width, view.height), weight)
+    /// Declares the targets of `view` (and W when `weight`), lit by the
+    /// lighting constants in `lighting` (the lighting technique declares
+    /// that region, sized by its own type).
+    pub fn declare<P: 'static>(
+        graph: &mut RenderGraph<P>,
+        view: &View,
+        weight: bool,
+        lighting: UploadRegion,
+    ) -> SceneTargets {
+        let lighting = LightingInputs {
+            constants: lighting,
+            images: Vec::new(),
+            buffers: Vec::new(),
+        };
+        SceneTargets::declare_named(graph, &view.name, (view.width, view.height), weight, lighting)
     }
 
     /// Declares `width`×`height` targets whose images are named after
-    /// `view_name` (the targets a view's post-processing resamples into).
+    /// `view_name` (the targets a view's post-processing resamples into),
+    /// lit by `lighting`.
     pub fn declare_named<P: 'static>(
         graph: &mut RenderGraph<P>,
         view_name: &str,
         (w, h): (u32, u32),
         weight: bool,
+        lighting: LightingInputs,
     ) -> SceneTargets {
         let formats = TargetFormats::default();
         let name = |what: &str| super::pass_name(what, view_name);
-        let constants = graph.upload_region(&name("lighting"), LIGHTING_CONSTANTS_BYTES);
         let mut image = |what: &str, format| graph.create_image(&name(what), ImageInfo::new(w, h, format));
         SceneTargets {
             width: w,
@@ -149,11 +159,7 @@ impl SceneTargets {
             ids: image("class and instance", formats.ids),
             motion: image("motion", formats.motion),
             distance: image("distance", formats.distance),
-            lighting: LightingInputs {
-                constants,
-                images: Vec::new(),
-                buffers: Vec::new(),
-            },
+            lighting,
         }
     }
 }

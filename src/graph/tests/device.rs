@@ -109,5 +109,5 @@ fn heap_handles_are_reused_only_after_the_gpu_is_done() {
 #[test]
 fn baked_graph_is_send() {
     fn assert_send<T: Send>() {}
-    assert_send::<crate::graph::BakedGraph<crate::view::Frame>>();
+    assert_send::<crate::graph::BakedGraph<crate::renderer::RenderFrame>>();
 }

@@ -33,7 +33,7 @@ pub use cascades::{plan_cascades, plan_cascades_into, CascadePlan, SceneBounds, 
 
 use crate::error::{Error, Result};
 use crate::graph::{ImageAccess, ImageId, RenderGraph};
-use crate::view::{pass_name, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
+use crate::view::{pass_name, per_view, Declare, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
 use crate::vulkan::{CommandRecorder, Context, Format, Image, ImageDesc, ImageUsageFlags};
 
 /// The depth format of shadow atlases.
@@ -77,11 +77,10 @@ pub struct ShadowFrame {
 }
 
 impl ShadowFrame {
-    /// The cascades of view `index`.
+    /// The cascades of view `index` (at `views[index]` when the views were
+    /// declared in order, as the renderer does).
     pub fn view(&self, index: ViewIndex) -> Result<&CascadePlan> {
-        self.views
-            .iter()
-            .find(|(v, _)| *v == index)
+        per_view(&self.views, index, |(v, _)| *v)
             .map(|(_, p)| p)
             .ok_or_else(|| Error::Graph(format!("shadows: view {index} was not prepared")))
     }
@@ -127,10 +126,10 @@ impl ShadowMaps {
 
     /// Creates view `index`'s atlas, imports it and declares `shadow.clear`
     /// (clears it to depth 1 each frame). Declare before the caster passes.
-    pub fn declare_view(
+    pub fn declare_view<S: 'static>(
         &mut self,
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         (index, view): (ViewIndex, &View),
     ) -> Result<ShadowTarget> {
         if self.views.iter().any(|v| v.target.view == index) {
@@ -225,16 +224,34 @@ impl ShadowMaps {
     }
 }
 
+/// `shadow.clear` of a view: nothing in, the view's atlas out (the casters
+/// draw into it, the shading passes sample it).
+impl<S: 'static> Declare<S> for ShadowMaps {
+    type Inputs<'a> = ();
+    type Outputs = ShadowTarget;
+
+    fn declare(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: (ViewIndex, &View),
+        (): (),
+    ) -> Result<ShadowTarget> {
+        self.declare_view(ctx, graph, view)
+    }
+}
+
 impl Technique for ShadowMaps {
     type Prepared = ShadowFrame;
+    type Needs<'a> = ();
 
     fn name(&self) -> &'static str {
         "shadows"
     }
 
     /// Plans every declared view's cascades for the frame's sun.
-    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<ShadowFrame> {
-        let sun = frame.lighting.sun_direction();
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, (): ()) -> Result<ShadowFrame> {
+        let sun = frame.lighting.sun;
         let mut views = std::mem::take(&mut self.spare);
         views.truncate(self.views.len());
         for (k, v) in self.views.iter().enumerate() {

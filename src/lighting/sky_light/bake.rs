@@ -20,7 +20,7 @@ use crate::error::{Error, Result};
 use crate::graph::{BufferAccess, RenderGraph, Stage};
 use crate::io::heightmap::HeightField;
 use crate::shaders;
-use crate::view::Lighting;
+use crate::view::{Lighting, LightingSetup};
 use crate::vulkan::{
     Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, Format, FrameRing, Image, ImageDesc,
     ImageUsageFlags, MemoryLocation,
@@ -57,10 +57,15 @@ impl BakeSettings {
     /// The bake a frame's lighting needs: its bands and bounces, the albedo
     /// override (or 0.3) as bounce albedo, 32 azimuths.
     pub fn from_lighting(lighting: &Lighting) -> BakeSettings {
+        BakeSettings::from_setup(&lighting.setup())
+    }
+
+    /// The bake of the lighting the renderer is built with.
+    pub fn from_setup(setup: &LightingSetup) -> BakeSettings {
         BakeSettings {
-            sh_bands: lighting.sh_bands,
-            bounces: lighting.bounces,
-            bounce_albedo: lighting.albedo_override.unwrap_or(0.3),
+            sh_bands: setup.sh_bands,
+            bounces: setup.bounces,
+            bounce_albedo: setup.bounce_albedo,
             ..BakeSettings::default()
         }
     }

@@ -148,9 +148,9 @@ impl SkyLight {
     /// constants in `lighting` and the sampled images in `sky_inputs`, e.g.
     /// the atmosphere's lookup tables) and `lighting.sky_light`; imports
     /// the persistent resources. Once per graph.
-    pub fn declare(
+    pub fn declare<S: 'static>(
         &self,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         lighting: UploadRegion,
         sky_inputs: &[ImageId],
     ) -> SkyLightIds {
@@ -191,7 +191,7 @@ impl SkyLight {
             .read(transfer, BufferAccess::StorageRead(Stage::Compute))
             .read(environment, BufferAccess::StorageRead(Stage::Compute))
             .write(map, ImageAccess::StorageWrite(Stage::Compute))
-            .record(move |pass, frame: &Frame| {
+            .record(move |pass, frame: &Frame<S>| {
                 let lighting = &frame.lighting;
                 if lighting.sky_light == SkyLightMode::Reference {
                     return Ok(());

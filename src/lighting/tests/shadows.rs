@@ -10,6 +10,7 @@ use std::sync::Arc;
 use crate::graph::{BufferAccess, ImageAccess, RenderGraph, Stage};
 use crate::lighting::constants::{LightingFrame, SHADOWS_CASCADED, SUN_ANGULAR_RADIUS};
 use crate::lighting::shadows::{record_cascades, SceneBounds, ShadowFrame, ShadowMaps, ShadowSettings};
+use crate::points::render::shadow::PointShadowFrame;
 use crate::points::render::shadow::PointShadows;
 use crate::points::render::{PointRenderer, SplatSettings};
 use crate::points::scene::{PointScene, PointTransform};
@@ -17,7 +18,15 @@ use crate::shaders;
 use crate::terrain::shadow::shadow_pipeline;
 use crate::test_support::{assert_validation_clean, validated_context};
 use crate::view::lighting::sun_direction;
-use crate::view::{Camera, Frame, Lighting, SunPosition, View};
+use crate::view::{frame_slots, Camera, Frame, FrameLighting, Lighting, SunPosition, View};
+
+frame_slots! {
+    /// What the shadow test's techniques prepare.
+    struct Slots {
+        shadows: ShadowFrame,
+        point_shadows: PointShadowFrame,
+    }
+}
 use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, FrameRing, MemoryLocation};
 use bytemuck::Zeroable;
 use glam::DVec3;
@@ -171,7 +180,7 @@ fn run(
     }
     let view = View::new(camera(), 320, 200);
     let mut shadows = ShadowMaps::new(settings, bounds).expect("shadow maps");
-    let mut graph = RenderGraph::<Frame>::new();
+    let mut graph = RenderGraph::<Frame<Slots>>::new();
     let target = shadows.declare_view(ctx, &mut graph, (0, &view)).expect("atlas");
     let mut point_shadows = renderer.as_ref().map(|r| PointShadows::new(r, &shadows));
     if let Some(p) = point_shadows.as_mut() {
@@ -266,13 +275,16 @@ fn run(
             },
             ..Lighting::default()
         };
-        let mut frame = Frame::new(index as u64, vec![view.clone()], lighting_request);
+        let lighting_request = FrameLighting::new(lighting_request).expect("lighting");
+        let mut frame = Frame::<Slots>::new(index as u64, vec![view.clone()], lighting_request);
         let mut uploads = baked.uploads(index as u64);
         frame
-            .prepare(&mut shadows, &mut uploads, &mut Vec::new())
+            .prepare_into(&mut shadows, (), &mut uploads, &mut Vec::new())
             .expect("prepare");
         if let Some(p) = point_shadows.as_mut() {
-            frame.prepare(p, &mut uploads, &mut Vec::new()).expect("prepare points");
+            frame
+                .prepare_into(p, (), &mut uploads, &mut Vec::new())
+                .expect("prepare points");
         }
         let plan = frame.prepared::<ShadowFrame>().unwrap().view(0).unwrap().clone();
         let mut constants = LightingFrame::zeroed();

@@ -23,7 +23,7 @@ use crate::lighting::constants::{LightingFrame, LIGHTING_SUN_IN_ENVIRONMENT, SKY
 use crate::lighting::sh;
 use crate::lighting::sky_light::{BakeSettings, SkyLight, SkyLightBake, ENVIRONMENT_VEC4S};
 use crate::test_support::{assert_validation_clean, validated_context};
-use crate::view::{Frame, Lighting, SkyLightMode};
+use crate::view::{Frame, FrameLighting, Lighting, SkyLightMode};
 use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Context, FrameRing, MemoryLocation};
 use bytemuck::Zeroable;
 use glam::{DVec2, DVec3};
@@ -83,7 +83,7 @@ fn run_frames(ctx: &Context, sky: &SkyLight, frames_in: &[(LightingFrame, Lighti
     let texels = sky.bake().texels();
     let mut out = Vec::new();
     for (constants, lighting) in frames_in {
-        let mut graph: RenderGraph<Frame> = RenderGraph::new();
+        let mut graph: RenderGraph<Frame<()>> = RenderGraph::new();
         let region = graph.upload_region("lighting", std::mem::size_of::<LightingFrame>() as u64);
         let ids = sky.declare(&mut graph, region, &[]);
         let env = host_buffer(ctx, "environment readback", u64::from(ENVIRONMENT_VEC4S) * 16);
@@ -109,7 +109,11 @@ fn run_frames(ctx: &Context, sky: &SkyLight, frames_in: &[(LightingFrame, Lighti
         sky.fill(&mut constants);
         baked.uploads(next).write_pod(region, &constants).unwrap();
         baked
-            .execute(&mut frames, &Frame::new(next, Vec::new(), *lighting), &[])
+            .execute(
+                &mut frames,
+                &Frame::new(next, Vec::new(), FrameLighting::new(*lighting).unwrap()),
+                &[],
+            )
             .unwrap();
         baked.finish(&mut frames).unwrap();
         let vec4s = |b: &Buffer| bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(b.mapped().unwrap());

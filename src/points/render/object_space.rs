@@ -158,7 +158,7 @@ impl ObjectSpaceResources {
 
     /// Imports the resources into `graph`; `splats` is the splat list's id
     /// (the per-instance vertex buffer of `object-instanced`).
-    pub(super) fn import(&self, graph: &mut RenderGraph<Frame>, splats: BufferId) -> ObjectSpaceBuffers {
+    pub(super) fn import<S: 'static>(&self, graph: &mut RenderGraph<Frame<S>>, splats: BufferId) -> ObjectSpaceBuffers {
         ObjectSpaceBuffers {
             kernel: graph.import_image(self.kernel.clone()),
             vertices: self
@@ -180,7 +180,7 @@ pub(super) struct ObjectSpaceBuffers {
 
 impl ObjectSpaceBuffers {
     /// Declares what a splat pass reads: vertices, indices and the kernel texture.
-    pub(super) fn read_by<'g>(&self, builder: PassBuilder<'g, Frame>) -> PassBuilder<'g, Frame> {
+    pub(super) fn read_by<'g, S: 'static>(&self, builder: PassBuilder<'g, Frame<S>>) -> PassBuilder<'g, Frame<S>> {
         builder
             .read(self.vertices, BufferAccess::Vertex)
             .read(self.indices, BufferAccess::Index)

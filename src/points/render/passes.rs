@@ -15,7 +15,7 @@ use super::{PointsFrame, SplatPrimitive};
 use crate::error::{Error, Result};
 use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, PassBuilder, RenderGraph, Stage, UploadRegion};
 use crate::shaders;
-use crate::view::{Frame, SceneTargets, ViewIndex};
+use crate::view::{Frame, Provides, SceneTargets, ViewIndex};
 use crate::vulkan::{
     Blend, Buffer, CommandRecorder, CompareOp, Context, GraphicsPipeline, GraphicsPipelineDesc, Image, LoadOp, SpirV,
 };
@@ -111,11 +111,11 @@ pub(super) struct PointView {
 impl PointView {
     /// Declares the writes of a pass that draws the view's shaded outputs
     /// (radiance, view depth, W with `weight`, visibility, normal, ids).
-    pub(super) fn write_outputs<'g>(
+    pub(super) fn write_outputs<'g, S: Provides<PointsFrame> + 'static>(
         &self,
-        builder: PassBuilder<'g, Frame>,
+        builder: PassBuilder<'g, Frame<S>>,
         weight: ImageAccess,
-    ) -> PassBuilder<'g, Frame> {
+    ) -> PassBuilder<'g, Frame<S>> {
         builder
             .write(self.radiance, ImageAccess::ColorAttachmentReadWrite)
             .write(self.view_depth, ImageAccess::ColorAttachmentReadWrite)
@@ -164,7 +164,12 @@ impl PointView {
 
 impl PointBuffers {
     /// Declares the reads every splat pass makes (and the counter's write when `count`).
-    fn read_by<'g>(&self, builder: PassBuilder<'g, Frame>, frame: UploadRegion, count: bool) -> PassBuilder<'g, Frame> {
+    fn read_by<'g, S: Provides<PointsFrame> + 'static>(
+        &self,
+        builder: PassBuilder<'g, Frame<S>>,
+        frame: UploadRegion,
+        count: bool,
+    ) -> PassBuilder<'g, Frame<S>> {
         let mut builder = builder
             .read(self.splats, BufferAccess::StorageRead(Stage::Vertex))
             .read(frame, BufferAccess::StorageRead(Stage::Graphics))
@@ -221,7 +226,7 @@ impl PointBuffers {
 }
 
 /// The plan of view `index` in `frame`.
-pub(super) fn plan_of(frame: &Frame, index: ViewIndex) -> Result<&FramePlan> {
+pub(super) fn plan_of<S: Provides<PointsFrame> + 'static>(frame: &Frame<S>, index: ViewIndex) -> Result<&FramePlan> {
     Ok(&frame.prepared::<PointsFrame>()?.view(index)?.plan)
 }
 
@@ -335,9 +340,9 @@ impl PassPipelines {
 /// `points.opaque` (the `--splat opaque` baseline): shaded opaque discs
 /// with ray–plane depth, and the hybrid triangles; without `draw_splats`
 /// only the triangles (`points.single_pass.triangles`).
-pub(super) fn declare_opaque(
+pub(super) fn declare_opaque<S: Provides<PointsFrame> + 'static>(
     ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
+    graph: &mut RenderGraph<Frame<S>>,
     name: &str,
     (buffers, view): (PointBuffers, PointView),
     targets: &SceneTargets,
@@ -403,9 +408,9 @@ pub(super) struct Accumulation {
 
 /// `points.visibility`, `points.accumulate` and `points.normalize`: the
 /// three passes of perspective-accurate EWA splatting (§10.2, Table 10.1).
-pub(super) fn declare_ewa(
+pub(super) fn declare_ewa<S: Provides<PointsFrame> + 'static>(
     ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
+    graph: &mut RenderGraph<Frame<S>>,
     names: [&str; 3],
     (buffers, view): (PointBuffers, PointView),
     targets: &SceneTargets,
@@ -425,9 +430,9 @@ pub(super) fn declare_ewa(
 /// `points.visibility`: ray–plane depth pushed back by ε (§10.2.3), hybrid
 /// triangles first; the ids of the surfel that wins the depth test (a
 /// single surfel per pixel: ids are never blended) into `ids`.
-fn declare_visibility(
+fn declare_visibility<S: Provides<PointsFrame> + 'static>(
     ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
+    graph: &mut RenderGraph<Frame<S>>,
     name: &str,
     (buffers, view): (PointBuffers, PointView),
     targets: &SceneTargets,
@@ -480,9 +485,9 @@ fn declare_visibility(
 /// `points.accumulate`: depth test ≤ without writes, additive (w·colour,
 /// w) and (w·normal, w·depth) into the float targets (§10.2); the ids of
 /// the last accumulated surfel (never blended).
-fn declare_accumulate(
+fn declare_accumulate<S: Provides<PointsFrame> + 'static>(
     ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
+    graph: &mut RenderGraph<Frame<S>>,
     name: &str,
     (buffers, view): (PointBuffers, PointView),
     targets: &SceneTargets,
@@ -545,9 +550,9 @@ fn declare_accumulate(
 /// `points.normalize`: full screen, divide by w, shade (sun, sky, haze),
 /// write radiance, view depth, W, the world normal and the ids (the
 /// nearest surfel's, else the last accumulated one's).
-fn declare_normalize(
+fn declare_normalize<S: Provides<PointsFrame> + 'static>(
     ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
+    graph: &mut RenderGraph<Frame<S>>,
     name: &str,
     view: PointView,
     targets: &SceneTargets,

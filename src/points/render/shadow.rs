@@ -32,7 +32,9 @@ use crate::lighting::shadows::{
 };
 use crate::points::scene::PointScene;
 use crate::shaders;
-use crate::view::{pass_name, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
+use crate::view::{
+    pass_name, per_view, Declare, Frame, FrameContext, Provides, ShadowMode, Technique, View, ViewIndex,
+};
 use crate::vulkan::{Blend, Buffer, CompareOp, Context, GraphicsPipeline, GraphicsPipelineDesc, PrimitiveTopology};
 
 /// Header of a view's shadow records (`ShadowPoints` in shadow_points.vert).
@@ -71,9 +73,7 @@ pub struct PointShadowFrame {
 
 impl PointShadowFrame {
     fn view(&self, index: ViewIndex) -> Result<&[ShadowDraw]> {
-        self.views
-            .iter()
-            .find(|(v, _)| *v == index)
+        per_view(&self.views, index, |(v, _)| *v)
             .map(|(_, d)| d.as_slice())
             .ok_or_else(|| Error::Graph(format!("points.shadow: view {index} was not prepared")))
     }
@@ -152,10 +152,10 @@ impl PointShadows {
 
     /// Declares `points.shadow` of view `index` into `target` (after
     /// `shadow.clear`; the cascades come from the frame's [`ShadowFrame`]).
-    pub fn declare(
+    pub fn declare<S: Provides<ShadowFrame> + Provides<PointShadowFrame> + 'static>(
         &mut self,
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         (index, view): (ViewIndex, &View),
         target: ShadowTarget,
     ) -> Result<()> {
@@ -268,8 +268,25 @@ impl PointShadows {
     }
 }
 
+/// `points.shadow` of a view: its shadow atlas in, nothing out.
+impl<S: Provides<ShadowFrame> + Provides<PointShadowFrame> + 'static> Declare<S> for PointShadows {
+    type Inputs<'a> = ShadowTarget;
+    type Outputs = ();
+
+    fn declare(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: (ViewIndex, &View),
+        target: ShadowTarget,
+    ) -> Result<()> {
+        PointShadows::declare(self, ctx, graph, view, target)
+    }
+}
+
 impl Technique for PointShadows {
     type Prepared = PointShadowFrame;
+    type Needs<'a> = ();
 
     fn name(&self) -> &'static str {
         "points.shadow"
@@ -277,7 +294,7 @@ impl Technique for PointShadows {
 
     /// Per view: the cascades (as [`ShadowMaps`] plans them), the instances
     /// that can cast into them and their prefixes, uploaded as records.
-    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<PointShadowFrame> {
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, (): ()) -> Result<PointShadowFrame> {
         let mut views = std::mem::take(&mut self.spare);
         views.truncate(self.views.len());
         let mut records = std::mem::take(&mut self.records);
@@ -286,7 +303,7 @@ impl Technique for PointShadows {
                 .views
                 .get(v.index)
                 .ok_or_else(|| Error::Graph(format!("points.shadow: the frame has no view {}", v.index)))?;
-            let sun = frame.lighting.sun_direction();
+            let sun = frame.lighting.sun;
             if views.len() <= k {
                 views.push((v.index, Vec::new()));
             }

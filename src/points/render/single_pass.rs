@@ -38,11 +38,11 @@ use bytemuck::{Pod, Zeroable};
 use super::passes::{
     declare_opaque, plan_of, PointBuffers, PointView, SplatPush, NO_HANDLE, PASS_OPAQUE, PRIMITIVE_QUAD,
 };
-use super::{SplatBackend, SplatPrimitive};
+use super::{PointsFrame, SplatBackend, SplatPrimitive};
 use crate::error::{Error, Result};
 use crate::graph::{BufferAccess, BufferId, BufferInfo, ImageAccess, PassBuilder, RenderGraph, Stage};
 use crate::shaders;
-use crate::view::{Frame, SceneTargets};
+use crate::view::{Frame, Provides, SceneTargets};
 use crate::vulkan::{
     ComputePipeline, Context, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, MemoryLocation, PrimitiveTopology,
 };
@@ -171,9 +171,9 @@ impl Pipelines {
 
 /// The passes of single-pass splatting of one view (see the module's
 /// list); `name` gives a pass's name for the view.
-pub(super) fn declare_single_pass(
+pub(super) fn declare_single_pass<S: Provides<PointsFrame> + 'static>(
     ctx: &Context,
-    graph: &mut RenderGraph<Frame>,
+    graph: &mut RenderGraph<Frame<S>>,
     name: &dyn Fn(&str) -> String,
     (buffers, view): (PointBuffers, PointView),
     targets: &SceneTargets,
@@ -181,7 +181,7 @@ pub(super) fn declare_single_pass(
 ) -> Result<()> {
     let pipelines = Pipelines::new(ctx, targets, backend)?;
     let pixels = targets.width * targets.height;
-    let buffer = |graph: &mut RenderGraph<Frame>, what, bytes: u64| {
+    let buffer = |graph: &mut RenderGraph<Frame<S>>, what, bytes: u64| {
         graph.create_buffer(
             what,
             BufferInfo {
@@ -229,7 +229,12 @@ pub(super) fn declare_single_pass(
 }
 
 /// `points.single_pass.clear`: every pixel unlocked, z_d = +inf, sums 0.
-fn declare_clear(graph: &mut RenderGraph<Frame>, name: &str, state: PixelState, pipeline: ComputePipeline) {
+fn declare_clear<S: Provides<PointsFrame> + 'static>(
+    graph: &mut RenderGraph<Frame<S>>,
+    name: &str,
+    state: PixelState,
+    pipeline: ComputePipeline,
+) {
     graph
         .pass(name)
         .write(state.words, BufferAccess::StorageWrite(Stage::Compute))
@@ -262,13 +267,13 @@ fn workgroups(n: u32) -> (u32, u32) {
 
 /// The reads and writes of the splat pass at `stage`: splats, frame,
 /// table, counter, the pixel state and the depth buffer when written.
-fn splat_pass_uses<'g>(
-    builder: PassBuilder<'g, Frame>,
+fn splat_pass_uses<'g, S: Provides<PointsFrame> + 'static>(
+    builder: PassBuilder<'g, Frame<S>>,
     (buffers, view): (PointBuffers, PointView),
     state: PixelState,
     depth_written: bool,
     (vertex, fragment): (Stage, Stage),
-) -> PassBuilder<'g, Frame> {
+) -> PassBuilder<'g, Frame<S>> {
     let mut builder = builder
         .read(buffers.splats, BufferAccess::StorageRead(vertex))
         .read(
@@ -311,8 +316,8 @@ fn splat_push(
 
 /// `points.single_pass`, compute backend: one dispatch per planned draw,
 /// one invocation per splat (`glsl/include/single_pass.glsl`).
-fn declare_compute(
-    graph: &mut RenderGraph<Frame>,
+fn declare_compute<S: Provides<PointsFrame> + 'static>(
+    graph: &mut RenderGraph<Frame<S>>,
     (name, buffers, view): (String, PointBuffers, PointView),
     state: PixelState,
     depth_written: bool,
@@ -339,8 +344,8 @@ fn declare_compute(
 /// fragments merge in a pixel-ordered critical section
 /// (`glsl/points/single_pass_interlock.frag`); W is its nominal target,
 /// never written (loaded when the triangles pass wrote it).
-fn declare_interlock(
-    graph: &mut RenderGraph<Frame>,
+fn declare_interlock<S: Provides<PointsFrame> + 'static>(
+    graph: &mut RenderGraph<Frame<S>>,
     (name, buffers, view): (String, PointBuffers, PointView),
     state: PixelState,
     (depth_written, weight_written): (bool, bool),
@@ -377,8 +382,8 @@ fn declare_interlock(
 
 /// `points.single_pass.resolve`: full screen, as `points.normalize`, from
 /// the pixel sums; W cleared first unless the triangles pass wrote it.
-fn declare_resolve(
-    graph: &mut RenderGraph<Frame>,
+fn declare_resolve<S: Provides<PointsFrame> + 'static>(
+    graph: &mut RenderGraph<Frame<S>>,
     name: &str,
     view: PointView,
     targets: &SceneTargets,

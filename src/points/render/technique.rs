@@ -18,7 +18,9 @@ use crate::error::{Error, Result};
 use crate::graph::RenderGraph;
 use crate::points::build::clusters::{cluster_normals, CLUSTER_COUNT};
 use crate::points::scene::PointScene;
-use crate::view::{pass_name, Frame, FrameContext, SceneTargets, Technique, View, ViewIndex};
+use crate::view::{
+    pass_name, per_view, Declare, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex,
+};
 use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Context, MemoryLocation};
 
 /// What the points passes read this frame: each view's plan.
@@ -35,9 +37,7 @@ pub struct PointViewFrame {
 impl PointsFrame {
     /// The prepared plan of view `index`.
     pub fn view(&self, index: ViewIndex) -> Result<&PointViewFrame> {
-        self.views
-            .iter()
-            .find(|v| v.view == index)
+        per_view(&self.views, index, |v| v.view)
             .ok_or_else(|| Error::Graph(format!("points: view {index} was not prepared")))
     }
 }
@@ -167,10 +167,10 @@ impl PointRenderer {
     /// `points.normalize` for EWA splats, `points.single_pass*` for
     /// single-pass splats (§10.4), or `points.opaque`.
     /// `clear_depth`: no terrain drew into the depth buffer.
-    pub fn declare(
+    pub fn declare<S: Provides<PointsFrame> + 'static>(
         &mut self,
         ctx: &Context,
-        graph: &mut RenderGraph<Frame>,
+        graph: &mut RenderGraph<Frame<S>>,
         (index, view): (ViewIndex, &View),
         targets: &SceneTargets,
         clear_depth: bool,
@@ -259,8 +259,26 @@ impl PointRenderer {
     }
 }
 
+/// The points passes of a view: its targets (W required) and whether
+/// they clear the depth buffer (no terrain drew into it) in, nothing out.
+impl<S: Provides<PointsFrame> + 'static> Declare<S> for PointRenderer {
+    type Inputs<'a> = (&'a SceneTargets, bool);
+    type Outputs = ();
+
+    fn declare(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: (ViewIndex, &View),
+        (targets, clear_depth): Self::Inputs<'_>,
+    ) -> Result<()> {
+        PointRenderer::declare(self, ctx, graph, view, targets, clear_depth)
+    }
+}
+
 impl Technique for PointRenderer {
     type Prepared = PointsFrame;
+    type Needs<'a> = ();
 
     fn name(&self) -> &'static str {
         "points"
@@ -269,7 +287,7 @@ impl Technique for PointRenderer {
     /// Per view: the prefix of every visible instance and its record
     /// (object→camera in f64), uploaded with the view's header; the frame's
     /// statistics (the GPU counts of the slot's previous frame are read now).
-    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<PointsFrame> {
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, (): ()) -> Result<PointsFrame> {
         let started = Instant::now();
         let mut views = std::mem::take(&mut self.spare);
         let mut stats = PointFrameStats {

@@ -16,19 +16,28 @@ use crate::graph::{BakedGraph, FrameOutcome, RenderGraph};
 use crate::renderer::Scene;
 use crate::surface::gpu_layout::TexturingMode;
 use crate::terrain::geometry_image::TerrainSettings;
-use crate::terrain::{Terrain, TerrainTexturing};
+use crate::terrain::{Terrain, TerrainFrame, TerrainTexturing};
 use crate::test_support::atlas::{check_texels_against_cpu, ground_camera};
 use crate::test_support::{assert_validation_clean, jacksboro_field, validated_context};
 use crate::texturing::atlas::{AtlasSettings, GpuTimeBudget};
-use crate::texturing::generation::{quadtree_view, TextureAtlas, TextureFrameStats, TextureStreaming};
+use crate::texturing::generation::{quadtree_view, TextureAtlas, TextureFrame, TextureFrameStats, TextureStreaming};
 use crate::texturing::quadtree::{select_tiles, HeightBounds};
-use crate::view::{Frame, Lighting, View};
+use crate::view::{frame_slots, Frame, FrameLighting, View};
 use crate::vulkan::{Context, FrameRing, FRAMES_IN_FLIGHT};
 use glam::DVec2;
 
+frame_slots! {
+    /// What the streaming test's techniques prepare (the terrain's passes
+    /// are declared but not run).
+    struct Slots {
+        terrain: TerrainFrame,
+        texturing: TextureFrame,
+    }
+}
+
 /// The atlas's passes in a graph of their own.
 struct Rig {
-    graph: BakedGraph<Frame>,
+    graph: BakedGraph<Frame<Slots>>,
     frames: FrameRing,
     atlas: TextureAtlas,
     _terrain: Terrain,
@@ -61,12 +70,12 @@ impl Rig {
     /// frames completed so far, as the renderer does.
     fn frame(&mut self, views: &[View]) -> FrameOutcome {
         let index = self.frames.wait_for_next().expect("next frame");
-        let mut frame = Frame::new(index, views.to_vec(), Lighting::default());
+        let mut frame = Frame::<Slots>::new(index, views.to_vec(), FrameLighting::default());
         let mut stages = Vec::new();
         let mut uploads = self.graph.uploads(index);
         self.atlas.observe_profiles(self.graph.profiles());
         frame
-            .prepare(&mut self.atlas, &mut uploads, &mut stages)
+            .prepare_into(&mut self.atlas, (), &mut uploads, &mut stages)
             .expect("prepare");
         self.graph.execute(&mut self.frames, &frame, &stages).expect("execute")
     }
