@@ -213,6 +213,29 @@ fn validate<P>(graph: &RenderGraph<P>) -> Result<()> {
     Ok(())
 }
 
+/// Every [`super::RenderGraph::edge`] holds among the live passes (which
+/// run in declaration order).
+fn check_edges<P>(graph: &RenderGraph<P>, live: &[bool]) -> Result<()> {
+    let names = || {
+        (graph.passes.iter().zip(live))
+            .filter(|(_, l)| **l)
+            .map(|(p, _)| p.name.as_str())
+    };
+    for edge in &graph.edges {
+        let last_before = names().enumerate().filter(|(_, n)| n.starts_with(&edge.before)).last();
+        let first_after = names().enumerate().find(|(_, n)| n.starts_with(&edge.after));
+        if let (Some((b, before)), Some((a, after))) = (last_before, first_after) {
+            if b > a {
+                return Err(Error::Graph(format!(
+                    "'{before}' is declared after '{after}', but the edge {}… → {}… orders it before: {}",
+                    edge.before, edge.after, edge.reason
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The format of an image resource.
 fn image_format(decl: &ResourceDecl) -> Option<crate::vulkan::Format> {
     match decl {
@@ -421,6 +444,7 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
     validate(&graph)?;
     let serial = graph.serial;
     let live = live_passes(&graph);
+    check_edges(&graph, &live)?;
     let mut image_usage = vec![ImageUsageFlags::empty(); graph.resources.len()];
     let mut buffer_usage = vec![BufferUsageFlags::empty(); graph.resources.len()];
     for (pass, _) in graph.passes.iter().zip(&live).filter(|(_, l)| **l) {
@@ -525,6 +549,30 @@ mod tests {
             err.contains("'bad'") && err.contains("read() of the writing access"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn an_edge_broken_by_the_declaration_order_is_named() {
+        let declare = |first: &str, second: &str| {
+            let mut g: RenderGraph<()> = RenderGraph::new();
+            for name in [first, second] {
+                let out = g.create_image(name, ImageInfo::new(4, 4, Format::R8G8B8A8_UNORM));
+                g.pass(name)
+                    .write(out, ImageAccess::StorageWrite(Stage::Compute))
+                    .record(|_, _| Ok(()));
+                g.keep(out);
+            }
+            g.edge("texturing.", "terrain.shadow", "the reason");
+            let live = live_passes(&g);
+            check_edges(&g, &live).map_err(|e| e.to_string())
+        };
+        assert_eq!(declare("texturing.generate", "terrain.shadow@left"), Ok(()));
+        let err = declare("terrain.shadow@left", "texturing.generate").unwrap_err();
+        assert!(
+            err.contains("'texturing.generate' is declared after 'terrain.shadow@left'") && err.contains("the reason"),
+            "{err}"
+        );
+        assert_eq!(declare("sky", "tonemap"), Ok(()), "an edge without its passes holds");
     }
 
     #[test]

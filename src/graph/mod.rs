@@ -191,6 +191,17 @@ pub struct RenderGraph<P> {
     pub(crate) upload_arena: Option<ResourceId>,
     /// This graph's number (its passes' bindings carry it).
     pub(crate) serial: u32,
+    /// Orderings beyond what the declared accesses imply ([`RenderGraph::edge`]).
+    pub(crate) edges: Vec<Edge>,
+}
+
+/// Every live pass named `before…` runs before every live pass named
+/// `after…`, for `reason` ([`RenderGraph::edge`]).
+#[derive(Clone, Debug)]
+pub(crate) struct Edge {
+    pub before: String,
+    pub after: String,
+    pub reason: &'static str,
 }
 
 impl<P> Default for RenderGraph<P> {
@@ -203,6 +214,7 @@ impl<P> Default for RenderGraph<P> {
             upload_regions: Vec::new(),
             upload_arena: None,
             serial: binding::next_graph_serial(),
+            edges: Vec::new(),
         }
     }
 }
@@ -275,6 +287,19 @@ impl<P: 'static> RenderGraph<P> {
             size: size.max(4),
             arena,
         }
+    }
+
+    /// An explicit ordering the declared accesses do not imply: every live
+    /// pass whose name starts with `before` runs before every live pass
+    /// whose name starts with `after`, for `reason` (e.g. a workaround of
+    /// a validation layer). Passes run in declaration order; bake checks
+    /// the edge and names it when a declaration breaks it.
+    pub fn edge(&mut self, before: &str, after: &str, reason: &'static str) {
+        self.edges.push(Edge {
+            before: before.into(),
+            after: after.into(),
+            reason,
+        });
     }
 
     /// Whether transient images whose uses within a frame do not overlap may

@@ -609,8 +609,7 @@ impl Wiring<'_> {
             true => Some(PointRenderer::new(ctx, &scene.points, settings.points)?),
             false => None,
         };
-        // Edge: the atlas's generation passes before the shadow casters
-        // (whose barrier on the geometry image must come after them).
+        // Edge (validation_layer_edges): the atlas's generation passes before the shadow casters.
         let atlas = match (&terrain, settings.texturing) {
             (Some(terrain), TexturingMode::Atlas) => Some(TextureAtlas::declare(
                 ctx,
@@ -622,8 +621,7 @@ impl Wiring<'_> {
         };
         let casters = (terrain.as_ref(), points.as_ref());
         let shadows = lighting::declare_shadows(ctx, graph, (views, &mut targets), casters, settings.shadows)?;
-        // Edge: every view's draws before any view's post-processing
-        // dispatches (the other views' geometry images).
+        // Edge (validation_layer_edges): every view's draws before any post-processing.
         if let Some(terrain) = &mut terrain {
             let atlas = atlas.as_ref().map(|a| a.bindings());
             declare_views(terrain, ctx, graph, views, targets.iter().map(|t| (t, atlas)))?;
@@ -634,6 +632,7 @@ impl Wiring<'_> {
         }
         let mut aovs = Aovs::new(ctx, &targets[0].formats)?;
         declare_views(&mut aovs, ctx, graph, views, &targets)?;
+        validation_layer_edges(graph);
         let techniques = Techniques {
             lighting: scene_lighting,
             shadows,
@@ -643,6 +642,28 @@ impl Wiring<'_> {
             aovs,
         };
         Ok((techniques, targets))
+    }
+}
+
+/// The orderings beyond the declared accesses, kept for validation layers
+/// before 1.3.268, which count a dispatch as writing every buffer of the
+/// bindless heap (the geometry images included): a pass's barrier on a
+/// geometry image must come after those dispatches, so the atlas's
+/// generation passes precede the shadow casters, and every view's draws
+/// precede any view's post-processing (the other views' geometry images).
+/// The graph checks them at bake.
+fn validation_layer_edges(graph: &mut RenderGraph<RenderFrame>) {
+    const ATLAS: &str = "validation layers before 1.3.268: the shadow casters' geometry-image barrier \
+                         must follow the atlas's dispatches";
+    const DRAWS: &str = "validation layers before 1.3.268: every view's draws (geometry images) \
+                         before any post-processing dispatch";
+    for caster in ["terrain.shadow", "points.shadow"] {
+        graph.edge("texturing.", caster, ATLAS);
+    }
+    for draw in ["terrain.draw", "points."] {
+        for post in ["aovs", "post.", "exposure", "tonemap"] {
+            graph.edge(draw, post, DRAWS);
+        }
     }
 }
 
