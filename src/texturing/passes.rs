@@ -32,7 +32,7 @@ pub(crate) struct TileGenerationPush {
     grid: [u32; 4],
     /// Sample spacing x, y (metres), lowest and highest height.
     spacing_range: [f32; 4],
-    /// Input maps ([`crate::texturing::input_maps::MapBindings::handles`]).
+    /// Input maps ([`crate::surface::input_maps::MapBindings::handles`]).
     maps: [u32; 4],
     /// Terrain rectangle x, y (metres).
     extent: [f32; 4],
