@@ -79,11 +79,6 @@ impl<'a> PassContext<'a> {
             .ok_or_else(|| Error::Graph(format!("buffer #{r} is not of this graph")))
     }
 
-    /// TEMPORARY (stub_toka).
-    pub(super) fn uploads_arena(&self) -> Result<&'a UploadArena> {
-        self.uploads.ok_or_else(|| Error::Graph("the graph has no upload arena".into()))
-    }
-
     /// Heap handle for sampling the image `id`.
     pub fn sampled(&self, id: ImageId) -> Result<u32> {
         let image = self.image(id)?;

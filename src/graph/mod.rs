@@ -31,8 +31,6 @@ mod bake;
 mod execute;
 mod typed;
 mod uploads;
-mod stub_toka;
-pub use stub_toka::{Binding, GraphicsBuilder};
 
 use std::sync::Arc;
 
