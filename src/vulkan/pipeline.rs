@@ -164,6 +164,9 @@ impl GraphicsPipelineDesc {
 pub struct GraphicsPipeline {
     ctx: Context,
     pub(crate) raw: vk::Pipeline,
+    name: &'static str,
+    color_formats: Vec<vk::Format>,
+    depth_format: Option<vk::Format>,
 }
 
 impl GraphicsPipeline {
@@ -295,7 +298,28 @@ impl GraphicsPipeline {
         destroy_module(ctx, fragment);
         let raw = result.map_err(|(_, e)| vk_err("vkCreateGraphicsPipelines")(e))?[0];
         ctx.name_object(raw, desc.name);
-        Ok(GraphicsPipeline { ctx: ctx.clone(), raw })
+        Ok(GraphicsPipeline {
+            ctx: ctx.clone(),
+            raw,
+            name: desc.name,
+            color_formats: desc.color_formats.clone(),
+            depth_format: desc.depth_format,
+        })
+    }
+
+    /// The pipeline's name (its debug name).
+    pub fn name(&self) -> &'static str {
+        self.name
+    }
+
+    /// The colour attachment formats the pipeline renders into, in order.
+    pub fn color_formats(&self) -> &[vk::Format] {
+        &self.color_formats
+    }
+
+    /// The depth attachment format, if the pipeline has one.
+    pub fn depth_format(&self) -> Option<vk::Format> {
+        self.depth_format
     }
 }
 
