@@ -34,12 +34,7 @@ pub struct MapBindings {
 }
 
 /// Uploads `map`'s samples as an R32F texture `name` and imports it.
-fn upload<P: 'static>(
-    ctx: &Context,
-    graph: &mut RenderGraph<P>,
-    name: String,
-    map: &HeightField,
-) -> Result<ImageId> {
+fn upload<P: 'static>(ctx: &Context, graph: &mut RenderGraph<P>, name: String, map: &HeightField) -> Result<ImageId> {
     let image = Image::with_data(
         ctx,
         ImageDesc {
@@ -95,7 +90,9 @@ impl InputMaps {
     pub fn sample_in<P: 'static>(&self, pass: &mut PassBuilder<'_, P>, stage: Stage) -> MapBindings {
         MapBindings {
             maps: self.maps.map(|map| map.map(|id| pass.sample(id, stage))),
-            blurred: self.blurred.map(|b| b.map(|(radius, id)| (radius, pass.sample(id, stage)))),
+            blurred: self
+                .blurred
+                .map(|b| b.map(|(radius, id)| (radius, pass.sample(id, stage)))),
         }
     }
 }

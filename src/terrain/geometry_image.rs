@@ -313,7 +313,12 @@ pub fn declare_warp_pass(ctx: &Context, graph: &mut RenderGraph<Frame>, name: &s
         // The view's warp upload is this frame's only when it was prepared.
         frame.prepared::<crate::terrain::TerrainFrame>()?.view(pass.view)?;
         let push = WarpPush {
-            handles: [ctx.handle(atlas)?, ctx.handle(upload)?, ctx.handle(vertices)?, ctx.handle(noise)?],
+            handles: [
+                ctx.handle(atlas)?,
+                ctx.handle(upload)?,
+                ctx.handle(vertices)?,
+                ctx.handle(noise)?,
+            ],
             ..pass.push
         };
         let groups = pass.push.grid[0].div_ceil(8);

@@ -15,10 +15,10 @@ use crate::graph::{
     Binding, BufferAccess, BufferId, ImageId, PassBuilder, PassContext, RenderGraph, Stage, UploadRegion,
 };
 use crate::shaders;
+use crate::surface::gpu_layout::{LayerTable, TexturingFrame};
 use crate::surface::input_maps::InputMaps;
 use crate::terrain::geometry_image::VERTEX_STRIDE;
 use crate::texturing::generation::AtlasBindings;
-use crate::surface::gpu_layout::{LayerTable, TexturingFrame};
 use crate::view::{Frame, SceneTargets, ViewIndex};
 use crate::vulkan::{
     Blend, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, PrimitiveTopology,
@@ -86,7 +86,11 @@ impl AtlasSamples {
         AtlasSamples {
             page_table: builder.upload(atlas.page_table, stage),
             colors: atlas.colors.iter().map(|&image| builder.sample(image, stage)).collect(),
-            normals: atlas.normals.iter().map(|&image| builder.sample(image, stage)).collect(),
+            normals: atlas
+                .normals
+                .iter()
+                .map(|&image| builder.sample(image, stage))
+                .collect(),
         }
     }
 

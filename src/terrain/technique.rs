@@ -296,7 +296,10 @@ impl Technique for Terrain {
                 noise_tile: 0,
                 texturing_frame: 0,
             };
-            views.push(TerrainViewFrame { view: state.index, draw });
+            views.push(TerrainViewFrame {
+                view: state.index,
+                draw,
+            });
         }
         Ok(TerrainFrame { views })
     }

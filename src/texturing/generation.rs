@@ -32,13 +32,13 @@ use crate::error::{Error, Result};
 use crate::graph::{BufferInfo, ImageId, RenderGraph, UploadRegion};
 use crate::io::heightmap::HeightField;
 use crate::profile::FrameProfile;
+use crate::surface::gpu_layout::LayerTable;
 use crate::surface::input_maps::InputMaps;
 use crate::surface::layers::LayerTree;
 #[cfg(doc)]
 use crate::texturing::atlas::GenerationBudget;
 use crate::texturing::atlas::{TileCache, TilePlan};
 use crate::texturing::fit::{select_to_fit, Coarsening};
-use crate::surface::gpu_layout::LayerTable;
 use crate::texturing::pacing::GenerationPacer;
 #[cfg(test)]
 use crate::texturing::pacing::GpuTimeBudget;

@@ -10,7 +10,9 @@ use std::sync::Arc;
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::{Error, Result};
-use crate::graph::{Binding, BufferAccess, BufferId, ImageAccess, ImageId, PassContext, RenderGraph, Stage, UploadRegion};
+use crate::graph::{
+    Binding, BufferAccess, BufferId, ImageAccess, ImageId, PassContext, RenderGraph, Stage, UploadRegion,
+};
 use crate::io::heightmap::HeightField;
 use crate::shaders;
 use crate::texturing::generation::{GenerationInputs, TextureFrame, TileJob, GROUP};
@@ -109,7 +111,12 @@ impl GenerationPasses {
                 let tiles = frame.prepared::<TextureFrame>()?;
                 layers.write(ctx, table, &maps)?;
                 let push = TileGenerationPush {
-                    handles: [ctx.handle(jobs)?, ctx.handle(scratch)?, ctx.handle(table)?, ctx.handle(noise)?],
+                    handles: [
+                        ctx.handle(jobs)?,
+                        ctx.handle(scratch)?,
+                        ctx.handle(table)?,
+                        ctx.handle(noise)?,
+                    ],
                     counts: [
                         tiles.jobs,
                         tiles.texels as u32,
