@@ -1,9 +1,14 @@
 //! What the texturing shaders read (`glsl/include/surface_layers.glsl`): the
 //! layer tree as a flat depth-first array, and the per-frame constants.
 
+use std::sync::Arc;
+
 use bytemuck::{Pod, Zeroable};
 
-use super::layers::{Constraint, LayerTree};
+use super::input_maps::MapBindings;
+use super::layers::{Constraint, LayerTree, MAX_BLUR_RADII};
+use crate::error::Result;
+use crate::graph::{Binding, PassBuilder, PassContext, RenderGraph, Stage, UploadRegion};
 
 /// How the terrain is coloured.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -83,7 +88,7 @@ pub fn pack_constraint(c: Option<&Constraint>, layer_count: usize, samples: &mut
 
 /// The tree in evaluation order, with the samples of its sampled functions;
 /// `blurred`: the sampled handle of the blurred height field of each
-/// `height_blur` radius ([`crate::surface::input_maps::InputMaps::blurred_handles`]).
+/// `height_blur` radius ([`crate::surface::input_maps::MapBindings::blurred_handles`]).
 pub fn pack_layers(tree: &LayerTree, blurred: &[(f32, u32)]) -> PackedLayers {
     let count = tree.layers.len();
     let mut samples = Vec::new();
@@ -113,6 +118,53 @@ pub fn pack_layers(tree: &LayerTree, blurred: &[(f32, u32)]) -> PackedLayers {
         })
         .collect();
     PackedLayers { layers, samples }
+}
+
+/// The layers buffer ([`pack_layers`]) as an upload region of the frame
+/// graph. It embeds the sampled handles of the blurred height fields, so
+/// every pass that reads it also writes it, the same bytes each time, from
+/// the blurred fields that pass declared ([`LayerTable::write`]).
+#[derive(Clone, Debug)]
+pub struct LayerTable {
+    region: UploadRegion,
+    /// The table with every blurred handle 0.
+    packed: Arc<PackedLayers>,
+    /// Per layer, its `height_blur` radius.
+    radii: Arc<[Option<f32>]>,
+}
+
+impl LayerTable {
+    /// Packs `tree` and declares its upload region in `graph`.
+    pub fn declare<P: 'static>(graph: &mut RenderGraph<P>, tree: &LayerTree) -> LayerTable {
+        let radii = tree.blur_radii().into_iter().take(MAX_BLUR_RADII);
+        let blurred: Vec<(f32, u32)> = radii.map(|r| (r, 0)).collect();
+        let packed = pack_layers(tree, &blurred);
+        let bytes = std::mem::size_of_val(packed.layers.as_slice()) + std::mem::size_of_val(packed.samples.as_slice());
+        LayerTable {
+            region: graph.upload_region("surface layers", bytes as u64),
+            packed: Arc::new(packed),
+            radii: tree.layers.iter().map(|l| l.layer.height_blur).collect(),
+        }
+    }
+
+    /// Declares that `pass` reads the table at `stage`.
+    pub fn read_in<P: 'static>(&self, pass: &mut PassBuilder<'_, P>, stage: Stage) -> Binding {
+        pass.upload(self.region, stage)
+    }
+
+    /// Writes this frame's table through `table` (the recording pass's
+    /// [`LayerTable::read_in`]) with the handles of the blurred height
+    /// fields it declared in `maps`.
+    pub fn write(&self, ctx: &mut PassContext<'_>, table: Binding, maps: &MapBindings) -> Result<()> {
+        let blurred = maps.blurred_handles(ctx)?;
+        let mut packed = (*self.packed).clone();
+        for (layer, radius) in packed.layers.iter_mut().zip(self.radii.iter()) {
+            if let Some(r) = radius {
+                layer.tree[2] = blurred.iter().find(|(radius, _)| radius == r).map_or(0, |b| b.1);
+            }
+        }
+        ctx.write_upload(table, &packed.bytes())
+    }
 }
 
 /// Per-frame constants of terrain texturing (`TerrainTexturing`).

@@ -11,31 +11,34 @@ use std::path::Path;
 use std::sync::Arc;
 
 use crate::error::{Error, Result};
-use crate::graph::{ImageId, RenderGraph};
+use crate::graph::{Binding, ImageId, PassBuilder, PassContext, RenderGraph, Stage};
 use crate::io::heightmap::HeightField;
 use crate::surface::blurred_height::blurred_height;
 use crate::surface::layers::{LayerTree, INPUT_NAMES, MAX_BLUR_RADII};
 use crate::vulkan::{Context, Format, Image, ImageDesc, ImageUsageFlags};
 
-/// The input maps as graph resources with their sampled heap handles
-/// (`None`: absent), and the blurred height fields with their radius.
+/// The input maps as graph resources (`None`: absent), and the blurred
+/// height fields with their radius.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct InputMaps {
-    pub maps: [Option<(ImageId, u32)>; 3],
-    pub blurred: [Option<(f32, ImageId, u32)>; MAX_BLUR_RADII],
+    pub maps: [Option<ImageId>; 3],
+    pub blurred: [Option<(f32, ImageId)>; MAX_BLUR_RADII],
+}
+
+/// The input maps and blurred height fields one pass declared it samples
+/// ([`InputMaps::sample_in`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct MapBindings {
+    maps: [Option<Binding>; 3],
+    blurred: [Option<(f32, Binding)>; MAX_BLUR_RADII],
 }
 
 /// Uploads `map`'s samples as an R32F texture `name` and imports it.
-fn upload<P: 'static>(
-    ctx: &Context,
-    graph: &mut RenderGraph<P>,
-    name: String,
-    map: &HeightField,
-) -> Result<(ImageId, u32)> {
+fn upload<P: 'static>(ctx: &Context, graph: &mut RenderGraph<P>, name: String, map: &HeightField) -> Result<ImageId> {
     let image = Image::with_data(
         ctx,
         ImageDesc {
-            name: name.clone(),
+            name,
             width: map.columns,
             height: map.rows,
             format: Format::R32_SFLOAT,
@@ -43,10 +46,7 @@ fn upload<P: 'static>(
         },
         bytemuck::cast_slice(&map.heights),
     )?;
-    let handle = image
-        .sampled_handle()
-        .ok_or_else(|| Error::Graph(format!("{name} has no sampled handle")))?;
-    Ok((graph.import_image(Arc::new(image)), handle))
+    Ok(graph.import_image(Arc::new(image)))
 }
 
 impl InputMaps {
@@ -79,33 +79,42 @@ impl InputMaps {
             let layer = (tree.layers.iter()).find(|l| l.layer.height_blur == Some(radius));
             let what = format!("layer '{}': height_blur", layer.map_or("", |l| l.layer.name.as_str()));
             let blurred = blurred_height(field, radius, &what)?;
-            let (image, handle) = upload(ctx, graph, format!("height blurred by {radius} m"), &blurred)?;
-            out.blurred[k] = Some((radius, image, handle));
+            let image = upload(ctx, graph, format!("height blurred by {radius} m"), &blurred)?;
+            out.blurred[k] = Some((radius, image));
         }
         Ok(out)
     }
 
-    /// The present maps and blurred height fields.
-    pub fn present(&self) -> impl Iterator<Item = ImageId> + '_ {
-        let blurred = self.blurred.iter().flatten().map(|(_, id, _)| *id);
-        self.maps.iter().flatten().map(|(id, _)| *id).chain(blurred)
+    /// Declares that `pass` samples every present map and blurred height
+    /// field at `stage`.
+    pub fn sample_in<P: 'static>(&self, pass: &mut PassBuilder<'_, P>, stage: Stage) -> MapBindings {
+        MapBindings {
+            maps: self.maps.map(|map| map.map(|id| pass.sample(id, stage))),
+            blurred: self
+                .blurred
+                .map(|b| b.map(|(radius, id)| (radius, pass.sample(id, stage)))),
+        }
     }
+}
 
+impl MapBindings {
     /// Radii and sampled handles of the blurred height fields.
-    pub fn blurred_handles(&self) -> Vec<(f32, u32)> {
-        self.blurred.iter().flatten().map(|&(r, _, h)| (r, h)).collect()
+    pub fn blurred_handles(&self, ctx: &PassContext<'_>) -> Result<Vec<(f32, u32)>> {
+        (self.blurred.iter().flatten())
+            .map(|&(radius, binding)| Ok((radius, ctx.handle(binding)?)))
+            .collect()
     }
 
     /// `maps` of the shaders: sampled handles, and in w bit k when map k is
     /// present.
-    pub fn handles(&self) -> [u32; 4] {
+    pub fn handles(&self, ctx: &PassContext<'_>) -> Result<[u32; 4]> {
         let mut handles = [0u32; 4];
         for (k, map) in self.maps.iter().enumerate() {
-            if let Some((_, handle)) = map {
-                handles[k] = *handle;
+            if let Some(binding) = map {
+                handles[k] = ctx.handle(*binding)?;
                 handles[3] |= 1 << k;
             }
         }
-        handles
+        Ok(handles)
     }
 }

@@ -34,7 +34,7 @@ use super::search::{
 };
 use crate::error::{Error, Result};
 use crate::graph::{
-    BakedGraph, BufferAccess, BufferId, BufferInfo, FrameOutcome, PassContext, RenderGraph, Stage, UploadRegion,
+    BakedGraph, Binding, BufferAccess, BufferId, BufferInfo, FrameOutcome, RenderGraph, Stage, UploadRegion,
 };
 use crate::profile::FrameProfile;
 use crate::shaders;
@@ -99,7 +99,7 @@ struct Batch {
     queries: u32,
 }
 
-/// The graph resources and constants every pass's push constants hold.
+/// The graph resources of the passes and the constants of their push constants.
 #[derive(Clone, Copy)]
 struct Bindings {
     texels: BufferId,
@@ -115,37 +115,24 @@ struct Bindings {
     rule: [u32; 3],
 }
 
-impl Bindings {
-    fn push(&self, pass: &PassContext<'_>, batch: &Batch) -> Result<SearchPush> {
-        let [candidates, window, width] = self.shape;
-        let [seed, lambda, tolerance] = self.rule;
-        Ok(SearchPush {
-            inputs: [
-                pass.storage_buffer(self.texels)?,
-                pass.storage_buffer(self.centres)?,
-                pass.upload(self.taps)?,
-                pass.upload(self.pixels)?,
-            ],
-            outputs: [
-                pass.storage_buffer(self.sums)?,
-                pass.storage_buffer(self.results)?,
-                pass.storage_buffer(self.readback)?,
-                0,
-            ],
-            sizes: [batch.queries, candidates, window, width],
-            rule: [seed, lambda, tolerance, 0],
-        })
-    }
-}
+/// Slots of the handles in [`SearchPush`]: `inputs` 0–3, `outputs` 4–7.
+const TEXELS: usize = 0;
+const CENTRES: usize = 1;
+const TAPS: usize = 2;
+const PIXELS: usize = 3;
+const SUMS: usize = 4;
+const RESULTS: usize = 5;
+const READBACK: usize = 6;
 
-/// One pass of the search: name, shader, accesses and its dispatch (from
-/// the batch's query count).
+/// One pass of the search: name, shader, accesses (each with the slot of
+/// its handle in the push constants) and its dispatch (from the batch's
+/// query count).
 struct PassSpec {
     name: &'static str,
     shader: SpirV,
-    reads: Vec<BufferId>,
-    uploads: Vec<UploadRegion>,
-    writes: Vec<(BufferId, BufferAccess)>,
+    reads: Vec<(usize, BufferId)>,
+    uploads: Vec<(usize, UploadRegion)>,
+    writes: Vec<(usize, BufferId, BufferAccess)>,
     dispatch: Box<dyn Fn(u32) -> [u32; 3] + Send + Sync>,
 }
 
@@ -408,67 +395,74 @@ fn pass_specs(b: &Bindings, candidates: u32, max_x: u32) -> Vec<PassSpec> {
             shader: shaders::SYNTHESIS_CLEAR,
             reads: vec![],
             uploads: vec![],
-            writes: vec![(b.results, write)],
+            writes: vec![(RESULTS, b.results, write)],
             dispatch: Box::new(|q| [q.div_ceil(QUERY_GROUP), 1, 1]),
         },
         PassSpec {
             name: "synthesis.distance",
             shader: shaders::SYNTHESIS_DISTANCE,
-            reads: vec![b.texels, b.centres],
-            uploads: vec![b.taps],
-            writes: vec![(b.sums, write), (b.results, read_write)],
+            reads: vec![(TEXELS, b.texels), (CENTRES, b.centres)],
+            uploads: vec![(TAPS, b.taps)],
+            writes: vec![(SUMS, b.sums, write), (RESULTS, b.results, read_write)],
             dispatch: Box::new(move |q| [per_query(DISTANCE_BLOCK), q, 1]),
         },
         PassSpec {
             name: "synthesis.accept",
             shader: shaders::SYNTHESIS_ACCEPT,
-            reads: vec![b.sums],
-            uploads: vec![b.pixels],
-            writes: vec![(b.results, read_write)],
+            reads: vec![(SUMS, b.sums)],
+            uploads: vec![(PIXELS, b.pixels)],
+            writes: vec![(RESULTS, b.results, read_write)],
             dispatch: Box::new(move |q| [per_query(ACCEPT_BLOCK), q, 1]),
         },
         PassSpec {
             name: "synthesis.pick",
             shader: shaders::SYNTHESIS_PICK,
-            reads: vec![b.sums],
-            uploads: vec![b.pixels],
-            writes: vec![(b.results, read_write)],
+            reads: vec![(SUMS, b.sums)],
+            uploads: vec![(PIXELS, b.pixels)],
+            writes: vec![(RESULTS, b.results, read_write)],
             dispatch: Box::new(move |q| [per_query(ACCEPT_BLOCK), q, 1]),
         },
         PassSpec {
             name: "synthesis.resolve",
             shader: shaders::SYNTHESIS_RESOLVE,
-            reads: vec![b.sums, b.results],
+            reads: vec![(SUMS, b.sums), (RESULTS, b.results)],
             uploads: vec![],
-            writes: vec![(b.readback, write)],
+            writes: vec![(READBACK, b.readback, write)],
             dispatch: Box::new(|q| [q.div_ceil(QUERY_GROUP), 1, 1]),
         },
     ]
 }
 
-/// Declares `spec` in `graph`: its accesses, and a recording that binds its
-/// pipeline, pushes the bindings and dispatches.
+/// Declares `spec` in `graph`: its bindings, and a recording that pushes
+/// their handles and dispatches.
 fn declare(ctx: &Context, graph: &mut RenderGraph<Batch>, bindings: &Bindings, spec: PassSpec) -> Result<()> {
-    let pipeline = Arc::new(ComputePipeline::new(ctx, spec.shader)?);
+    let pipeline = ComputePipeline::new(ctx, spec.shader)?;
     let mut pass = graph.pass(spec.name);
-    for buffer in spec.reads {
-        pass = pass.read(buffer, BufferAccess::StorageRead(Stage::Compute));
+    let read = BufferAccess::StorageRead(Stage::Compute);
+    let mut slots: Vec<(usize, Binding)> = Vec::new();
+    for (slot, buffer) in spec.reads {
+        slots.push((slot, pass.storage_buffer(buffer, read)));
     }
-    for region in spec.uploads {
-        pass = pass.read(region, BufferAccess::StorageRead(Stage::Compute));
+    for (slot, region) in spec.uploads {
+        slots.push((slot, pass.upload(region, Stage::Compute)));
     }
-    for (buffer, access) in spec.writes {
-        pass = pass.write(buffer, access);
+    for (slot, buffer, access) in spec.writes {
+        slots.push((slot, pass.storage_buffer(buffer, access)));
     }
-    let (bindings, dispatch) = (*bindings, spec.dispatch);
-    pass.record(move |pass, batch| {
-        let push = bindings.push(pass, batch)?;
-        let [x, y, z] = dispatch(batch.queries);
-        let cmd = pass.cmd();
-        cmd.bind_compute(&pipeline);
-        cmd.push_constants(&push)?;
-        cmd.dispatch(x, y, z);
-        Ok(())
+    let ([candidates, window, width], [seed, lambda, tolerance]) = (bindings.shape, bindings.rule);
+    let dispatch = spec.dispatch;
+    pass.record(move |ctx, batch| {
+        let mut handles = [0u32; 8];
+        for &(slot, binding) in &slots {
+            handles[slot] = ctx.handle(binding)?;
+        }
+        let push = SearchPush {
+            inputs: [handles[0], handles[1], handles[2], handles[3]],
+            outputs: [handles[4], handles[5], handles[6], handles[7]],
+            sizes: [batch.queries, candidates, window, width],
+            rule: [seed, lambda, tolerance, 0],
+        };
+        ctx.dispatch(&pipeline, &push, dispatch(batch.queries))
     });
     Ok(())
 }

@@ -17,7 +17,7 @@ use std::sync::Arc;
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::{Error, Result};
-use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, RenderGraph, Stage, UploadRegion};
+use crate::graph::{BufferAccess, BufferId, ImageId, RenderGraph, Stage, UploadRegion};
 use crate::io::heightmap::HeightField;
 use crate::shaders;
 use crate::surface::wavelet_noise::{self, NOISE_TILE};
@@ -255,7 +255,8 @@ impl GeometryImage {
         )?))
     }
 
-    /// The push constants of `terrain.warp` but for its handles.
+    /// The push constants of `terrain.warp` but for its handles (the
+    /// pass's bindings).
     pub fn warp_push(&self) -> WarpPush {
         let (field, settings) = (&self.field, &self.settings);
         let extent = field.extent();
@@ -294,14 +295,14 @@ pub struct WarpPass {
     pub upload: UploadRegion,
     /// The view's geometry image.
     pub vertices: BufferId,
-    /// Grid side N.
-    pub grid_side: u32,
+    /// The push constants but for the handles ([`GeometryImage::warp_push`]).
+    pub push: WarpPush,
 }
 
 /// Declares `terrain.warp` for one view (§7.4.2 "Warp and Zoom"): the
 /// prepared warp of the sketch map, bilinearly to N×N, heights re-sampled
 /// from the atlas, detail displacement, normals; into the vertex buffer.
-/// Its push constants come from the view's [`crate::terrain::TerrainFrame`].
+/// Its upload is written by [`crate::terrain::Terrain`]'s `prepare`.
 pub fn declare_warp_pass<S: Provides<TerrainFrame> + 'static>(
     ctx: &Context,
     graph: &mut RenderGraph<Frame<S>>,
@@ -309,22 +310,26 @@ pub fn declare_warp_pass<S: Provides<TerrainFrame> + 'static>(
     pass: WarpPass,
 ) -> Result<()> {
     let pipeline = ComputePipeline::new(ctx, shaders::TERRAIN_WARP)?;
-    graph
-        .pass(name)
-        .read(pass.atlas, ImageAccess::Sampled(Stage::Compute))
-        .read(pass.noise, ImageAccess::Sampled(Stage::Compute))
-        .read(pass.upload, BufferAccess::StorageRead(Stage::Compute))
-        .write(pass.vertices, BufferAccess::StorageWrite(Stage::Compute))
-        .record(move |ctx, frame| {
-            let prepared = frame.prepared::<crate::terrain::TerrainFrame>()?;
-            let push = prepared.view(pass.view)?.warp;
-            let cmd = ctx.cmd();
-            cmd.bind_compute(&pipeline);
-            cmd.push_constants(&push)?;
-            let groups = pass.grid_side.div_ceil(8);
-            cmd.dispatch(groups, groups, 1);
-            Ok(())
-        });
+    let mut builder = graph.pass(name);
+    let atlas = builder.sample(pass.atlas, Stage::Compute);
+    let noise = builder.sample(pass.noise, Stage::Compute);
+    let upload = builder.upload(pass.upload, Stage::Compute);
+    let vertices = builder.storage_buffer(pass.vertices, BufferAccess::StorageWrite(Stage::Compute));
+    builder.record(move |ctx, frame| {
+        // The view's warp upload is this frame's only when it was prepared.
+        frame.prepared::<crate::terrain::TerrainFrame>()?.view(pass.view)?;
+        let push = WarpPush {
+            handles: [
+                ctx.handle(atlas)?,
+                ctx.handle(upload)?,
+                ctx.handle(vertices)?,
+                ctx.handle(noise)?,
+            ],
+            ..pass.push
+        };
+        let groups = pass.push.grid[0].div_ceil(8);
+        ctx.dispatch(&pipeline, &push, [groups, groups, 1])
+    });
     Ok(())
 }
 

@@ -11,8 +11,11 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
-use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, RenderGraph, Stage, UploadRegion};
+use crate::graph::{
+    Binding, BufferAccess, BufferId, ImageId, PassBuilder, PassContext, RenderGraph, Stage, UploadRegion,
+};
 use crate::shaders;
+use crate::surface::gpu_layout::{LayerTable, TexturingFrame};
 use crate::surface::input_maps::InputMaps;
 use crate::terrain::geometry_image::VERTEX_STRIDE;
 use crate::terrain::TerrainFrame;
@@ -61,11 +64,45 @@ pub struct DrawPass {
     pub noise: ImageId,
     pub heights: ImageId,
     /// The surface layers, their input maps and the frame's texturing constants.
-    pub layers: BufferId,
+    pub layers: LayerTable,
     pub maps: InputMaps,
     pub constants: UploadRegion,
+    /// The texturing constants but for their heap handles.
+    pub texturing: TexturingFrame,
     /// The texture atlas and page table (atlas texturing only).
     pub atlas: Option<AtlasBindings>,
+}
+
+/// What `terrain.draw` samples of the texture atlas.
+struct AtlasSamples {
+    page_table: Binding,
+    colors: Vec<Binding>,
+    normals: Vec<Binding>,
+}
+
+impl AtlasSamples {
+    /// Declares that `builder` reads `atlas`.
+    fn declare<P: 'static>(builder: &mut PassBuilder<'_, P>, atlas: &AtlasBindings) -> AtlasSamples {
+        let stage = Stage::Fragment;
+        AtlasSamples {
+            page_table: builder.upload(atlas.page_table, stage),
+            colors: atlas.colors.iter().map(|&image| builder.sample(image, stage)).collect(),
+            normals: atlas
+                .normals
+                .iter()
+                .map(|&image| builder.sample(image, stage))
+                .collect(),
+        }
+    }
+
+    /// Puts the atlas's heap handles into `frame`.
+    fn set_handles(&self, ctx: &PassContext<'_>, frame: &mut TexturingFrame) -> Result<()> {
+        frame.atlas[0] = ctx.handle(self.page_table)?;
+        for (k, (&color, &normal)) in self.colors.iter().zip(&self.normals).enumerate() {
+            (frame.color[k], frame.normal[k]) = (ctx.handle(color)?, ctx.handle(normal)?);
+        }
+        Ok(())
+    }
 }
 
 fn pipeline(ctx: &Context, targets: &SceneTargets) -> Result<GraphicsPipeline> {
@@ -103,7 +140,9 @@ fn pipeline(ctx: &Context, targets: &SceneTargets) -> Result<GraphicsPipeline> {
 
 /// Declares `terrain.draw` for one view into its radiance and view depth
 /// (loaded: the sky pass wrote them) with its depth buffer (cleared). Its
-/// push constants come from the view's [`crate::terrain::TerrainFrame`].
+/// push constants come from the view's [`crate::terrain::TerrainFrame`];
+/// it writes the frame's layers buffer and texturing constants, which hold
+/// the handles of what it declared.
 pub fn declare_draw_pass<S: Provides<TerrainFrame> + 'static>(
     ctx: &Context,
     graph: &mut RenderGraph<Frame<S>>,
@@ -116,52 +155,47 @@ pub fn declare_draw_pass<S: Provides<TerrainFrame> + 'static>(
         .pass(name)
         .graphics()
         .read(pass.vertices, BufferAccess::Vertex)
-        .read(pass.indices, BufferAccess::Index)
-        .read(pass.noise, ImageAccess::Sampled(Stage::Fragment))
-        .read(pass.heights, ImageAccess::Sampled(Stage::Fragment))
-        .read(pass.layers, BufferAccess::StorageRead(Stage::Fragment))
-        .read(pass.constants, BufferAccess::StorageRead(Stage::Graphics));
-    for map in pass.maps.present() {
-        builder = builder.read(map, ImageAccess::Sampled(Stage::Fragment));
-    }
-    if let Some(atlas) = &pass.atlas {
-        builder = builder.read(atlas.page_table, BufferAccess::StorageRead(Stage::Fragment));
-        for &(image, _) in atlas.colors.iter().chain(&atlas.normals) {
-            builder = builder.read(image, ImageAccess::Sampled(Stage::Fragment));
-        }
-    }
-    let (radiance, view_depth, depth) = (targets.radiance, targets.view_depth, targets.depth);
-    let (visibility, normal, ids) = (targets.visibility, targets.normal, targets.ids);
+        .read(pass.indices, BufferAccess::Index);
+    let noise = builder.sample(pass.noise, Stage::Fragment);
+    let heights = builder.sample(pass.heights, Stage::Fragment);
+    let table = pass.layers.read_in(&mut builder, Stage::Fragment);
+    let maps = pass.maps.sample_in(&mut builder, Stage::Fragment);
+    let constants = builder.upload(pass.constants, Stage::Graphics);
+    let atlas = (pass.atlas.as_ref()).map(|atlas| AtlasSamples::declare(&mut builder, atlas));
+    let lighting = builder.upload(targets.lighting.constants, Stage::Fragment);
     builder = targets.lighting.read_in(builder, Stage::Fragment);
+    let load = LoadOp::Load;
     builder
-        .write(radiance, ImageAccess::ColorAttachmentReadWrite)
-        .write(visibility, ImageAccess::ColorAttachmentReadWrite)
-        .write(view_depth, ImageAccess::ColorAttachmentReadWrite)
-        .write(normal, ImageAccess::ColorAttachmentReadWrite)
-        .write(ids, ImageAccess::ColorAttachmentReadWrite)
-        .write(depth, ImageAccess::DepthAttachmentWrite)
+        .pipeline(&pipeline)
+        .color(targets.radiance, load)
+        .color(targets.view_depth, load)
+        .color(targets.visibility, load)
+        .color(targets.normal, load)
+        .color(targets.ids, load)
+        .depth(targets.depth, Some(1.0))
         .record(move |ctx, frame| {
-            let push = frame.prepared::<crate::terrain::TerrainFrame>()?.view(pass.view)?.draw;
-            let (radiance, view_depth, depth) = (ctx.image(radiance)?, ctx.image(view_depth)?, ctx.image(depth)?);
+            let prepared = frame.prepared::<crate::terrain::TerrainFrame>()?.view(pass.view)?.draw;
+            pass.layers.write(ctx, table, &maps)?;
+            let mut texturing = pass.texturing;
+            texturing.handles[..3].copy_from_slice(&[ctx.handle(table)?, ctx.handle(heights)?, ctx.handle(noise)?]);
+            texturing.maps = maps.handles(ctx)?;
+            if let Some(atlas) = &atlas {
+                atlas.set_handles(ctx, &mut texturing)?;
+            }
+            ctx.write_upload_pod(constants, &texturing)?;
+            let push = TerrainDrawPush {
+                lighting: [ctx.handle(lighting)?, 0, 0, 0],
+                noise_tile: ctx.handle(noise)?,
+                texturing_frame: ctx.handle(constants)?,
+                ..prepared
+            };
             let (vertices, indices) = (ctx.buffer(pass.vertices)?, ctx.buffer(pass.indices)?);
-            let (visibility, normal, ids) = (ctx.image(visibility)?, ctx.image(normal)?, ctx.image(ids)?);
             let cmd = ctx.cmd();
-            cmd.begin_rendering(
-                &[
-                    (radiance, LoadOp::Load),
-                    (view_depth, LoadOp::Load),
-                    (visibility, LoadOp::Load),
-                    (normal, LoadOp::Load),
-                    (ids, LoadOp::Load),
-                ],
-                Some((depth, Some(1.0))),
-            );
             cmd.bind_graphics(&pipeline);
             cmd.push_constants(&push)?;
             cmd.bind_vertex_buffer(vertices);
             cmd.bind_index_buffer(indices);
             cmd.draw_indexed(pass.index_count, 1);
-            cmd.end_rendering();
             Ok(())
         });
     Ok(())

@@ -12,17 +12,17 @@ use bytemuck::Zeroable;
 use crate::error::{Error, Result};
 use crate::graph::{BufferId, ImageId, RenderGraph, UploadRegion};
 use crate::io::heightmap::HeightField;
-use crate::surface::gpu_layout::{pack_layers, TexturingFrame, TexturingMode};
+use crate::surface::gpu_layout::{LayerTable, TexturingFrame, TexturingMode};
 use crate::surface::input_maps::InputMaps;
 use crate::surface::layers::LayerTree;
-use crate::terrain::geometry_image::{declare_warp_pass, GeometryImage, TerrainSettings, WarpPass, WarpPush};
+use crate::terrain::geometry_image::{declare_warp_pass, GeometryImage, TerrainSettings, WarpPass};
 use crate::terrain::lod::LodFrame;
 use crate::terrain::shading::{declare_draw_pass, DrawPass, TerrainDrawPush};
 use crate::texturing::generation::{AtlasBindings, GenerationInputs};
 use crate::view::{
     pass_name, per_view, Declare, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex,
 };
-use crate::vulkan::{Buffer, BufferUsageFlags, Context, Image};
+use crate::vulkan::Context;
 
 /// How `terrain.draw` colours the surface (§7.4.3 or §8.2).
 pub struct TerrainTexturing<'a> {
@@ -38,13 +38,11 @@ struct TerrainViewState {
     lod: LodFrame,
     /// The warped sketch map (per frame).
     warp: UploadRegion,
-    /// The texturing constants `terrain.draw` reads (per frame).
+    /// The texturing constants `terrain.draw` writes and reads (per frame).
     constants: UploadRegion,
     vertices: BufferId,
-    vertices_handle: u32,
-    atlas: Option<AtlasBindings>,
-    /// The view's lighting constants (set by `declare_draw`).
-    lighting: Option<UploadRegion>,
+    /// Whether `terrain.draw` of the view was declared.
+    drawn: bool,
 }
 
 /// The terrain: persistent GPU state, `terrain.warp` and `terrain.draw` per
@@ -56,10 +54,8 @@ pub struct Terrain {
     atlas: ImageId,
     noise: ImageId,
     indices: BufferId,
-    layers: BufferId,
+    layers: LayerTable,
     maps: InputMaps,
-    /// Heap handles: sketch atlas (sampled), noise tile (sampled), layers (storage).
-    handles: [u32; 3],
     views: Vec<TerrainViewState>,
     /// The previous frame's prepared views, reused ([`Technique::recycle`]).
     spare: Vec<TerrainViewFrame>,
@@ -70,11 +66,11 @@ pub struct TerrainFrame {
     pub views: Vec<TerrainViewFrame>,
 }
 
-/// One view's prepared push constants.
+/// One view's prepared push constants of `terrain.draw` (its handles come
+/// from the pass's bindings).
 #[derive(Clone, Copy, Debug)]
 pub struct TerrainViewFrame {
     pub view: ViewIndex,
-    pub warp: WarpPush,
     pub draw: TerrainDrawPush,
 }
 
@@ -84,10 +80,6 @@ impl TerrainFrame {
         per_view(&self.views, index, |v| v.view)
             .ok_or_else(|| Error::Graph(format!("terrain: view {index} was not prepared")))
     }
-}
-
-fn heap_handle(image_or_buffer: Option<u32>, what: &str) -> Result<u32> {
-    image_or_buffer.ok_or_else(|| Error::Graph(format!("terrain: {what} has no heap handle")))
 }
 
 impl Terrain {
@@ -106,28 +98,15 @@ impl Terrain {
         if layer_count == 0 {
             return Err(Error::invalid("surface layers", "the tree has no layer"));
         }
-        let layers = Arc::new(Buffer::with_data(
-            ctx,
-            "surface layers",
-            BufferUsageFlags::STORAGE_BUFFER,
-            &pack_layers(texturing.layers, &maps.blurred_handles()).bytes(),
-        )?);
-        let sampled = |image: &Image, what| heap_handle(image.sampled_handle(), what);
-        let handles = [
-            sampled(&geometry.atlas, "the sketch atlas")?,
-            sampled(&geometry.noise, "the noise tile")?,
-            heap_handle(layers.storage_handle(), "the layers buffer")?,
-        ];
         Ok(Terrain {
             atlas: graph.import_image(geometry.atlas.clone()),
             noise: graph.import_image(geometry.noise.clone()),
             indices: graph.import_buffer(geometry.indices.clone()),
-            layers: graph.import_buffer(layers),
+            layers: LayerTable::declare(graph, texturing.layers),
             geometry,
             mode: texturing.mode,
             layer_count,
             maps,
-            handles,
             views: Vec::new(),
             spare: Vec::new(),
         })
@@ -139,7 +118,7 @@ impl Terrain {
             field: self.geometry.field.clone(),
             heights: self.atlas,
             noise: self.noise,
-            layers: self.layers,
+            layers: self.layers.clone(),
             maps: self.maps,
             tree,
         }
@@ -153,7 +132,6 @@ impl Terrain {
         (index, view): (ViewIndex, &View),
     ) -> Result<()> {
         let vertex_buffer = self.geometry.vertex_buffer(ctx, &view.name)?;
-        let vertices_handle = heap_handle(vertex_buffer.storage_handle(), "the vertex buffer")?;
         let vertices = graph.import_buffer(vertex_buffer);
         let warp = graph.upload_region(
             &pass_name("terrain warp", &view.name),
@@ -169,7 +147,7 @@ impl Terrain {
             noise: self.noise,
             upload: warp,
             vertices,
-            grid_side: self.geometry.settings.grid_side,
+            push: self.geometry.warp_push(),
         };
         declare_warp_pass(ctx, graph, &pass_name("terrain.warp", &view.name), pass)?;
         self.views.push(TerrainViewState {
@@ -178,9 +156,7 @@ impl Terrain {
             warp,
             constants,
             vertices,
-            vertices_handle,
-            atlas: None,
-            lighting: None,
+            drawn: false,
         });
         Ok(())
     }
@@ -195,10 +171,10 @@ impl Terrain {
         targets: &SceneTargets,
         atlas: Option<&AtlasBindings>,
     ) -> Result<()> {
+        let texturing = self.texturing_constants(atlas);
         let state = (self.views.iter_mut().find(|v| v.index == index))
             .ok_or_else(|| Error::Graph(format!("terrain.draw of view {index} before its terrain.warp")))?;
-        state.atlas = atlas.cloned();
-        state.lighting = Some(targets.lighting.constants);
+        state.drawn = true;
         let side = self.geometry.settings.grid_side;
         let pass = DrawPass {
             view: index,
@@ -207,10 +183,11 @@ impl Terrain {
             index_count: (side - 1) * (side - 1) * 6,
             noise: self.noise,
             heights: self.atlas,
-            layers: self.layers,
+            layers: self.layers.clone(),
             maps: self.maps,
             constants: state.constants,
-            atlas: state.atlas.clone(),
+            texturing,
+            atlas: atlas.cloned(),
         };
         declare_draw_pass(ctx, graph, &pass_name("terrain.draw", &view.name), pass, targets)
     }
@@ -230,26 +207,22 @@ impl Terrain {
     }
 
     /// The texturing constants of `terrain.draw` (`TerrainTexturing` in
-    /// glsl/include/texture_atlas.glsl); `page_table`: this frame's handle.
-    fn texturing_constants(&self, atlas: Option<(&AtlasBindings, u32)>) -> TexturingFrame {
+    /// glsl/include/texture_atlas.glsl) but for their heap handles, which
+    /// the pass puts in from its bindings.
+    fn texturing_constants(&self, atlas: Option<&AtlasBindings>) -> TexturingFrame {
         let field = &self.geometry.field;
         let (lo, hi) = field.min_max();
         let extent = field.extent();
-        let [heights, noise, layers] = self.handles;
         let mut frame = TexturingFrame {
-            handles: [layers, heights, noise, self.mode.code()],
+            handles: [0, 0, 0, self.mode.code()],
             grid: [field.columns, field.rows, self.layer_count, 0],
             spacing_range: [field.spacing.x as f32, field.spacing.y as f32, lo, hi],
             extent: [extent.x as f32, extent.y as f32, 0.0, 0.0],
-            maps: self.maps.handles(),
             draw: self.geometry.settings.draw_constants(),
             ..TexturingFrame::zeroed()
         };
-        if let Some((a, page_table)) = atlas {
-            frame.atlas = [page_table, a.colors.len() as u32, a.atlas_size, 0];
-            for (k, (c, n)) in a.colors.iter().zip(&a.normals).enumerate() {
-                (frame.color[k], frame.normal[k]) = (c.1, n.1);
-            }
+        if let Some(a) = atlas {
+            frame.atlas = [0, a.colors.len() as u32, a.atlas_size, 0];
         }
         frame
     }
@@ -312,58 +285,37 @@ impl Technique for Terrain {
     }
 
     /// Per view: sketch map, importance map and warp (§7.4.2) into the
-    /// warp upload, the texturing constants, and the passes' push constants.
+    /// warp upload, and the push constants of `terrain.draw`.
     fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, (): ()) -> Result<TerrainFrame> {
         let mut views = std::mem::take(&mut self.spare);
         views.clear();
         let settings = self.geometry.settings;
         self.plan_views(frame.views)?;
-        for k in 0..self.views.len() {
-            let state = &self.views[k];
+        for (k, state) in self.views.iter().enumerate() {
             let view = frame
                 .views
                 .get(state.index)
                 .ok_or_else(|| Error::Graph(format!("terrain: the frame has no view {}", state.index)))?;
-            let camera = &view.camera;
-            let page_table = match &state.atlas {
-                Some(a) => Some((a, frame.uploads.handle(a.page_table)?)),
-                None => None,
-            };
-            let constants = self.texturing_constants(page_table);
-            let (warp_region, constants_region) = (state.warp, state.constants);
-            frame.uploads.write_pod(constants_region, &constants)?;
-            let [heights, noise, _] = self.handles;
-            let warp = WarpPush {
-                handles: [
-                    heights,
-                    frame.uploads.handle(warp_region)?,
-                    self.views[k].vertices_handle,
-                    noise,
-                ],
-                ..self.geometry.warp_push()
-            };
-            let state = &self.views[k];
+            if !state.drawn {
+                return Err(Error::Graph(format!("terrain.draw of view {k} was not declared")));
+            }
             frame
                 .uploads
-                .write(warp_region, bytemuck::cast_slice(&state.lod.upload))?;
+                .write(state.warp, bytemuck::cast_slice(&state.lod.upload))?;
+            let camera = &view.camera;
             let pixel_footprint = view.pixel_angle();
-            let lighting = match state.lighting {
-                Some(region) => frame.uploads.handle(region)?,
-                None => return Err(Error::Graph(format!("terrain.draw of view {k} was not declared"))),
-            };
             let draw = TerrainDrawPush {
                 view_proj: view.view_proj().to_cols_array(),
                 eye: camera.eye.as_vec3().extend(self.geometry.atlas_spacing()).to_array(),
                 forward: camera.forward().as_vec3().extend(pixel_footprint as f32).to_array(),
-                lighting: [lighting, 0, 0, 0],
+                lighting: [0; 4],
                 detail_amplitude: settings.detail_amplitude,
                 detail_h: settings.detail_h,
-                noise_tile: noise,
-                texturing_frame: frame.uploads.handle(constants_region)?,
+                noise_tile: 0,
+                texturing_frame: 0,
             };
             views.push(TerrainViewFrame {
                 view: state.index,
-                warp,
                 draw,
             });
         }

@@ -29,9 +29,10 @@ use bytemuck::{Pod, Zeroable};
 use glam::DVec2;
 
 use crate::error::{Error, Result};
-use crate::graph::{BufferId, BufferInfo, ImageId, RenderGraph, UploadRegion};
+use crate::graph::{BufferInfo, ImageId, RenderGraph, UploadRegion};
 use crate::io::heightmap::HeightField;
 use crate::profile::FrameProfile;
+use crate::surface::gpu_layout::LayerTable;
 use crate::surface::input_maps::InputMaps;
 use crate::surface::layers::LayerTree;
 #[cfg(doc)]
@@ -66,7 +67,9 @@ pub struct TileJob {
     pub world: [f32; 4],
     /// First scratch texel, tile size (border included), slot x, slot y.
     pub tile: [u32; 4],
-    /// Colour and normal textures (storage handles), 0, 0.
+    /// Colour and normal textures (storage handles), 0, 0. In the
+    /// prepared [`TextureFrame`] x holds the texture's index instead:
+    /// `texturing.finish`, which declares the textures, puts in the handles.
     pub images: [u32; 4],
 }
 
@@ -113,10 +116,7 @@ pub struct TextureAtlas {
     extent: DVec2,
     cache: TileCache,
     bounds: HeightBounds,
-    /// Storage handles (colour, normal) of each atlas texture.
-    storage: Vec<[u32; 2]>,
     bindings: AtlasBindings,
-    jobs: UploadRegion,
     max_jobs: usize,
     scratch_texels: u64,
     /// The last prepared frame's page table.
@@ -132,21 +132,23 @@ pub struct TextureAtlas {
 }
 
 /// What the generation passes read this frame (prepared by [`TextureAtlas`]).
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct TextureFrame {
     /// Dirty tiles and their texels.
     pub jobs: u32,
     pub texels: u64,
+    /// The dirty tiles' jobs, `images` holding the texture's index
+    /// ([`TileJob::images`]).
+    pub tile_jobs: Vec<TileJob>,
 }
 
 /// The atlas and page table the generation passes leave for `terrain.draw`.
 #[derive(Clone, Debug)]
 pub struct AtlasBindings {
-    /// Colour (sRGB-encoded RGBA8) textures, in texture order, with their
-    /// sampled heap handles.
-    pub colors: Vec<(ImageId, u32)>,
+    /// Colour (sRGB-encoded RGBA8) textures, in texture order.
+    pub colors: Vec<ImageId>,
     /// Displacement normal (RGBA8, n·½ + ½) textures.
-    pub normals: Vec<(ImageId, u32)>,
+    pub normals: Vec<ImageId>,
     /// This frame's page table (an upload region, written by `prepare`).
     pub page_table: UploadRegion,
     /// Texels per atlas side.
@@ -160,7 +162,7 @@ pub struct GenerationInputs<'a> {
     /// layers buffer.
     pub heights: ImageId,
     pub noise: ImageId,
-    pub layers: BufferId,
+    pub layers: LayerTable,
     /// The layers' extra input maps.
     pub maps: InputMaps,
     pub tree: &'a LayerTree,
@@ -200,11 +202,6 @@ fn atlas_textures<S: Provides<TextureFrame> + 'static>(
     Ok(textures)
 }
 
-/// A heap handle `handle` of `image`, or an error naming it.
-fn handle(image: &Image, handle: Option<u32>, what: &str) -> Result<u32> {
-    handle.ok_or_else(|| Error::Graph(format!("'{}' has no {what} handle", image.desc().name)))
-}
-
 impl TextureAtlas {
     /// Creates the atlas and declares `texturing.upsample`, one
     /// `texturing.layer*` pass per layer and `texturing.finish` (module
@@ -217,17 +214,11 @@ impl TextureAtlas {
     ) -> Result<TextureAtlas> {
         streaming.validate()?;
         let field = inputs.field.clone();
-        let textures = atlas_textures(ctx, graph, &streaming)?;
-        let mut storage = Vec::new();
-        let (mut colors, mut normals) = (Vec::new(), Vec::new());
-        for [(color, color_image), (normal, normal_image)] in &textures {
-            storage.push([
-                handle(color_image, color_image.storage_handle(), "storage")?,
-                handle(normal_image, normal_image.storage_handle(), "storage")?,
-            ]);
-            colors.push((*color, handle(color_image, color_image.sampled_handle(), "sampled")?));
-            normals.push((*normal, handle(normal_image, normal_image.sampled_handle(), "sampled")?));
-        }
+        let textures: Vec<[ImageId; 2]> = (atlas_textures(ctx, graph, &streaming)?.into_iter())
+            .map(|[(color, _), (normal, _)]| [color, normal])
+            .collect();
+        let colors: Vec<ImageId> = textures.iter().map(|t| t[0]).collect();
+        let normals: Vec<ImageId> = textures.iter().map(|t| t[1]).collect();
         let max_jobs = streaming.budget.tiles.saturating_add(1).min(1 << 16);
         let jobs = graph.upload_region("texture tile jobs", (max_jobs * std::mem::size_of::<TileJob>()) as u64);
         let page_table = graph.upload_region("texture page table", (PAGE_TABLE_WORDS * 16) as u64);
@@ -239,7 +230,6 @@ impl TextureAtlas {
                 location: MemoryLocation::GpuOnly,
             },
         );
-        let images: Vec<ImageId> = colors.iter().chain(&normals).map(|(id, _)| *id).collect();
         let passes = GenerationPasses {
             jobs,
             scratch,
@@ -247,7 +237,7 @@ impl TextureAtlas {
         };
         passes.declare_upsample(ctx, graph, inputs.heights)?;
         passes.declare_layers(ctx, graph, &inputs)?;
-        passes.declare_finish(ctx, graph, &images)?;
+        passes.declare_finish(ctx, graph, &textures)?;
         let readback = match streaming.readback {
             true => Some(add_atlas_readback(ctx, graph, &colors, streaming.atlas.size)?),
             false => None,
@@ -256,14 +246,12 @@ impl TextureAtlas {
             extent: field.extent(),
             cache: TileCache::new(streaming.atlas)?,
             bounds: HeightBounds::new(&field, streaming.quadtree.max_depth)?,
-            storage,
             bindings: AtlasBindings {
                 colors,
                 normals,
                 page_table,
                 atlas_size: streaming.atlas.size,
             },
-            jobs,
             max_jobs,
             scratch_texels,
             table: PageTable::default(),
@@ -352,8 +340,7 @@ impl TextureAtlas {
         }
         let plan = self.cache.plan_frame(frame, &needed, budget);
         let table = PageTable::build(&plan, extent)?;
-        let storage = &self.storage;
-        let (jobs, texels) = tile_jobs(&plan, extent, &|t| storage[t as usize]);
+        let (jobs, texels) = tile_jobs(&plan, extent, &|texture| [texture, texture]);
         if texels > self.scratch_texels || jobs.len() > self.max_jobs {
             return Err(Error::Graph(format!(
                 "texturing: {} tiles of {texels} texels exceed the scratch buffer",
@@ -424,7 +411,6 @@ impl Technique for TextureAtlas {
                     format!("{} words exceed the capacity of {PAGE_TABLE_WORDS}", words.len()),
                 ));
             }
-            frame.uploads.write(self.jobs, bytemuck::cast_slice(&p.jobs))?;
             frame
                 .uploads
                 .write(self.bindings.page_table, bytemuck::cast_slice(&words))?;
@@ -451,6 +437,7 @@ impl Technique for TextureAtlas {
         Ok(TextureFrame {
             jobs: p.jobs.len() as u32,
             texels: p.texels,
+            tile_jobs: p.jobs,
         })
     }
 }

@@ -9,11 +9,13 @@ use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::error::Result;
-use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, RenderGraph, Stage, UploadRegion};
+use crate::error::{Error, Result};
+use crate::graph::{
+    Binding, BufferAccess, BufferId, ImageAccess, ImageId, PassContext, RenderGraph, Stage, UploadRegion,
+};
 use crate::io::heightmap::HeightField;
 use crate::shaders;
-use crate::texturing::generation::{GenerationInputs, TextureFrame, GROUP};
+use crate::texturing::generation::{GenerationInputs, TextureFrame, TileJob, GROUP};
 use crate::view::{Frame, Provides};
 use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, MemoryLocation};
 
@@ -32,7 +34,7 @@ pub(crate) struct TileGenerationPush {
     grid: [u32; 4],
     /// Sample spacing x, y (metres), lowest and highest height.
     spacing_range: [f32; 4],
-    /// Input maps ([`InputMaps::handles`]).
+    /// Input maps ([`crate::surface::input_maps::MapBindings::handles`]).
     maps: [u32; 4],
     /// Terrain rectangle x, y (metres).
     extent: [f32; 4],
@@ -54,6 +56,7 @@ pub(crate) fn base_push(field: &HeightField) -> TileGenerationPush {
 
 /// The resources every generation pass shares.
 pub(crate) struct GenerationPasses {
+    /// This frame's tile jobs, written by `texturing.finish`.
     pub jobs: UploadRegion,
     pub scratch: BufferId,
     pub base_push: TileGenerationPush,
@@ -68,21 +71,20 @@ impl GenerationPasses {
         heights: ImageId,
     ) -> Result<()> {
         let pipeline = ComputePipeline::new(ctx, shaders::TEXTURING_UPSAMPLE)?;
-        let (jobs, scratch, base_push) = (self.jobs, self.scratch, self.base_push);
-        graph
-            .pass("texturing.upsample")
-            .read(heights, ImageAccess::Sampled(Stage::Compute))
-            .read(jobs, BufferAccess::StorageRead(Stage::Compute))
-            .write(scratch, BufferAccess::StorageWrite(Stage::Compute))
-            .record(move |pass, frame| {
-                let tiles = frame.prepared::<TextureFrame>()?;
-                let push = TileGenerationPush {
-                    handles: [pass.upload(jobs)?, pass.storage_buffer(scratch)?, 0, 0],
-                    counts: [tiles.jobs, tiles.texels as u32, 0, pass.sampled(heights)?],
-                    ..base_push
-                };
-                dispatch(pass.cmd(), &pipeline, &push)
-            });
+        let base_push = self.base_push;
+        let mut pass = graph.pass("texturing.upsample");
+        let heights = pass.sample(heights, Stage::Compute);
+        let jobs = pass.upload(self.jobs, Stage::Compute);
+        let scratch = pass.storage_buffer(self.scratch, BufferAccess::StorageWrite(Stage::Compute));
+        pass.record(move |ctx, frame| {
+            let tiles = frame.prepared::<TextureFrame>()?;
+            let push = TileGenerationPush {
+                handles: [ctx.handle(jobs)?, ctx.handle(scratch)?, 0, 0],
+                counts: [tiles.jobs, tiles.texels as u32, 0, ctx.handle(heights)?],
+                ..base_push
+            };
+            dispatch(ctx, &pipeline, &push)
+        });
         Ok(())
     }
 
@@ -94,76 +96,88 @@ impl GenerationPasses {
         inputs: &GenerationInputs,
     ) -> Result<()> {
         let layer_pipeline = Arc::new(ComputePipeline::new(ctx, shaders::TEXTURING_LAYER)?);
-        let (jobs, scratch, base_push) = (self.jobs, self.scratch, self.base_push);
-        let (layers, noise, maps, heights) = (inputs.layers, inputs.noise, inputs.maps, inputs.heights);
+        let base_push = self.base_push;
         for (i, flat) in inputs.tree.layers.iter().enumerate() {
             let name = format!(
                 "texturing.layer{i}.{}",
                 crate::error::printable(&flat.layer.name.replace(char::is_whitespace, "_"))
             );
             let pipeline = layer_pipeline.clone();
-            let mut pass = graph
-                .pass(&name)
-                .read(jobs, BufferAccess::StorageRead(Stage::Compute))
-                .read(layers, BufferAccess::StorageRead(Stage::Compute))
-                .read(noise, ImageAccess::Sampled(Stage::Compute));
-            for map in maps.present() {
-                pass = pass.read(map, ImageAccess::Sampled(Stage::Compute));
-            }
+            let mut pass = graph.pass(&name);
+            let jobs = pass.upload(self.jobs, Stage::Compute);
+            let table = inputs.layers.read_in(&mut pass, Stage::Compute);
+            let noise = pass.sample(inputs.noise, Stage::Compute);
+            let maps = inputs.maps.sample_in(&mut pass, Stage::Compute);
             // A height_blur layer reads the base height beside its blurred one.
-            let blurred = flat.layer.height_blur.is_some();
-            if blurred {
-                pass = pass.read(heights, ImageAccess::Sampled(Stage::Compute));
-            }
-            pass.write(scratch, BufferAccess::StorageReadWrite(Stage::Compute))
-                .record(move |pass, frame| {
-                    let tiles = frame.prepared::<TextureFrame>()?;
-                    let push = TileGenerationPush {
-                        handles: [
-                            pass.upload(jobs)?,
-                            pass.storage_buffer(scratch)?,
-                            pass.storage_buffer(layers)?,
-                            pass.sampled(noise)?,
-                        ],
-                        counts: [
-                            tiles.jobs,
-                            tiles.texels as u32,
-                            i as u32,
-                            if blurred { pass.sampled(heights)? } else { 0 },
-                        ],
-                        maps: maps.handles(),
-                        ..base_push
-                    };
-                    dispatch(pass.cmd(), &pipeline, &push)
-                });
+            let heights = (flat.layer.height_blur.is_some()).then(|| pass.sample(inputs.heights, Stage::Compute));
+            let scratch = pass.storage_buffer(self.scratch, BufferAccess::StorageReadWrite(Stage::Compute));
+            let layers = inputs.layers.clone();
+            pass.record(move |ctx, frame| {
+                let tiles = frame.prepared::<TextureFrame>()?;
+                layers.write(ctx, table, &maps)?;
+                let push = TileGenerationPush {
+                    handles: [
+                        ctx.handle(jobs)?,
+                        ctx.handle(scratch)?,
+                        ctx.handle(table)?,
+                        ctx.handle(noise)?,
+                    ],
+                    counts: [
+                        tiles.jobs,
+                        tiles.texels as u32,
+                        i as u32,
+                        heights.map_or(Ok(0), |h| ctx.handle(h))?,
+                    ],
+                    maps: maps.handles(ctx)?,
+                    ..base_push
+                };
+                dispatch(ctx, &pipeline, &push)
+            });
         }
         Ok(())
     }
 
-    /// `texturing.finish`: colour and normal into the atlas.
+    /// `texturing.finish`: colour and normal into the atlas textures
+    /// (colour, normal per texture). It writes the frame's tile jobs, which
+    /// hold the textures' storage handles (the host writes land before the
+    /// frame is submitted, so the passes before it read them too).
     pub fn declare_finish<S: Provides<TextureFrame> + 'static>(
         &self,
         ctx: &Context,
         graph: &mut RenderGraph<Frame<S>>,
-        images: &[ImageId],
+        textures: &[[ImageId; 2]],
     ) -> Result<()> {
         let pipeline = ComputePipeline::new(ctx, shaders::TEXTURING_FINISH)?;
-        let (jobs, scratch, base_push) = (self.jobs, self.scratch, self.base_push);
-        let mut pass = graph
-            .pass("texturing.finish")
-            .read(jobs, BufferAccess::StorageRead(Stage::Compute))
-            .read(scratch, BufferAccess::StorageRead(Stage::Compute));
-        for &image in images {
-            pass = pass.write(image, ImageAccess::StorageReadWrite(Stage::Compute));
-        }
-        pass.record(move |pass, frame| {
+        let base_push = self.base_push;
+        let mut pass = graph.pass("texturing.finish");
+        let jobs = pass.upload(self.jobs, Stage::Compute);
+        let scratch = pass.storage_buffer(self.scratch, BufferAccess::StorageRead(Stage::Compute));
+        let access = ImageAccess::StorageReadWrite(Stage::Compute);
+        let textures: Vec<[Binding; 2]> = (textures.iter())
+            .map(|&[color, normal]| [pass.storage_image(color, access), pass.storage_image(normal, access)])
+            .collect();
+        pass.record(move |ctx, frame| {
             let tiles = frame.prepared::<TextureFrame>()?;
+            let storage = (textures.iter())
+                .map(|&[color, normal]| Ok([ctx.handle(color)?, ctx.handle(normal)?]))
+                .collect::<Result<Vec<[u32; 2]>>>()?;
+            let with_handles = (tiles.tile_jobs.iter())
+                .map(|job| {
+                    let [color, normal] = *(storage.get(job.images[0] as usize))
+                        .ok_or_else(|| Error::Graph(format!("texturing: no atlas texture {}", job.images[0])))?;
+                    Ok(TileJob {
+                        images: [color, normal, 0, 0],
+                        ..*job
+                    })
+                })
+                .collect::<Result<Vec<TileJob>>>()?;
+            ctx.write_upload(jobs, bytemuck::cast_slice(&with_handles))?;
             let push = TileGenerationPush {
-                handles: [pass.upload(jobs)?, pass.storage_buffer(scratch)?, 0, 0],
+                handles: [ctx.handle(jobs)?, ctx.handle(scratch)?, 0, 0],
                 counts: [tiles.jobs, tiles.texels as u32, 0, 0],
                 ..base_push
             };
-            dispatch(pass.cmd(), &pipeline, &push)
+            dispatch(ctx, &pipeline, &push)
         });
         Ok(())
     }
@@ -173,12 +187,12 @@ impl GenerationPasses {
 pub(crate) fn add_atlas_readback<S: Provides<TextureFrame> + 'static>(
     ctx: &Context,
     graph: &mut RenderGraph<Frame<S>>,
-    colors: &[(ImageId, u32)],
+    colors: &[ImageId],
     atlas_size: u32,
 ) -> Result<Vec<Vec<Arc<Buffer>>>> {
     let mut copies = Vec::new();
     let mut buffers = Vec::new();
-    for (k, &(image, _)) in colors.iter().enumerate() {
+    for (k, &image) in colors.iter().enumerate() {
         let per_frame = Buffer::per_frame(
             ctx,
             BufferDesc {
@@ -196,17 +210,10 @@ pub(crate) fn add_atlas_readback<S: Provides<TextureFrame> + 'static>(
 }
 
 /// One thread per dirty texel; nothing when no tile is dirty.
-fn dispatch(
-    cmd: &mut crate::vulkan::CommandRecorder,
-    pipeline: &ComputePipeline,
-    push: &TileGenerationPush,
-) -> Result<()> {
+fn dispatch(ctx: &mut PassContext<'_>, pipeline: &ComputePipeline, push: &TileGenerationPush) -> Result<()> {
     let groups = u64::from(push.counts[1]).div_ceil(GROUP);
     if groups == 0 {
         return Ok(());
     }
-    cmd.bind_compute(pipeline);
-    cmd.push_constants(push)?;
-    cmd.dispatch(groups as u32, 1, 1);
-    Ok(())
+    ctx.dispatch(pipeline, push, [groups as u32, 1, 1])
 }
