@@ -267,6 +267,14 @@ impl Renderer {
                 progress,
             )?;
         }
+        let shadow_casters = scene.draw_terrain || points_present;
+        let atlases = lighting::shadow_atlases(
+            ctx,
+            &mut graph,
+            (&views, &mut targets),
+            shadow_casters,
+            &settings.shadows,
+        )?;
         let sky = Sky::new(ctx, &targets[0].formats)?;
         for (k, view) in views.iter().enumerate() {
             sky.declare(&mut graph, (k, view), &targets[k]);
@@ -295,7 +303,7 @@ impl Renderer {
         let shadows = lighting::declare_shadows(
             ctx,
             &mut graph,
-            (&views, &mut targets),
+            (&views, atlases),
             (terrain.as_ref(), points.as_ref()),
             settings.shadows,
         )?;

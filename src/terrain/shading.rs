@@ -131,7 +131,7 @@ pub fn declare_draw_pass(
     }
     let (radiance, view_depth, depth) = (targets.radiance, targets.view_depth, targets.depth);
     let (visibility, normal, ids) = (targets.visibility, targets.normal, targets.ids);
-    builder = targets.lighting.read_in(builder, Stage::Fragment);
+    targets.lighting.read_in(&mut builder, Stage::Fragment);
     builder
         .write(radiance, ImageAccess::ColorAttachmentReadWrite)
         .write(visibility, ImageAccess::ColorAttachmentReadWrite)

@@ -85,7 +85,7 @@ mod tests;
 pub use cpu::{CpuReference, SunInput};
 pub use gpu::MonteCarloReference;
 #[cfg(test)]
-pub use gpu::ReferenceProgress;
+pub use gpu::{ReferenceFrame, ReferenceProgress, ReferenceWork};
 #[cfg(test)]
 pub use trace::HeightFieldTracer;
 

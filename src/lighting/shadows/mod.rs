@@ -32,7 +32,7 @@ use bytemuck::{Pod, Zeroable};
 pub use cascades::{plan_cascades, plan_cascades_into, CascadePlan, SceneBounds, ShadowSettings};
 
 use crate::error::{Error, Result};
-use crate::graph::{ImageAccess, ImageId, RenderGraph};
+use crate::graph::{ImageId, RenderGraph};
 use crate::view::{pass_name, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
 use crate::vulkan::{CommandRecorder, Context, Format, Image, ImageDesc, ImageUsageFlags};
 
@@ -58,10 +58,58 @@ pub struct ShadowTarget {
     pub view: ViewIndex,
     /// The atlas (declare `ImageAccess::Sampled(..)` to read it).
     pub atlas: ImageId,
-    /// Its sampled heap handle (fixed for the atlas's lifetime).
-    pub handle: u32,
     /// Side in texels.
     pub size: u32,
+}
+
+/// One view's shadow atlas, created and imported into a graph before its
+/// passes are declared ([`ShadowMaps::declare_clear`]): the passes that
+/// write the view's lighting constants must declare it first.
+pub struct ShadowAtlas {
+    target: ShadowTarget,
+    /// Kept alive with the graph that imported it.
+    image: Arc<Image>,
+    /// The view's name (for the pass names).
+    view_name: String,
+}
+
+impl ShadowAtlas {
+    /// Creates view `index`'s atlas of `settings.atlas_size` and imports it
+    /// into `graph`.
+    pub fn new<P: 'static>(
+        ctx: &Context,
+        graph: &mut RenderGraph<P>,
+        (index, view): (ViewIndex, &View),
+        settings: &ShadowSettings,
+    ) -> Result<ShadowAtlas> {
+        settings.validate()?;
+        let size = settings.atlas_size;
+        let image = Arc::new(Image::new(
+            ctx,
+            ImageDesc {
+                name: pass_name("shadow atlas", &view.name),
+                width: size,
+                height: size,
+                format: SHADOW_FORMAT,
+                usage: ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | ImageUsageFlags::SAMPLED,
+            },
+        )?);
+        let atlas = graph.import_image(image.clone());
+        Ok(ShadowAtlas {
+            target: ShadowTarget {
+                view: index,
+                atlas,
+                size,
+            },
+            image,
+            view_name: view.name.clone(),
+        })
+    }
+
+    /// The atlas in the graph.
+    pub fn id(&self) -> ImageId {
+        self.target.atlas
+    }
 }
 
 struct ShadowView {
@@ -133,41 +181,32 @@ impl ShadowMaps {
         graph: &mut RenderGraph<Frame>,
         (index, view): (ViewIndex, &View),
     ) -> Result<ShadowTarget> {
-        if self.views.iter().any(|v| v.target.view == index) {
-            return Err(Error::Graph(format!("shadows: view {index} declared twice")));
+        let atlas = ShadowAtlas::new(ctx, graph, (index, view), &self.settings)?;
+        self.declare_clear(graph, atlas)
+    }
+
+    /// Declares `shadow.clear` of an atlas created with this graph (clears
+    /// it to depth 1 each frame). Declare before the caster passes.
+    pub fn declare_clear(&mut self, graph: &mut RenderGraph<Frame>, atlas: ShadowAtlas) -> Result<ShadowTarget> {
+        let ShadowAtlas {
+            target,
+            image,
+            view_name,
+        } = atlas;
+        if self.views.iter().any(|v| v.target.view == target.view) {
+            return Err(Error::Graph(format!("shadows: view {} declared twice", target.view)));
         }
-        let size = self.settings.atlas_size;
-        let image = Arc::new(Image::new(
-            ctx,
-            ImageDesc {
-                name: pass_name("shadow atlas", &view.name),
-                width: size,
-                height: size,
-                format: SHADOW_FORMAT,
-                usage: ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | ImageUsageFlags::SAMPLED,
-            },
-        )?);
-        let handle = image
-            .sampled_handle()
-            .ok_or_else(|| Error::Graph("shadows: the atlas has no sampled handle".into()))?;
-        let atlas = graph.import_image(image.clone());
+        if target.size != self.settings.atlas_size {
+            return Err(Error::Graph(format!(
+                "shadows: the atlas is {} texels, the settings {}",
+                target.size, self.settings.atlas_size
+            )));
+        }
         graph
-            .pass(&pass_name("shadow.clear", &view.name))
+            .pass(&pass_name("shadow.clear", &view_name))
             .graphics()
-            .write(atlas, ImageAccess::DepthAttachmentWrite)
-            .record(move |ctx, _| {
-                let image = ctx.image(atlas)?;
-                let cmd = ctx.cmd();
-                cmd.begin_rendering(&[], Some((image, Some(1.0))));
-                cmd.end_rendering();
-                Ok(())
-            });
-        let target = ShadowTarget {
-            view: index,
-            atlas,
-            handle,
-            size,
-        };
+            .depth(target.atlas, Some(1.0))
+            .record(|_, _| Ok(()));
         self.views.push(ShadowView { target, _image: image });
         Ok(target)
     }
@@ -185,14 +224,13 @@ impl ShadowMaps {
     /// it). With `mode` other than [`ShadowMode::Cascaded`] the plan has no
     /// cascade and the passes only clear.
     pub fn plan(&self, index: ViewIndex, view: &View, sun: glam::Vec3, mode: ShadowMode) -> Result<CascadePlan> {
-        let target = self.target(index)?;
+        self.target(index)?;
         let mut plan = plan_cascades(
             &view.culling_camera(),
             view.culling_aspect(),
             sun,
             self.bounds,
             &self.settings,
-            target.handle,
         )?;
         if mode != ShadowMode::Cascaded {
             plan.cascades.clear();
@@ -208,7 +246,7 @@ impl ShadowMaps {
         sun: glam::Vec3,
         mode: ShadowMode,
     ) -> Result<()> {
-        let target = self.target(index)?;
+        self.target(index)?;
         let camera = view.culling_camera();
         plan_cascades_into(
             plan,
@@ -216,7 +254,6 @@ impl ShadowMaps {
             sun,
             self.bounds,
             &self.settings,
-            target.handle,
         )?;
         if mode != ShadowMode::Cascaded {
             plan.cascades.clear();
@@ -258,9 +295,10 @@ impl Technique for ShadowMaps {
     }
 }
 
-/// Records a caster pass: renders into `atlas` (loaded), and per cascade of
-/// `plan` sets the scissor on its quadrant and calls `draw` with the
-/// cascade's push constants (`handles` left to `draw`).
+/// Records a caster pass, which declared `atlas` its depth attachment
+/// (loaded: `.depth(atlas, None)`): per cascade of `plan` sets the scissor
+/// on its quadrant and calls `draw` with the cascade's push constants
+/// (`handles` left to `draw`).
 pub fn record_cascades(
     cmd: &mut CommandRecorder,
     atlas: &Image,
@@ -272,7 +310,6 @@ pub fn record_cascades(
         return Ok(());
     }
     let quadrant = atlas.desc().width / 2;
-    cmd.begin_rendering(&[], Some((atlas, None)));
     let mut result = Ok(());
     for (i, c) in plan.cascades.iter().take(count).enumerate() {
         let (x, y) = ((i as u32 % 2) * quadrant, (i as u32 / 2) * quadrant);
@@ -287,6 +324,5 @@ pub fn record_cascades(
             break;
         }
     }
-    cmd.end_rendering();
     result
 }

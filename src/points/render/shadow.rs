@@ -25,7 +25,7 @@ use glam::DVec3;
 use super::selection::{keeps_instance, ObjectLayout};
 use super::PointRenderer;
 use crate::error::{Error, Result};
-use crate::graph::{BufferAccess, BufferId, ImageAccess, RenderGraph, Stage, UploadRegion};
+use crate::graph::{BufferAccess, BufferId, RenderGraph, Stage, UploadRegion};
 use crate::lighting::shadows::{
     plan_cascades, plan_cascades_into, record_cascades, CascadePlan, SceneBounds, ShadowFrame, ShadowMaps,
     ShadowSettings, ShadowTarget, SHADOW_FORMAT,
@@ -187,19 +187,20 @@ impl PointShadows {
             },
         )?;
         let atlas = target.atlas;
-        graph
-            .pass(&pass_name("points.shadow", &view.name))
-            .graphics()
-            .read(splats, BufferAccess::StorageRead(Stage::Vertex))
-            .read(region, BufferAccess::StorageRead(Stage::Vertex))
-            .write(atlas, ImageAccess::DepthAttachmentWrite)
+        let mut pass = graph.pass(&pass_name("points.shadow", &view.name)).graphics();
+        let handles = [
+            pass.storage_buffer(splats, BufferAccess::StorageRead(Stage::Vertex)),
+            pass.upload(region, Stage::Vertex),
+        ];
+        pass.pipeline(&pipeline)
+            .depth(atlas, None)
             .record(move |ctx, frame| {
                 let plan = frame.prepared::<ShadowFrame>()?.view(index)?;
                 let draws = frame.prepared::<PointShadowFrame>()?.view(index)?;
                 if draws.is_empty() {
                     return Ok(());
                 }
-                let handles = [ctx.storage_buffer(splats)?, ctx.upload(region)?];
+                let handles = [ctx.handle(handles[0])?, ctx.handle(handles[1])?];
                 let image = ctx.image(atlas)?;
                 record_cascades(ctx.cmd(), image, plan, |cmd, mut push| {
                     cmd.bind_graphics(&pipeline);
@@ -299,7 +300,7 @@ impl Technique for PointShadows {
                 let (aspect, bounds) = (view.culling_aspect(), self.bounds);
                 let mut plan = match self.scratch_plan.take() {
                     Some(mut plan) => {
-                        plan_cascades_into(&mut plan, (&camera, aspect), sun, bounds, &self.settings, 0)?;
+                        plan_cascades_into(&mut plan, (&camera, aspect), sun, bounds, &self.settings)?;
                         plan
                     }
                     None => plan_cascades(&camera, aspect, sun, bounds, &self.settings, 0)?,
