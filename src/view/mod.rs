@@ -26,7 +26,7 @@ pub use lens::Intrinsics;
 pub use lighting::{Exposure, Lighting, ShadowMode, SkyLightMode, SkyModel, SunPosition};
 #[cfg(test)]
 pub use targets::LIGHTING_CONSTANTS_BYTES;
-pub use targets::{LightingBindings, LightingInputs, LightingMap, SceneTargets, TargetFormats};
+pub use targets::{LightingBindings, LightingMap, SceneTargets, TargetFormats};
 
 use glam::{DMat4, Mat4, Vec3};
 

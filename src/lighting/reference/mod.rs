@@ -83,9 +83,9 @@ mod tests;
 
 #[cfg(test)]
 pub use cpu::{CpuReference, SunInput};
-pub use gpu::MonteCarloReference;
+pub use gpu::{MonteCarloReference, ReferenceWork};
 #[cfg(test)]
-pub use gpu::{ReferenceFrame, ReferenceProgress, ReferenceWork};
+pub use gpu::ReferenceProgress;
 #[cfg(test)]
 pub use trace::HeightFieldTracer;
 

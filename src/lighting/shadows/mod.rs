@@ -2,25 +2,27 @@
 //! with the horizon maps of the height field; `ALGORITHMS.md` §6).
 //!
 //! [`ShadowMaps`] owns one shadow atlas per view: a single `D32_SFLOAT` 2-D
-//! image, 2×2 quadrants, one per cascade, imported into the graph so its
-//! sampled heap handle never changes. Per frame its `prepare`
+//! image, 2×2 quadrants, one per cascade ([`ShadowAtlas`]), imported into
+//! the graph before the view's `sky` pass, which declares it and writes its
+//! heap handle into the view's lighting constants. Per frame its `prepare`
 //! ([`Technique`]) plans each view's cascades ([`cascades::plan_cascades`])
-//! into a [`ShadowFrame`]; the lead copies a view's [`CascadePlan`] into its
-//! `LightingFrame` with [`CascadePlan::fill`].
+//! into a [`ShadowFrame`]; the lighting copies a view's [`CascadePlan`] into
+//! its `LightingFrame` with [`CascadePlan::fill`].
 //!
-//! Passes, in this order, each writing the atlas as a depth attachment:
+//! Passes, in this order, each writing the atlas as a depth attachment
+//! (`.depth(atlas, ..)`: the graph begins and ends rendering):
 //!
 //! | pass | declared by | what |
 //! |---|---|---|
-//! | `shadow.clear` | [`ShadowMaps::declare_view`] | clears the atlas to 1 |
+//! | `shadow.clear` | [`ShadowMaps::declare_clear`] | clears the atlas to 1 |
 //! | `terrain.shadow` | `Terrain::declare_shadow` (`src/terrain/shadow.rs`) | the view's warped geometry image, per cascade |
 //! | `points.shadow` | `PointShadows::declare` (`src/points/render/shadow.rs`) | splats as depth discs, per cascade |
 //!
 //! The caster passes read the cascade matrices from the frame's prepared
 //! [`ShadowFrame`] and push them (no upload region): each cascade is one
-//! draw with the scissor on its quadrant. Consumers sample the atlas
-//! through `glsl/include/shadows.glsl` after declaring
-//! `ImageAccess::Sampled(Stage::Fragment)` (or `Compute`) of
+//! draw with the scissor on its quadrant ([`record_cascades`]). Consumers
+//! sample the atlas through `glsl/include/shadows.glsl` after declaring
+//! `pass.sample(atlas, Stage::Fragment)` (or `Compute`) of
 //! [`ShadowTarget::atlas`].
 
 pub mod cascades;
@@ -175,6 +177,7 @@ impl ShadowMaps {
 
     /// Creates view `index`'s atlas, imports it and declares `shadow.clear`
     /// (clears it to depth 1 each frame). Declare before the caster passes.
+    #[cfg(test)]
     pub fn declare_view(
         &mut self,
         ctx: &Context,

@@ -303,7 +303,7 @@ impl Technique for PointShadows {
                         plan_cascades_into(&mut plan, (&camera, aspect), sun, bounds, &self.settings)?;
                         plan
                     }
-                    None => plan_cascades(&camera, aspect, sun, bounds, &self.settings, 0)?,
+                    None => plan_cascades(&camera, aspect, sun, bounds, &self.settings)?,
                 };
                 self.plan_view(
                     view.camera.eye,
