@@ -28,7 +28,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use alpenglow::files::{load_keyframes, write_png_rgba8};
 use alpenglow::tools::profile::{chrome_trace, median, summarize};
-use alpenglow::{Camera, CameraPath, FrameImages, Orbit, Rig, Scene};
+use alpenglow::{Camera, CameraPath, FrameImages, FrameProfile, Orbit, Rig, Scene, TextureFrameStats};
 
 use super::args::FlyArgs;
 use super::{
@@ -176,6 +176,38 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     };
     drop(ctx);
     check_validation(report)?;
+    let run = FlyRun {
+        device: &device,
+        profiles: &profiles,
+        wall: &wall,
+        writes: staging.is_some(),
+    };
+    report_fly(&args, &run, &texture_stats, &mut outputs)?;
+    outputs.commit()?;
+    if let Some(dir) = &args.out_dir {
+        println!("  {} frames written to {}", args.frames, dir.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// What a flythrough measured: the device, each frame's profile and wall
+/// time, and whether frames were written.
+struct FlyRun<'a> {
+    device: &'a str,
+    profiles: &'a [FrameProfile],
+    wall: &'a [Duration],
+    writes: bool,
+}
+
+/// Prints the flythrough's GPU, wall and CPU warp times and stages the
+/// `--profile` and `--trace` files.
+fn report_fly(
+    args: &FlyArgs,
+    run: &FlyRun<'_>,
+    texture_stats: &[TextureFrameStats],
+    outputs: &mut Outputs,
+) -> Result<()> {
+    let (device, profiles, wall) = (run.device, run.profiles, run.wall);
     let wall_ms: Vec<f64> = wall.iter().map(|d| d.as_secs_f64() * 1e3).collect();
 
     let gpu: Vec<f64> = profiles.iter().map(|p| p.gpu_ms).collect();
@@ -202,11 +234,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
         "  wall per frame   min {wmin:.3}  median {wmed:.3}  max {wmax:.3} ms, first {:.3} ms \
          (each frame's submission{}, start-up excluded)",
         wall_ms[0],
-        if staging.is_some() {
-            " + read-back + file writes"
-        } else {
-            ""
-        }
+        if run.writes { " + read-back + file writes" } else { "" }
     );
     println!("  CPU warp         min {cmin:.3}  median {cmed:.3}  max {cmax:.3} ms");
     let textures = report_textures(&texture_stats, &profiles);
@@ -214,7 +242,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     if args.profile.is_some() {
         let (passes, frame) = summarize(&profiles);
         let value = serde_json::json!({
-            "device": device,
+            "device": run.device,
             "frames": profiles.len(),
             "gpu_ms": {"min": gmin, "median": gmed, "max": gmax, "per_frame": gpu},
             "wall_ms": {"min": wmin, "median": wmed, "max": wmax, "first": wall_ms[0]},
@@ -227,11 +255,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
         outputs.stage(args.profile.as_deref(), || Ok(text.into_bytes()))?;
     }
     outputs.stage(args.trace.as_deref(), || {
-        Ok(chrome_trace(&device, &profiles)?.into_bytes())
+        Ok(chrome_trace(run.device, &profiles)?.into_bytes())
     })?;
-    outputs.commit()?;
-    if let Some(dir) = &args.out_dir {
-        println!("  {} frames written to {}", args.frames, dir.display());
-    }
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }
