@@ -90,7 +90,7 @@ pub(super) fn declare_shadows(
         return Err(crate::error::Error::Graph("shadows: a view has no atlas".into()));
     }
     for (k, (view, atlas)) in views.iter().zip(atlases).enumerate() {
-        let target = maps.declare_clear(graph, atlas)?;
+        let target = maps.declare_clear(ctx, graph, atlas)?;
         if let Some(terrain) = terrain {
             terrain.declare_shadow(ctx, graph, (k, view), target)?;
         }

@@ -36,7 +36,11 @@ pub use cascades::{plan_cascades, plan_cascades_into, CascadePlan, SceneBounds, 
 use crate::error::{Error, Result};
 use crate::graph::{ImageId, RenderGraph};
 use crate::view::{pass_name, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
-use crate::vulkan::{CommandRecorder, Context, Format, Image, ImageDesc, ImageUsageFlags};
+use crate::shaders;
+use crate::vulkan::{
+    Blend, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
+    ImageUsageFlags, PrimitiveTopology,
+};
 
 /// The depth format of shadow atlases.
 pub const SHADOW_FORMAT: Format = Format::D32_SFLOAT;
@@ -144,6 +148,32 @@ pub struct ShadowMaps {
     views: Vec<ShadowView>,
     /// The previous frame's plans, reused ([`Technique::recycle`]).
     spare: Vec<(ViewIndex, CascadePlan)>,
+    /// The depth-only pipeline `shadow.clear` declares (never bound).
+    clear_pipeline: Option<GraphicsPipeline>,
+}
+
+/// A depth-only pipeline into a shadow atlas: what `shadow.clear` renders
+/// into (it draws nothing).
+fn clear_pipeline(ctx: &Context) -> Result<GraphicsPipeline> {
+    GraphicsPipeline::new(
+        ctx,
+        &GraphicsPipelineDesc {
+            name: "shadow.clear",
+            vertex: shaders::SHADOW_POINTS_VERT,
+            fragment: shaders::SHADOW_POINTS_FRAG,
+            vertex_stride: 0,
+            vertex_attributes: Vec::new(),
+            topology: PrimitiveTopology::TRIANGLE_LIST,
+            cull_back_faces: false,
+            wireframe: false,
+            color_formats: Vec::new(),
+            blend: Blend::None,
+            depth_format: Some(SHADOW_FORMAT),
+            depth_test: true,
+            depth_write: true,
+            depth_compare: CompareOp::LESS_OR_EQUAL,
+        },
+    )
 }
 
 impl ShadowMaps {
@@ -162,6 +192,7 @@ impl ShadowMaps {
             bounds,
             views: Vec::new(),
             spare: Vec::new(),
+            clear_pipeline: None,
         })
     }
 
@@ -185,12 +216,17 @@ impl ShadowMaps {
         (index, view): (ViewIndex, &View),
     ) -> Result<ShadowTarget> {
         let atlas = ShadowAtlas::new(ctx, graph, (index, view), &self.settings)?;
-        self.declare_clear(graph, atlas)
+        self.declare_clear(ctx, graph, atlas)
     }
 
     /// Declares `shadow.clear` of an atlas created with this graph (clears
     /// it to depth 1 each frame). Declare before the caster passes.
-    pub fn declare_clear(&mut self, graph: &mut RenderGraph<Frame>, atlas: ShadowAtlas) -> Result<ShadowTarget> {
+    pub fn declare_clear(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame>,
+        atlas: ShadowAtlas,
+    ) -> Result<ShadowTarget> {
         let ShadowAtlas {
             target,
             image,
@@ -205,9 +241,16 @@ impl ShadowMaps {
                 target.size, self.settings.atlas_size
             )));
         }
+        if self.clear_pipeline.is_none() {
+            self.clear_pipeline = Some(clear_pipeline(ctx)?);
+        }
+        let pipeline = self.clear_pipeline.as_ref().ok_or_else(|| Error::Graph("shadows: no pipeline".into()))?;
+        // Clears only: the graph begins rendering with the clear; the
+        // pipeline states the attachment's format.
         graph
             .pass(&pass_name("shadow.clear", &view_name))
             .graphics()
+            .pipeline(pipeline)
             .depth(target.atlas, Some(1.0))
             .record(|_, _| Ok(()));
         self.views.push(ShadowView { target, _image: image });
