@@ -3,7 +3,9 @@
 //! literal of their own.
 
 use super::View;
-use crate::graph::{Binding, BufferAccess, BufferId, ImageId, ImageInfo, PassBuilder, RenderGraph, Stage, UploadRegion};
+use crate::graph::{
+    Binding, BufferAccess, BufferId, ImageId, ImageInfo, PassBuilder, RenderGraph, Stage, UploadRegion,
+};
 use crate::vulkan::Format;
 
 /// Bytes of one view's lighting constants (`crate::lighting::constants::LightingFrame`).

@@ -178,7 +178,9 @@ impl PhysicalAtmosphere {
     /// `view` must have a sky-view table.
     pub fn fill_altitude(&self, view: ViewIndex, eye_z: f64, frame: &mut LightingFrame) -> Result<()> {
         if view >= self.sky_views.len() {
-            return Err(Error::Graph(format!("the atmosphere has no sky-view table for view {view}")));
+            return Err(Error::Graph(format!(
+                "the atmosphere has no sky-view table for view {view}"
+            )));
         }
         let altitude = (eye_z - f64::from(frame.mie[3])) as f32;
         if !altitude.is_finite() {
@@ -217,64 +219,61 @@ impl PhysicalAtmosphere {
         };
         let push = AtmospherePush::new(&self.params);
         let (transmittance, multiscattering) = (luts.transmittance, luts.multiscattering);
-        let compute = Stage::Compute;
 
-        let pipelines = self.pipelines.clone();
-        let (w, h) = self.sizes.transmittance;
-        let mut pass = graph.pass("lighting.transmittance");
-        let lighting = pass.upload(first, compute);
-        let output = pass.storage_image(transmittance, ImageAccess::StorageWrite(compute));
-        pass.record(move |ctx, _| {
-            let push = AtmospherePush {
-                handles: [ctx.handle(lighting)?, ctx.handle(output)?, 0, 0],
-                size: [w, h, 0, 0],
-                ..push
-            };
-            ctx.dispatch(&pipelines.transmittance, &push, [w.div_ceil(8), h.div_ceil(8), 1])
-        });
-
-        let pipelines = self.pipelines.clone();
-        let (w, h) = self.sizes.multiscattering;
-        let mut pass = graph.pass("lighting.multiscattering");
-        let lighting = pass.upload(first, compute);
-        let transmittance_lut = pass.sample(transmittance, compute);
-        let output = pass.storage_image(multiscattering, ImageAccess::StorageWrite(compute));
-        pass.record(move |ctx, _| {
-            let push = AtmospherePush {
-                handles: [
-                    ctx.handle(lighting)?,
-                    ctx.handle(output)?,
-                    ctx.handle(transmittance_lut)?,
-                    0,
-                ],
-                size: [w, h, 0, 0],
-                ..push
-            };
-            ctx.dispatch(&pipelines.multiscattering, &push, [w.div_ceil(8), h.div_ceil(8), 1])
-        });
-
-        let (w, h) = self.sizes.sky_view;
+        let pipelines = &self.pipelines;
+        declare_table(
+            graph,
+            "lighting.transmittance",
+            (pipelines.clone(), |p| &p.transmittance),
+            (first, &[], transmittance),
+            (self.sizes.transmittance, push),
+        );
+        declare_table(
+            graph,
+            "lighting.multiscattering",
+            (pipelines.clone(), |p| &p.multiscattering),
+            (first, &[transmittance], multiscattering),
+            (self.sizes.multiscattering, push),
+        );
         for (&(name, region), &sky_view) in views.iter().zip(&luts.sky_views) {
-            let pipelines = self.pipelines.clone();
-            let mut pass = graph.pass(&pass_name("lighting.sky_view", name));
-            let lighting = pass.upload(region, compute);
-            let transmittance_lut = pass.sample(transmittance, compute);
-            let multiscattering_lut = pass.sample(multiscattering, compute);
-            let output = pass.storage_image(sky_view, ImageAccess::StorageWrite(compute));
-            pass.record(move |ctx, _| {
-                let push = AtmospherePush {
-                    handles: [
-                        ctx.handle(lighting)?,
-                        ctx.handle(output)?,
-                        ctx.handle(transmittance_lut)?,
-                        ctx.handle(multiscattering_lut)?,
-                    ],
-                    size: [w, h, 0, 0],
-                    ..push
-                };
-                ctx.dispatch(&pipelines.sky_view, &push, [w.div_ceil(8), h.div_ceil(8), 1])
-            });
+            declare_table(
+                graph,
+                &pass_name("lighting.sky_view", name),
+                (pipelines.clone(), |p| &p.sky_view),
+                (region, &[transmittance, multiscattering], sky_view),
+                (self.sizes.sky_view, push),
+            );
         }
         Ok(luts)
     }
+}
+
+/// Declares the table pass `name`: reads the LightingFrame in `region`,
+/// samples `inputs` (handles 2, 3), writes the `size` table `output` with
+/// the pipeline `pick` chooses.
+#[allow(clippy::type_complexity)]
+fn declare_table<P: 'static>(
+    graph: &mut RenderGraph<P>,
+    name: &str,
+    (pipelines, pick): (Arc<Pipelines>, fn(&Pipelines) -> &ComputePipeline),
+    (region, inputs, output): (UploadRegion, &[ImageId], ImageId),
+    ((w, h), push): ((u32, u32), AtmospherePush),
+) {
+    let compute = Stage::Compute;
+    let mut pass = graph.pass(name);
+    let lighting = pass.upload(region, compute);
+    let inputs: Vec<_> = inputs.iter().map(|&image| pass.sample(image, compute)).collect();
+    let output = pass.storage_image(output, ImageAccess::StorageWrite(compute));
+    pass.record(move |ctx, _| {
+        let mut handles = [ctx.handle(lighting)?, ctx.handle(output)?, 0, 0];
+        for (slot, &input) in handles[2..].iter_mut().zip(&inputs) {
+            *slot = ctx.handle(input)?;
+        }
+        let push = AtmospherePush {
+            handles,
+            size: [w, h, 0, 0],
+            ..push
+        };
+        ctx.dispatch(pick(&pipelines), &push, [w.div_ceil(8), h.div_ceil(8), 1])
+    });
 }

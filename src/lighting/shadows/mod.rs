@@ -35,8 +35,8 @@ pub use cascades::{plan_cascades, plan_cascades_into, CascadePlan, SceneBounds, 
 
 use crate::error::{Error, Result};
 use crate::graph::{ImageId, RenderGraph};
-use crate::view::{pass_name, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
 use crate::shaders;
+use crate::view::{pass_name, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
 use crate::vulkan::{
     Blend, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
     ImageUsageFlags, PrimitiveTopology,
@@ -244,7 +244,10 @@ impl ShadowMaps {
         if self.clear_pipeline.is_none() {
             self.clear_pipeline = Some(clear_pipeline(ctx)?);
         }
-        let pipeline = self.clear_pipeline.as_ref().ok_or_else(|| Error::Graph("shadows: no pipeline".into()))?;
+        let pipeline = self
+            .clear_pipeline
+            .as_ref()
+            .ok_or_else(|| Error::Graph("shadows: no pipeline".into()))?;
         // Clears only: the graph begins rendering with the clear; the
         // pipeline states the attachment's format.
         graph
@@ -294,13 +297,7 @@ impl ShadowMaps {
     ) -> Result<()> {
         self.target(index)?;
         let camera = view.culling_camera();
-        plan_cascades_into(
-            plan,
-            (&camera, view.culling_aspect()),
-            sun,
-            self.bounds,
-            &self.settings,
-        )?;
+        plan_cascades_into(plan, (&camera, view.culling_aspect()), sun, self.bounds, &self.settings)?;
         if mode != ShadowMode::Cascaded {
             plan.cascades.clear();
         }

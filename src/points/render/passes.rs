@@ -203,7 +203,8 @@ impl PointBuffers {
             ..*self
         };
         let (mut builder, mut bindings) = buffers.read_by_at(builder, frame, (Stage::Vertex, Stage::Fragment));
-        bindings.triangles = (self.triangles).map(|t| builder.storage_buffer(t, BufferAccess::StorageRead(Stage::Vertex)));
+        bindings.triangles =
+            (self.triangles).map(|t| builder.storage_buffer(t, BufferAccess::StorageRead(Stage::Vertex)));
         match &self.object {
             Some(object) => {
                 let (builder, kernel) = object.read_by(builder);

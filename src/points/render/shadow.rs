@@ -192,26 +192,24 @@ impl PointShadows {
             pass.storage_buffer(splats, BufferAccess::StorageRead(Stage::Vertex)),
             pass.upload(region, Stage::Vertex),
         ];
-        pass.pipeline(&pipeline)
-            .depth(atlas, None)
-            .record(move |ctx, frame| {
-                let plan = frame.prepared::<ShadowFrame>()?.view(index)?;
-                let draws = frame.prepared::<PointShadowFrame>()?.view(index)?;
-                if draws.is_empty() {
-                    return Ok(());
+        pass.pipeline(&pipeline).depth(atlas, None).record(move |ctx, frame| {
+            let plan = frame.prepared::<ShadowFrame>()?.view(index)?;
+            let draws = frame.prepared::<PointShadowFrame>()?.view(index)?;
+            if draws.is_empty() {
+                return Ok(());
+            }
+            let handles = [ctx.handle(handles[0])?, ctx.handle(handles[1])?];
+            let image = ctx.image(atlas)?;
+            record_cascades(ctx.cmd(), image, plan, |cmd, mut push| {
+                cmd.bind_graphics(&pipeline);
+                for d in draws {
+                    push.handles = [handles[0], handles[1], d.record, 0];
+                    cmd.push_constants(&push)?;
+                    cmd.draw(d.count * 6, 1);
                 }
-                let handles = [ctx.handle(handles[0])?, ctx.handle(handles[1])?];
-                let image = ctx.image(atlas)?;
-                record_cascades(ctx.cmd(), image, plan, |cmd, mut push| {
-                    cmd.bind_graphics(&pipeline);
-                    for d in draws {
-                        push.handles = [handles[0], handles[1], d.record, 0];
-                        cmd.push_constants(&push)?;
-                        cmd.draw(d.count * 6, 1);
-                    }
-                    Ok(())
-                })
-            });
+                Ok(())
+            })
+        });
         self.views.push(ShadowView { index, region });
         Ok(())
     }

@@ -44,7 +44,9 @@ use crate::error::{Error, Result};
 use crate::graph::{Binding, BufferAccess, BufferId, BufferInfo, LoadOp, PassBuilder, PassContext, RenderGraph, Stage};
 use crate::shaders;
 use crate::view::{Frame, SceneTargets};
-use crate::vulkan::{ComputePipeline, Context, GraphicsPipeline, GraphicsPipelineDesc, MemoryLocation, PrimitiveTopology};
+use crate::vulkan::{
+    ComputePipeline, Context, GraphicsPipeline, GraphicsPipelineDesc, MemoryLocation, PrimitiveTopology,
+};
 
 /// Bytes of a pixel's lock and z_d (`glsl/include/single_pass_merge.glsl`).
 const PIXEL_WORD_BYTES: u64 = 8;
