@@ -152,28 +152,26 @@ pub struct ShadowMaps {
     clear_pipeline: Option<GraphicsPipeline>,
 }
 
-/// A depth-only pipeline into a shadow atlas: what `shadow.clear` renders
-/// into (it draws nothing).
-fn clear_pipeline(ctx: &Context) -> Result<GraphicsPipeline> {
-    GraphicsPipeline::new(
-        ctx,
-        &GraphicsPipelineDesc {
-            name: "shadow.clear",
-            vertex: shaders::SHADOW_POINTS_VERT,
-            fragment: shaders::SHADOW_POINTS_FRAG,
-            vertex_stride: 0,
-            vertex_attributes: Vec::new(),
-            topology: PrimitiveTopology::TRIANGLE_LIST,
-            cull_back_faces: false,
-            wireframe: false,
-            color_formats: Vec::new(),
-            blend: Blend::None,
-            depth_format: Some(SHADOW_FORMAT),
-            depth_test: true,
-            depth_write: true,
-            depth_compare: CompareOp::LESS_OR_EQUAL,
-        },
-    )
+/// The pipeline of splat-shaped casters into a shadow atlas, depth only
+/// (`glsl/lighting/shadow_points.*`, no vertex input): `points.shadow`'s,
+/// and what `shadow.clear` declares (it draws nothing).
+pub fn splat_caster_desc(name: &'static str) -> GraphicsPipelineDesc {
+    GraphicsPipelineDesc {
+        name,
+        vertex: shaders::SHADOW_POINTS_VERT,
+        fragment: shaders::SHADOW_POINTS_FRAG,
+        vertex_stride: 0,
+        vertex_attributes: Vec::new(),
+        topology: PrimitiveTopology::TRIANGLE_LIST,
+        cull_back_faces: false,
+        wireframe: false,
+        color_formats: Vec::new(),
+        blend: Blend::None,
+        depth_format: Some(SHADOW_FORMAT),
+        depth_test: true,
+        depth_write: true,
+        depth_compare: CompareOp::LESS_OR_EQUAL,
+    }
 }
 
 impl ShadowMaps {
@@ -242,7 +240,7 @@ impl ShadowMaps {
             )));
         }
         if self.clear_pipeline.is_none() {
-            self.clear_pipeline = Some(clear_pipeline(ctx)?);
+            self.clear_pipeline = Some(GraphicsPipeline::new(ctx, &splat_caster_desc("shadow.clear"))?);
         }
         let pipeline = self
             .clear_pipeline

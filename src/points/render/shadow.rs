@@ -27,13 +27,12 @@ use super::PointRenderer;
 use crate::error::{Error, Result};
 use crate::graph::{BufferAccess, BufferId, RenderGraph, Stage, UploadRegion};
 use crate::lighting::shadows::{
-    plan_cascades, plan_cascades_into, record_cascades, CascadePlan, SceneBounds, ShadowFrame, ShadowMaps,
-    ShadowSettings, ShadowTarget, SHADOW_FORMAT,
+    plan_cascades, plan_cascades_into, record_cascades, splat_caster_desc, CascadePlan, SceneBounds, ShadowFrame,
+    ShadowMaps, ShadowSettings, ShadowTarget,
 };
 use crate::points::scene::PointScene;
-use crate::shaders;
 use crate::view::{pass_name, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
-use crate::vulkan::{Blend, Buffer, CompareOp, Context, GraphicsPipeline, GraphicsPipelineDesc, PrimitiveTopology};
+use crate::vulkan::{Buffer, Context, GraphicsPipeline};
 
 /// Header of a view's shadow records (`ShadowPoints` in shadow_points.vert).
 #[repr(C)]
@@ -167,25 +166,7 @@ impl PointShadows {
             &pass_name("point shadow casters", &view.name),
             HEADER_BYTES + RECORD_BYTES * records,
         );
-        let pipeline = GraphicsPipeline::new(
-            ctx,
-            &GraphicsPipelineDesc {
-                name: "points.shadow",
-                vertex: shaders::SHADOW_POINTS_VERT,
-                fragment: shaders::SHADOW_POINTS_FRAG,
-                vertex_stride: 0,
-                vertex_attributes: Vec::new(),
-                topology: PrimitiveTopology::TRIANGLE_LIST,
-                cull_back_faces: false,
-                wireframe: false,
-                color_formats: Vec::new(),
-                blend: Blend::None,
-                depth_format: Some(SHADOW_FORMAT),
-                depth_test: true,
-                depth_write: true,
-                depth_compare: CompareOp::LESS_OR_EQUAL,
-            },
-        )?;
+        let pipeline = GraphicsPipeline::new(ctx, &splat_caster_desc("points.shadow"))?;
         let atlas = target.atlas;
         let mut pass = graph.pass(&pass_name("points.shadow", &view.name)).graphics();
         let handles = [
