@@ -237,10 +237,10 @@ fn report_fly(
         if run.writes { " + read-back + file writes" } else { "" }
     );
     println!("  CPU warp         min {cmin:.3}  median {cmed:.3}  max {cmax:.3} ms");
-    let textures = report_textures(&texture_stats, &profiles);
+    let textures = report_textures(texture_stats, profiles);
 
     if args.profile.is_some() {
-        let (passes, frame) = summarize(&profiles);
+        let (passes, frame) = summarize(profiles);
         let value = serde_json::json!({
             "device": run.device,
             "frames": profiles.len(),
@@ -255,7 +255,7 @@ fn report_fly(
         outputs.stage(args.profile.as_deref(), || Ok(text.into_bytes()))?;
     }
     outputs.stage(args.trace.as_deref(), || {
-        Ok(chrome_trace(run.device, &profiles)?.into_bytes())
+        Ok(chrome_trace(run.device, profiles)?.into_bytes())
     })?;
     Ok(())
 }

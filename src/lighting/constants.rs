@@ -1,9 +1,14 @@
 //! The per-view lighting constants (`glsl/include/lighting.glsl`,
-//! `LightingFrame`), written by the lighting technique's prepare step into
-//! the frame's upload arena; every shading pass reads them through one
-//! storage handle.
+//! `LightingFrame`): the lighting technique's prepare step computes their
+//! values, and the view's `sky` pass, which declares every lighting map,
+//! adds the maps' heap handles and writes them into the frame's upload
+//! arena; every shading pass reads them through one storage handle.
 
 use bytemuck::{Pod, Zeroable};
+
+use crate::error::Result;
+use crate::graph::PassContext;
+use crate::view::{LightingBindings, LightingMap};
 
 /// Angular radius of the sun's disc (rad).
 pub const SUN_ANGULAR_RADIUS: f32 = 0.004_654;
@@ -77,6 +82,36 @@ pub struct LightingFrame {
     pub cascade_far: [f32; 4],
     /// World size (m) of one shadow texel per cascade.
     pub cascade_texel: [f32; 4],
+}
+
+impl LightingFrame {
+    /// Writes `handle`, the heap handle of the lighting map `map`, into its
+    /// slot. The reference's maps replace the sky-light map only in the
+    /// reference mode (`models.z`, set first).
+    pub fn set_map_handle(&mut self, map: LightingMap, handle: u32) {
+        let reference = self.models[2] == SKY_LIGHT_REFERENCE;
+        match map {
+            LightingMap::Transmittance => self.atmosphere[0] = handle,
+            LightingMap::Multiscattering => self.atmosphere[1] = handle,
+            LightingMap::SkyView => self.atmosphere[2] = handle,
+            LightingMap::ShadowAtlas => self.shadows[0] = handle,
+            LightingMap::SkyLight if !reference => self.maps[0] = handle,
+            LightingMap::Horizon => self.maps[1] = handle,
+            LightingMap::Environment => self.maps[3] = handle,
+            LightingMap::ReferenceSkyLight if reference => self.maps[0] = handle,
+            LightingMap::ReferenceSunVisibility if reference => self.maps[2] = handle,
+            LightingMap::SkyLight | LightingMap::ReferenceSkyLight | LightingMap::ReferenceSunVisibility => {}
+        }
+    }
+
+    /// Writes the heap handles of every lighting map `bindings` holds (the
+    /// declarations of the pass recording, `ctx`).
+    pub fn set_map_handles(&mut self, ctx: &PassContext<'_>, bindings: &LightingBindings) -> Result<()> {
+        for &(map, binding) in &bindings.maps {
+            self.set_map_handle(map, ctx.handle(binding)?);
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]

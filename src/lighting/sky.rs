@@ -3,15 +3,18 @@
 //! `glsl/include/sky.glsl`) along its view ray plus the sun disc, in
 //! absolute units, and clearing view-space depth to +inf, the lighting
 //! AOVs to (1, 1), the world normal to 0 and the class and instance ids to
-//! sky (0, 0; `crate::view::aov`).
+//! sky (0, 0; `crate::view::aov`). It also writes the view's lighting
+//! constants: it declares every lighting map, so the constants can name
+//! their heap handles.
 
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
-use crate::graph::{ImageAccess, RenderGraph, Stage};
+use crate::graph::{LoadOp, RenderGraph, Stage};
+use crate::lighting::technique::PreparedLighting;
 use crate::shaders;
-use crate::view::{pass_name, Declare, Frame, SceneTargets, TargetFormats, View, ViewIndex};
-use crate::vulkan::{Context, GraphicsPipeline, GraphicsPipelineDesc, LoadOp};
+use crate::view::{pass_name, Declare, Frame, Provides, SceneTargets, TargetFormats, View, ViewIndex};
+use crate::vulkan::{Context, GraphicsPipeline, GraphicsPipelineDesc};
 
 /// Push constants of `sky` (`glsl/lighting/sky.frag`): the view ray basis
 /// and the sun.
@@ -55,59 +58,43 @@ impl Sky {
     }
 
     /// Declares `sky` for view `index`: writes its radiance, view depth,
-    /// lighting AOVs, normal and ids.
-    pub fn declare<S: 'static>(
+    /// lighting AOVs, normal and ids, and the view's lighting constants
+    /// (the values the lighting prepared, with the heap handles of the
+    /// lighting maps this pass declares).
+    pub fn declare<S: Provides<PreparedLighting> + 'static>(
         &self,
         graph: &mut RenderGraph<Frame<S>>,
         (index, view): (ViewIndex, &View),
         targets: &SceneTargets,
     ) {
         let pipeline = self.pipeline.clone();
-        let (radiance, view_depth, visibility) = (targets.radiance, targets.view_depth, targets.visibility);
-        let (normal, ids) = (targets.normal, targets.ids);
-        let lighting = targets.lighting.constants;
-        let builder = graph.pass(&pass_name("sky", &view.name)).graphics();
-        targets
-            .lighting
-            .read_in(builder, Stage::Fragment)
-            .write(radiance, ImageAccess::ColorAttachmentWrite)
-            .write(view_depth, ImageAccess::ColorAttachmentWrite)
-            .write(visibility, ImageAccess::ColorAttachmentWrite)
-            .write(normal, ImageAccess::ColorAttachmentWrite)
-            .write(ids, ImageAccess::ColorAttachmentWrite)
-            .record(move |pass, frame| {
+        let mut pass = graph.pass(&pass_name("sky", &view.name)).graphics();
+        let lighting = targets.lighting.read_in(&mut pass, Stage::Fragment);
+        pass.pipeline(&pipeline)
+            .color(targets.radiance, LoadOp::DontCare)
+            .color(targets.view_depth, LoadOp::DontCare)
+            .color(targets.visibility, LoadOp::DontCare)
+            .color(targets.normal, LoadOp::DontCare)
+            .color(targets.ids, LoadOp::DontCare)
+            .record(move |ctx, frame| {
+                let mut constants = *frame.prepared::<PreparedLighting>()?.view(index)?;
+                constants.set_map_handles(ctx, &lighting)?;
+                ctx.write_upload_pod(lighting.constants, &constants)?;
                 let view = frame.view(index)?;
                 let (right, up, forward) = view.ray_basis();
                 let push = SkyPush {
                     right: right.extend(0.0).to_array(),
                     up: up.extend(0.0).to_array(),
                     forward: forward.extend(0.0).to_array(),
-                    lighting: [pass.upload(lighting)?, 0, 0, 0],
+                    lighting: [ctx.handle(lighting.constants)?, 0, 0, 0],
                 };
-                let (radiance, view_depth) = (pass.image(radiance)?, pass.image(view_depth)?);
-                let (visibility, normal, ids) = (pass.image(visibility)?, pass.image(normal)?, pass.image(ids)?);
-                let cmd = pass.cmd();
-                cmd.begin_rendering(
-                    &[
-                        (radiance, LoadOp::DontCare),
-                        (view_depth, LoadOp::DontCare),
-                        (visibility, LoadOp::DontCare),
-                        (normal, LoadOp::DontCare),
-                        (ids, LoadOp::DontCare),
-                    ],
-                    None,
-                );
-                cmd.bind_graphics(&pipeline);
-                cmd.push_constants(&push)?;
-                cmd.draw(3, 1);
-                cmd.end_rendering();
-                Ok(())
+                ctx.draw_full_screen(&pipeline, &push)
             });
     }
 }
 
 /// `sky` of a view: its targets in, nothing out.
-impl<S: 'static> Declare<S> for Sky {
+impl<S: Provides<PreparedLighting> + 'static> Declare<S> for Sky {
     type Inputs<'a> = &'a SceneTargets;
     type Outputs = ();
 

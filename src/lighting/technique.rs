@@ -1,10 +1,10 @@
 //! The lighting technique (§6.3, §9): its prepare step turns the frame's
 //! [`FrameLighting`] into each view's [`LightingFrame`] constants (sun,
-//! sky model coefficients, aerial perspective, cascades, map handles) in the
-//! view's upload region ([`SceneLighting::declare_constants`]), which
-//! every shading pass reads; the lighting passes (lookup tables, shadow
-//! casters, sky light) are declared by its parts. It needs the frame's
-//! shadow cascades ([`ShadowFrame`]) when the scene has shadow casters.
+//! sky model coefficients, aerial perspective, cascades); the view's `sky`
+//! pass adds the maps' heap handles and writes them into the view's upload
+//! region ([`crate::view::LightingInputs::constants`]), which every shading
+//! pass reads; the lighting passes (lookup tables, shadow casters, sky
+//! light) are declared by its parts.
 
 use glam::Vec3;
 
@@ -12,7 +12,7 @@ use super::aerial::AerialCoefficients;
 use super::atmosphere::{sun_transmittance, AtmosphereParameters, PhysicalAtmosphere};
 use super::constants::*;
 use super::preetham::PreethamSky;
-use super::reference::MonteCarloReference;
+use super::reference::{MonteCarloReference, ReferenceWork};
 use super::shadows::ShadowFrame;
 use super::sky_light::SkyLight;
 use crate::error::{Error, Result};
@@ -30,9 +30,21 @@ pub struct FieldInfo {
     pub ground: f32,
 }
 
-/// The frame's lighting constants, per view, as written.
+/// The frame's lighting constants, per view, without the maps' heap
+/// handles (the view's `sky` pass adds them and writes the constants).
 pub struct PreparedLighting {
     pub views: Vec<LightingFrame>,
+    /// What `lighting.reference` dispatches this frame (the reference mode).
+    pub reference: Option<ReferenceWork>,
+}
+
+impl PreparedLighting {
+    /// The constants of view `index`.
+    pub fn view(&self, index: usize) -> Result<&LightingFrame> {
+        self.views
+            .get(index)
+            .ok_or_else(|| Error::Graph(format!("lighting: view {index} was not prepared")))
+    }
 }
 
 /// The lighting of a scene: per-view constant regions and the parts'
@@ -155,10 +167,11 @@ impl Technique for SceneLighting {
         let mut views = std::mem::take(&mut self.spare);
         views.clear();
         let shared = self.constants(frame.lighting)?;
+        let mut reference_work = None;
         for (k, view) in frame.views.iter().enumerate() {
             let mut constants = shared;
             if let Some(atmosphere) = &self.atmosphere {
-                atmosphere.fill_handles(k, view.camera.eye.z, &mut constants)?;
+                atmosphere.fill_altitude(k, view.camera.eye.z, &mut constants)?;
             }
             if let Some(shadows) = shadows {
                 shadows.view(k)?.fill(&mut constants);
@@ -167,23 +180,24 @@ impl Technique for SceneLighting {
                 sky_light.fill(&mut constants);
             }
             if frame.lighting.sky_light == SkyLightMode::Reference {
-                let reference = self.reference.as_ref().ok_or_else(|| {
+                let reference = self.reference.as_mut().ok_or_else(|| {
                     Error::invalid(
                         "lighting.sky_light",
                         "reference: the renderer was built without the Monte Carlo reference (start with it)",
                     )
                 })?;
-                reference.prepare(&constants)?;
-                reference.fill(&mut constants)?;
+                reference_work = Some(reference.prepare(&constants).0);
+                reference.fill(&mut constants);
             }
-            let region = *self
-                .regions
-                .get(k)
-                .ok_or_else(|| crate::error::Error::Graph(format!("view {k} has no lighting constants region")))?;
-            frame.uploads.write_pod(region, &constants)?;
+            if k >= self.regions.len() {
+                return Err(Error::Graph(format!("view {k} has no lighting constants region")));
+            }
             views.push(constants);
         }
-        Ok(PreparedLighting { views })
+        Ok(PreparedLighting {
+            views,
+            reference: reference_work,
+        })
     }
 
     fn recycle(&mut self, previous: PreparedLighting) {

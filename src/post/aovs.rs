@@ -27,10 +27,10 @@ use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
 
 use crate::error::{Error, Result};
-use crate::graph::{BufferAccess, ImageAccess, RenderGraph, Stage, UploadRegion};
+use crate::graph::{LoadOp, RenderGraph, Stage, UploadRegion};
 use crate::shaders;
 use crate::view::{pass_name, Declare, Frame, FrameContext, SceneTargets, TargetFormats, Technique, View, ViewIndex};
-use crate::vulkan::{Context, GraphicsPipeline, GraphicsPipelineDesc, LoadOp};
+use crate::vulkan::{Context, GraphicsPipeline, GraphicsPipelineDesc};
 
 /// Per-view constants of `aovs` (`AovConstants` in glsl/post/aovs.frag).
 #[repr(C)]
@@ -134,27 +134,19 @@ impl Aovs {
         let constants = graph.upload_region(&pass_name("aov constants", &view.name), AOV_CONSTANTS_BYTES);
         let pipeline = self.pipeline.clone();
         let (view_depth, motion, distance) = (targets.view_depth, targets.motion, targets.distance);
-        graph
-            .pass(&pass_name("aovs", &view.name))
-            .graphics()
-            .read(view_depth, ImageAccess::Sampled(Stage::Fragment))
-            .read(constants, BufferAccess::StorageRead(Stage::Fragment))
-            .write(motion, ImageAccess::ColorAttachmentWrite)
-            .write(distance, ImageAccess::ColorAttachmentWrite)
-            .record(move |pass, _| {
+        let mut pass = graph.pass(&pass_name("aovs", &view.name)).graphics();
+        let depth = pass.sample(view_depth, Stage::Fragment);
+        let constants_binding = pass.upload(constants, Stage::Fragment);
+        pass.pipeline(&pipeline)
+            .color(motion, LoadOp::DontCare)
+            .color(distance, LoadOp::DontCare)
+            .record(move |ctx, _| {
                 let push = AovPush {
-                    depth: pass.sampled(view_depth)?,
-                    constants: pass.upload(constants)?,
+                    depth: ctx.handle(depth)?,
+                    constants: ctx.handle(constants_binding)?,
                     _pad: [0; 2],
                 };
-                let (motion, distance) = (pass.image(motion)?, pass.image(distance)?);
-                let cmd = pass.cmd();
-                cmd.begin_rendering(&[(motion, LoadOp::DontCare), (distance, LoadOp::DontCare)], None);
-                cmd.bind_graphics(&pipeline);
-                cmd.push_constants(&push)?;
-                cmd.draw(3, 1);
-                cmd.end_rendering();
-                Ok(())
+                ctx.draw_full_screen(&pipeline, &push)
             });
         self.views.push(AovView { index, constants });
         self.previous.push(None);

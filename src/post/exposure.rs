@@ -71,29 +71,24 @@ impl ExposureMeter {
         );
         let pipeline = self.pipeline.clone();
         let (radiance, width, height) = (targets.radiance, targets.width, targets.height);
-        graph
-            .pass(&pass_name("exposure.meter", &view.name))
-            .read(radiance, ImageAccess::StorageRead(Stage::Compute))
-            .write(exposure, BufferAccess::StorageWrite(Stage::Compute))
-            .record(move |pass, frame| {
-                let manual = match frame.lighting.exposure {
-                    Exposure::Auto => 0.0,
-                    Exposure::Ev100(ev) => multiplier_of_ev100(ev),
-                };
-                let push = MeterPush {
-                    radiance: pass.storage_image(radiance)?,
-                    exposure: pass.storage_buffer(exposure)?,
-                    width,
-                    height,
-                    manual,
-                    ..MeterPush::zeroed()
-                };
-                let cmd = pass.cmd();
-                cmd.bind_compute(&pipeline);
-                cmd.push_constants(&push)?;
-                cmd.dispatch(1, 1, 1);
-                Ok(())
-            });
+        let mut pass = graph.pass(&pass_name("exposure.meter", &view.name));
+        let radiance = pass.storage_image(radiance, ImageAccess::StorageRead(Stage::Compute));
+        let output = pass.storage_buffer(exposure, BufferAccess::StorageWrite(Stage::Compute));
+        pass.record(move |ctx, frame| {
+            let manual = match frame.lighting.exposure {
+                Exposure::Auto => 0.0,
+                Exposure::Ev100(ev) => multiplier_of_ev100(ev),
+            };
+            let push = MeterPush {
+                radiance: ctx.handle(radiance)?,
+                exposure: ctx.handle(output)?,
+                width,
+                height,
+                manual,
+                ..MeterPush::zeroed()
+            };
+            ctx.dispatch(&pipeline, &push, [1, 1, 1])
+        });
         exposure
     }
 }

@@ -175,29 +175,22 @@ impl MotionBlur {
         let i = *images;
         let params = [settings.factor(), settings.max_length_px, SOFT_DEPTH, 0.0];
         let samples = settings.samples;
-        let mut builder = graph.pass(&pass_name("post.motion_blur", view_name));
-        for image in read {
-            builder = builder.read(image, ImageAccess::Sampled(Stage::Compute));
-        }
-        builder
-            .write(i.output, ImageAccess::StorageWrite(Stage::Compute))
-            .record(move |pass, _| {
-                let push = MotionBlurPush {
-                    handles: [
-                        pass.sampled(i.radiance)?,
-                        pass.sampled(i.depth)?,
-                        pass.sampled(i.motion)?,
-                        pass.storage_image(i.output)?,
-                    ],
-                    size: [i.width, i.height, samples, 0],
-                    params,
-                };
-                let cmd = pass.cmd();
-                cmd.bind_compute(&pipeline);
-                cmd.push_constants(&push)?;
-                cmd.dispatch(i.width.div_ceil(8), i.height.div_ceil(8), 1);
-                Ok(())
-            });
+        let mut pass = graph.pass(&pass_name("post.motion_blur", view_name));
+        let [radiance, depth, motion] = read.map(|image| pass.sample(image, Stage::Compute));
+        let output = pass.storage_image(i.output, ImageAccess::StorageWrite(Stage::Compute));
+        pass.record(move |ctx, _| {
+            let push = MotionBlurPush {
+                handles: [
+                    ctx.handle(radiance)?,
+                    ctx.handle(depth)?,
+                    ctx.handle(motion)?,
+                    ctx.handle(output)?,
+                ],
+                size: [i.width, i.height, samples, 0],
+                params,
+            };
+            ctx.dispatch(&pipeline, &push, [i.width.div_ceil(8), i.height.div_ceil(8), 1])
+        });
         Ok(())
     }
 }

@@ -10,7 +10,7 @@ use std::sync::Arc;
 use bytemuck::Pod;
 
 use crate::error::{Error, Result};
-use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, PassContext, RenderGraph, Stage};
+use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, RenderGraph, Stage};
 use crate::vulkan::{ComputePipeline, Format};
 
 /// How a resampling pass treats an image.
@@ -148,9 +148,10 @@ pub(crate) fn check_size(parameter: &str, (width, height): (u32, u32)) -> Result
 }
 
 /// Declares the compute pass `name`: reads every source (sampled) and
-/// `buffers`, writes every target, and per image pushes what `push` makes of
-/// it (with its source's sampled and its target's storage handle) and
-/// dispatches 8×8 groups over `target_size`.
+/// `buffers` (storage), writes every target, and per image pushes what
+/// `push` makes of it (with its source's sampled and its target's storage
+/// handle, and the handles of `buffers`, in order) and dispatches 8×8
+/// groups over `target_size`.
 pub(crate) fn declare_pass<P: 'static, T: Pod>(
     graph: &mut RenderGraph<P>,
     name: &str,
@@ -158,26 +159,25 @@ pub(crate) fn declare_pass<P: 'static, T: Pod>(
     images: Vec<CheckedImage>,
     buffers: &[BufferId],
     target_size: (u32, u32),
-    push: impl Fn(&PassContext<'_>, &CheckedImage, [u32; 2]) -> Result<T> + Send + Sync + 'static,
+    push: impl Fn(&CheckedImage, [u32; 2], &[u32]) -> Result<T> + Send + Sync + 'static,
 ) {
-    let mut builder = graph.pass(name);
-    for image in &images {
-        builder = builder.read(image.source, ImageAccess::Sampled(Stage::Compute));
-    }
-    for &buffer in buffers {
-        builder = builder.read(buffer, BufferAccess::StorageRead(Stage::Compute));
-    }
-    for image in &images {
-        builder = builder.write(image.target, ImageAccess::StorageWrite(Stage::Compute));
-    }
-    builder.record(move |pass, _| {
-        for image in &images {
-            let handles = [pass.sampled(image.source)?, pass.storage_image(image.target)?];
-            let constants = push(pass, image, handles)?;
-            let cmd = pass.cmd();
-            cmd.bind_compute(&pipeline);
-            cmd.push_constants(&constants)?;
-            cmd.dispatch(target_size.0.div_ceil(8), target_size.1.div_ceil(8), 1);
+    let mut pass = graph.pass(name);
+    let sources: Vec<_> = (images.iter())
+        .map(|image| pass.sample(image.source, Stage::Compute))
+        .collect();
+    let buffers: Vec<_> = (buffers.iter())
+        .map(|&buffer| pass.storage_buffer(buffer, BufferAccess::StorageRead(Stage::Compute)))
+        .collect();
+    let targets: Vec<_> = (images.iter())
+        .map(|image| pass.storage_image(image.target, ImageAccess::StorageWrite(Stage::Compute)))
+        .collect();
+    pass.record(move |ctx, _| {
+        let buffers = (buffers.iter()).map(|&b| ctx.handle(b)).collect::<Result<Vec<_>>>()?;
+        for ((image, &source), &target) in images.iter().zip(&sources).zip(&targets) {
+            let handles = [ctx.handle(source)?, ctx.handle(target)?];
+            let constants = push(image, handles, &buffers)?;
+            let groups = [target_size.0.div_ceil(8), target_size.1.div_ceil(8), 1];
+            ctx.dispatch(&pipeline, &constants, groups)?;
         }
         Ok(())
     });

@@ -170,7 +170,7 @@ impl Resolve {
             checked,
             &[],
             t,
-            move |_, image, h| {
+            move |image, h, _| {
                 Ok(ResolvePush {
                     handles: [h[0], h[1], image.format, image.kind],
                     size: [s.0, s.1, t.0, t.1],

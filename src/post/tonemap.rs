@@ -50,25 +50,20 @@ impl Tonemap {
     ) {
         let pipeline = self.pipeline.clone();
         let (radiance, display, width, height) = (targets.radiance, targets.display, targets.width, targets.height);
-        graph
-            .pass(&pass_name("tonemap", &view.name))
-            .read(radiance, ImageAccess::StorageRead(Stage::Compute))
-            .read(exposure, BufferAccess::StorageRead(Stage::Compute))
-            .write(display, ImageAccess::StorageWrite(Stage::Compute))
-            .record(move |pass, _| {
-                let push = TonemapPush {
-                    radiance: pass.storage_image(radiance)?,
-                    display: pass.storage_image(display)?,
-                    exposure: pass.storage_buffer(exposure)?,
-                    width,
-                    height,
-                    ..TonemapPush::zeroed()
-                };
-                let cmd = pass.cmd();
-                cmd.bind_compute(&pipeline);
-                cmd.push_constants(&push)?;
-                cmd.dispatch(width.div_ceil(8), height.div_ceil(8), 1);
-                Ok(())
-            });
+        let mut pass = graph.pass(&pass_name("tonemap", &view.name));
+        let radiance = pass.storage_image(radiance, ImageAccess::StorageRead(Stage::Compute));
+        let exposure = pass.storage_buffer(exposure, BufferAccess::StorageRead(Stage::Compute));
+        let display = pass.storage_image(display, ImageAccess::StorageWrite(Stage::Compute));
+        pass.record(move |ctx, _| {
+            let push = TonemapPush {
+                radiance: ctx.handle(radiance)?,
+                display: ctx.handle(display)?,
+                exposure: ctx.handle(exposure)?,
+                width,
+                height,
+                ..TonemapPush::zeroed()
+            };
+            ctx.dispatch(&pipeline, &push, [width.div_ceil(8), height.div_ceil(8), 1])
+        });
     }
 }

@@ -9,13 +9,13 @@ use crate::error::Result;
 use crate::graph::{RenderGraph, UploadRegion};
 use crate::lighting::atmosphere::{AtmosphereParameters, LutSizes, PhysicalAtmosphere};
 use crate::lighting::reference::{MonteCarloReference, ReferenceSettings};
-use crate::lighting::shadows::{ShadowMaps, ShadowSettings};
+use crate::lighting::shadows::{ShadowAtlas, ShadowMaps, ShadowSettings};
 use crate::lighting::sky_light::{BakeSettings, SkyLight, SkyLightBake};
 use crate::lighting::technique::{FieldInfo, SceneLighting};
 use crate::points::render::shadow::PointShadows;
 use crate::points::render::PointRenderer;
 use crate::terrain::Terrain;
-use crate::view::{LightingSetup, SceneTargets, View};
+use crate::view::{LightingMap, LightingSetup, SceneTargets, View};
 use crate::vulkan::Context;
 
 use super::{RenderFrame, Scene};
@@ -45,14 +45,35 @@ pub(super) fn scene_lighting(scene: &Scene, regions: Vec<UploadRegion>) -> Scene
     )
 }
 
-/// Declares each view's shadow atlas (`shadow.clear`) and its casters
-/// (`terrain.shadow` after the view's `terrain.warp`, `points.shadow`), and
-/// adds the atlas to what the view's shading passes read. None without
-/// casters.
-pub(super) fn declare_shadows(
+/// Creates each view's shadow atlas (when the scene has casters) and adds
+/// it to what the view's shading passes read: before the views' `sky`
+/// passes, which write the lighting constants that name it.
+pub(super) fn shadow_atlases(
     ctx: &Context,
     graph: &mut RenderGraph<RenderFrame>,
     (views, targets): (&[View], &mut [SceneTargets]),
+    casters: bool,
+    settings: &ShadowSettings,
+) -> Result<Vec<ShadowAtlas>> {
+    if !casters {
+        return Ok(Vec::new());
+    }
+    let mut atlases = Vec::with_capacity(views.len());
+    for (k, (view, targets)) in views.iter().zip(targets).enumerate() {
+        let atlas = ShadowAtlas::new(ctx, graph, (k, view), settings)?;
+        targets.lighting.images.push((LightingMap::ShadowAtlas, atlas.id()));
+        atlases.push(atlas);
+    }
+    Ok(atlases)
+}
+
+/// Declares each view's `shadow.clear` of its atlas ([`shadow_atlases`])
+/// and its casters (`terrain.shadow` after the view's `terrain.warp`,
+/// `points.shadow`). None without casters.
+pub(super) fn declare_shadows(
+    ctx: &Context,
+    graph: &mut RenderGraph<RenderFrame>,
+    (views, atlases): (&[View], Vec<ShadowAtlas>),
     (terrain, points): (Option<&Terrain>, Option<&PointRenderer>),
     settings: ShadowSettings,
 ) -> Result<Option<SunShadows>> {
@@ -65,15 +86,17 @@ pub(super) fn declare_shadows(
     };
     let mut maps = ShadowMaps::new(settings, bounds)?;
     let mut casters = points.map(|p| PointShadows::new(p, &maps));
-    for (k, (view, targets)) in views.iter().zip(targets).enumerate() {
-        let target = maps.declare_view(ctx, graph, (k, view))?;
+    if atlases.len() != views.len() {
+        return Err(crate::error::Error::Graph("shadows: a view has no atlas".into()));
+    }
+    for (k, (view, atlas)) in views.iter().zip(atlases).enumerate() {
+        let target = maps.declare_clear(ctx, graph, atlas)?;
         if let Some(terrain) = terrain {
             terrain.declare_shadow(ctx, graph, (k, view), target)?;
         }
         if let Some(casters) = &mut casters {
             casters.declare(ctx, graph, (k, view), target)?;
         }
-        targets.lighting.images.push(target.atlas);
     }
     Ok(Some(SunShadows { maps, points: casters }))
 }
@@ -91,7 +114,7 @@ pub(super) fn declare_sky_light(
     progress: &mut dyn FnMut(f32),
 ) -> Result<()> {
     let region = targets[0].lighting.constants;
-    let sky_inputs = targets[0].lighting.images.clone();
+    let sky_inputs = targets[0].lighting.image_ids();
     let bake = SkyLightBake::bake(
         ctx,
         &scene.heights,
@@ -102,8 +125,8 @@ pub(super) fn declare_sky_light(
     let sky_light = SkyLight::new(ctx, bake)?;
     let ids = sky_light.declare(graph, region, &sky_inputs);
     for t in targets.iter_mut() {
-        t.lighting.images.extend([ids.map, ids.horizon]);
-        t.lighting.buffers.push(ids.environment);
+        (t.lighting.images).extend([(LightingMap::SkyLight, ids.map), (LightingMap::Horizon, ids.horizon)]);
+        (t.lighting.buffers).push((LightingMap::Environment, ids.environment));
     }
     scene_lighting.sky_light = Some(sky_light);
     if lighting.reference {
@@ -120,10 +143,10 @@ pub(super) fn declare_sky_light(
         };
         let reference = MonteCarloReference::new(ctx, &scene.heights, settings)?;
         let images = reference.declare(graph, region, &sky_inputs);
-        targets
-            .lighting
-            .images
-            .extend([images.sky_light, images.sun_visibility]);
+        targets.lighting.images.extend([
+            (LightingMap::ReferenceSkyLight, images.sky_light),
+            (LightingMap::ReferenceSunVisibility, images.sun_visibility),
+        ]);
         scene_lighting.reference = Some(reference);
     }
     Ok(())
@@ -145,7 +168,12 @@ pub(super) fn declare_atmosphere(
         .collect();
     let luts = atmosphere.declare(graph, &regions)?;
     for (k, t) in targets.iter_mut().enumerate() {
-        t.lighting.images.extend(luts.reads(k)?);
+        let [transmittance, multiscattering, sky_view] = luts.reads(k)?;
+        t.lighting.images.extend([
+            (LightingMap::Transmittance, transmittance),
+            (LightingMap::Multiscattering, multiscattering),
+            (LightingMap::SkyView, sky_view),
+        ]);
     }
     scene_lighting.atmosphere = Some(atmosphere);
     Ok(())

@@ -600,6 +600,10 @@ impl Wiring<'_> {
                 progress,
             )?;
         }
+        // Each view's shadow atlas before its sky: `sky` writes the view's
+        // lighting constants, which name the atlas.
+        let casters = scene.draw_terrain || points_present;
+        let atlases = lighting::shadow_atlases(ctx, graph, (views, &mut targets), casters, &settings.shadows)?;
         declare_views(&mut Sky::new(ctx, &targets[0].formats)?, ctx, graph, views, &targets)?;
         let mut terrain = match scene.draw_terrain {
             true => Some(warped_terrain(ctx, graph, scene, settings, views)?),
@@ -620,7 +624,7 @@ impl Wiring<'_> {
             _ => None,
         };
         let casters = (terrain.as_ref(), points.as_ref());
-        let shadows = lighting::declare_shadows(ctx, graph, (views, &mut targets), casters, settings.shadows)?;
+        let shadows = lighting::declare_shadows(ctx, graph, (views, atlases), casters, settings.shadows)?;
         // Edge (validation_layer_edges): every view's draws before any post-processing.
         if let Some(terrain) = &mut terrain {
             let atlas = atlas.as_ref().map(|a| a.bindings());

@@ -162,8 +162,7 @@ pub fn declare_draw_pass<S: Provides<TerrainFrame> + 'static>(
     let maps = pass.maps.sample_in(&mut builder, Stage::Fragment);
     let constants = builder.upload(pass.constants, Stage::Graphics);
     let atlas = (pass.atlas.as_ref()).map(|atlas| AtlasSamples::declare(&mut builder, atlas));
-    let lighting = builder.upload(targets.lighting.constants, Stage::Fragment);
-    builder = targets.lighting.read_in(builder, Stage::Fragment);
+    let lighting = targets.lighting.read_in(&mut builder, Stage::Fragment).constants;
     let load = LoadOp::Load;
     builder
         .pipeline(&pipeline)

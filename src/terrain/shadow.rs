@@ -13,7 +13,7 @@ use glam::DVec3;
 use super::geometry_image::VERTEX_STRIDE;
 use super::Terrain;
 use crate::error::Result;
-use crate::graph::{BufferAccess, ImageAccess, RenderGraph};
+use crate::graph::{BufferAccess, RenderGraph};
 use crate::lighting::shadows::{record_cascades, SceneBounds, ShadowFrame, ShadowTarget, SHADOW_FORMAT};
 use crate::shaders;
 use crate::view::{pass_name, Frame, Provides, View, ViewIndex};
@@ -82,7 +82,8 @@ impl Terrain {
             .graphics()
             .read(vertices, BufferAccess::Vertex)
             .read(indices, BufferAccess::Index)
-            .write(atlas, ImageAccess::DepthAttachmentWrite)
+            .pipeline(&pipeline)
+            .depth(atlas, None)
             .record(move |ctx, frame| {
                 let plan = frame.prepared::<ShadowFrame>()?.view(index)?;
                 let (image, vertices, indices) = (ctx.image(atlas)?, ctx.buffer(vertices)?, ctx.buffer(indices)?);

@@ -26,7 +26,7 @@ pub(crate) use frame::frame_slots;
 pub use frame::{declare_views, per_view, Declare, Frame, FrameContext, Provides, Technique};
 pub use lens::Intrinsics;
 pub use lighting::{Exposure, FrameLighting, Lighting, LightingSetup, ShadowMode, SkyLightMode, SkyModel, SunPosition};
-pub use targets::{SceneTargets, TargetFormats};
+pub use targets::{LightingBindings, LightingMap, SceneTargets, TargetFormats};
 
 use glam::{DMat4, Mat4, Vec3};
 

@@ -4,7 +4,7 @@
 
 use super::View;
 use crate::graph::{
-    BufferAccess, BufferId, ImageAccess, ImageId, ImageInfo, PassBuilder, RenderGraph, Stage, UploadRegion,
+    Binding, BufferAccess, BufferId, ImageId, ImageInfo, PassBuilder, RenderGraph, Stage, UploadRegion,
 };
 use crate::vulkan::Format;
 
@@ -54,30 +54,71 @@ impl Default for TargetFormats {
     }
 }
 
+/// Which heap-handle slot of the lighting constants
+/// (`crate::lighting::constants::LightingFrame`) a lighting image or buffer
+/// fills.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightingMap {
+    /// `atmosphere.x`: the transmittance table.
+    Transmittance,
+    /// `atmosphere.y`: the multiple-scattering table.
+    Multiscattering,
+    /// `atmosphere.z`: the view's sky-view table.
+    SkyView,
+    /// `shadows.x`: the view's shadow atlas.
+    ShadowAtlas,
+    /// `maps.x` (unless the sky light is the reference's): the sky-light map.
+    SkyLight,
+    /// `maps.y`: the sun horizon map.
+    Horizon,
+    /// `maps.w`: the sky-light environment (a storage buffer).
+    Environment,
+    /// `maps.x` with the Monte Carlo reference's sky light.
+    ReferenceSkyLight,
+    /// `maps.z` with the Monte Carlo reference's sky light.
+    ReferenceSunVisibility,
+}
+
 /// What every shading pass of a view reads for its lighting (§9): the
-/// view's lighting constants (an upload region the lighting technique writes
-/// in its prepare step) and the images and buffers the lighting passes
-/// write (lookup tables, shadow atlas, sky-light maps), which the pass must
-/// declare as reads so the graph orders it after them.
+/// view's lighting constants (an upload region written by the view's `sky`
+/// pass, which declares every lighting image and so may embed their heap
+/// handles) and the images and buffers the lighting passes write (lookup
+/// tables, shadow atlas, sky-light maps), which the pass must declare as
+/// reads so the graph orders it after them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightingInputs {
     pub constants: UploadRegion,
-    pub images: Vec<ImageId>,
-    pub buffers: Vec<BufferId>,
+    pub images: Vec<(LightingMap, ImageId)>,
+    pub buffers: Vec<(LightingMap, BufferId)>,
+}
+
+/// What [`LightingInputs::read_in`] declared on a pass: the binding of the
+/// lighting constants, and of each lighting image and buffer by its slot.
+#[derive(Clone, Debug)]
+pub struct LightingBindings {
+    pub constants: Binding,
+    pub maps: Vec<(LightingMap, Binding)>,
 }
 
 impl LightingInputs {
     /// Declares the reads of a pass whose shaders (at `stage`) shade with
-    /// the lighting.
-    pub fn read_in<'g, P: 'static>(&self, mut builder: PassBuilder<'g, P>, stage: Stage) -> PassBuilder<'g, P> {
-        builder = builder.read(self.constants, BufferAccess::StorageRead(stage));
-        for &image in &self.images {
-            builder = builder.read(image, ImageAccess::Sampled(stage));
+    /// the lighting, and returns their bindings.
+    pub fn read_in<P: 'static>(&self, pass: &mut PassBuilder<'_, P>, stage: Stage) -> LightingBindings {
+        let constants = pass.upload(self.constants, stage);
+        let mut maps = Vec::with_capacity(self.images.len() + self.buffers.len());
+        for &(map, image) in &self.images {
+            maps.push((map, pass.sample(image, stage)));
         }
-        for &buffer in &self.buffers {
-            builder = builder.read(buffer, BufferAccess::StorageRead(stage));
+        for &(map, buffer) in &self.buffers {
+            maps.push((map, pass.storage_buffer(buffer, BufferAccess::StorageRead(stage))));
         }
-        builder
+        LightingBindings { constants, maps }
+    }
+
+    /// The lighting images (for passes that evaluate the sky through the
+    /// constants: they read the lookup tables the constants name).
+    pub fn image_ids(&self) -> Vec<ImageId> {
+        self.images.iter().map(|&(_, image)| image).collect()
     }
 }
 

@@ -24,11 +24,10 @@
 //! let atmosphere = PhysicalAtmosphere::new(&ctx, &AtmosphereParameters::default(), LutSizes::default(), views)?;
 //! let luts = atmosphere.declare(&mut graph, &[(view.name.as_str(), lighting_region)])?;
 //! let mut pass = graph.pass("sky").graphics();
-//! for id in luts.reads(view_index)? {
-//!     pass = pass.read(id, ImageAccess::Sampled(Stage::Fragment));
-//! }
+//! let tables = luts.reads(view_index)?.map(|id| pass.sample(id, Stage::Fragment));
 //! // prepare: AtmosphereParameters::for_turbidity(lighting.turbidity)?.fill(&mut frame);
-//! //          atmosphere.fill_handles(view_index, camera.eye.z, &mut frame)?;
+//! //          atmosphere.fill_altitude(view_index, camera.eye.z, &mut frame)?;
+//! // record (the pass that writes the constants): frame.atmosphere[..3] = ctx.handle(tables[i])?
 //! //          frame.sun_radiance from sun_transmittance(&params, eye altitude, sun) × disc radiance
 //! ```
 //!

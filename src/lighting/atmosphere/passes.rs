@@ -6,7 +6,7 @@
 //! region) for the sun direction (`sun.xyz`), the planet (`planet`), the
 //! Rayleigh and Mie scattering at the ground and the Mie g (`rayleigh`,
 //! `mie.rgb`, filled by [`super::AtmosphereParameters::fill`]) and the
-//! camera altitude (`atmosphere.w`, [`PhysicalAtmosphere::fill_handles`]);
+//! camera altitude (`atmosphere.w`, [`PhysicalAtmosphere::fill_altitude`]);
 //! what the LightingFrame has no room for (ozone, the Mie absorption, the
 //! ground albedo, the solar irradiance) comes in push constants from the
 //! [`AtmosphereParameters`] the tables were created with, which do not
@@ -19,7 +19,7 @@ use bytemuck::{Pod, Zeroable};
 
 use super::parameters::AtmosphereParameters;
 use crate::error::{Error, Result};
-use crate::graph::{BufferAccess, ImageAccess, ImageId, RenderGraph, Stage, UploadRegion};
+use crate::graph::{ImageAccess, ImageId, RenderGraph, Stage, UploadRegion};
 use crate::lighting::constants::LightingFrame;
 use crate::shaders;
 use crate::view::{pass_name, ViewIndex};
@@ -108,7 +108,8 @@ struct Pipelines {
 
 /// The physical atmosphere's persistent tables (RGBA32F, storage and
 /// sampled) and pipelines. The tables' sampled heap handles never change,
-/// so the LightingFrame can name them ([`PhysicalAtmosphere::fill_handles`]).
+/// so the LightingFrame can name them (written by the view's `sky` pass,
+/// which declares them: [`crate::view::LightingMap`]).
 pub struct PhysicalAtmosphere {
     params: AtmosphereParameters,
     sizes: LutSizes,
@@ -129,12 +130,6 @@ fn lut_image(ctx: &Context, name: &str, (width, height): (u32, u32)) -> Result<A
             usage: ImageUsageFlags::STORAGE | ImageUsageFlags::SAMPLED | ImageUsageFlags::TRANSFER_SRC,
         },
     )?))
-}
-
-fn sampled(image: &Image) -> Result<u32> {
-    image
-        .sampled_handle()
-        .ok_or_else(|| Error::Graph(format!("'{}' has no sampled handle", image.desc().name)))
 }
 
 impl PhysicalAtmosphere {
@@ -175,26 +170,23 @@ impl PhysicalAtmosphere {
         })
     }
 
-    /// Writes the tables' sampled handles into `frame.atmosphere` (x
-    /// transmittance, y multiple scattering, z view `view`'s sky view) and,
-    /// as f32 bits in `atmosphere.w`, the camera altitude above the ground
-    /// level: `eye_z` (world, m) − `frame.mie[3]` (the ground altitude; set
-    /// it first). The sky-view pass and `physical_sky` both read it.
-    pub fn fill_handles(&self, view: ViewIndex, eye_z: f64, frame: &mut LightingFrame) -> Result<()> {
-        let sky_view = self
-            .sky_views
-            .get(view)
-            .ok_or_else(|| Error::Graph(format!("the atmosphere has no sky-view table for view {view}")))?;
+    /// Writes, as f32 bits in `frame.atmosphere.w`, the camera altitude
+    /// above the ground level: `eye_z` (world, m) − `frame.mie[3]` (the
+    /// ground altitude; set it first). The sky-view pass and `physical_sky`
+    /// both read it. The tables' handles (`atmosphere.xyz`) are written by
+    /// the pass that declares the tables ([`crate::view::LightingMap`]).
+    /// `view` must have a sky-view table.
+    pub fn fill_altitude(&self, view: ViewIndex, eye_z: f64, frame: &mut LightingFrame) -> Result<()> {
+        if view >= self.sky_views.len() {
+            return Err(Error::Graph(format!(
+                "the atmosphere has no sky-view table for view {view}"
+            )));
+        }
         let altitude = (eye_z - f64::from(frame.mie[3])) as f32;
         if !altitude.is_finite() {
             return Err(Error::invalid("camera", "the eye's altitude is not finite"));
         }
-        frame.atmosphere = [
-            sampled(&self.transmittance)?,
-            sampled(&self.multiscattering)?,
-            sampled(sky_view)?,
-            altitude.to_bits(),
-        ];
+        frame.atmosphere[3] = altitude.to_bits();
         Ok(())
     }
 
@@ -227,79 +219,61 @@ impl PhysicalAtmosphere {
         };
         let push = AtmospherePush::new(&self.params);
         let (transmittance, multiscattering) = (luts.transmittance, luts.multiscattering);
-        let compute = Stage::Compute;
 
-        let pipelines = self.pipelines.clone();
-        let (w, h) = self.sizes.transmittance;
-        graph
-            .pass("lighting.transmittance")
-            .read(first, BufferAccess::StorageRead(compute))
-            .write(transmittance, ImageAccess::StorageWrite(compute))
-            .record(move |pass, _| {
-                let push = AtmospherePush {
-                    handles: [pass.upload(first)?, pass.storage_image(transmittance)?, 0, 0],
-                    size: [w, h, 0, 0],
-                    ..push
-                };
-                let cmd = pass.cmd();
-                cmd.bind_compute(&pipelines.transmittance);
-                cmd.push_constants(&push)?;
-                cmd.dispatch(w.div_ceil(8), h.div_ceil(8), 1);
-                Ok(())
-            });
-
-        let pipelines = self.pipelines.clone();
-        let (w, h) = self.sizes.multiscattering;
-        graph
-            .pass("lighting.multiscattering")
-            .read(first, BufferAccess::StorageRead(compute))
-            .read(transmittance, ImageAccess::Sampled(compute))
-            .write(multiscattering, ImageAccess::StorageWrite(compute))
-            .record(move |pass, _| {
-                let push = AtmospherePush {
-                    handles: [
-                        pass.upload(first)?,
-                        pass.storage_image(multiscattering)?,
-                        pass.sampled(transmittance)?,
-                        0,
-                    ],
-                    size: [w, h, 0, 0],
-                    ..push
-                };
-                let cmd = pass.cmd();
-                cmd.bind_compute(&pipelines.multiscattering);
-                cmd.push_constants(&push)?;
-                cmd.dispatch(w.div_ceil(8), h.div_ceil(8), 1);
-                Ok(())
-            });
-
-        let (w, h) = self.sizes.sky_view;
+        let pipelines = &self.pipelines;
+        declare_table(
+            graph,
+            "lighting.transmittance",
+            (pipelines.clone(), |p| &p.transmittance),
+            (first, &[], transmittance),
+            (self.sizes.transmittance, push),
+        );
+        declare_table(
+            graph,
+            "lighting.multiscattering",
+            (pipelines.clone(), |p| &p.multiscattering),
+            (first, &[transmittance], multiscattering),
+            (self.sizes.multiscattering, push),
+        );
         for (&(name, region), &sky_view) in views.iter().zip(&luts.sky_views) {
-            let pipelines = self.pipelines.clone();
-            graph
-                .pass(&pass_name("lighting.sky_view", name))
-                .read(region, BufferAccess::StorageRead(compute))
-                .read(transmittance, ImageAccess::Sampled(compute))
-                .read(multiscattering, ImageAccess::Sampled(compute))
-                .write(sky_view, ImageAccess::StorageWrite(compute))
-                .record(move |pass, _| {
-                    let push = AtmospherePush {
-                        handles: [
-                            pass.upload(region)?,
-                            pass.storage_image(sky_view)?,
-                            pass.sampled(transmittance)?,
-                            pass.sampled(multiscattering)?,
-                        ],
-                        size: [w, h, 0, 0],
-                        ..push
-                    };
-                    let cmd = pass.cmd();
-                    cmd.bind_compute(&pipelines.sky_view);
-                    cmd.push_constants(&push)?;
-                    cmd.dispatch(w.div_ceil(8), h.div_ceil(8), 1);
-                    Ok(())
-                });
+            declare_table(
+                graph,
+                &pass_name("lighting.sky_view", name),
+                (pipelines.clone(), |p| &p.sky_view),
+                (region, &[transmittance, multiscattering], sky_view),
+                (self.sizes.sky_view, push),
+            );
         }
         Ok(luts)
     }
+}
+
+/// Declares the table pass `name`: reads the LightingFrame in `region`,
+/// samples `inputs` (handles 2, 3), writes the `size` table `output` with
+/// the pipeline `pick` chooses.
+#[allow(clippy::type_complexity)]
+fn declare_table<P: 'static>(
+    graph: &mut RenderGraph<P>,
+    name: &str,
+    (pipelines, pick): (Arc<Pipelines>, fn(&Pipelines) -> &ComputePipeline),
+    (region, inputs, output): (UploadRegion, &[ImageId], ImageId),
+    ((w, h), push): ((u32, u32), AtmospherePush),
+) {
+    let compute = Stage::Compute;
+    let mut pass = graph.pass(name);
+    let lighting = pass.upload(region, compute);
+    let inputs: Vec<_> = inputs.iter().map(|&image| pass.sample(image, compute)).collect();
+    let output = pass.storage_image(output, ImageAccess::StorageWrite(compute));
+    pass.record(move |ctx, _| {
+        let mut handles = [ctx.handle(lighting)?, ctx.handle(output)?, 0, 0];
+        for (slot, &input) in handles[2..].iter_mut().zip(&inputs) {
+            *slot = ctx.handle(input)?;
+        }
+        let push = AtmospherePush {
+            handles,
+            size: [w, h, 0, 0],
+            ..push
+        };
+        ctx.dispatch(pick(&pipelines), &push, [w.div_ceil(8), h.div_ceil(8), 1])
+    });
 }

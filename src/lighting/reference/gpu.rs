@@ -6,18 +6,21 @@
 //! The pass recomputes the maps only when the lighting that matters to
 //! them changed (or on [`MonteCarloReference::restart`]): call
 //! [`MonteCarloReference::prepare`] with the frame's lighting constants
-//! before executing the frame; a frame with nothing to do records no
-//! dispatch. The work is split into dispatches of `rows_per_dispatch` rows,
-//! and with `rows_per_frame` spread over several frames (progressive).
+//! before executing the frame; it plans the frame's [`ReferenceWork`],
+//! which the pass reads from the frame's prepared data ([`ReferenceFrame`];
+//! nothing is shared between preparing and recording). A frame with
+//! nothing to do records no dispatch. The work is split into dispatches of
+//! `rows_per_dispatch` rows, and with `rows_per_frame` spread over several
+//! frames (progressive).
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
 use super::pyramid::field_buffer_words;
 use super::{ray_offset, ReferenceSettings};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::graph::{BufferAccess, ImageAccess, ImageId, RenderGraph, Stage, UploadRegion};
 use crate::io::heightmap::HeightField;
 use crate::lighting::constants::LightingFrame;
@@ -71,16 +74,43 @@ impl ReferenceProgress {
     }
 }
 
-/// What the recording closure dispatches this frame.
+/// Where the computation stands across frames (the technique's state).
 #[derive(Debug, Default)]
 struct Schedule {
     /// The lighting the maps are (being) computed for.
     key: Option<Vec<u32>>,
     next_row: u32,
-    /// Rows `[first, first + count)` to dispatch this frame.
-    pending: (u32, u32),
     /// Analytic test sky (constant, per unit ω.z) instead of the frame's.
     test_sky: Option<(Vec3, Vec3)>,
+}
+
+/// What `lighting.reference` dispatches in one frame, planned by
+/// [`MonteCarloReference::prepare`] (prepared data, read by the pass).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ReferenceWork {
+    /// Rows `[first, first + count)`.
+    rows: (u32, u32),
+    /// Analytic test sky (constant, per unit ω.z) instead of the frame's.
+    test_sky: Option<(Vec3, Vec3)>,
+}
+
+/// The frame data `lighting.reference` reads its [`ReferenceWork`] from
+/// (None: nothing to dispatch).
+pub trait ReferenceFrame {
+    fn reference_work(&self) -> Option<&ReferenceWork>;
+}
+
+impl ReferenceFrame for ReferenceWork {
+    fn reference_work(&self) -> Option<&ReferenceWork> {
+        Some(self)
+    }
+}
+
+impl<S: crate::view::Provides<crate::lighting::technique::PreparedLighting>> ReferenceFrame for crate::view::Frame<S> {
+    fn reference_work(&self) -> Option<&ReferenceWork> {
+        let lighting = self.prepared::<crate::lighting::technique::PreparedLighting>().ok()?;
+        lighting.reference.as_ref()
+    }
 }
 
 /// The Monte Carlo reference pass and its maps (§9.2).
@@ -94,13 +124,7 @@ pub struct MonteCarloReference {
     rows: u32,
     spacing: [f32; 2],
     offset: f32,
-    schedule: Arc<Mutex<Schedule>>,
-}
-
-fn lock(schedule: &Mutex<Schedule>) -> Result<std::sync::MutexGuard<'_, Schedule>> {
-    schedule
-        .lock()
-        .map_err(|_| Error::Graph("lighting.reference: schedule lock poisoned".into()))
+    schedule: Schedule,
 }
 
 /// Between two chunks' dispatches: storage writes before storage accesses.
@@ -171,7 +195,7 @@ impl MonteCarloReference {
             rows: h,
             spacing: [field.spacing.x as f32, field.spacing.y as f32],
             offset: ray_offset(field),
-            schedule: Arc::new(Mutex::new(Schedule::default())),
+            schedule: Schedule::default(),
         })
     }
 
@@ -192,25 +216,24 @@ impl MonteCarloReference {
 
     /// Tests only: the sky is `constant + per_z · ω.z` instead of the
     /// frame's sky model (`None`: the frame's). Restarts.
-    pub fn set_test_sky(&self, sky: Option<(Vec3, Vec3)>) -> Result<()> {
-        let mut s = lock(&self.schedule)?;
-        s.test_sky = sky;
-        s.key = None;
-        Ok(())
+    pub fn set_test_sky(&mut self, sky: Option<(Vec3, Vec3)>) {
+        self.schedule.test_sky = sky;
+        self.schedule.key = None;
     }
 
     /// Computes the maps anew from the next frame on.
-    pub fn restart(&self) -> Result<()> {
-        lock(&self.schedule)?.key = None;
-        Ok(())
+    pub fn restart(&mut self) {
+        self.schedule.key = None;
     }
 
     /// Plans this frame's work for the lighting constants `lighting` (the
     /// ones the pass reads): starts over when what the maps depend on
     /// changed, else continues an unfinished computation; nothing once done.
-    pub fn prepare(&self, lighting: &LightingFrame) -> Result<ReferenceProgress> {
+    /// Returns the frame's work (for the pass, through the frame's prepared
+    /// data) and the progress.
+    pub fn prepare(&mut self, lighting: &LightingFrame) -> (ReferenceWork, ReferenceProgress) {
         let key = lighting_key(lighting);
-        let mut s = lock(&self.schedule)?;
+        let s = &mut self.schedule;
         let restarted = s.key.as_ref() != Some(&key);
         if restarted {
             s.key = Some(key);
@@ -218,28 +241,29 @@ impl MonteCarloReference {
         }
         let first = s.next_row;
         let count = self.settings.rows_per_frame.unwrap_or(self.rows).min(self.rows - first);
-        s.pending = (first, count);
         s.next_row = first + count;
-        Ok(ReferenceProgress {
+        let work = ReferenceWork {
+            rows: (first, count),
+            test_sky: s.test_sky,
+        };
+        let progress = ReferenceProgress {
             rows_done: s.next_row,
             rows: self.rows,
             restarted,
-        })
+        };
+        (work, progress)
     }
 
-    /// Sets the maps' sampled handles (`maps.x`, `maps.z`) and the field
-    /// (`field`) of a view's lighting constants.
-    pub fn fill(&self, lighting: &mut LightingFrame) -> Result<()> {
-        let missing = || Error::Graph("lighting.reference: a map has no sampled handle".into());
-        lighting.maps[0] = self.sky_light.sampled_handle().ok_or_else(missing)?;
-        lighting.maps[2] = self.sun_visibility.sampled_handle().ok_or_else(missing)?;
+    /// Sets the field (`field`) of a view's lighting constants (the maps'
+    /// handles, `maps.x` and `maps.z`, are written by the pass that
+    /// declares them: [`crate::view::LightingMap::ReferenceSkyLight`]).
+    pub fn fill(&self, lighting: &mut LightingFrame) {
         lighting.field = [
             (self.columns - 1) as f32 * self.spacing[0],
             (self.rows - 1) as f32 * self.spacing[1],
             (self.columns - 1) as f32,
             (self.rows - 1) as f32,
         ];
-        Ok(())
     }
 
     /// Imports the maps and the field into `graph` and declares
@@ -247,7 +271,7 @@ impl MonteCarloReference {
     /// (any view's: the maps do not depend on the view) and samples
     /// `environment` (the sky model's lookup tables, whatever
     /// `sky_radiance` reads), and writes the maps.
-    pub fn declare<P: 'static>(
+    pub fn declare<P: ReferenceFrame + 'static>(
         &self,
         graph: &mut RenderGraph<P>,
         lighting: UploadRegion,
@@ -256,22 +280,27 @@ impl MonteCarloReference {
         let field = graph.import_buffer(self.field.clone());
         let sky_light = graph.import_image(self.sky_light.clone());
         let sun_visibility = graph.import_image(self.sun_visibility.clone());
-        let mut pass = graph
-            .pass("lighting.reference")
-            .read(lighting, BufferAccess::StorageRead(Stage::Compute))
-            .read(field, BufferAccess::StorageRead(Stage::Compute))
-            .write(sky_light, ImageAccess::StorageReadWrite(Stage::Compute))
-            .write(sun_visibility, ImageAccess::StorageReadWrite(Stage::Compute));
+        let compute = Stage::Compute;
+        let mut pass = graph.pass("lighting.reference");
+        let bindings = [
+            pass.upload(lighting, compute),
+            pass.storage_buffer(field, BufferAccess::StorageRead(compute)),
+            pass.storage_image(sky_light, ImageAccess::StorageReadWrite(compute)),
+            pass.storage_image(sun_visibility, ImageAccess::StorageReadWrite(compute)),
+        ];
         for &image in environment {
-            pass = pass.read(image, ImageAccess::Sampled(Stage::Compute));
+            pass.sample(image, compute);
         }
-        let (pipeline, schedule, settings) = (self.pipeline.clone(), self.schedule.clone(), self.settings);
+        let (pipeline, settings) = (self.pipeline.clone(), self.settings);
         let (columns, spacing, offset) = (self.columns, self.spacing, self.offset);
-        pass.record(move |pass, _| {
-            // Taken: a frame without `prepare` records nothing.
-            let ((first, count), test_sky) = {
-                let mut s = lock(&schedule)?;
-                (std::mem::take(&mut s.pending), s.test_sky)
+        pass.record(move |ctx, frame| {
+            // A frame without `prepare` records nothing.
+            let Some(&ReferenceWork {
+                rows: (first, count),
+                test_sky,
+            }) = frame.reference_work()
+            else {
+                return Ok(());
             };
             if count == 0 {
                 return Ok(());
@@ -279,21 +308,20 @@ impl MonteCarloReference {
             let flags =
                 u32::from(test_sky.is_some()) * FLAG_TEST_SKY + u32::from(settings.sun_bounces) * FLAG_SUN_BOUNCES;
             let (a, b) = test_sky.unwrap_or_default();
+            let mut handles = [0; 4];
+            for (h, &binding) in handles.iter_mut().zip(&bindings) {
+                *h = ctx.handle(binding)?;
+            }
             let mut push = ReferencePush {
-                handles: [
-                    pass.upload(lighting)?,
-                    pass.storage_buffer(field)?,
-                    pass.storage_image(sky_light)?,
-                    pass.storage_image(sun_visibility)?,
-                ],
+                handles,
                 work: [first, 0, settings.samples, settings.seed],
                 options: [settings.bounces, flags, 0, 0],
                 surface: [spacing[0], spacing[1], settings.bounce_albedo, offset],
                 sky_a: [a.x, a.y, a.z, 0.0],
                 sky_b: [b.x, b.y, b.z, 0.0],
             };
-            let maps = [pass.image(sky_light)?, pass.image(sun_visibility)?];
-            let cmd = pass.cmd();
+            let maps = [ctx.image(sky_light)?, ctx.image(sun_visibility)?];
+            let cmd = ctx.cmd();
             cmd.bind_compute(&pipeline);
             let mut row = first;
             while row < first + count {

@@ -83,9 +83,9 @@ mod tests;
 
 #[cfg(test)]
 pub use cpu::{CpuReference, SunInput};
-pub use gpu::MonteCarloReference;
 #[cfg(test)]
 pub use gpu::ReferenceProgress;
+pub use gpu::{MonteCarloReference, ReferenceWork};
 #[cfg(test)]
 pub use trace::HeightFieldTracer;
 

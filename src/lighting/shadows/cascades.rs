@@ -151,8 +151,6 @@ pub struct CascadePlan {
     pub sun: DVec3,
     /// Sun-space basis: x, y across the sun, z = `sun`.
     pub basis: [DVec3; 3],
-    /// Sampled heap handle of the atlas.
-    pub atlas: u32,
     pub atlas_size: u32,
     pub pcf_radius: u32,
 }
@@ -167,10 +165,12 @@ impl CascadePlan {
         }
     }
 
-    /// Writes the shadow fields of `frame` (`shadows`, `cascade_view_proj`,
-    /// `cascade_far`, `cascade_texel`).
+    /// Writes the shadow fields of `frame` (`shadows.yzw`, `cascade_view_proj`,
+    /// `cascade_far`, `cascade_texel`); the atlas's heap handle, `shadows.x`,
+    /// is written by the pass that declares the atlas
+    /// ([`crate::view::LightingMap::ShadowAtlas`]).
     pub fn fill(&self, frame: &mut LightingFrame) {
-        frame.shadows = [self.atlas, self.count(), self.atlas_size, self.pcf_radius];
+        frame.shadows = [frame.shadows[0], self.count(), self.atlas_size, self.pcf_radius];
         frame.cascade_view_proj = [[0.0; 16]; MAX_CASCADES];
         frame.cascade_far = [0.0; 4];
         frame.cascade_texel = [0.0; 4];
@@ -229,25 +229,22 @@ pub fn slice_sphere(near: f64, far: f64, k: f64) -> (f64, f64) {
 }
 
 /// Plans the cascades of `camera` (image aspect `aspect`) for a sun in
-/// direction `sun` over a scene inside `bounds`; `atlas` is the atlas's
-/// sampled handle.
+/// direction `sun` over a scene inside `bounds`.
 pub fn plan_cascades(
     camera: &Camera,
     aspect: f64,
     sun: Vec3,
     bounds: SceneBounds,
     settings: &ShadowSettings,
-    atlas: u32,
 ) -> Result<CascadePlan> {
     let mut plan = CascadePlan {
         cascades: Vec::new(),
         sun: DVec3::Z,
         basis: [DVec3::X, DVec3::Y, DVec3::Z],
-        atlas,
         atlas_size: settings.atlas_size,
         pcf_radius: settings.pcf_radius,
     };
-    plan_cascades_into(&mut plan, (camera, aspect), sun, bounds, settings, atlas)?;
+    plan_cascades_into(&mut plan, (camera, aspect), sun, bounds, settings)?;
     Ok(plan)
 }
 
@@ -258,7 +255,6 @@ pub fn plan_cascades_into(
     sun: Vec3,
     bounds: SceneBounds,
     settings: &ShadowSettings,
-    atlas: u32,
 ) -> Result<()> {
     settings.validate()?;
     camera.validate()?;
@@ -326,7 +322,6 @@ pub fn plan_cascades_into(
         cascades,
         sun,
         basis,
-        atlas,
         atlas_size: settings.atlas_size,
         pcf_radius: settings.pcf_radius,
     };
@@ -384,7 +379,7 @@ mod tests {
         assert!((s[0] - 1.0).abs() < 1e-9 && (s[4] - 30_000.0).abs() < 1e-6);
         assert!(s.windows(2).all(|w| w[1] > w[0]));
         let cam = camera(DVec3::new(100.0, 200.0, 900.0), DVec3::new(5000.0, 9000.0, 400.0));
-        let plan = plan_cascades(&cam, 16.0 / 9.0, sun(), bounds(), &ShadowSettings::default(), 7).unwrap();
+        let plan = plan_cascades(&cam, 16.0 / 9.0, sun(), bounds(), &ShadowSettings::default()).unwrap();
         assert_eq!(plan.cascades.len(), 4);
         assert_eq!(plan.cascades[0].near, cam.near);
         assert!(
@@ -409,7 +404,7 @@ mod tests {
             ),
         ] {
             let cam = camera(eye, target);
-            let plan = plan_cascades(&cam, aspect, sun(), bounds(), &settings, 0).unwrap();
+            let plan = plan_cascades(&cam, aspect, sun(), bounds(), &settings).unwrap();
             let mut rng = crate::random::SplitMix64(3);
             for _ in 0..20_000 {
                 let d = cam.near + (30_000.0 - cam.near) * rng.next_f64().powi(3);
@@ -442,7 +437,7 @@ mod tests {
     fn casters_between_the_slice_and_the_sun_are_in_depth_range() {
         let cam = camera(DVec3::new(100.0, 200.0, 900.0), DVec3::new(5000.0, 9000.0, 400.0));
         let settings = ShadowSettings::default();
-        let plan = plan_cascades(&cam, 1.5, sun(), bounds(), &settings, 0).unwrap();
+        let plan = plan_cascades(&cam, 1.5, sun(), bounds(), &settings).unwrap();
         let s = plan.sun;
         for c in &plan.cascades {
             // A point of the slice moved towards the sun until it reaches the top of the scene.
@@ -458,7 +453,7 @@ mod tests {
         let settings = ShadowSettings::default();
         let size = f64::from(settings.atlas_size);
         let base = camera(DVec3::new(100.0, 200.0, 900.0), DVec3::new(5000.0, 9000.0, 400.0));
-        let a = plan_cascades(&base, 1.5, sun(), bounds(), &settings, 0).unwrap();
+        let a = plan_cascades(&base, 1.5, sun(), bounds(), &settings).unwrap();
         let probe = DVec3::new(1234.5, 2345.25, 812.0);
         for (dx, turn) in [
             (DVec3::new(3.3, -7.1, 0.4), 0.0),
@@ -469,7 +464,7 @@ mod tests {
             let dir = base.target - base.eye;
             let (s, c) = f64::sin_cos(turn);
             moved.target = moved.eye + DVec3::new(c * dir.x - s * dir.y, s * dir.x + c * dir.y, dir.z);
-            let b = plan_cascades(&moved, 1.5, sun(), bounds(), &settings, 0).unwrap();
+            let b = plan_cascades(&moved, 1.5, sun(), bounds(), &settings).unwrap();
             for (ca, cb) in a.cascades.iter().zip(&b.cascades) {
                 assert_eq!(ca.texel, cb.texel, "rotation- and translation-invariant size");
                 let (ta, tb) = (atlas_texel(ca, probe, size), atlas_texel(cb, probe, size));
@@ -487,15 +482,15 @@ mod tests {
             cascades: 3,
             ..ShadowSettings::default()
         };
-        let plan = plan_cascades(&cam, 1.0, sun(), bounds(), &settings, 42).unwrap();
+        let plan = plan_cascades(&cam, 1.0, sun(), bounds(), &settings).unwrap();
         let mut frame = bytemuck::Zeroable::zeroed();
         plan.fill(&mut frame);
         let f: LightingFrame = frame;
-        assert_eq!(f.shadows, [42, 3, 4096, 2]);
+        assert_eq!(f.shadows, [0, 3, 4096, 2]);
         assert_eq!(f.cascade_far[2], 30_000.0);
         assert_eq!(f.cascade_far[3], 0.0);
         assert!(f.cascade_texel[0] > 0.0 && f.cascade_texel[0] < f.cascade_texel[1]);
-        let below = plan_cascades(&cam, 1.0, Vec3::new(0.3, 0.2, -0.1), bounds(), &settings, 42).unwrap();
+        let below = plan_cascades(&cam, 1.0, Vec3::new(0.3, 0.2, -0.1), bounds(), &settings).unwrap();
         assert_eq!(below.count(), 0, "no cascade when the sun is down");
     }
 

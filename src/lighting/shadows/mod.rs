@@ -2,25 +2,27 @@
 //! with the horizon maps of the height field; `ALGORITHMS.md` §6).
 //!
 //! [`ShadowMaps`] owns one shadow atlas per view: a single `D32_SFLOAT` 2-D
-//! image, 2×2 quadrants, one per cascade, imported into the graph so its
-//! sampled heap handle never changes. Per frame its `prepare`
+//! image, 2×2 quadrants, one per cascade ([`ShadowAtlas`]), imported into
+//! the graph before the view's `sky` pass, which declares it and writes its
+//! heap handle into the view's lighting constants. Per frame its `prepare`
 //! ([`Technique`]) plans each view's cascades ([`cascades::plan_cascades`])
-//! into a [`ShadowFrame`]; the lead copies a view's [`CascadePlan`] into its
-//! `LightingFrame` with [`CascadePlan::fill`].
+//! into a [`ShadowFrame`]; the lighting copies a view's [`CascadePlan`] into
+//! its `LightingFrame` with [`CascadePlan::fill`].
 //!
-//! Passes, in this order, each writing the atlas as a depth attachment:
+//! Passes, in this order, each writing the atlas as a depth attachment
+//! (`.depth(atlas, ..)`: the graph begins and ends rendering):
 //!
 //! | pass | declared by | what |
 //! |---|---|---|
-//! | `shadow.clear` | [`ShadowMaps::declare_view`] | clears the atlas to 1 |
+//! | `shadow.clear` | [`ShadowMaps::declare_clear`] | clears the atlas to 1 |
 //! | `terrain.shadow` | `Terrain::declare_shadow` (`src/terrain/shadow.rs`) | the view's warped geometry image, per cascade |
 //! | `points.shadow` | `PointShadows::declare` (`src/points/render/shadow.rs`) | splats as depth discs, per cascade |
 //!
 //! The caster passes read the cascade matrices from the frame's prepared
 //! [`ShadowFrame`] and push them (no upload region): each cascade is one
-//! draw with the scissor on its quadrant. Consumers sample the atlas
-//! through `glsl/include/shadows.glsl` after declaring
-//! `ImageAccess::Sampled(Stage::Fragment)` (or `Compute`) of
+//! draw with the scissor on its quadrant ([`record_cascades`]). Consumers
+//! sample the atlas through `glsl/include/shadows.glsl` after declaring
+//! `pass.sample(atlas, Stage::Fragment)` (or `Compute`) of
 //! [`ShadowTarget::atlas`].
 
 pub mod cascades;
@@ -32,9 +34,13 @@ use bytemuck::{Pod, Zeroable};
 pub use cascades::{plan_cascades, plan_cascades_into, CascadePlan, SceneBounds, ShadowSettings};
 
 use crate::error::{Error, Result};
-use crate::graph::{ImageAccess, ImageId, RenderGraph};
+use crate::graph::{ImageId, RenderGraph};
+use crate::shaders;
 use crate::view::{pass_name, per_view, Declare, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
-use crate::vulkan::{CommandRecorder, Context, Format, Image, ImageDesc, ImageUsageFlags};
+use crate::vulkan::{
+    Blend, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
+    ImageUsageFlags, PrimitiveTopology,
+};
 
 /// The depth format of shadow atlases.
 pub const SHADOW_FORMAT: Format = Format::D32_SFLOAT;
@@ -58,10 +64,58 @@ pub struct ShadowTarget {
     pub view: ViewIndex,
     /// The atlas (declare `ImageAccess::Sampled(..)` to read it).
     pub atlas: ImageId,
-    /// Its sampled heap handle (fixed for the atlas's lifetime).
-    pub handle: u32,
     /// Side in texels.
     pub size: u32,
+}
+
+/// One view's shadow atlas, created and imported into a graph before its
+/// passes are declared ([`ShadowMaps::declare_clear`]): the passes that
+/// write the view's lighting constants must declare it first.
+pub struct ShadowAtlas {
+    target: ShadowTarget,
+    /// Kept alive with the graph that imported it.
+    image: Arc<Image>,
+    /// The view's name (for the pass names).
+    view_name: String,
+}
+
+impl ShadowAtlas {
+    /// Creates view `index`'s atlas of `settings.atlas_size` and imports it
+    /// into `graph`.
+    pub fn new<P: 'static>(
+        ctx: &Context,
+        graph: &mut RenderGraph<P>,
+        (index, view): (ViewIndex, &View),
+        settings: &ShadowSettings,
+    ) -> Result<ShadowAtlas> {
+        settings.validate()?;
+        let size = settings.atlas_size;
+        let image = Arc::new(Image::new(
+            ctx,
+            ImageDesc {
+                name: pass_name("shadow atlas", &view.name),
+                width: size,
+                height: size,
+                format: SHADOW_FORMAT,
+                usage: ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | ImageUsageFlags::SAMPLED,
+            },
+        )?);
+        let atlas = graph.import_image(image.clone());
+        Ok(ShadowAtlas {
+            target: ShadowTarget {
+                view: index,
+                atlas,
+                size,
+            },
+            image,
+            view_name: view.name.clone(),
+        })
+    }
+
+    /// The atlas in the graph.
+    pub fn id(&self) -> ImageId {
+        self.target.atlas
+    }
 }
 
 struct ShadowView {
@@ -93,6 +147,30 @@ pub struct ShadowMaps {
     views: Vec<ShadowView>,
     /// The previous frame's plans, reused ([`Technique::recycle`]).
     spare: Vec<(ViewIndex, CascadePlan)>,
+    /// The depth-only pipeline `shadow.clear` declares (never bound).
+    clear_pipeline: Option<GraphicsPipeline>,
+}
+
+/// The pipeline of splat-shaped casters into a shadow atlas, depth only
+/// (`glsl/lighting/shadow_points.*`, no vertex input): `points.shadow`'s,
+/// and what `shadow.clear` declares (it draws nothing).
+pub fn splat_caster_desc(name: &'static str) -> GraphicsPipelineDesc {
+    GraphicsPipelineDesc {
+        name,
+        vertex: shaders::SHADOW_POINTS_VERT,
+        fragment: shaders::SHADOW_POINTS_FRAG,
+        vertex_stride: 0,
+        vertex_attributes: Vec::new(),
+        topology: PrimitiveTopology::TRIANGLE_LIST,
+        cull_back_faces: false,
+        wireframe: false,
+        color_formats: Vec::new(),
+        blend: Blend::None,
+        depth_format: Some(SHADOW_FORMAT),
+        depth_test: true,
+        depth_write: true,
+        depth_compare: CompareOp::LESS_OR_EQUAL,
+    }
 }
 
 impl ShadowMaps {
@@ -111,6 +189,7 @@ impl ShadowMaps {
             bounds,
             views: Vec::new(),
             spare: Vec::new(),
+            clear_pipeline: None,
         })
     }
 
@@ -132,41 +211,47 @@ impl ShadowMaps {
         graph: &mut RenderGraph<Frame<S>>,
         (index, view): (ViewIndex, &View),
     ) -> Result<ShadowTarget> {
-        if self.views.iter().any(|v| v.target.view == index) {
-            return Err(Error::Graph(format!("shadows: view {index} declared twice")));
+        let atlas = ShadowAtlas::new(ctx, graph, (index, view), &self.settings)?;
+        self.declare_clear(ctx, graph, atlas)
+    }
+
+    /// Declares `shadow.clear` of an atlas created with this graph (clears
+    /// it to depth 1 each frame). Declare before the caster passes.
+    pub fn declare_clear<S: 'static>(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        atlas: ShadowAtlas,
+    ) -> Result<ShadowTarget> {
+        let ShadowAtlas {
+            target,
+            image,
+            view_name,
+        } = atlas;
+        if self.views.iter().any(|v| v.target.view == target.view) {
+            return Err(Error::Graph(format!("shadows: view {} declared twice", target.view)));
         }
-        let size = self.settings.atlas_size;
-        let image = Arc::new(Image::new(
-            ctx,
-            ImageDesc {
-                name: pass_name("shadow atlas", &view.name),
-                width: size,
-                height: size,
-                format: SHADOW_FORMAT,
-                usage: ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | ImageUsageFlags::SAMPLED,
-            },
-        )?);
-        let handle = image
-            .sampled_handle()
-            .ok_or_else(|| Error::Graph("shadows: the atlas has no sampled handle".into()))?;
-        let atlas = graph.import_image(image.clone());
+        if target.size != self.settings.atlas_size {
+            return Err(Error::Graph(format!(
+                "shadows: the atlas is {} texels, the settings {}",
+                target.size, self.settings.atlas_size
+            )));
+        }
+        if self.clear_pipeline.is_none() {
+            self.clear_pipeline = Some(GraphicsPipeline::new(ctx, &splat_caster_desc("shadow.clear"))?);
+        }
+        let pipeline = self
+            .clear_pipeline
+            .as_ref()
+            .ok_or_else(|| Error::Graph("shadows: no pipeline".into()))?;
+        // Clears only: the graph begins rendering with the clear; the
+        // pipeline states the attachment's format.
         graph
-            .pass(&pass_name("shadow.clear", &view.name))
+            .pass(&pass_name("shadow.clear", &view_name))
             .graphics()
-            .write(atlas, ImageAccess::DepthAttachmentWrite)
-            .record(move |ctx, _| {
-                let image = ctx.image(atlas)?;
-                let cmd = ctx.cmd();
-                cmd.begin_rendering(&[], Some((image, Some(1.0))));
-                cmd.end_rendering();
-                Ok(())
-            });
-        let target = ShadowTarget {
-            view: index,
-            atlas,
-            handle,
-            size,
-        };
+            .pipeline(pipeline)
+            .depth(target.atlas, Some(1.0))
+            .record(|_, _| Ok(()));
         self.views.push(ShadowView { target, _image: image });
         Ok(target)
     }
@@ -184,14 +269,13 @@ impl ShadowMaps {
     /// it). With `mode` other than [`ShadowMode::Cascaded`] the plan has no
     /// cascade and the passes only clear.
     pub fn plan(&self, index: ViewIndex, view: &View, sun: glam::Vec3, mode: ShadowMode) -> Result<CascadePlan> {
-        let target = self.target(index)?;
+        self.target(index)?;
         let mut plan = plan_cascades(
             &view.culling_camera(),
             view.culling_aspect(),
             sun,
             self.bounds,
             &self.settings,
-            target.handle,
         )?;
         if mode != ShadowMode::Cascaded {
             plan.cascades.clear();
@@ -207,16 +291,9 @@ impl ShadowMaps {
         sun: glam::Vec3,
         mode: ShadowMode,
     ) -> Result<()> {
-        let target = self.target(index)?;
+        self.target(index)?;
         let camera = view.culling_camera();
-        plan_cascades_into(
-            plan,
-            (&camera, view.culling_aspect()),
-            sun,
-            self.bounds,
-            &self.settings,
-            target.handle,
-        )?;
+        plan_cascades_into(plan, (&camera, view.culling_aspect()), sun, self.bounds, &self.settings)?;
         if mode != ShadowMode::Cascaded {
             plan.cascades.clear();
         }
@@ -275,9 +352,10 @@ impl Technique for ShadowMaps {
     }
 }
 
-/// Records a caster pass: renders into `atlas` (loaded), and per cascade of
-/// `plan` sets the scissor on its quadrant and calls `draw` with the
-/// cascade's push constants (`handles` left to `draw`).
+/// Records a caster pass, which declared `atlas` its depth attachment
+/// (loaded: `.depth(atlas, None)`): per cascade of `plan` sets the scissor
+/// on its quadrant and calls `draw` with the cascade's push constants
+/// (`handles` left to `draw`).
 pub fn record_cascades(
     cmd: &mut CommandRecorder,
     atlas: &Image,
@@ -289,7 +367,6 @@ pub fn record_cascades(
         return Ok(());
     }
     let quadrant = atlas.desc().width / 2;
-    cmd.begin_rendering(&[], Some((atlas, None)));
     let mut result = Ok(());
     for (i, c) in plan.cascades.iter().take(count).enumerate() {
         let (x, y) = ((i as u32 % 2) * quadrant, (i as u32 / 2) * quadrant);
@@ -304,6 +381,5 @@ pub fn record_cascades(
             break;
         }
     }
-    cmd.end_rendering();
     result
 }

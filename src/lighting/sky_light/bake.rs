@@ -144,10 +144,6 @@ struct TransferPush {
     params: [f32; 4],
 }
 
-fn handle(h: Option<u32>, what: &str) -> Result<u32> {
-    h.ok_or_else(|| Error::Graph(format!("sky light: {what} has no heap handle")))
-}
-
 /// A device-local storage buffer of `floats` floats, within the device's
 /// storage-buffer range.
 fn storage(ctx: &Context, name: &str, bytes: u64) -> Result<Arc<Buffer>> {
@@ -327,12 +323,7 @@ impl SkyLightBake {
             horizons: graph.import_buffer(horizons.clone()),
             map: graph.import_image(horizon_map.clone()),
             push: HorizonPush {
-                handles: [
-                    handle(heights.storage_handle(), "the heights")?,
-                    handle(horizons.storage_handle(), "the horizons")?,
-                    handle(horizon_map.storage_handle(), "the horizon map")?,
-                    0,
-                ],
+                handles: [0; 4],
                 grid,
                 spacing: [spacing[0], spacing[1], field.min_max().1, 0.0],
             },
@@ -343,50 +334,52 @@ impl SkyLightBake {
 
         // Direct transfer, visibility, bent normals.
         let push = TransferPush {
-            handles: [
-                handle(heights.storage_handle(), "the heights")?,
-                handle(horizons.storage_handle(), "the horizons")?,
-                handle(tables.storage_handle(), "the tables")?,
-                handle(transfers[0].storage_handle(), "the transfer")?,
-            ],
+            handles: [0; 4],
             grid,
-            layout: [
-                settings.coefficients(),
-                stride,
-                handle(surface.storage_handle(), "the surface buffer")?,
-                ENTRIES as u32,
-            ],
+            layout: [settings.coefficients(), stride, 0, ENTRIES as u32],
             params: [spacing[0], spacing[1], 0.0, 0.0],
         };
         let mut graph = RenderGraph::new();
-        let reads = [heights.clone(), horizons.clone(), tables.clone()].map(|b| graph.import_buffer(b));
-        let writes = [transfers[0].clone(), surface.clone()].map(|b| graph.import_buffer(b));
+        let mut import = |buffer: &Arc<Buffer>| graph.import_buffer(buffer.clone());
+        let buffers = [
+            ChunkBuffer::read(import(&heights), &[Slot::Handle(0)]),
+            ChunkBuffer::read(import(&horizons), &[Slot::Handle(1)]),
+            ChunkBuffer::read(import(&tables), &[Slot::Handle(2)]),
+            ChunkBuffer::write(import(&transfers[0]), &[Slot::Handle(3)]),
+            ChunkBuffer::write(import(&surface), &[Slot::Layout(2)]),
+        ];
         let pipeline = Arc::new(ComputePipeline::new(ctx, shaders::SKY_LIGHT_TRANSFER)?);
-        declare_chunked(&mut graph, "sky_light.transfer", pipeline, &reads, &writes, push);
+        declare_chunked(&mut graph, "sky_light.transfer", pipeline, &buffers, push);
         run_chunks(ctx, &mut frames, graph, rows, chunk_rows, progress, (&mut done, total))?;
 
         // Bounces: T^b = T^0 + ρ_b Σ w T^{b−1}(horizon point).
         let pipeline = Arc::new(ComputePipeline::new(ctx, shaders::SKY_LIGHT_BOUNCE)?);
         for b in 1..transfers.len() {
             let push = TransferPush {
-                handles: [
-                    handle(surface.storage_handle(), "the surface buffer")?,
-                    handle(horizons.storage_handle(), "the horizons")?,
-                    handle(transfers[b - 1].storage_handle(), "the previous bounce")?,
-                    handle(transfers[0].storage_handle(), "the direct transfer")?,
-                ],
+                handles: [0; 4],
                 grid,
-                layout: [stride, handle(transfers[b].storage_handle(), "the bounce")?, 0, 0],
+                layout: [stride, 0, 0, 0],
                 params: [spacing[0], spacing[1], settings.bounce_albedo, 0.0],
             };
             let mut graph = RenderGraph::new();
-            let mut inputs = vec![surface.clone(), horizons.clone(), transfers[b - 1].clone()];
-            if b > 1 {
-                inputs.push(transfers[0].clone());
+            let mut import = |buffer: &Arc<Buffer>| graph.import_buffer(buffer.clone());
+            let mut buffers = vec![
+                ChunkBuffer::read(import(&surface), &[Slot::Handle(0)]),
+                ChunkBuffer::read(import(&horizons), &[Slot::Handle(1)]),
+            ];
+            // The previous bounce, and the direct transfer (the same buffer after the first bounce).
+            match b {
+                1 => buffers.push(ChunkBuffer::read(
+                    import(&transfers[0]),
+                    &[Slot::Handle(2), Slot::Handle(3)],
+                )),
+                _ => buffers.extend([
+                    ChunkBuffer::read(import(&transfers[b - 1]), &[Slot::Handle(2)]),
+                    ChunkBuffer::read(import(&transfers[0]), &[Slot::Handle(3)]),
+                ]),
             }
-            let reads: Vec<_> = inputs.into_iter().map(|x| graph.import_buffer(x)).collect();
-            let writes = [graph.import_buffer(transfers[b].clone())];
-            declare_chunked(&mut graph, "sky_light.bounce", pipeline.clone(), &reads, &writes, push);
+            buffers.push(ChunkBuffer::write(import(&transfers[b]), &[Slot::Layout(1)]));
+            declare_chunked(&mut graph, "sky_light.bounce", pipeline.clone(), &buffers, push);
             run_chunks(ctx, &mut frames, graph, rows, chunk_rows, progress, (&mut done, total))?;
         }
         frames.finish()?;
@@ -507,29 +500,65 @@ impl SkyLightBake {
     }
 }
 
-/// Declares a chunked compute pass reading `reads` and writing (part of) `writes`.
+/// Where a buffer's heap handle goes in a [`TransferPush`].
+#[derive(Clone, Copy, Debug)]
+enum Slot {
+    Handle(usize),
+    Layout(usize),
+}
+
+/// A buffer a chunked pass reads or writes (part of), and the words of
+/// the push constants its handle fills.
+struct ChunkBuffer {
+    id: crate::graph::BufferId,
+    access: BufferAccess,
+    slots: Vec<Slot>,
+}
+
+impl ChunkBuffer {
+    fn read(id: crate::graph::BufferId, slots: &[Slot]) -> ChunkBuffer {
+        ChunkBuffer {
+            id,
+            access: BufferAccess::StorageRead(Stage::Compute),
+            slots: slots.to_vec(),
+        }
+    }
+
+    fn write(id: crate::graph::BufferId, slots: &[Slot]) -> ChunkBuffer {
+        ChunkBuffer {
+            id,
+            access: BufferAccess::StorageReadWrite(Stage::Compute),
+            slots: slots.to_vec(),
+        }
+    }
+}
+
+/// Declares a chunked compute pass of `buffers`, whose handles it writes
+/// into `push` while recording.
 fn declare_chunked(
     graph: &mut RenderGraph<Chunk>,
     name: &str,
     pipeline: Arc<ComputePipeline>,
-    reads: &[crate::graph::BufferId],
-    writes: &[crate::graph::BufferId],
+    buffers: &[ChunkBuffer],
     push: TransferPush,
 ) {
     let mut pass = graph.pass(name);
-    for &r in reads {
-        pass = pass.read(r, BufferAccess::StorageRead(Stage::Compute));
-    }
-    for &w in writes {
-        pass = pass.write(w, BufferAccess::StorageReadWrite(Stage::Compute));
-    }
-    pass.record(move |pass, chunk| {
+    let bindings: Vec<_> = (buffers.iter())
+        .map(|b| (pass.storage_buffer(b.id, b.access), b.slots.clone()))
+        .collect();
+    pass.record(move |ctx, chunk| {
         let mut push = push;
+        for (binding, slots) in &bindings {
+            let handle = ctx.handle(*binding)?;
+            for slot in slots {
+                match *slot {
+                    Slot::Handle(i) => push.handles[i] = handle,
+                    Slot::Layout(i) => push.layout[i] = handle,
+                }
+            }
+        }
         push.grid[3] = chunk.first_row;
-        let cmd = pass.cmd();
-        cmd.bind_compute(&pipeline);
-        cmd.push_constants(&push)?;
-        cmd.dispatch(push.grid[0].div_ceil(8), chunk.rows.div_ceil(8), 1);
-        Ok(())
+        let groups = [push.grid[0].div_ceil(8), chunk.rows.div_ceil(8), 1];
+        ctx.dispatch(&pipeline, &push, groups)
     });
 }

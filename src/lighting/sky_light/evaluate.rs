@@ -13,7 +13,7 @@ use bytemuck::{Pod, Zeroable};
 
 use super::bake::SkyLightBake;
 use super::ENVIRONMENT_VEC4S;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, RenderGraph, Stage, UploadRegion};
 use crate::lighting::constants::{
     LightingFrame, SKY_LIGHT_AO, SKY_LIGHT_OFF, SKY_LIGHT_PATCHES, SKY_LIGHT_REFERENCE, SKY_LIGHT_SH,
@@ -77,12 +77,6 @@ pub struct SkyLight {
     environment: Arc<Buffer>,
     environment_pipeline: Arc<ComputePipeline>,
     evaluate_pipeline: Arc<ComputePipeline>,
-    /// Sampled map, sampled horizon map, environment storage.
-    handles: [u32; 3],
-}
-
-fn handle(h: Option<u32>, what: &str) -> Result<u32> {
-    h.ok_or_else(|| Error::Graph(format!("sky light: {what} has no heap handle")))
 }
 
 impl SkyLight {
@@ -107,18 +101,12 @@ impl SkyLight {
                 location: MemoryLocation::GpuOnly,
             },
         )?);
-        let handles = [
-            handle(map.sampled_handle(), "the sky-light map")?,
-            handle(bake.horizon_map.sampled_handle(), "the horizon map")?,
-            handle(environment.storage_handle(), "the environment")?,
-        ];
         Ok(SkyLight {
             environment_pipeline: Arc::new(ComputePipeline::new(ctx, shaders::LIGHTING_ENVIRONMENT)?),
             evaluate_pipeline: Arc::new(ComputePipeline::new(ctx, shaders::SKY_LIGHT_EVALUATE)?),
             bake,
             map,
             environment,
-            handles,
         })
     }
 
@@ -128,13 +116,11 @@ impl SkyLight {
         &self.bake
     }
 
-    /// Writes the sky-light fields of a view's lighting constants:
-    /// `maps.x` (sky-light map), `maps.y` (horizon map), `maps.w`
-    /// (environment) and `field` (extent, texel counts − 1).
+    /// Writes the sky-light field of a view's lighting constants, `field`
+    /// (extent, texel counts − 1); the maps' heap handles (`maps.x`,
+    /// `maps.y`, `maps.w`) are written by the pass that declares them
+    /// ([`crate::view::LightingMap`]).
     pub fn fill(&self, frame: &mut LightingFrame) {
-        frame.maps[0] = self.handles[0];
-        frame.maps[1] = self.handles[1];
-        frame.maps[3] = self.handles[2];
         let (c, r) = ((self.bake.columns - 1) as f32, (self.bake.rows - 1) as f32);
         frame.field = [
             (f64::from(c) * self.bake.spacing.x) as f32,
@@ -164,55 +150,48 @@ impl SkyLight {
 
         let pipeline = self.environment_pipeline.clone();
         let environment = ids.environment;
-        let mut pass = graph
-            .pass("lighting.environment")
-            .read(lighting, BufferAccess::StorageRead(Stage::Compute));
+        let compute = Stage::Compute;
+        let mut pass = graph.pass("lighting.environment");
+        let constants = pass.upload(lighting, compute);
         for &image in sky_inputs {
-            pass = pass.read(image, ImageAccess::Sampled(Stage::Compute));
+            pass.sample(image, compute);
         }
-        pass.write(environment, BufferAccess::StorageWrite(Stage::Compute))
-            .record(move |pass, _frame| {
-                let push = EnvironmentPush {
-                    handles: [pass.upload(lighting)?, pass.storage_buffer(environment)?, 0, 0],
-                };
-                let cmd = pass.cmd();
-                cmd.bind_compute(&pipeline);
-                cmd.push_constants(&push)?;
-                cmd.dispatch(1, 1, 1);
-                Ok(())
-            });
+        let output = pass.storage_buffer(environment, BufferAccess::StorageWrite(compute));
+        pass.record(move |ctx, _frame| {
+            let push = EnvironmentPush {
+                handles: [ctx.handle(constants)?, ctx.handle(output)?, 0, 0],
+            };
+            ctx.dispatch(&pipeline, &push, [1, 1, 1])
+        });
 
         let pipeline = self.evaluate_pipeline.clone();
-        let (map, columns, rows) = (ids.map, self.bake.columns, self.bake.rows);
+        let (columns, rows) = (self.bake.columns, self.bake.rows);
         let baked = self.bake.settings;
-        graph
-            .pass("lighting.sky_light")
-            .read(surface, BufferAccess::StorageRead(Stage::Compute))
-            .read(transfer, BufferAccess::StorageRead(Stage::Compute))
-            .read(environment, BufferAccess::StorageRead(Stage::Compute))
-            .write(map, ImageAccess::StorageWrite(Stage::Compute))
-            .record(move |pass, frame: &Frame<S>| {
-                let lighting = &frame.lighting;
-                if lighting.sky_light == SkyLightMode::Reference {
-                    return Ok(());
-                }
-                let bands = lighting.sh_bands.min(baked.sh_bands);
-                let push = EvaluatePush {
-                    handles: [
-                        pass.storage_buffer(surface)?,
-                        pass.storage_buffer(transfer)?,
-                        pass.storage_buffer(environment)?,
-                        pass.storage_image(map)?,
-                    ],
-                    grid: [columns, rows, mode_code(lighting.sky_light), bands * bands],
-                    layout: [baked.coefficients(), baked.stride(), lighting.sky_patches, 0],
-                };
-                let cmd = pass.cmd();
-                cmd.bind_compute(&pipeline);
-                cmd.push_constants(&push)?;
-                cmd.dispatch(columns.div_ceil(8), rows.div_ceil(8), 1);
-                Ok(())
-            });
+        let mut pass = graph.pass("lighting.sky_light");
+        let handles = [
+            pass.storage_buffer(surface, BufferAccess::StorageRead(compute)),
+            pass.storage_buffer(transfer, BufferAccess::StorageRead(compute)),
+            pass.storage_buffer(environment, BufferAccess::StorageRead(compute)),
+            pass.storage_image(ids.map, ImageAccess::StorageWrite(compute)),
+        ];
+        pass.record(move |ctx, frame: &Frame<S>| {
+            let lighting = &frame.lighting;
+            if lighting.sky_light == SkyLightMode::Reference {
+                return Ok(());
+            }
+            let bands = lighting.sh_bands.min(baked.sh_bands);
+            let push = EvaluatePush {
+                handles: [
+                    ctx.handle(handles[0])?,
+                    ctx.handle(handles[1])?,
+                    ctx.handle(handles[2])?,
+                    ctx.handle(handles[3])?,
+                ],
+                grid: [columns, rows, mode_code(lighting.sky_light), bands * bands],
+                layout: [baked.coefficients(), baked.stride(), lighting.sky_patches, 0],
+            };
+            ctx.dispatch(&pipeline, &push, [columns.div_ceil(8), rows.div_ceil(8), 1])
+        });
         ids
     }
 }

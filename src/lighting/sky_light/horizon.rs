@@ -23,7 +23,8 @@ use crate::vulkan::ComputePipeline;
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub(crate) struct HorizonPush {
-    /// Heights, horizons (written), horizon map (storage image).
+    /// Heights, horizons (written), horizon map (storage image): written
+    /// by the pass from its bindings.
     pub handles: [u32; 4],
     /// Columns, rows, azimuths K, first row of the chunk.
     pub grid: [u32; 4],
@@ -47,18 +48,20 @@ pub(crate) fn declare_horizon(graph: &mut RenderGraph<Chunk>, pipeline: Arc<Comp
         map,
         push,
     } = pass;
-    graph
-        .pass("sky_light.horizon")
-        .read(heights, BufferAccess::StorageRead(Stage::Compute))
-        .write(horizons, BufferAccess::StorageReadWrite(Stage::Compute))
-        .write(map, ImageAccess::StorageReadWrite(Stage::Compute))
-        .record(move |pass, chunk| {
-            let mut push = push;
-            push.grid[3] = chunk.first_row;
-            let cmd = pass.cmd();
-            cmd.bind_compute(&pipeline);
-            cmd.push_constants(&push)?;
-            cmd.dispatch(push.grid[0].div_ceil(8), chunk.rows.div_ceil(8), 1);
-            Ok(())
-        });
+    let compute = Stage::Compute;
+    let mut pass = graph.pass("sky_light.horizon");
+    let handles = [
+        pass.storage_buffer(heights, BufferAccess::StorageRead(compute)),
+        pass.storage_buffer(horizons, BufferAccess::StorageReadWrite(compute)),
+        pass.storage_image(map, ImageAccess::StorageReadWrite(compute)),
+    ];
+    pass.record(move |ctx, chunk| {
+        let mut push = push;
+        for (slot, &binding) in push.handles.iter_mut().zip(&handles) {
+            *slot = ctx.handle(binding)?;
+        }
+        push.grid[3] = chunk.first_row;
+        let groups = [push.grid[0].div_ceil(8), chunk.rows.div_ceil(8), 1];
+        ctx.dispatch(&pipeline, &push, groups)
+    });
 }

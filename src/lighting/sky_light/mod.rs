@@ -22,7 +22,7 @@
 //! let bake = SkyLightBake::bake(&ctx, &field, &BakeSettings::from_lighting(&lighting), cache_dir, &mut |f| bar.set(f))?;
 //! let sky_light = SkyLight::new(&ctx, bake)?;
 //! let ids = sky_light.declare(&mut graph, lighting_region, &atmosphere_luts);   // passes read ids.map, ids.horizon, ids.environment
-//! sky_light.fill(&mut lighting_frame);                                          // maps.x, maps.y, maps.w, field
+//! sky_light.fill(&mut lighting_frame);                                          // field (the handles: the `sky` pass)
 //! ```
 
 pub mod bake;

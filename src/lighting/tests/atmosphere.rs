@@ -69,7 +69,7 @@ fn render(cases: &[Case]) -> Vec<Tables> {
             .declare(&mut RenderGraph::<()>::new(), &[("a", region), ("b", region)])
             .is_err());
         let mut scratch: LightingFrame = bytemuck::Zeroable::zeroed();
-        assert!(atmosphere.fill_handles(1, EYE_Z, &mut scratch).is_err());
+        assert!(atmosphere.fill_altitude(1, EYE_Z, &mut scratch).is_err());
         let luts = atmosphere.declare(&mut graph, &[("", region)]).expect("declare");
         let readback = |name: &str, (w, h): (u32, u32)| {
             Arc::new(
@@ -117,7 +117,7 @@ fn render(cases: &[Case]) -> Vec<Tables> {
                 .to_array();
             lighting.mie[3] = GROUND_Z;
             p.fill(&mut lighting);
-            atmosphere.fill_handles(0, EYE_Z, &mut lighting).expect("handles");
+            atmosphere.fill_altitude(0, EYE_Z, &mut lighting).expect("altitude");
             baked
                 .uploads(index)
                 .write_pod(region, &lighting)

@@ -12,7 +12,9 @@ use std::time::{Duration, Instant};
 use crate::graph::RenderGraph;
 use crate::io::heightmap::HeightField;
 use crate::lighting::constants::{LightingFrame, LIGHTING_ALBEDO_OVERRIDE, LIGHTING_SUN_IN_ENVIRONMENT};
-use crate::lighting::reference::{CpuReference, MonteCarloReference, ReferenceProgress, ReferenceSettings, SunInput};
+use crate::lighting::reference::{
+    CpuReference, MonteCarloReference, ReferenceProgress, ReferenceSettings, ReferenceWork, SunInput,
+};
 use crate::test_support::{assert_validation_clean, validated_context};
 use crate::view::lighting::sun_direction;
 use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Context, FrameRing, MemoryLocation};
@@ -75,11 +77,11 @@ fn run_gpu(
     frames: &[LightingFrame],
     sky: Option<(Vec3, Vec3)>,
 ) -> (Maps, Vec<ReferenceProgress>, Duration) {
-    let reference = MonteCarloReference::new(ctx, field, settings).expect("reference");
-    reference.set_test_sky(sky).unwrap();
+    let mut reference = MonteCarloReference::new(ctx, field, settings).expect("reference");
+    reference.set_test_sky(sky);
     let texels = u64::from(field.columns * field.rows);
     let (sky_buffer, sun_buffer) = (readback(ctx, "sky", texels * 16), readback(ctx, "sun", texels * 4));
-    let mut graph: RenderGraph<()> = RenderGraph::new();
+    let mut graph: RenderGraph<ReferenceWork> = RenderGraph::new();
     let region = graph.upload_region("lighting", std::mem::size_of::<LightingFrame>() as u64);
     let images = reference.declare(&mut graph, region, &[]);
     let (sky_id, sun_id) = (
@@ -97,10 +99,11 @@ fn run_gpu(
     for frame in frames {
         let index = ring.wait_for_next().unwrap();
         let mut constants = *frame;
-        reference.fill(&mut constants).unwrap();
+        reference.fill(&mut constants);
         baked.uploads(index).write_pod(region, &constants).unwrap();
-        progress.push(reference.prepare(frame).unwrap());
-        baked.execute(&mut ring, &(), &[]).unwrap();
+        let (work, frame_progress) = reference.prepare(frame);
+        progress.push(frame_progress);
+        baked.execute(&mut ring, &work, &[]).unwrap();
     }
     baked.finish(&mut ring).unwrap();
     let elapsed = start.elapsed();

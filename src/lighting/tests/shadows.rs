@@ -7,7 +7,7 @@
 
 use std::sync::Arc;
 
-use crate::graph::{BufferAccess, ImageAccess, RenderGraph, Stage};
+use crate::graph::{BufferAccess, RenderGraph, Stage};
 use crate::lighting::constants::{LightingFrame, SHADOWS_CASCADED, SUN_ANGULAR_RADIUS};
 use crate::lighting::shadows::{record_cascades, SceneBounds, ShadowFrame, ShadowMaps, ShadowSettings};
 use crate::points::render::shadow::PointShadowFrame;
@@ -18,7 +18,7 @@ use crate::shaders;
 use crate::terrain::shadow::shadow_pipeline;
 use crate::test_support::{assert_validation_clean, validated_context};
 use crate::view::lighting::sun_direction;
-use crate::view::{frame_slots, Camera, Frame, FrameLighting, Lighting, SunPosition, View};
+use crate::view::{frame_slots, Camera, Frame, FrameLighting, Lighting, LightingMap, SunPosition, View};
 
 frame_slots! {
     /// What the shadow test's techniques prepare.
@@ -213,7 +213,8 @@ fn run(
         .graphics()
         .read(vertices, BufferAccess::Vertex)
         .read(indices, BufferAccess::Index)
-        .write(atlas, ImageAccess::DepthAttachmentWrite)
+        .pipeline(&pipeline)
+        .depth(atlas, None)
         .record(move |pass, frame| {
             let plan = frame.prepared::<ShadowFrame>()?.view(0)?;
             let (image, v, i) = (pass.image(atlas)?, pass.buffer(vertices)?, pass.buffer(indices)?);
@@ -243,25 +244,28 @@ fn run(
     let out_id = graph.import_buffer(out.clone());
     let probe = ComputePipeline::new(ctx, shaders::SHADOW_PROBE).expect("probe pipeline");
     let count = probes.len() as u32;
-    graph
-        .pass("shadow probe")
-        .read(atlas, ImageAccess::Sampled(Stage::Compute))
-        .read(lighting, BufferAccess::StorageRead(Stage::Compute))
-        .read(probe_region, BufferAccess::StorageRead(Stage::Compute))
-        .write(out_id, BufferAccess::StorageWrite(Stage::Compute))
-        .record(move |pass, _| {
-            let handles = [
-                pass.upload(lighting)?,
-                pass.upload(probe_region)?,
-                pass.storage_buffer(out_id)?,
-                count,
-            ];
-            let cmd = pass.cmd();
-            cmd.bind_compute(&probe);
-            cmd.push_constants(&handles)?;
-            cmd.dispatch(count.div_ceil(64), 1, 1);
-            Ok(())
-        });
+    let mut pass = graph.pass("shadow probe");
+    let atlas = pass.sample(atlas, Stage::Compute);
+    let lighting = pass.upload(lighting, Stage::Compute);
+    let probe_binding = pass.upload(probe_region, Stage::Compute);
+    let out_binding = pass.storage_buffer(out_id, BufferAccess::StorageWrite(Stage::Compute));
+    pass.record(move |pass, frame: &Frame<Slots>| {
+        // The lighting constants name the atlas: written by the pass that declares it.
+        let plan = frame.prepared::<ShadowFrame>()?.view(0)?;
+        let mut constants = LightingFrame::zeroed();
+        constants.sun = frame.lighting.sun_direction().extend(SUN_ANGULAR_RADIUS).to_array();
+        constants.models = [0, SHADOWS_CASCADED, 0, 0];
+        plan.fill(&mut constants);
+        constants.set_map_handle(LightingMap::ShadowAtlas, pass.handle(atlas)?);
+        pass.write_upload_pod(lighting, &constants)?;
+        let handles = [
+            pass.handle(lighting)?,
+            pass.handle(probe_binding)?,
+            pass.handle(out_binding)?,
+            count,
+        ];
+        pass.dispatch(&probe, &handles, [count.div_ceil(64), 1, 1])
+    });
     graph.read_back(out_id);
     let mut baked = graph.bake(ctx).expect("bake");
     let mut frames = FrameRing::new(ctx).expect("frames");
@@ -287,13 +291,6 @@ fn run(
                 .expect("prepare points");
         }
         let plan = frame.prepared::<ShadowFrame>().unwrap().view(0).unwrap().clone();
-        let mut constants = LightingFrame::zeroed();
-        constants.sun = sun_direction(elevation_deg, azimuth_deg)
-            .extend(SUN_ANGULAR_RADIUS)
-            .to_array();
-        constants.models = [0, SHADOWS_CASCADED, 0, 0];
-        plan.fill(&mut constants);
-        uploads.write_pod(lighting, &constants).unwrap();
         let packed: Vec<Probe> = probes
             .iter()
             .map(|&(p, n)| Probe {

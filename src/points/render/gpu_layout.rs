@@ -81,8 +81,8 @@ pub struct FrameHeader {
     pub depth: [f32; 4],
     /// Width, height, largest point size, near plane.
     pub viewport: [f32; 4],
-    /// x: storage handle of the view's lighting constants; y: 1 shaded, 0
-    /// unlit (albedo).
+    /// x: storage handle of the view's lighting constants (written by the
+    /// shading pass that declares them); y: 1 shaded, 0 unlit (albedo).
     pub lighting: [u32; 4],
     /// Rows of the camera → world rotation.
     pub camera_to_world: [[f32; 4]; 3],
@@ -137,8 +137,9 @@ pub fn view_and_intrinsics(view: &View) -> (DMat4, DMat3) {
     (matrix, k)
 }
 
-/// The header of a frame, and the world → camera matrix it was built from.
-pub fn frame_header(view: &View, lighting: u32, settings: &SplatSettings, max_point_size: f32) -> (FrameHeader, DMat4) {
+/// The header of a frame (without the lighting constants' handle), and
+/// the world → camera matrix it was built from.
+pub fn frame_header(view: &View, settings: &SplatSettings, max_point_size: f32) -> (FrameHeader, DMat4) {
     let (camera, width, height) = (&view.camera, view.width, view.height);
     let (view, k) = view_and_intrinsics(view);
     let k_inv = k.inverse();
@@ -156,7 +157,7 @@ pub fn frame_header(view: &View, lighting: u32, settings: &SplatSettings, max_po
         k_inv: rows(k_inv),
         depth: [p22 as f32, p32 as f32, settings.visibility_offset, settings.cutoff],
         viewport: [width as f32, height as f32, max_point_size, near as f32],
-        lighting: [lighting, settings.shaded as u32, 0, 0],
+        lighting: [0, settings.shaded as u32, 0, 0],
         camera_to_world: rows(view3.transpose()),
         eye: camera
             .eye
@@ -194,7 +195,7 @@ mod tests {
             let got = (x.x / x.z, x.y / x.z);
             assert!((got.0 - expected.0).abs() < 1e-3 && (got.1 - expected.1).abs() < 1e-3);
             let z = view.transform_point3(p).z;
-            let (header, _) = frame_header(&v, 0, &SplatSettings::default(), 64.0);
+            let (header, _) = frame_header(&v, &SplatSettings::default(), 64.0);
             let depth = (f64::from(header.depth[0]) * z + f64::from(header.depth[1])) / -z;
             assert!((depth - ndc.z).abs() < 1e-5, "{depth} vs {}", ndc.z);
         }

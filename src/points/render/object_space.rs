@@ -28,7 +28,7 @@ use super::pipeline_spec::PipelineSpec;
 use super::selection::FramePlan;
 use super::SplatPrimitive;
 use crate::error::{Error, Result};
-use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, PassBuilder, RenderGraph, Stage};
+use crate::graph::{Binding, BufferAccess, BufferId, ImageId, PassBuilder, RenderGraph, Stage};
 use crate::shaders;
 use crate::view::Frame;
 use crate::vulkan::{
@@ -179,12 +179,17 @@ pub(super) struct ObjectSpaceBuffers {
 }
 
 impl ObjectSpaceBuffers {
-    /// Declares what a splat pass reads: vertices, indices and the kernel texture.
-    pub(super) fn read_by<'g, S: 'static>(&self, builder: PassBuilder<'g, Frame<S>>) -> PassBuilder<'g, Frame<S>> {
-        builder
+    /// Declares what a splat pass reads: vertices, indices and the kernel
+    /// texture (whose binding it returns).
+    pub(super) fn read_by<'g, S: 'static>(
+        &self,
+        builder: PassBuilder<'g, Frame<S>>,
+    ) -> (PassBuilder<'g, Frame<S>>, Binding) {
+        let mut builder = builder
             .read(self.vertices, BufferAccess::Vertex)
-            .read(self.indices, BufferAccess::Index)
-            .read(self.kernel, ImageAccess::Sampled(Stage::Fragment))
+            .read(self.indices, BufferAccess::Index);
+        let kernel = builder.sample(self.kernel, Stage::Fragment);
+        (builder, kernel)
     }
 }
 

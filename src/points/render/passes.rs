@@ -13,11 +13,13 @@ use super::selection::FramePlan;
 use super::triangles::draw_triangles;
 use super::{PointsFrame, SplatPrimitive};
 use crate::error::{Error, Result};
-use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, PassBuilder, RenderGraph, Stage, UploadRegion};
+use crate::graph::{
+    Binding, BufferAccess, BufferId, ImageId, LoadOp, PassBuilder, PassContext, RenderGraph, Stage, UploadRegion,
+};
 use crate::shaders;
 use crate::view::{Frame, Provides, SceneTargets, ViewIndex};
 use crate::vulkan::{
-    Blend, Buffer, CommandRecorder, CompareOp, Context, GraphicsPipeline, GraphicsPipelineDesc, Image, LoadOp, SpirV,
+    Blend, Buffer, CommandRecorder, CompareOp, Context, GraphicsPipeline, GraphicsPipelineDesc, SpirV,
 };
 
 /// `SplatPush.pass`: which pass the shaders run in.
@@ -102,109 +104,86 @@ pub(super) struct PointView {
     /// The world normal and ids AOVs (`crate::view::aov`).
     pub normal: ImageId,
     pub ids: ImageId,
-    /// The view's lighting constants.
-    pub lighting: UploadRegion,
     /// Clear the depth buffer first (no terrain drew into it).
     pub clear_depth: bool,
 }
 
 impl PointView {
-    /// Declares the writes of a pass that draws the view's shaded outputs
-    /// (radiance, view depth, W with `weight`, visibility, normal, ids).
+    /// Declares the colour attachments of a pass that draws the view's
+    /// shaded outputs (radiance, view depth, W, visibility, normal, ids):
+    /// every output loaded but W, which `weight` loads or clears.
     pub(super) fn write_outputs<'g, S: Provides<PointsFrame> + 'static>(
         &self,
         builder: PassBuilder<'g, Frame<S>>,
-        weight: ImageAccess,
+        weight: LoadOp,
     ) -> PassBuilder<'g, Frame<S>> {
         builder
-            .write(self.radiance, ImageAccess::ColorAttachmentReadWrite)
-            .write(self.view_depth, ImageAccess::ColorAttachmentReadWrite)
-            .write(self.weight, weight)
-            .write(self.visibility, ImageAccess::ColorAttachmentReadWrite)
-            .write(self.normal, ImageAccess::ColorAttachmentReadWrite)
-            .write(self.ids, ImageAccess::ColorAttachmentReadWrite)
-    }
-
-    /// The colour attachments of [`Self::write_outputs`]: every output
-    /// loaded but W, which `weight` loads or clears.
-    pub(super) fn output_attachments<'a>(
-        &self,
-        pass: &crate::graph::PassContext<'a>,
-        weight: LoadOp,
-    ) -> Result<[(&'a Image, LoadOp); 6]> {
-        Ok([
-            (pass.image(self.radiance)?, LoadOp::Load),
-            (pass.image(self.view_depth)?, LoadOp::Load),
-            (pass.image(self.weight)?, weight),
-            (pass.image(self.visibility)?, LoadOp::Load),
-            (pass.image(self.normal)?, LoadOp::Load),
-            (pass.image(self.ids)?, LoadOp::Load),
-        ])
-    }
-
-    /// Draws `pipeline` full screen with `push` into the outputs (W loaded
-    /// or cleared by `weight`): the resolve passes.
-    pub(super) fn draw_full_screen<T: Pod>(
-        &self,
-        pass: &mut crate::graph::PassContext<'_>,
-        weight: LoadOp,
-        pipeline: &GraphicsPipeline,
-        push: &T,
-    ) -> Result<()> {
-        let colors = self.output_attachments(pass, weight)?;
-        let cmd = pass.cmd();
-        cmd.begin_rendering(&colors, None);
-        cmd.bind_graphics(pipeline);
-        cmd.push_constants(push)?;
-        cmd.draw(3, 1);
-        cmd.end_rendering();
-        Ok(())
+            .color(self.radiance, LoadOp::Load)
+            .color(self.view_depth, LoadOp::Load)
+            .color(self.weight, weight)
+            .color(self.visibility, LoadOp::Load)
+            .color(self.normal, LoadOp::Load)
+            .color(self.ids, LoadOp::Load)
     }
 }
 
-impl PointBuffers {
-    /// Declares the reads every splat pass makes (and the counter's write when `count`).
-    fn read_by<'g, S: Provides<PointsFrame> + 'static>(
-        &self,
-        builder: PassBuilder<'g, Frame<S>>,
-        frame: UploadRegion,
-        count: bool,
-    ) -> PassBuilder<'g, Frame<S>> {
-        let mut builder = builder
-            .read(self.splats, BufferAccess::StorageRead(Stage::Vertex))
-            .read(frame, BufferAccess::StorageRead(Stage::Graphics))
-            .read(self.table, BufferAccess::StorageRead(Stage::Fragment));
-        if let (true, Some(c)) = (count, self.counter) {
-            builder = builder.write(c, BufferAccess::StorageReadWrite(Stage::Vertex));
-        }
-        if let Some(t) = self.triangles {
-            builder = builder.read(t, BufferAccess::StorageRead(Stage::Vertex));
-        }
-        match &self.object {
-            Some(object) => object.read_by(builder),
-            None => builder,
-        }
+/// The heap bindings of a shading pass of the points: the view's point
+/// frame and lighting constants. The pass writes the frame's header (which
+/// names the lighting constants) while recording.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct ShadingBindings {
+    pub frame: Binding,
+    pub lighting: Binding,
+}
+
+impl ShadingBindings {
+    /// Declares the reads of a pass that shades view `view`'s points (its
+    /// point frame read at `stage`).
+    pub(super) fn read_in<P: 'static>(
+        pass: &mut PassBuilder<'_, P>,
+        (view, targets): (&PointView, &SceneTargets),
+        stage: Stage,
+    ) -> ShadingBindings {
+        let lighting = targets.lighting.read_in(pass, Stage::Fragment).constants;
+        let frame = pass.upload(view.frame, stage);
+        ShadingBindings { frame, lighting }
     }
 
-    /// The push constants of `pass` (counting the drawn splats when `count`).
-    pub(super) fn push(
+    /// Writes the header of the view's point frame (prepared, with the
+    /// heap handle of the lighting constants), and returns the frame's handle.
+    pub(super) fn write_header<S: Provides<PointsFrame>>(
         &self,
-        ctx: &crate::graph::PassContext<'_>,
-        frame: UploadRegion,
-        pass: u32,
-        count: bool,
-    ) -> Result<SplatPush> {
+        ctx: &mut PassContext<'_>,
+        frame: &Frame<S>,
+        index: ViewIndex,
+    ) -> Result<u32> {
+        let mut header = frame.prepared::<PointsFrame>()?.view(index)?.header;
+        header.lighting[0] = ctx.handle(self.lighting)?;
+        ctx.write_upload_pod(self.frame, &header)?;
+        ctx.handle(self.frame)
+    }
+}
+
+/// The heap bindings of a splat pass ([`PointBuffers::read_by`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SplatBindings {
+    splats: Binding,
+    frame: Binding,
+    counter: Option<Binding>,
+    /// The Gaussian table, or the object-space primitives' kernel texture.
+    table: Binding,
+    triangles: Option<Binding>,
+}
+
+impl SplatBindings {
+    /// The push constants of `pass` (the drawn splats counted when the
+    /// pass declared the counter).
+    pub(super) fn push(&self, ctx: &PassContext<'_>, pass: u32) -> Result<SplatPush> {
         Ok(SplatPush {
-            splats: ctx.storage_buffer(self.splats)?,
-            frame: ctx.upload(frame)?,
-            counter: match (count, self.counter) {
-                (true, Some(c)) => ctx.storage_buffer(c)?,
-                _ => NO_HANDLE,
-            },
-            table: match &self.object {
-                Some(object) => ctx.sampled(object.kernel)?,
-                None => ctx.storage_buffer(self.table)?,
-            },
+            splats: ctx.handle(self.splats)?,
+            frame: ctx.handle(self.frame)?,
+            counter: self.counter.map(|c| ctx.handle(c)).transpose()?.unwrap_or(NO_HANDLE),
+            table: ctx.handle(self.table)?,
             pass,
             primitive: PRIMITIVE_QUAD,
             size_class: SIZE_ANY,
@@ -212,13 +191,62 @@ impl PointBuffers {
         })
     }
 
-    /// The triangle buffer's handle in a pass.
-    pub(super) fn triangle_handle(&self, ctx: &crate::graph::PassContext<'_>) -> Result<Option<u32>> {
-        self.triangles.map(|t| ctx.storage_buffer(t)).transpose()
+    /// The triangle buffer's handle in the pass.
+    pub(super) fn triangle_handle(&self, ctx: &PassContext<'_>) -> Result<Option<u32>> {
+        self.triangles.map(|t| ctx.handle(t)).transpose()
+    }
+}
+
+impl PointBuffers {
+    /// Declares the reads every splat pass makes (and the counter's write
+    /// when `count`); `frame`: the binding of the view's point frame,
+    /// declared by the pass.
+    fn read_by<'g, S: 'static>(
+        &self,
+        builder: PassBuilder<'g, Frame<S>>,
+        frame: Binding,
+        count: bool,
+    ) -> (PassBuilder<'g, Frame<S>>, SplatBindings) {
+        let buffers = PointBuffers {
+            counter: self.counter.filter(|_| count),
+            ..*self
+        };
+        let (mut builder, mut bindings) = buffers.read_by_at(builder, frame, (Stage::Vertex, Stage::Fragment));
+        bindings.triangles =
+            (self.triangles).map(|t| builder.storage_buffer(t, BufferAccess::StorageRead(Stage::Vertex)));
+        match &self.object {
+            Some(object) => {
+                let (builder, kernel) = object.read_by(builder);
+                bindings.table = kernel;
+                (builder, bindings)
+            }
+            None => (builder, bindings),
+        }
+    }
+
+    /// Declares the splats' read at `vertex`, the Gaussian table's at
+    /// `fragment` and the counter's write (if any) at `vertex`.
+    pub(super) fn read_by_at<'g, S: 'static>(
+        &self,
+        mut builder: PassBuilder<'g, Frame<S>>,
+        frame: Binding,
+        (vertex, fragment): (Stage, Stage),
+    ) -> (PassBuilder<'g, Frame<S>>, SplatBindings) {
+        let splats = builder.storage_buffer(self.splats, BufferAccess::StorageRead(vertex));
+        let table = builder.storage_buffer(self.table, BufferAccess::StorageRead(fragment));
+        let counter = (self.counter).map(|c| builder.storage_buffer(c, BufferAccess::StorageReadWrite(vertex)));
+        let bindings = SplatBindings {
+            splats,
+            frame,
+            counter,
+            table,
+            triangles: None,
+        };
+        (builder, bindings)
     }
 
     /// The vertex and index buffers of the object-space primitives in a pass.
-    fn object_buffers<'a>(&self, ctx: &crate::graph::PassContext<'a>) -> Result<Option<(&'a Buffer, &'a Buffer)>> {
+    fn object_buffers<'a>(&self, ctx: &PassContext<'a>) -> Result<Option<(&'a Buffer, &'a Buffer)>> {
         self.object
             .map(|o| Ok((ctx.buffer(o.vertices)?, ctx.buffer(o.indices)?)))
             .transpose()
@@ -268,6 +296,20 @@ impl PassPipelines {
             points,
             hybrid: buffers.triangles.map(|_| hybrid.build(ctx, depth, false)).transpose()?,
         })
+    }
+
+    /// Declares the pipelines on `builder` (their formats are checked
+    /// against the pass's attachments).
+    fn declare_on<'g, S: 'static>(&self, builder: PassBuilder<'g, Frame<S>>) -> PassBuilder<'g, Frame<S>> {
+        let builder = builder.pipeline(&self.triangles);
+        let builder = match &self.points {
+            Some(p) => builder.pipeline(p),
+            None => builder,
+        };
+        match &self.hybrid {
+            Some(p) => builder.pipeline(p),
+            None => builder,
+        }
     }
 
     /// Records one draw per planned instance (`object`: the vertex and index
@@ -370,25 +412,23 @@ pub(super) fn declare_opaque<S: Provides<PointsFrame> + 'static>(
             ..spec("points.opaque.triangles", shaders::HYBRID_OPAQUE_FRAG)
         },
     )?;
-    let builder = buffers.read_by(graph.pass(name).graphics(), view.frame, true);
-    let builder = targets.lighting.read_in(builder, Stage::Fragment);
-    view.write_outputs(builder, ImageAccess::ColorAttachmentWrite)
-        .write(view.depth, ImageAccess::DepthAttachmentWrite)
+    let mut builder = graph.pass(name).graphics();
+    let shading = ShadingBindings::read_in(&mut builder, (&view, targets), Stage::Graphics);
+    let (builder, splat) = buffers.read_by(builder, shading.frame, true);
+    let builder = view.write_outputs(pipelines.declare_on(builder), LoadOp::Clear([0.0; 4]));
+    builder
+        .depth(view.depth, view.clear_depth.then_some(1.0))
         .record(move |pass, frame| {
+            shading.write_header(pass, frame, view.index)?;
             let plan = plan_of(frame, view.index)?;
-            let push = buffers.push(pass, view.frame, PASS_OPAQUE, true)?;
-            let triangles = buffers.triangle_handle(pass)?;
+            let push = splat.push(pass, PASS_OPAQUE)?;
+            let triangles = splat.triangle_handle(pass)?;
             let object = buffers.object_buffers(pass)?;
-            let colors = view.output_attachments(pass, LoadOp::Clear([0.0; 4]))?;
-            let depth = pass.image(view.depth)?;
             let cmd = pass.cmd();
-            cmd.begin_rendering(&colors, Some((depth, view.clear_depth.then_some(1.0))));
             if draw_splats {
                 pipelines.draw(cmd, plan, (buffers.primitive, object), push)?;
             }
-            pipelines.draw_hybrid(cmd, plan, push, triangles)?;
-            cmd.end_rendering();
-            Ok(())
+            pipelines.draw_hybrid(cmd, plan, push, triangles)
         });
     Ok(())
 }
@@ -461,23 +501,21 @@ fn declare_visibility<S: Provides<PointsFrame> + 'static>(
             (shaders::HYBRID_VERT, shaders::HYBRID_VISIBILITY_FRAG),
         ),
     )?;
-    let builder = buffers.read_by(graph.pass(name).graphics(), view.frame, true);
-    builder
-        .write(ids, ImageAccess::ColorAttachmentWrite)
-        .write(view.depth, ImageAccess::DepthAttachmentWrite)
+    let mut builder = graph.pass(name).graphics();
+    let frame = builder.upload(view.frame, Stage::Graphics);
+    let (builder, splat) = buffers.read_by(builder, frame, true);
+    pipelines
+        .declare_on(builder)
+        .color(ids, LoadOp::Clear([0.0; 4]))
+        .depth(view.depth, view.clear_depth.then_some(1.0))
         .record(move |pass, frame| {
             let plan = plan_of(frame, view.index)?;
-            let push = buffers.push(pass, view.frame, PASS_VISIBILITY, true)?;
-            let triangles = buffers.triangle_handle(pass)?;
+            let push = splat.push(pass, PASS_VISIBILITY)?;
+            let triangles = splat.triangle_handle(pass)?;
             let object = buffers.object_buffers(pass)?;
-            let (ids, depth) = (pass.image(ids)?, pass.image(view.depth)?);
             let cmd = pass.cmd();
-            let clear = view.clear_depth.then_some(1.0);
-            cmd.begin_rendering(&[(ids, LoadOp::Clear([0.0; 4]))], Some((depth, clear)));
             pipelines.draw_hybrid(cmd, plan, push, triangles)?;
-            pipelines.draw(cmd, plan, (buffers.primitive, object), push)?;
-            cmd.end_rendering();
-            Ok(())
+            pipelines.draw(cmd, plan, (buffers.primitive, object), push)
         });
     Ok(())
 }
@@ -520,29 +558,24 @@ fn declare_accumulate<S: Provides<PointsFrame> + 'static>(
             (shaders::HYBRID_VERT, shaders::HYBRID_ACCUMULATE_FRAG),
         ),
     )?;
-    let builder = buffers.read_by(graph.pass(name).graphics(), view.frame, false);
-    builder
-        .read(view.depth, ImageAccess::DepthAttachmentRead)
-        .write(accumulation.color_weight, ImageAccess::ColorAttachmentWrite)
-        .write(accumulation.normal_depth, ImageAccess::ColorAttachmentWrite)
-        .write(accumulation.any_ids, ImageAccess::ColorAttachmentWrite)
+    let mut builder = graph.pass(name).graphics();
+    let frame = builder.upload(view.frame, Stage::Graphics);
+    let (builder, splat) = buffers.read_by(builder, frame, false);
+    let clear = LoadOp::Clear([0.0; 4]);
+    pipelines
+        .declare_on(builder)
+        .color(accumulation.color_weight, clear)
+        .color(accumulation.normal_depth, clear)
+        .color(accumulation.any_ids, clear)
+        .depth_read(view.depth)
         .record(move |pass, frame| {
             let plan = plan_of(frame, view.index)?;
-            let push = buffers.push(pass, view.frame, PASS_ACCUMULATE, false)?;
-            let triangles = buffers.triangle_handle(pass)?;
+            let push = splat.push(pass, PASS_ACCUMULATE)?;
+            let triangles = splat.triangle_handle(pass)?;
             let object = buffers.object_buffers(pass)?;
-            let (cw, nd) = (
-                pass.image(accumulation.color_weight)?,
-                pass.image(accumulation.normal_depth)?,
-            );
-            let (ids, depth) = (pass.image(accumulation.any_ids)?, pass.image(view.depth)?);
-            let clear = LoadOp::Clear([0.0; 4]);
             let cmd = pass.cmd();
-            cmd.begin_rendering(&[(cw, clear), (nd, clear), (ids, clear)], Some((depth, None)));
             pipelines.draw(cmd, plan, (buffers.primitive, object), push)?;
-            pipelines.draw_hybrid(cmd, plan, push, triangles)?;
-            cmd.end_rendering();
-            Ok(())
+            pipelines.draw_hybrid(cmd, plan, push, triangles)
         });
     Ok(())
 }
@@ -574,25 +607,26 @@ fn declare_normalize<S: Provides<PointsFrame> + 'static>(
             ],
         ),
     )?);
-    let builder = targets
-        .lighting
-        .read_in(graph.pass(name).graphics(), Stage::Fragment)
-        .read(accumulation.color_weight, ImageAccess::Sampled(Stage::Fragment))
-        .read(accumulation.normal_depth, ImageAccess::Sampled(Stage::Fragment))
-        .read(accumulation.nearest_ids, ImageAccess::Sampled(Stage::Fragment))
-        .read(accumulation.any_ids, ImageAccess::Sampled(Stage::Fragment))
-        .read(view.frame, BufferAccess::StorageRead(Stage::Fragment));
-    view.write_outputs(builder, ImageAccess::ColorAttachmentWrite)
-        .record(move |pass, _| {
+    let mut builder = graph.pass(name).graphics();
+    let shading = ShadingBindings::read_in(&mut builder, (&view, targets), Stage::Fragment);
+    let sampled = [
+        accumulation.color_weight,
+        accumulation.normal_depth,
+        accumulation.nearest_ids,
+        accumulation.any_ids,
+    ]
+    .map(|image| builder.sample(image, Stage::Fragment));
+    view.write_outputs(builder.pipeline(&pipeline), LoadOp::Clear([0.0; 4]))
+        .record(move |pass, frame| {
             let push = NormalizePush {
-                color_weight: pass.sampled(accumulation.color_weight)?,
-                frame: pass.upload(view.frame)?,
-                normal_depth: pass.sampled(accumulation.normal_depth)?,
-                nearest_ids: pass.sampled(accumulation.nearest_ids)?,
-                any_ids: pass.sampled(accumulation.any_ids)?,
+                color_weight: pass.handle(sampled[0])?,
+                frame: shading.write_header(pass, frame, view.index)?,
+                normal_depth: pass.handle(sampled[1])?,
+                nearest_ids: pass.handle(sampled[2])?,
+                any_ids: pass.handle(sampled[3])?,
                 ..NormalizePush::zeroed()
             };
-            view.draw_full_screen(pass, LoadOp::Clear([0.0; 4]), &pipeline, &push)
+            pass.draw_full_screen(&pipeline, &push)
         });
     Ok(())
 }

@@ -25,17 +25,16 @@ use glam::DVec3;
 use super::selection::{keeps_instance, ObjectLayout};
 use super::PointRenderer;
 use crate::error::{Error, Result};
-use crate::graph::{BufferAccess, BufferId, ImageAccess, RenderGraph, Stage, UploadRegion};
+use crate::graph::{BufferAccess, BufferId, RenderGraph, Stage, UploadRegion};
 use crate::lighting::shadows::{
-    plan_cascades, plan_cascades_into, record_cascades, CascadePlan, SceneBounds, ShadowFrame, ShadowMaps,
-    ShadowSettings, ShadowTarget, SHADOW_FORMAT,
+    plan_cascades, plan_cascades_into, record_cascades, splat_caster_desc, CascadePlan, SceneBounds, ShadowFrame,
+    ShadowMaps, ShadowSettings, ShadowTarget,
 };
 use crate::points::scene::PointScene;
-use crate::shaders;
 use crate::view::{
     pass_name, per_view, Declare, Frame, FrameContext, Provides, ShadowMode, Technique, View, ViewIndex,
 };
-use crate::vulkan::{Blend, Buffer, CompareOp, Context, GraphicsPipeline, GraphicsPipelineDesc, PrimitiveTopology};
+use crate::vulkan::{Buffer, Context, GraphicsPipeline};
 
 /// Header of a view's shadow records (`ShadowPoints` in shadow_points.vert).
 #[repr(C)]
@@ -167,50 +166,31 @@ impl PointShadows {
             &pass_name("point shadow casters", &view.name),
             HEADER_BYTES + RECORD_BYTES * records,
         );
-        let pipeline = GraphicsPipeline::new(
-            ctx,
-            &GraphicsPipelineDesc {
-                name: "points.shadow",
-                vertex: shaders::SHADOW_POINTS_VERT,
-                fragment: shaders::SHADOW_POINTS_FRAG,
-                vertex_stride: 0,
-                vertex_attributes: Vec::new(),
-                topology: PrimitiveTopology::TRIANGLE_LIST,
-                cull_back_faces: false,
-                wireframe: false,
-                color_formats: Vec::new(),
-                blend: Blend::None,
-                depth_format: Some(SHADOW_FORMAT),
-                depth_test: true,
-                depth_write: true,
-                depth_compare: CompareOp::LESS_OR_EQUAL,
-            },
-        )?;
+        let pipeline = GraphicsPipeline::new(ctx, &splat_caster_desc("points.shadow"))?;
         let atlas = target.atlas;
-        graph
-            .pass(&pass_name("points.shadow", &view.name))
-            .graphics()
-            .read(splats, BufferAccess::StorageRead(Stage::Vertex))
-            .read(region, BufferAccess::StorageRead(Stage::Vertex))
-            .write(atlas, ImageAccess::DepthAttachmentWrite)
-            .record(move |ctx, frame| {
-                let plan = frame.prepared::<ShadowFrame>()?.view(index)?;
-                let draws = frame.prepared::<PointShadowFrame>()?.view(index)?;
-                if draws.is_empty() {
-                    return Ok(());
+        let mut pass = graph.pass(&pass_name("points.shadow", &view.name)).graphics();
+        let handles = [
+            pass.storage_buffer(splats, BufferAccess::StorageRead(Stage::Vertex)),
+            pass.upload(region, Stage::Vertex),
+        ];
+        pass.pipeline(&pipeline).depth(atlas, None).record(move |ctx, frame| {
+            let plan = frame.prepared::<ShadowFrame>()?.view(index)?;
+            let draws = frame.prepared::<PointShadowFrame>()?.view(index)?;
+            if draws.is_empty() {
+                return Ok(());
+            }
+            let handles = [ctx.handle(handles[0])?, ctx.handle(handles[1])?];
+            let image = ctx.image(atlas)?;
+            record_cascades(ctx.cmd(), image, plan, |cmd, mut push| {
+                cmd.bind_graphics(&pipeline);
+                for d in draws {
+                    push.handles = [handles[0], handles[1], d.record, 0];
+                    cmd.push_constants(&push)?;
+                    cmd.draw(d.count * 6, 1);
                 }
-                let handles = [ctx.storage_buffer(splats)?, ctx.upload(region)?];
-                let image = ctx.image(atlas)?;
-                record_cascades(ctx.cmd(), image, plan, |cmd, mut push| {
-                    cmd.bind_graphics(&pipeline);
-                    for d in draws {
-                        push.handles = [handles[0], handles[1], d.record, 0];
-                        cmd.push_constants(&push)?;
-                        cmd.draw(d.count * 6, 1);
-                    }
-                    Ok(())
-                })
-            });
+                Ok(())
+            })
+        });
         self.views.push(ShadowView { index, region });
         Ok(())
     }
@@ -316,10 +296,10 @@ impl Technique for PointShadows {
                 let (aspect, bounds) = (view.culling_aspect(), self.bounds);
                 let mut plan = match self.scratch_plan.take() {
                     Some(mut plan) => {
-                        plan_cascades_into(&mut plan, (&camera, aspect), sun, bounds, &self.settings, 0)?;
+                        plan_cascades_into(&mut plan, (&camera, aspect), sun, bounds, &self.settings)?;
                         plan
                     }
-                    None => plan_cascades(&camera, aspect, sun, bounds, &self.settings, 0)?,
+                    None => plan_cascades(&camera, aspect, sun, bounds, &self.settings)?,
                 };
                 self.plan_view(
                     view.camera.eye,

@@ -36,15 +36,16 @@ use std::sync::Arc;
 use bytemuck::{Pod, Zeroable};
 
 use super::passes::{
-    declare_opaque, plan_of, PointBuffers, PointView, SplatPush, NO_HANDLE, PASS_OPAQUE, PRIMITIVE_QUAD,
+    declare_opaque, plan_of, PointBuffers, PointView, ShadingBindings, SplatBindings, SplatPush, NO_HANDLE,
+    PASS_OPAQUE, PRIMITIVE_QUAD,
 };
 use super::{PointsFrame, SplatBackend, SplatPrimitive};
 use crate::error::{Error, Result};
-use crate::graph::{BufferAccess, BufferId, BufferInfo, ImageAccess, PassBuilder, RenderGraph, Stage};
+use crate::graph::{Binding, BufferAccess, BufferId, BufferInfo, LoadOp, PassBuilder, PassContext, RenderGraph, Stage};
 use crate::shaders;
 use crate::view::{Frame, Provides, SceneTargets};
 use crate::vulkan::{
-    ComputePipeline, Context, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, MemoryLocation, PrimitiveTopology,
+    ComputePipeline, Context, GraphicsPipeline, GraphicsPipelineDesc, MemoryLocation, PrimitiveTopology,
 };
 
 /// Bytes of a pixel's lock and z_d (`glsl/include/single_pass_merge.glsl`).
@@ -235,27 +236,17 @@ fn declare_clear<S: Provides<PointsFrame> + 'static>(
     state: PixelState,
     pipeline: ComputePipeline,
 ) {
-    graph
-        .pass(name)
-        .write(state.words, BufferAccess::StorageWrite(Stage::Compute))
-        .write(state.sums, BufferAccess::StorageWrite(Stage::Compute))
-        .record(move |pass, _| {
-            let push = StatePush {
-                handles: [
-                    pass.storage_buffer(state.words)?,
-                    pass.storage_buffer(state.sums)?,
-                    state.pixels,
-                    0,
-                ],
-                mode: [0; 4],
-            };
-            let cmd = pass.cmd();
-            cmd.bind_compute(&pipeline);
-            cmd.push_constants(&push)?;
-            let (x, y) = workgroups(state.pixels);
-            cmd.dispatch(x, y, 1);
-            Ok(())
-        });
+    let mut pass = graph.pass(name);
+    let words = pass.storage_buffer(state.words, BufferAccess::StorageWrite(Stage::Compute));
+    let sums = pass.storage_buffer(state.sums, BufferAccess::StorageWrite(Stage::Compute));
+    pass.record(move |ctx, _| {
+        let push = StatePush {
+            handles: [ctx.handle(words)?, ctx.handle(sums)?, state.pixels, 0],
+            mode: [0; 4],
+        };
+        let (x, y) = workgroups(state.pixels);
+        ctx.dispatch(&pipeline, &push, [x, y, 1])
+    });
 }
 
 /// Workgroups for `n` invocations: (per row, rows).
@@ -265,53 +256,53 @@ fn workgroups(n: u32) -> (u32, u32) {
     (groups.div_ceil(rows), rows)
 }
 
+/// The heap bindings of the splat pass.
+#[derive(Clone, Copy, Debug)]
+struct SplatPassBindings {
+    splat: SplatBindings,
+    words: Binding,
+    sums: Binding,
+    /// The depth buffer, when written before.
+    depth: Option<Binding>,
+}
+
+impl SplatPassBindings {
+    /// The push constants of the splat pass.
+    fn push(&self, ctx: &PassContext<'_>) -> Result<SinglePassPush> {
+        Ok(SinglePassPush {
+            splat: SplatPush {
+                primitive: PRIMITIVE_QUAD,
+                ..self.splat.push(ctx, PASS_OPAQUE)?
+            },
+            words: ctx.handle(self.words)?,
+            sums: ctx.handle(self.sums)?,
+            depth: self.depth.map(|d| ctx.handle(d)).transpose()?.unwrap_or(NO_HANDLE),
+            count: 0,
+        })
+    }
+}
+
 /// The reads and writes of the splat pass at `stage`: splats, frame,
 /// table, counter, the pixel state and the depth buffer when written.
 fn splat_pass_uses<'g, S: Provides<PointsFrame> + 'static>(
-    builder: PassBuilder<'g, Frame<S>>,
+    mut builder: PassBuilder<'g, Frame<S>>,
     (buffers, view): (PointBuffers, PointView),
     state: PixelState,
     depth_written: bool,
     (vertex, fragment): (Stage, Stage),
-) -> PassBuilder<'g, Frame<S>> {
-    let mut builder = builder
-        .read(buffers.splats, BufferAccess::StorageRead(vertex))
-        .read(
-            view.frame,
-            BufferAccess::StorageRead(if vertex == fragment { vertex } else { Stage::Graphics }),
-        )
-        .read(buffers.table, BufferAccess::StorageRead(fragment))
-        .write(state.words, BufferAccess::StorageReadWrite(fragment))
-        .write(state.sums, BufferAccess::StorageReadWrite(fragment));
-    if let Some(c) = buffers.counter {
-        builder = builder.write(c, BufferAccess::StorageReadWrite(vertex));
-    }
-    if depth_written {
-        builder = builder.read(view.depth, ImageAccess::Sampled(fragment));
-    }
-    builder
-}
-
-/// The push constants of the splat pass.
-fn splat_push(
-    pass: &crate::graph::PassContext<'_>,
-    (buffers, view): (PointBuffers, PointView),
-    state: PixelState,
-    depth_written: bool,
-) -> Result<SinglePassPush> {
-    Ok(SinglePassPush {
-        splat: SplatPush {
-            primitive: PRIMITIVE_QUAD,
-            ..buffers.push(pass, view.frame, PASS_OPAQUE, true)?
-        },
-        words: pass.storage_buffer(state.words)?,
-        sums: pass.storage_buffer(state.sums)?,
-        depth: match depth_written {
-            true => pass.sampled(view.depth)?,
-            false => NO_HANDLE,
-        },
-        count: 0,
-    })
+) -> (PassBuilder<'g, Frame<S>>, SplatPassBindings) {
+    let frame = builder.upload(view.frame, if vertex == fragment { vertex } else { Stage::Graphics });
+    let words = builder.storage_buffer(state.words, BufferAccess::StorageReadWrite(fragment));
+    let sums = builder.storage_buffer(state.sums, BufferAccess::StorageReadWrite(fragment));
+    let depth = depth_written.then(|| builder.sample(view.depth, fragment));
+    let (builder, splat) = buffers.read_by_at(builder, frame, (vertex, fragment));
+    let bindings = SplatPassBindings {
+        splat,
+        words,
+        sums,
+        depth,
+    };
+    (builder, bindings)
 }
 
 /// `points.single_pass`, compute backend: one dispatch per planned draw,
@@ -325,9 +316,10 @@ fn declare_compute<S: Provides<PointsFrame> + 'static>(
 ) {
     let builder = graph.pass(&name);
     let stages = (Stage::Compute, Stage::Compute);
-    splat_pass_uses(builder, (buffers, view), state, depth_written, stages).record(move |pass, frame| {
+    let (builder, bindings) = splat_pass_uses(builder, (buffers, view), state, depth_written, stages);
+    builder.record(move |pass, frame| {
         let plan = plan_of(frame, view.index)?;
-        let mut push = splat_push(pass, (buffers, view), state, depth_written)?;
+        let mut push = bindings.push(pass)?;
         let cmd = pass.cmd();
         cmd.bind_compute(&pipeline);
         for d in &plan.draws {
@@ -353,18 +345,18 @@ fn declare_interlock<S: Provides<PointsFrame> + 'static>(
 ) {
     let builder = graph.pass(&name).graphics();
     let stages = (Stage::Vertex, Stage::Fragment);
-    let (weight_access, weight_load) = match weight_written {
-        true => (ImageAccess::ColorAttachmentReadWrite, LoadOp::Load),
-        false => (ImageAccess::ColorAttachmentWrite, LoadOp::DontCare),
+    let weight_load = match weight_written {
+        true => LoadOp::Load,
+        false => LoadOp::DontCare,
     };
-    splat_pass_uses(builder, (buffers, view), state, depth_written, stages)
-        .write(view.weight, weight_access)
+    let (builder, bindings) = splat_pass_uses(builder, (buffers, view), state, depth_written, stages);
+    builder
+        .pipeline(&pipeline)
+        .color(view.weight, weight_load)
         .record(move |pass, frame| {
             let plan = plan_of(frame, view.index)?;
-            let mut push = splat_push(pass, (buffers, view), state, depth_written)?;
-            let weight = pass.image(view.weight)?;
+            let mut push = bindings.push(pass)?;
             let cmd = pass.cmd();
-            cmd.begin_rendering(&[(weight, weight_load)], None);
             cmd.bind_graphics(&pipeline);
             for d in &plan.draws {
                 let vertices = d
@@ -375,7 +367,6 @@ fn declare_interlock<S: Provides<PointsFrame> + 'static>(
                 cmd.push_constants(&push)?;
                 cmd.draw(vertices, 1);
             }
-            cmd.end_rendering();
             Ok(())
         });
 }
@@ -391,26 +382,21 @@ fn declare_resolve<S: Provides<PointsFrame> + 'static>(
     pipeline: GraphicsPipeline,
 ) {
     let pipeline = Arc::new(pipeline);
-    let weight_access = match weight_written {
-        true => ImageAccess::ColorAttachmentReadWrite,
-        false => ImageAccess::ColorAttachmentWrite,
+    let weight_load = match weight_written {
+        true => LoadOp::Load,
+        false => LoadOp::Clear([0.0; 4]),
     };
-    let builder = targets
-        .lighting
-        .read_in(graph.pass(name).graphics(), Stage::Fragment)
-        .read(state.sums, BufferAccess::StorageRead(Stage::Fragment))
-        .read(view.frame, BufferAccess::StorageRead(Stage::Fragment));
-    view.write_outputs(builder, weight_access).record(move |pass, _| {
-        let push = StatePush {
-            handles: [pass.storage_buffer(state.sums)?, pass.upload(view.frame)?, 0, 0],
-            mode: [0; 4],
-        };
-        let weight_load = match weight_written {
-            true => LoadOp::Load,
-            false => LoadOp::Clear([0.0; 4]),
-        };
-        view.draw_full_screen(pass, weight_load, &pipeline, &push)
-    });
+    let mut builder = graph.pass(name).graphics();
+    let shading = ShadingBindings::read_in(&mut builder, (&view, targets), Stage::Fragment);
+    let sums = builder.storage_buffer(state.sums, BufferAccess::StorageRead(Stage::Fragment));
+    view.write_outputs(builder.pipeline(&pipeline), weight_load)
+        .record(move |pass, frame| {
+            let push = StatePush {
+                handles: [pass.handle(sums)?, shading.write_header(pass, frame, view.index)?, 0, 0],
+                mode: [0; 4],
+            };
+            pass.draw_full_screen(&pipeline, &push)
+        });
 }
 
 #[cfg(test)]

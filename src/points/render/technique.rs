@@ -6,7 +6,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::gpu_layout::{frame_header, gaussian_table, pack_nodes, HEADER_BYTES, INSTANCE_BYTES};
+use super::gpu_layout::{frame_header, gaussian_table, pack_nodes, FrameHeader, HEADER_BYTES, INSTANCE_BYTES};
 use super::object_space::ObjectSpaceResources;
 use super::passes::{declare_ewa, declare_opaque, PointBuffers, PointView};
 use super::selection::{plan_frame_into, FramePlan, ObjectLayout};
@@ -31,6 +31,10 @@ pub struct PointsFrame {
 /// One view's prepared selection.
 pub struct PointViewFrame {
     pub view: ViewIndex,
+    /// The header of the view's point frame, but the heap handle of the
+    /// lighting constants (the shading pass writes it; the instance records
+    /// follow it in the upload region, written by `prepare`).
+    pub header: FrameHeader,
     pub plan: FramePlan,
 }
 
@@ -216,7 +220,6 @@ impl PointRenderer {
             visibility: targets.visibility,
             normal: targets.normal,
             ids: targets.ids,
-            lighting: targets.lighting.constants,
             clear_depth,
         };
         let name = |base: &str| pass_name(base, &view.name);
@@ -301,27 +304,25 @@ impl Technique for PointRenderer {
                 .get(point_view.index)
                 .ok_or_else(|| Error::Graph(format!("points: the frame has no view {}", point_view.index)))?;
             let camera = &view.camera;
-            let (header, view_matrix) = frame_header(
-                view,
-                frame.uploads.handle(point_view.lighting)?,
-                &self.settings,
-                self.max_point_size,
-            );
+            // The header's handle of the lighting constants is the shading
+            // pass's to write (`ShadingBindings::write_header`).
+            let (header, view_matrix) = frame_header(view, &self.settings, self.max_point_size);
             let view_proj = view.view_proj_f64();
             let pixel = 1.0 / view.intrinsics().fy;
             // The previous frame's plan of this view, reused in place.
             if views.len() <= k {
                 views.push(PointViewFrame {
                     view: point_view.index,
+                    header,
                     plan: FramePlan::default(),
                 });
             }
             let slot = &mut views[k];
             slot.view = point_view.index;
+            slot.header = header;
             let eye_view = (camera.eye, view_matrix, view_proj);
             plan_frame_into(&mut slot.plan, &self.scene, &self.layouts, eye_view, pixel);
             let plan = &slot.plan;
-            frame.uploads.write_pod(point_view.frame, &header)?;
             frame
                 .uploads
                 .write_at(point_view.frame, HEADER_BYTES, bytemuck::cast_slice(&plan.records))?;

@@ -156,9 +156,9 @@ impl LensDistortion {
             checked,
             &[map],
             target,
-            move |pass, image, h| {
+            move |image, h, buffers| {
                 Ok(DistortionPush {
-                    handles: [h[0], h[1], pass.storage_buffer(map)?, image.format],
+                    handles: [h[0], h[1], buffers[0], image.format],
                     size,
                     mode: [image.kind, 0, 0, 0],
                     radial: lens.radial,
