@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use super::access::{derive_barrier, write_access_bits};
 use super::bake::{BakedGraph, PendingFrame, Physical};
 use super::binding::{Binding, BindingTarget};
-use super::uploads::{UploadArena, UploadRegion};
+use super::uploads::UploadArena;
 use super::{Access, Attachments, BufferId, ImageId, PassKind, ResourceId};
 use crate::error::{Error, Result};
 use crate::profile::{FrameProfile, PassTiming, StageTiming};
@@ -185,36 +185,6 @@ impl<'a> PassContext<'a> {
         cmd.push_constants(push)?;
         cmd.draw(3, 1);
         Ok(())
-    }
-
-    /// Heap handle for sampling the image `id` (transitional: use a
-    /// [`Binding`]).
-    pub fn sampled(&self, id: ImageId) -> Result<u32> {
-        let image = self.image(id)?;
-        image
-            .sampled_handle()
-            .ok_or_else(|| Error::Graph(format!("image '{}' is not sampled", image.desc().name)))
-    }
-
-    /// Heap handle of the storage image `id` (transitional).
-    pub fn storage_image(&self, id: ImageId) -> Result<u32> {
-        let image = self.image(id)?;
-        image
-            .storage_handle()
-            .ok_or_else(|| Error::Graph(format!("image '{}' is not a storage image", image.desc().name)))
-    }
-
-    /// Heap handle of the storage buffer `id` (transitional).
-    pub fn storage_buffer(&self, id: BufferId) -> Result<u32> {
-        let buffer = self.buffer(id)?;
-        buffer
-            .storage_handle()
-            .ok_or_else(|| Error::Graph(format!("buffer '{}' is not a storage buffer", buffer.desc().name)))
-    }
-
-    /// Heap handle of the upload region `region` this frame (transitional).
-    pub fn upload(&self, region: UploadRegion) -> Result<u32> {
-        self.arena()?.handle(region, self.frame)
     }
 }
 

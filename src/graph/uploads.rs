@@ -112,11 +112,6 @@ pub struct UploadWriter<'a> {
 }
 
 impl UploadWriter<'_> {
-    /// The heap handle of `region` in this slot (what shaders index).
-    pub fn handle(&self, region: UploadRegion) -> Result<u32> {
-        self.arena()?.handle(region, self.slot as u64)
-    }
-
     /// A writer for a graph without upload regions (every write fails).
     pub(crate) fn empty() -> UploadWriter<'static> {
         UploadWriter { arena: None, slot: 0 }
