@@ -328,7 +328,7 @@ impl Technique for Terrain {
             frame
                 .uploads
                 .write(warp_region, bytemuck::cast_slice(&state.lod.upload))?;
-            let pixel_footprint = view.pixel_angle();
+            let pixel_footprint = view.pixel_footprint();
             let lighting = match state.lighting {
                 Some(region) => frame.uploads.handle(region)?,
                 None => return Err(Error::Graph(format!("terrain.draw of view {k} was not declared"))),
