@@ -3,7 +3,7 @@
 //! Hidden from the documentation and not part of the API: no stability
 //! promise; it exists so that those programs need no public internals.
 
-pub use crate::graph::{ImageId, ImageInfo, RenderGraph};
+pub use crate::graph::{Binding, ImageId, ImageInfo, PassContext, RenderGraph, Stage};
 pub use crate::lighting::constants::LightingFrame;
 pub use crate::lighting::reference::{MonteCarloReference, ReferenceSettings};
 pub use crate::lighting::sky_light::{BakeSettings, SkyLightBake};

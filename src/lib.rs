@@ -88,6 +88,8 @@ pub(crate) mod renderer;
 #[forbid(unsafe_code)]
 pub(crate) mod shaders;
 #[forbid(unsafe_code)]
+pub(crate) mod surface;
+#[forbid(unsafe_code)]
 pub(crate) mod synthesis;
 #[forbid(unsafe_code)]
 pub(crate) mod terrain;
@@ -165,9 +167,9 @@ pub use renderer::scene::DEFAULT_ROCKS;
 /// # Ok::<(), alpenglow::Error>(())
 /// ```
 pub use renderer::Scene;
+pub use surface::layers::LayerTree;
 pub use terrain::ground::Ground;
 pub use terrain::procedural::{ProceduralTerrain, TerrainModel};
-pub use texturing::layers::LayerTree;
 
 // --- The renderer and its settings ---
 
@@ -205,11 +207,11 @@ pub use renderer::RenderSettings as Settings;
 /// # Ok::<(), alpenglow::Error>(())
 /// ```
 pub use renderer::Renderer;
+pub use surface::gpu_layout::TexturingMode;
 pub use terrain::geometry_image::{TerrainSettings, TerrainView};
 pub use terrain::lod::{ImportanceFactors, LodMode, LodSettings};
 pub use terrain::sketch_map::SketchAlignment;
 pub use texturing::generation::TextureStreaming;
-pub use texturing::gpu_layout::TexturingMode;
 pub use texturing::streaming::MAX_TILE_BUDGET;
 
 // --- Cameras, views and rigs ---

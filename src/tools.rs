@@ -38,14 +38,14 @@ pub mod synth {
 /// A layer tree from a classified image (`alpenglow layers from-image`),
 /// and the names of the layer tree's input maps.
 pub mod layers {
-    pub use crate::texturing::from_image::{
-        build_layers, load_rgb_image, ClassCount, FromImageOptions, PixelStatus, MAX_CLASSES,
-    };
-    pub use crate::texturing::layers::INPUT_NAMES;
+    pub use crate::surface::layers::INPUT_NAMES;
     /// The layer tree's limits (what a loaded tree is guaranteed to respect).
-    pub use crate::texturing::layers::{
+    pub use crate::surface::layers::{
         vegetation::{MAX_DENSITY as MAX_VEGETATION_DENSITY, MAX_SCALE as MAX_VEGETATION_SCALE},
         Constraint, MAX_BLUR_RADII, MAX_HEIGHT_BLUR, MAX_SAMPLES,
+    };
+    pub use crate::texturing::from_image::{
+        build_layers, load_rgb_image, ClassCount, FromImageOptions, PixelStatus, MAX_CLASSES,
     };
     pub use crate::texturing::reference::srgb8;
 }

@@ -16,8 +16,10 @@ const SMALL_TERRAIN: &str = "procedural:fbm,size=65,spacing=20";
 
 /// Runs the binary with `args` and the environment variables `env`.
 fn run_with(env: &[(&str, &str)], args: &[&str]) -> Output {
+    let renders = args.first().is_some_and(|a| ["render", "bench", "fly"].contains(a));
+    let validation = (renders && !args.contains(&"--validation")).then_some("--validation");
     Command::new(bin())
-        .args(args)
+        .args(args.iter().copied().chain(validation))
         .envs(env.iter().copied())
         .env(
             "XDG_CACHE_HOME",

@@ -25,6 +25,7 @@ fn render_with_env(png: &Path, extra: &[&str], env: &[(&str, Option<&Path>)]) ->
     let mut cmd = Command::new(bin());
     cmd.args([
         "render",
+        "--validation",
         "--width",
         "32",
         "--height",
@@ -136,6 +137,7 @@ fn a_relative_xdg_cache_home_is_ignored() {
         cmd.current_dir(&dir);
         cmd.args([
             "render",
+            "--validation",
             "--width",
             "32",
             "--height",

@@ -1,7 +1,7 @@
 // The height field as a uniform cubic B-spline surface (dissertation §7.4
 // "sketch atlas", §8.2 root upsampling; ALGORITHMS.md §3 item 5 and §4):
 // height and world gradient at world xy from the R32F height texture.
-// Same convention as src/terrain/bspline.rs.
+// Same convention as src/surface/bspline.rs.
 #ifndef ALPENGLOW_BSPLINE_HEIGHT_GLSL
 #define ALPENGLOW_BSPLINE_HEIGHT_GLSL
 

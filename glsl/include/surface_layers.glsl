@@ -3,9 +3,9 @@
 // (§8.3) constraints,
 // coverage with noise, depth-first colour blending, displacement feeding
 // the next layers' altitude and the normal. Same rules as the CPU reference
-// src/texturing/layers.rs (`evaluate`); layout as src/texturing/gpu_layout.rs.
+// src/surface/layers.rs (`evaluate`); layout as src/surface/gpu_layout.rs.
 // A `height_blur` layer's altitude, elevation and slope read a blurred
-// height field instead (§8.2.3, snow in furrows; src/texturing/blurred_height.rs).
+// height field instead (§8.2.3, snow in furrows; src/surface/blurred_height.rs).
 // Needs terrain_detail.glsl (wavelet noise) included first.
 #ifndef ALPENGLOW_SURFACE_LAYERS_GLSL
 #define ALPENGLOW_SURFACE_LAYERS_GLSL
@@ -34,11 +34,11 @@ layout(set = 0, binding = 2, std430) readonly buffer SurfaceLayerFloats { float 
 
 #define MAX_SURFACE_LAYERS 32
 
-// F(a) of a constraint h of the layers buffer `layers` (src/texturing/gpu_layout.rs
+// F(a) of a constraint h of the layers buffer `layers` (src/surface/gpu_layout.rs
 // `pack_constraint`): w = 0 unused (1); w = 1 a hat (min, max, fuzz); w = 1 + n a
 // sampled function of n samples over [min, max] starting at float z of the
 // buffer: linear between the bin centres, the end values in the outer
-// half-bins, 0 outside [min, max] (src/texturing/layers/constraint.rs).
+// half-bins, 0 outside [min, max] (src/surface/layers/constraint.rs).
 float constraint(uint layers, vec4 h, float a) {
     if (h.w == 0.0) {
         return 1.0;
@@ -120,7 +120,7 @@ struct LayerState {
     vec3 color;         // blended linear colour so far
     vec4 coverage;      // C_S of the last layer seen per tree level
     uint dominant;      // the layer with the largest share of the colour so far
-    float share;        // its share (src/texturing/dominant.rs)
+    float share;        // its share (src/surface/dominant.rs)
 };
 
 // The state before the root: base height h with gradient grad.
@@ -172,7 +172,7 @@ void apply_layer(uint layers, uint i, uint tile, vec2 xy, float footprint, vec2 
     }
     s.coverage[min(level, 3u)] = c_s;
     s.color = mix(s.color, color_roughness.rgb, c_s);
-    // The dominant layer (src/texturing/dominant.rs): every earlier share
+    // The dominant layer (src/surface/dominant.rs): every earlier share
     // scales by 1 − C_S, this layer's share is C_S.
     s.share *= 1.0 - c_s;
     if (c_s > s.share) {

@@ -23,7 +23,7 @@ const int NOISE_TILE = 128;
 
 // Cook & DeRose wavelet noise (2005), quadratic B-spline evaluation of the
 // periodic tile at p (tile texels); returns the value and writes d/dp.
-// Convention of src/terrain/wavelet_noise.rs: mid = ceil(p − 0.5),
+// Convention of src/surface/wavelet_noise.rs: mid = ceil(p − 0.5),
 // t = mid − (p − 0.5), w0 = t²/2, w2 = (1 − t)²/2, w1 = 1 − w0 − w2 for taps
 // mid − 1, mid, mid + 1 (periodic).
 float wavelet_noise(uint tile, vec2 p, out vec2 grad) {

@@ -1,5 +1,5 @@
 // Terrain shading's side of the surface layers (dissertation §8.2;
-// src/texturing/gpu_layout.rs, TexturingFrame; src/texturing/page_table.rs):
+// src/surface/gpu_layout.rs, TexturingFrame; src/texturing/page_table.rs):
 // the per-frame texturing constants, and for the atlas mode the walk of the
 // frame's page table from the root to the tile covering world xy, whose
 // colour and displacement normal are sampled bilinearly. Needs heap.glsl.

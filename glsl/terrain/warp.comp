@@ -6,7 +6,7 @@
 //  1. Φ: the CPU's warped sketch map (n×n world xy) bilinearly interpolated
 //     at (i, j)·(n−1)/(N−1), clamped onto the terrain's rectangle;
 //  2. height re-sampled from the sketch atlas there with the cubic B-spline
-//     (src/terrain/bspline.rs uses the same taps and clamping);
+//     (src/surface/bspline.rs uses the same taps and clamping);
 //  3. split octave o = log2(d0 / d) − SPLIT_BIAS, d the largest 3D distance
 //     to the four grid neighbours (from Φ and the atlas gradient);
 //  4. procedural displacement: wavelet octaves up to o (terrain_detail.glsl);

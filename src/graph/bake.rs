@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use super::alias::{assign_slots, AliasSlot};
 use super::uploads::{UploadArena, UploadWriter};
-use super::{Access, ImageInfo, PassDecl, PassKind, RenderGraph, ResourceDecl, ResourceId};
+use super::{Access, Attachments, ImageInfo, PassDecl, PassKind, RenderGraph, ResourceDecl, ResourceId};
 use crate::error::{Error, Result};
 use crate::profile::FrameProfile;
 use crate::vulkan::{
@@ -48,6 +48,10 @@ pub(crate) struct BakedPass<P> {
     pub kind: PassKind,
     pub uses: Vec<(ResourceId, Access)>,
     pub record: super::RecordFn<P>,
+    /// The pass's number in its graph (what its bindings carry).
+    pub serial: u32,
+    /// What the graph begins rendering into around the closure.
+    pub attachments: Attachments,
 }
 
 pub(crate) struct PendingFrame {
@@ -90,6 +94,8 @@ pub struct BakedGraph<P> {
     pub(crate) epoch: Instant,
     /// The upload arena, when a region was declared.
     pub(crate) uploads: Option<UploadArena>,
+    /// The graph's number (what its passes' bindings carry).
+    pub(crate) serial: u32,
 }
 
 impl<P> BakedGraph<P> {
@@ -191,6 +197,7 @@ fn validate<P>(graph: &RenderGraph<P>) -> Result<()> {
         if pass.record.is_none() {
             return Err(Error::Graph(format!("pass '{}' has no recording closure", pass.name)));
         }
+        check_attachments(graph, pass)?;
     }
     for (r, a) in &graph.outputs {
         if r.0 >= graph.resources.len() {
@@ -200,6 +207,57 @@ fn validate<P>(graph: &RenderGraph<P>) -> Result<()> {
             return Err(Error::Graph(format!(
                 "'{}': only buffers can be read back",
                 graph.resources[r.0].name()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The format of an image resource.
+fn image_format(decl: &ResourceDecl) -> Option<crate::vulkan::Format> {
+    match decl {
+        ResourceDecl::TransientImage { info, .. } => Some(info.format),
+        ResourceDecl::ImportedImages(images) => images.first().map(|i| i.desc().format),
+        _ => None,
+    }
+}
+
+/// A graphics pass's attachments against the pipelines it declared: same
+/// colour formats in the same order, same depth format (Granite checks its
+/// render passes against the pipelines' formats the same way).
+fn check_attachments<P>(graph: &RenderGraph<P>, pass: &PassDecl<P>) -> Result<()> {
+    let attachments = &pass.attachments;
+    if attachments.is_empty() {
+        return match pass.pipelines.first() {
+            Some(p) => Err(Error::Graph(format!(
+                "pass '{}' declares the pipeline '{}' but no attachment",
+                pass.name, p.name
+            ))),
+            None => Ok(()),
+        };
+    }
+    if pass.kind != PassKind::Graphics {
+        return Err(Error::Graph(format!(
+            "pass '{}' declares attachments but is not a graphics pass",
+            pass.name
+        )));
+    }
+    let format_of = |r: ResourceId| graph.resources.get(r.0).and_then(image_format);
+    let colors: Vec<_> = attachments.colors.iter().map(|(r, _)| format_of(*r)).collect();
+    let depth = attachments.depth.and_then(|(r, _)| format_of(r));
+    if pass.pipelines.is_empty() {
+        return Err(Error::Graph(format!(
+            "graphics pass '{}' declares attachments but no pipeline (PassBuilder::pipeline)",
+            pass.name
+        )));
+    }
+    for pipeline in &pass.pipelines {
+        let wanted: Vec<_> = pipeline.colors.iter().copied().map(Some).collect();
+        if wanted != colors || pipeline.depth != depth {
+            return Err(Error::Graph(format!(
+                "pass '{}': the pipeline '{}' renders into colours {:?} and depth {:?}, \
+                 but the pass declares colours {colors:?} and depth {depth:?}",
+                pass.name, pipeline.name, pipeline.colors, pipeline.depth
             )));
         }
     }
@@ -284,26 +342,18 @@ fn plan_aliasing<P>(
     Ok((alias_of, blocks))
 }
 
-pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<BakedGraph<P>> {
-    validate(&graph)?;
-    let live = live_passes(&graph);
-    let mut image_usage = vec![ImageUsageFlags::empty(); graph.resources.len()];
-    let mut buffer_usage = vec![BufferUsageFlags::empty(); graph.resources.len()];
-    for (pass, _) in graph.passes.iter().zip(&live).filter(|(_, l)| **l) {
-        for (r, a) in &pass.uses {
-            image_usage[r.0] |= a.image_usage();
-            buffer_usage[r.0] |= a.buffer_usage();
-        }
-    }
-    let (alias_of, blocks) = plan_aliasing(&graph, &live, &image_usage, ctx)?;
-    let uploads = match graph.upload_arena {
-        Some(_) => Some(UploadArena::new(ctx, &graph.upload_regions)?),
-        None => None,
-    };
-    let mut physical = Vec::with_capacity(graph.resources.len());
-    let mut imported = Vec::with_capacity(graph.resources.len());
-    for (i, decl) in graph.resources.into_iter().enumerate() {
-        imported.push(decl.is_imported());
+/// The physical resources: transients created (aliased into `blocks`
+/// where planned) with the usage their accesses need, imports checked for
+/// it, the upload arena's buffers.
+fn create_physical(
+    ctx: &Context,
+    resources: Vec<ResourceDecl>,
+    (image_usage, buffer_usage): (&[ImageUsageFlags], &[BufferUsageFlags]),
+    blocks: &[Option<Arc<MemoryBlock>>],
+    uploads: Option<&UploadArena>,
+) -> Result<Vec<Physical>> {
+    let mut physical = Vec::with_capacity(resources.len());
+    for (i, decl) in resources.into_iter().enumerate() {
         let p = match decl {
             ResourceDecl::TransientImage { name, info } => {
                 if image_usage[i].is_empty() {
@@ -357,13 +407,36 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
                 }
                 Physical::Buffer(buffers)
             }
-            ResourceDecl::Uploads => match &uploads {
+            ResourceDecl::Uploads => match uploads {
                 Some(u) => Physical::Buffer(u.buffers.clone()),
                 None => Physical::Unused,
             },
         };
         physical.push(p);
     }
+    Ok(physical)
+}
+
+pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<BakedGraph<P>> {
+    validate(&graph)?;
+    let serial = graph.serial;
+    let live = live_passes(&graph);
+    let mut image_usage = vec![ImageUsageFlags::empty(); graph.resources.len()];
+    let mut buffer_usage = vec![BufferUsageFlags::empty(); graph.resources.len()];
+    for (pass, _) in graph.passes.iter().zip(&live).filter(|(_, l)| **l) {
+        for (r, a) in &pass.uses {
+            image_usage[r.0] |= a.image_usage();
+            buffer_usage[r.0] |= a.buffer_usage();
+        }
+    }
+    let (alias_of, blocks) = plan_aliasing(&graph, &live, &image_usage, ctx)?;
+    let uploads = match graph.upload_arena {
+        Some(_) => Some(UploadArena::new(ctx, &graph.upload_regions)?),
+        None => None,
+    };
+    let imported = graph.resources.iter().map(ResourceDecl::is_imported).collect();
+    let usage = (image_usage.as_slice(), buffer_usage.as_slice());
+    let physical = create_physical(ctx, graph.resources, usage, &blocks, uploads.as_ref())?;
     let mut passes = Vec::new();
     let mut culled = Vec::new();
     for (decl, alive) in graph.passes.into_iter().zip(live) {
@@ -372,6 +445,8 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
             kind,
             uses,
             record,
+            serial,
+            attachments,
             ..
         } = decl;
         match (alive, record) {
@@ -381,6 +456,8 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
                 kind,
                 uses,
                 record,
+                serial,
+                attachments,
             }),
             _ => culled.push(name),
         }
@@ -405,6 +482,7 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
         spare_cpu_passes: Vec::new(),
         epoch: Instant::now(),
         uploads,
+        serial,
     })
 }
 

@@ -6,22 +6,30 @@ use std::time::{Duration, Instant};
 
 use super::access::{derive_barrier, write_access_bits};
 use super::bake::{BakedGraph, PendingFrame, Physical};
+use super::binding::{Binding, BindingTarget};
 use super::uploads::{UploadArena, UploadRegion};
-use super::{BufferId, ImageId, PassKind, ResourceId};
+use super::{Access, Attachments, BufferId, ImageId, PassKind, ResourceId};
 use crate::error::{Error, Result};
 use crate::profile::{FrameProfile, PassTiming, StageTiming};
 use crate::vulkan::{
-    AccessFlags2, AccessState, BarrierBatch, Buffer, CommandRecorder, CompletedFrame, FrameRing, Image,
-    PipelineStageFlags2,
+    AccessFlags2, AccessState, BarrierBatch, Buffer, CommandRecorder, CompletedFrame, ComputePipeline, FrameRing,
+    GraphicsPipeline, Image, PipelineStageFlags2,
 };
 
-/// What a pass's recording closure gets: the command recorder and the
-/// physical resources of this frame.
+/// What a pass's recording closure gets: the command recorder, the
+/// physical resources the pass declared, and the heap handles of its
+/// bindings ([`PassContext::handle`]) — nothing it did not declare.
 pub struct PassContext<'a> {
     cmd: &'a mut CommandRecorder,
     physical: &'a [Physical],
     uploads: Option<&'a UploadArena>,
     frame: u64,
+    /// What the pass declared.
+    uses: &'a [(ResourceId, Access)],
+    /// The pass's and its graph's numbers (its bindings carry them).
+    pass: u32,
+    graph: u32,
+    name: &'a str,
 }
 
 /// A CPU stage of a frame before recording (a technique's `prepare`), for
@@ -59,27 +67,128 @@ impl<'a> PassContext<'a> {
         self.frame
     }
 
-    /// The image behind `id` this frame.
-    pub fn image(&self, id: ImageId) -> Result<&'a Image> {
-        let ResourceId(r) = id.0;
+    fn declared(&self, r: ResourceId, what: &str) -> Result<()> {
+        match self.uses.iter().any(|(u, _)| *u == r) {
+            true => Ok(()),
+            false => Err(Error::Graph(format!(
+                "pass '{}' reaches {what} #{} it did not declare",
+                self.name, r.0
+            ))),
+        }
+    }
+
+    fn physical_image(&self, r: ResourceId) -> Result<&'a Image> {
         self.physical
-            .get(r)
+            .get(r.0)
             .and_then(|p| p.image(self.frame))
             .map(|i| &**i)
-            .ok_or_else(|| Error::Graph(format!("image #{r} is not of this graph")))
+            .ok_or_else(|| Error::Graph(format!("image #{} is not of this graph", r.0)))
     }
 
-    /// The buffer behind `id` this frame.
-    pub fn buffer(&self, id: BufferId) -> Result<&'a Buffer> {
-        let ResourceId(r) = id.0;
+    fn physical_buffer(&self, r: ResourceId) -> Result<&'a Buffer> {
         self.physical
-            .get(r)
+            .get(r.0)
             .and_then(|p| p.buffer(self.frame))
             .map(|b| &**b)
-            .ok_or_else(|| Error::Graph(format!("buffer #{r} is not of this graph")))
+            .ok_or_else(|| Error::Graph(format!("buffer #{} is not of this graph", r.0)))
     }
 
-    /// Heap handle for sampling the image `id`.
+    /// The image behind `id` this frame (attachments, copies); an error
+    /// unless the pass declared `id`.
+    pub fn image(&self, id: ImageId) -> Result<&'a Image> {
+        self.declared(id.0, "the image")?;
+        self.physical_image(id.0)
+    }
+
+    /// The buffer behind `id` this frame (vertex, index, indirect buffers,
+    /// copies); an error unless the pass declared `id`.
+    pub fn buffer(&self, id: BufferId) -> Result<&'a Buffer> {
+        self.declared(id.0, "the buffer")?;
+        self.physical_buffer(id.0)
+    }
+
+    /// The bindless heap handle of `binding`, which this pass declared
+    /// ([`super::PassBuilder::sample`], `storage_image`, `storage_buffer`,
+    /// `upload`): the only way a pass reaches the heap. A binding of
+    /// another pass is an error.
+    pub fn handle(&self, binding: Binding) -> Result<u32> {
+        self.own(binding)?;
+        let missing = |what: &str, name: &str| Error::Graph(format!("'{name}' has no {what} heap handle"));
+        match binding.target {
+            BindingTarget::SampledImage(r) => {
+                let image = self.physical_image(r)?;
+                (image.sampled_handle()).ok_or_else(|| missing("sampled", &image.desc().name))
+            }
+            BindingTarget::StorageImage(r) => {
+                let image = self.physical_image(r)?;
+                (image.storage_handle()).ok_or_else(|| missing("storage", &image.desc().name))
+            }
+            BindingTarget::StorageBuffer(r) => {
+                let buffer = self.physical_buffer(r)?;
+                (buffer.storage_handle()).ok_or_else(|| missing("storage", &buffer.desc().name))
+            }
+            BindingTarget::Upload(region) => self.arena()?.handle(region, self.frame),
+        }
+    }
+
+    fn own(&self, binding: Binding) -> Result<()> {
+        match binding.graph == self.graph && binding.pass == self.pass {
+            true => Ok(()),
+            false => Err(Error::Graph(format!(
+                "pass '{}' was handed a binding another pass declared",
+                self.name
+            ))),
+        }
+    }
+
+    fn arena(&self) -> Result<&'a UploadArena> {
+        self.uploads
+            .ok_or_else(|| Error::Graph("the graph has no upload arena".into()))
+    }
+
+    /// Writes `bytes` at the start of this frame's copy of the upload
+    /// region of `binding` (declared by this pass with
+    /// [`super::PassBuilder::upload`]): constants that embed the pass's
+    /// heap handles are written while recording (kajiya's dynamic
+    /// constants); the frame slot's previous frame has completed.
+    pub fn write_upload(&mut self, binding: Binding, bytes: &[u8]) -> Result<()> {
+        self.own(binding)?;
+        let BindingTarget::Upload(region) = binding.target else {
+            return Err(Error::Graph(format!(
+                "pass '{}' writes a binding that is not an upload region",
+                self.name
+            )));
+        };
+        self.arena()?.writer(self.frame).write(region, bytes)
+    }
+
+    /// [`PassContext::write_upload`] of one plain value.
+    pub fn write_upload_pod<T: bytemuck::Pod>(&mut self, binding: Binding, value: &T) -> Result<()> {
+        self.write_upload(binding, bytemuck::bytes_of(value))
+    }
+
+    /// Binds `pipeline` and the heap, sets `push` and dispatches `groups`
+    /// workgroups: the skeleton of every compute pass.
+    pub fn dispatch<T: bytemuck::Pod>(&mut self, pipeline: &ComputePipeline, push: &T, groups: [u32; 3]) -> Result<()> {
+        let cmd = self.cmd();
+        cmd.bind_compute(pipeline);
+        cmd.push_constants(push)?;
+        cmd.dispatch(groups[0], groups[1], groups[2]);
+        Ok(())
+    }
+
+    /// Binds `pipeline` and the heap, sets `push` and draws one
+    /// full-screen triangle: the skeleton of every full-screen pass.
+    pub fn draw_full_screen<T: bytemuck::Pod>(&mut self, pipeline: &GraphicsPipeline, push: &T) -> Result<()> {
+        let cmd = self.cmd();
+        cmd.bind_graphics(pipeline);
+        cmd.push_constants(push)?;
+        cmd.draw(3, 1);
+        Ok(())
+    }
+
+    /// Heap handle for sampling the image `id` (transitional: use a
+    /// [`Binding`]).
     pub fn sampled(&self, id: ImageId) -> Result<u32> {
         let image = self.image(id)?;
         image
@@ -87,7 +196,7 @@ impl<'a> PassContext<'a> {
             .ok_or_else(|| Error::Graph(format!("image '{}' is not sampled", image.desc().name)))
     }
 
-    /// Heap handle of the storage image `id`.
+    /// Heap handle of the storage image `id` (transitional).
     pub fn storage_image(&self, id: ImageId) -> Result<u32> {
         let image = self.image(id)?;
         image
@@ -95,7 +204,7 @@ impl<'a> PassContext<'a> {
             .ok_or_else(|| Error::Graph(format!("image '{}' is not a storage image", image.desc().name)))
     }
 
-    /// Heap handle of the storage buffer `id`.
+    /// Heap handle of the storage buffer `id` (transitional).
     pub fn storage_buffer(&self, id: BufferId) -> Result<u32> {
         let buffer = self.buffer(id)?;
         buffer
@@ -103,13 +212,37 @@ impl<'a> PassContext<'a> {
             .ok_or_else(|| Error::Graph(format!("buffer '{}' is not a storage buffer", buffer.desc().name)))
     }
 
-    /// Heap handle of the upload region `region` this frame (shaders read
-    /// it from offset 0).
+    /// Heap handle of the upload region `region` this frame (transitional).
     pub fn upload(&self, region: UploadRegion) -> Result<u32> {
-        self.uploads
-            .ok_or_else(|| Error::Graph("the graph has no upload arena".into()))?
-            .handle(region, self.frame)
+        self.arena()?.handle(region, self.frame)
     }
+}
+
+/// Begins rendering into a pass's declared attachments (none: nothing).
+fn begin_attachments(
+    cmd: &mut CommandRecorder,
+    physical: &[Physical],
+    attachments: &Attachments,
+    frame: u64,
+) -> Result<bool> {
+    if attachments.is_empty() {
+        return Ok(false);
+    }
+    let image = |r: ResourceId| {
+        (physical.get(r.0).and_then(|p| p.image(frame)))
+            .map(|i| &**i)
+            .ok_or_else(|| Error::Graph(format!("attachment #{} is not an image of this graph", r.0)))
+    };
+    for (r, _) in &attachments.colors {
+        image(*r)?;
+    }
+    let depth = match attachments.depth {
+        Some((r, clear)) => Some((image(r)?, clear)),
+        None => None,
+    };
+    let colors = (attachments.colors.iter()).filter_map(|&(r, load)| image(r).ok().map(|i| (i, load)));
+    cmd.begin_rendering_from(colors, depth);
+    Ok(true)
 }
 
 /// What executing one frame produced.
@@ -222,13 +355,24 @@ impl<P> BakedGraph<P> {
             cmd.begin_label_c(&pass.label, label_color(pass.kind));
             cmd.write_timestamp(pool, 2 * i as u32, PipelineStageFlags2::TOP_OF_PIPE);
             self.emit_barriers(cmd, &pass.uses, frame);
-            let mut ctx = PassContext {
-                cmd,
-                physical: &self.physical,
-                uploads: self.uploads.as_ref(),
-                frame,
-            };
-            if let Err(e) = (pass.record)(&mut ctx, params) {
+            let recorded = begin_attachments(cmd, &self.physical, &pass.attachments, frame).and_then(|rendering| {
+                let mut ctx = PassContext {
+                    cmd: &mut *cmd,
+                    physical: &self.physical,
+                    uploads: self.uploads.as_ref(),
+                    frame,
+                    uses: &pass.uses,
+                    pass: pass.serial,
+                    graph: self.serial,
+                    name: &pass.name,
+                };
+                let recorded = (pass.record)(&mut ctx, params);
+                if rendering {
+                    cmd.end_rendering();
+                }
+                recorded
+            });
+            if let Err(e) = recorded {
                 result = Err(Error::Graph(format!("pass '{}': {e}", pass.name)));
             }
             let cmd = &mut recording.recorder;

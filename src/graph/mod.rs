@@ -14,36 +14,48 @@
 //! let mut graph = RenderGraph::new();
 //! let vertices = graph.import_buffer(vertex_buffer);
 //! let hdr = graph.create_image("hdr", ImageInfo::new(w, h, Format::R32G32B32A32_SFLOAT));
-//! graph.pass("terrain.grid")
-//!     .write(vertices, BufferAccess::StorageWrite(Stage::Compute))
-//!     .record(move |pass, frame: &Frame| { /* bind, push, dispatch */ Ok(()) });
+//! let mut grid = graph.pass("terrain.grid");
+//! let out = grid.storage_buffer(vertices, BufferAccess::StorageWrite(Stage::Compute));
+//! grid.record(move |pass, frame: &Frame| {
+//!     let push = GridPush { vertices: pass.handle(out)?, .. };
+//!     pass.dispatch(&grid_pipeline, &push, [groups, 1, 1])
+//! });
 //! graph.pass("terrain.draw").graphics()
+//!     .pipeline(&draw_pipeline)
 //!     .read(vertices, BufferAccess::Vertex)
-//!     .write(hdr, ImageAccess::ColorAttachmentWrite)
-//!     .record(move |pass, frame| { /* begin_rendering, draw */ Ok(()) });
+//!     .color(hdr, LoadOp::Clear([0.0; 4]))
+//!     .record(move |pass, frame| { /* bind, draw: the graph begins and ends rendering */ Ok(()) });
 //! let mut baked = graph.bake(&ctx)?;
 //! baked.execute(&mut frames, &frame, &[])?;
 //! ```
+//!
+//! A pass reaches only what it declared ([`binding`]): heap handles come
+//! from the [`Binding`]s its declarations return, images and buffers from
+//! its declared ids, attachments from `color`/`depth`.
 
 pub mod access;
 mod alias;
 mod bake;
+pub mod binding;
 mod execute;
 mod typed;
 mod uploads;
 
 use std::sync::Arc;
 
+pub use crate::vulkan::LoadOp;
 #[cfg(test)]
 pub use access::derive_barrier;
 pub use access::{Access, Stage};
 pub use bake::{BakedGraph, DEFAULT_PROFILE_HISTORY};
+pub use binding::Binding;
 pub use execute::{CpuStage, FrameOutcome, PassContext};
 pub use typed::{BufferAccess, BufferId, ImageAccess, ImageId, Resource};
 pub use uploads::{UploadRegion, UploadWriter};
 
 use crate::error::Result;
-use crate::vulkan::{Buffer, Format, Image, MemoryLocation};
+use crate::vulkan::{Buffer, Format, GraphicsPipeline, Image, MemoryLocation};
+use binding::BindingTarget;
 
 /// A resource of the graph (transient or imported), by index.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -133,6 +145,35 @@ pub(crate) struct PassDecl<P> {
     /// Accesses declared with the wrong verb (`read` of a write access, or
     /// `write` of a read-only one), reported when baking.
     pub misdeclared: Vec<String>,
+    /// The pass's number in its graph (what its bindings carry).
+    pub serial: u32,
+    /// The attachments the graph begins rendering into around the closure.
+    pub attachments: Attachments,
+    /// The pipelines the pass draws with, whose attachment formats must
+    /// match the attachments (checked at bake).
+    pub pipelines: Vec<PipelineFormats>,
+}
+
+/// The colour and depth attachments of a graphics pass, in declaration order.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Attachments {
+    pub colors: Vec<(ResourceId, LoadOp)>,
+    /// The depth attachment and its clear value (None: loaded).
+    pub depth: Option<(ResourceId, Option<f32>)>,
+}
+
+impl Attachments {
+    pub(crate) fn is_empty(&self) -> bool {
+        self.colors.is_empty() && self.depth.is_none()
+    }
+}
+
+/// The attachment formats of a pipeline a pass declared.
+#[derive(Clone, Debug)]
+pub(crate) struct PipelineFormats {
+    pub name: &'static str,
+    pub colors: Vec<Format>,
+    pub depth: Option<Format>,
 }
 
 /// A render graph being declared. `P` is the per-frame parameter type every
@@ -148,6 +189,8 @@ pub struct RenderGraph<P> {
     pub(crate) upload_regions: Vec<(String, u64)>,
     /// The upload arena's resource, once a region was declared.
     pub(crate) upload_arena: Option<ResourceId>,
+    /// This graph's number (its passes' bindings carry it).
+    pub(crate) serial: u32,
 }
 
 impl<P> Default for RenderGraph<P> {
@@ -159,6 +202,7 @@ impl<P> Default for RenderGraph<P> {
             alias_transients: true,
             upload_regions: Vec::new(),
             upload_arena: None,
+            serial: binding::next_graph_serial(),
         }
     }
 }
@@ -213,7 +257,7 @@ impl<P: 'static> RenderGraph<P> {
 
     /// `size` bytes of the per-frame upload arena: host-written before each
     /// frame is recorded ([`BakedGraph::uploads`]), read by shaders through
-    /// their own heap handle ([`PassContext::upload`]) from offset 0. Every
+    /// their own heap handle (a pass's [`PassBuilder::upload`] binding) from offset 0. Every
     /// region of every technique lives in one host-visible buffer per frame
     /// slot.
     pub fn upload_region(&mut self, name: &str, size: u64) -> UploadRegion {
@@ -279,6 +323,7 @@ impl<P: 'static> RenderGraph<P> {
 
     /// Starts declaring a pass of the given kind.
     pub fn begin_pass(&mut self, name: &str, kind: PassKind) -> PassBuilder<'_, P> {
+        let serial = self.passes.len() as u32;
         PassBuilder {
             graph: self,
             decl: PassDecl {
@@ -287,6 +332,9 @@ impl<P: 'static> RenderGraph<P> {
                 uses: Vec::new(),
                 record: None,
                 misdeclared: Vec::new(),
+                serial,
+                attachments: Attachments::default(),
+                pipelines: Vec::new(),
             },
         }
     }
@@ -337,6 +385,106 @@ impl<P: 'static> PassBuilder<'_, P> {
                 .push(format!("write() of the read-only access {access:?}"));
         }
         self.decl.uses.push((resource, access));
+        self
+    }
+
+    fn binding(&self, target: BindingTarget) -> Binding {
+        Binding {
+            graph: self.graph.serial,
+            pass: self.decl.serial,
+            target,
+        }
+    }
+
+    /// Declares that the pass's shaders at `stage` sample `image`, and
+    /// returns the binding its closure turns into the heap handle
+    /// ([`PassContext::handle`]).
+    pub fn sample(&mut self, image: ImageId, stage: Stage) -> Binding {
+        self.decl.uses.push((image.0, Access::SampledImage(stage)));
+        self.binding(BindingTarget::SampledImage(image.0))
+    }
+
+    /// Declares a storage-image access (`StorageRead`, `StorageWrite` or
+    /// `StorageReadWrite`) of `image`, and returns its binding.
+    pub fn storage_image(&mut self, image: ImageId, access: ImageAccess) -> Binding {
+        if !matches!(
+            access,
+            ImageAccess::StorageRead(_) | ImageAccess::StorageWrite(_) | ImageAccess::StorageReadWrite(_)
+        ) {
+            self.decl
+                .misdeclared
+                .push(format!("storage_image() of the non-storage access {access:?}"));
+        }
+        self.decl.uses.push((image.0, access.into()));
+        self.binding(BindingTarget::StorageImage(image.0))
+    }
+
+    /// Declares a storage-buffer access (`StorageRead`, `StorageWrite` or
+    /// `StorageReadWrite`) of `buffer`, and returns its binding.
+    pub fn storage_buffer(&mut self, buffer: BufferId, access: BufferAccess) -> Binding {
+        if !matches!(
+            access,
+            BufferAccess::StorageRead(_) | BufferAccess::StorageWrite(_) | BufferAccess::StorageReadWrite(_)
+        ) {
+            self.decl
+                .misdeclared
+                .push(format!("storage_buffer() of the non-storage access {access:?}"));
+        }
+        self.decl.uses.push((buffer.0, access.into()));
+        self.binding(BindingTarget::StorageBuffer(buffer.0))
+    }
+
+    /// Declares that the pass's shaders at `stage` read the upload region
+    /// `region`, and returns its binding: the closure turns it into this
+    /// frame's handle, and may write the region's contents while recording
+    /// ([`PassContext::write_upload`]) — where they embed other bindings'
+    /// handles.
+    pub fn upload(&mut self, region: UploadRegion, stage: Stage) -> Binding {
+        self.decl.uses.push((region.arena, Access::StorageBufferRead(stage)));
+        self.binding(BindingTarget::Upload(region))
+    }
+
+    /// Declares a colour attachment, in order: `Load` reads and blends
+    /// into it, `Clear`/`DontCare` overwrite it. The graph begins rendering
+    /// into the pass's attachments before its closure and ends after.
+    pub fn color(mut self, image: ImageId, load: LoadOp) -> Self {
+        let access = match load {
+            LoadOp::Load => Access::ColorAttachmentReadWrite,
+            LoadOp::Clear(_) | LoadOp::DontCare => Access::ColorAttachmentWrite,
+        };
+        self.decl.uses.push((image.0, access));
+        self.decl.attachments.colors.push((image.0, load));
+        self
+    }
+
+    /// Declares the depth attachment, tested and written; cleared to
+    /// `clear` when given, else loaded.
+    pub fn depth(self, image: ImageId, clear: Option<f32>) -> Self {
+        self.set_depth(image, clear, Access::DepthAttachmentWrite)
+    }
+
+    /// Declares the depth attachment, tested only (loaded, not written).
+    pub fn depth_read(self, image: ImageId) -> Self {
+        self.set_depth(image, None, Access::DepthAttachmentRead)
+    }
+
+    fn set_depth(mut self, image: ImageId, clear: Option<f32>, access: Access) -> Self {
+        if self.decl.attachments.depth.is_some() {
+            self.decl.misdeclared.push("a second depth attachment".into());
+        }
+        self.decl.uses.push((image.0, access));
+        self.decl.attachments.depth = Some((image.0, clear));
+        self
+    }
+
+    /// Declares a pipeline the pass draws with: at bake, its attachment
+    /// formats must be those of the pass's attachments.
+    pub fn pipeline(mut self, pipeline: &GraphicsPipeline) -> Self {
+        self.decl.pipelines.push(PipelineFormats {
+            name: pipeline.name(),
+            colors: pipeline.color_formats().to_vec(),
+            depth: pipeline.depth_format(),
+        });
         self
     }
 

@@ -17,7 +17,7 @@ use super::build::spt_file::read_spt;
 use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
 use crate::random::SplitMix64;
-use crate::terrain::bspline::sample_bspline;
+use crate::surface::bspline::sample_bspline;
 
 /// A similarity transform: scale, then rotation, then translation.
 #[derive(Clone, Copy, Debug, PartialEq)]

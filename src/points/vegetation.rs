@@ -17,12 +17,13 @@ use std::sync::Arc;
 
 use glam::{DQuat, DVec2, DVec3};
 
+use super::build::plants::build_plant_tree;
 use super::build::plants::scatter::{Scatter, ScatterRule};
-use super::build::plants::{build_plant_tree, PlantModel};
 use super::build::spt::{epsilon_from_pixels, SptOptions};
 use super::scene::{PointClass, PointInstance, PointObject, PointScene, PointTransform};
 use crate::error::{Error, Result};
 use crate::random::SplitMix64;
+use crate::surface::plants::PlantModel;
 
 /// Most plants a scene gets by default (`VegetationOptions::max_plants`).
 pub const DEFAULT_MAX_PLANTS: usize = 60_000;

@@ -14,10 +14,10 @@ use crate::points::build::spt::{epsilon_from_pixels, SptOptions};
 use crate::points::scene::PointInstance;
 use crate::points::scene::{scatter_rocks, PointScene};
 use crate::points::vegetation::{plant_scene, VegetationOptions, VegetationReport};
+use crate::surface::layers::vegetation::subtree_shares;
 use crate::terrain::geometry_image::TerrainSettings;
 use crate::terrain::ground::Ground;
 use crate::terrain::procedural::ProceduralTerrain;
-use crate::texturing::layers::vegetation::subtree_shares;
 use crate::texturing::reference::ReferenceSurface;
 use crate::view::camera::Camera;
 use crate::view::{Lighting, SunPosition};
@@ -91,9 +91,9 @@ pub struct Scene {
     /// Unit direction towards the sun.
     pub sun_direction: Vec3,
     /// The surface-layer tree of §8.2 (atlas and direct texturing).
-    pub layers: crate::texturing::layers::LayerTree,
+    pub layers: crate::surface::layers::LayerTree,
     /// Extra input maps of the layer tree (rainfall, radiation, temperature;
-    /// [`crate::texturing::layers::INPUT_NAMES`]), registered to the height
+    /// [`crate::surface::layers::INPUT_NAMES`]), registered to the height
     /// field: each grid spans the terrain rectangle corner to corner, at any
     /// resolution (its spacing is ignored); values in the units the layers'
     /// hats use.
@@ -194,7 +194,7 @@ impl Scene {
             draw_terrain: true,
             points: PointScene::default(),
             sun_direction: Vec3::new(-0.55, 0.45, 0.42).normalize(),
-            layers: crate::texturing::layers::LayerTree::default_tree(),
+            layers: crate::surface::layers::LayerTree::default_tree(),
             input_maps: [None, None, None],
         }
     }

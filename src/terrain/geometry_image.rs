@@ -20,8 +20,8 @@ use crate::error::{Error, Result};
 use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, RenderGraph, Stage, UploadRegion};
 use crate::io::heightmap::HeightField;
 use crate::shaders;
+use crate::surface::wavelet_noise::{self, NOISE_TILE};
 use crate::terrain::lod::{DebugScalar, LodSettings};
-use crate::terrain::wavelet_noise;
 use crate::view::{pass_name, Frame, ViewIndex};
 use crate::vulkan::{
     Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, Format, Image, ImageDesc, ImageUsageFlags,
@@ -36,8 +36,6 @@ pub const VERTEX_STRIDE: u32 = 32;
 /// Conservative shift of detail from geometry to shading, in octaves (also
 /// `SPLIT_BIAS` in `glsl/include/terrain_detail.glsl`).
 pub const SPLIT_BIAS: f32 = 0.5;
-/// Side of the wavelet noise tile (also `NOISE_TILE` in the shader).
-pub const NOISE_TILE: usize = 128;
 /// Detail octaves at most, in geometry and shading (also
 /// `MAX_DETAIL_OCTAVES` in `glsl/include/terrain_detail.glsl`).
 pub const MAX_DETAIL_OCTAVES: u32 = 8;
@@ -99,7 +97,7 @@ impl Default for TerrainSettings {
             detail: true,
             detail_amplitude: 0.15,
             detail_h: 0.9,
-            noise_seed: 7,
+            noise_seed: wavelet_noise::DEFAULT_NOISE_SEED,
             view: TerrainView::Shaded,
         }
     }

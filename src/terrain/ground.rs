@@ -8,7 +8,7 @@
 //!
 //! `terrain.warp` (`glsl/terrain/warp.comp`) writes every vertex of the
 //! geometry image at `z = B(x, y) + D(x, y; 0, o)`: `B` the cubic B-spline
-//! of the sketch atlas ([`crate::terrain::bspline`]) and `D` the detail
+//! of the sketch atlas ([`crate::surface::bspline`]) and `D` the detail
 //! octaves of `glsl/include/terrain_detail.glsl`,
 //!
 //! ```text
@@ -16,7 +16,7 @@
 //! w(o, k)          = clamp(o − (k − 1), 0, 1)
 //! ```
 //!
-//! with `N` the wavelet noise tile ([`crate::terrain::wavelet_noise`]), `d0`
+//! with `N` the wavelet noise tile ([`crate::surface::wavelet_noise`]), `d0`
 //! the atlas spacing (the finer of `dx`, `dy`), and `A`, `H` and the tile's
 //! seed from [`TerrainSettings`]. `o` is the vertex's *split octave*
 //! ([`split_octave`]): `log2(d0 / d) − SPLIT_BIAS` clamped to `[0, 8]`, `d`
@@ -51,9 +51,10 @@ use glam::{DVec2, DVec3, DVec4};
 
 use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
-use crate::terrain::bspline::{sample_bspline, sample_bspline_gradient};
-use crate::terrain::geometry_image::{TerrainSettings, MAX_DETAIL_OCTAVES, NOISE_TILE, SPLIT_BIAS};
-use crate::terrain::wavelet_noise::{evaluate_gradient, noise_tile};
+use crate::surface::bspline::{sample_bspline, sample_bspline_gradient};
+use crate::surface::wavelet_noise::NOISE_TILE;
+use crate::surface::wavelet_noise::{evaluate_gradient, noise_tile};
+use crate::terrain::geometry_image::{TerrainSettings, MAX_DETAIL_OCTAVES, SPLIT_BIAS};
 use crate::terrain::zoom::zoom_xy;
 
 /// Per-octave shift of the noise lattice (times the octave number), as in
@@ -373,8 +374,8 @@ impl<'g, 'a> DrawnSurface<'g, 'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::surface::wavelet_noise::evaluate;
     use crate::terrain::procedural::ProceduralTerrain;
-    use crate::terrain::wavelet_noise::evaluate;
 
     fn field() -> HeightField {
         ProceduralTerrain::default().generate(65, 49, DVec2::new(20.0, 25.0))

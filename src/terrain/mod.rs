@@ -5,7 +5,6 @@
 //! [`shading`] (`terrain.draw`); [`technique`] ties them into the frame.
 //! [`ground`] is the CPU twin of the drawn surface, for height queries.
 
-pub mod bspline;
 pub mod geometry_image;
 pub mod ground;
 pub mod importance;
@@ -18,7 +17,6 @@ pub mod shadow;
 pub mod sketch_map;
 pub mod technique;
 pub mod warp;
-pub mod wavelet_noise;
 pub mod zoom;
 
 pub use technique::{Terrain, TerrainFrame, TerrainTexturing};

@@ -41,7 +41,7 @@ use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
-use crate::terrain::bspline::sample_bspline;
+use crate::surface::bspline::sample_bspline;
 
 /// Iterations of bisection on the bracketing step.
 const BISECTIONS: u32 = 30;
@@ -429,7 +429,7 @@ impl<'a> Raycaster<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::terrain::bspline::sample_bspline;
+    use crate::surface::bspline::sample_bspline;
 
     fn field(columns: u32, rows: u32, spacing: DVec2, f: impl Fn(f64, f64) -> f64) -> HeightField {
         HeightField::from_fn(columns, rows, spacing, |c, r| f(f64::from(c), f64::from(r)) as f32)

@@ -13,9 +13,9 @@ use bytemuck::{Pod, Zeroable};
 use crate::error::Result;
 use crate::graph::{BufferAccess, BufferId, ImageAccess, ImageId, RenderGraph, Stage, UploadRegion};
 use crate::shaders;
+use crate::surface::input_maps::InputMaps;
 use crate::terrain::geometry_image::VERTEX_STRIDE;
 use crate::texturing::generation::AtlasBindings;
-use crate::texturing::input_maps::InputMaps;
 use crate::view::{Frame, SceneTargets, ViewIndex};
 use crate::vulkan::{
     Blend, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, PrimitiveTopology,
@@ -23,7 +23,7 @@ use crate::vulkan::{
 };
 
 /// The classic surface types (§7.4.3) as the layers of the built-in tree
-/// ([`crate::texturing::layers::DEFAULT_LAYERS`]) their class reports:
+/// ([`crate::surface::layers::DEFAULT_LAYERS`]) their class reports:
 /// (name, layer index), in the order of `CLASSIC_LAYER` in
 /// `glsl/terrain/draw.frag`, which hard-codes the indices.
 #[cfg(test)]
@@ -169,7 +169,7 @@ pub fn declare_draw_pass(
 #[cfg(test)]
 mod tests {
     use super::CLASSIC_LAYERS;
-    use crate::texturing::layers::LayerTree;
+    use crate::surface::layers::LayerTree;
 
     #[test]
     fn classic_types_name_layers_of_the_built_in_tree() {

@@ -28,7 +28,7 @@ use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
-use crate::terrain::bspline::sample_bspline;
+use crate::surface::bspline::sample_bspline;
 use crate::view::Camera;
 
 /// Default sketch map side (texels), as in the text.

@@ -12,13 +12,13 @@ use bytemuck::Zeroable;
 use crate::error::{Error, Result};
 use crate::graph::{BufferId, ImageId, RenderGraph, UploadRegion};
 use crate::io::heightmap::HeightField;
+use crate::surface::gpu_layout::{pack_layers, TexturingFrame, TexturingMode};
+use crate::surface::input_maps::InputMaps;
+use crate::surface::layers::LayerTree;
 use crate::terrain::geometry_image::{declare_warp_pass, GeometryImage, TerrainSettings, WarpPass, WarpPush};
 use crate::terrain::lod::LodFrame;
 use crate::terrain::shading::{declare_draw_pass, DrawPass, TerrainDrawPush};
 use crate::texturing::generation::{AtlasBindings, GenerationInputs};
-use crate::texturing::gpu_layout::{pack_layers, TexturingFrame, TexturingMode};
-use crate::texturing::input_maps::InputMaps;
-use crate::texturing::layers::LayerTree;
 use crate::view::{pass_name, Frame, FrameContext, SceneTargets, Technique, View, ViewIndex};
 use crate::vulkan::{Buffer, BufferUsageFlags, Context, Image};
 
@@ -26,7 +26,7 @@ use crate::vulkan::{Buffer, BufferUsageFlags, Context, Image};
 pub struct TerrainTexturing<'a> {
     pub mode: TexturingMode,
     pub layers: &'a LayerTree,
-    /// Extra input maps of the layers ([`crate::texturing::input_maps`]).
+    /// Extra input maps of the layers ([`crate::surface::input_maps`]).
     pub input_maps: &'a [Option<HeightField>; 3],
 }
 

@@ -10,7 +10,7 @@ use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
-use crate::terrain::bspline::sample_bspline;
+use crate::surface::bspline::sample_bspline;
 use crate::terrain::warp::bilinear;
 use crate::view::View;
 

@@ -5,7 +5,7 @@
 use std::collections::HashSet;
 
 use crate::renderer::{Camera, Scene};
-use crate::terrain::bspline::sample_bspline;
+use crate::surface::bspline::sample_bspline;
 use crate::terrain::geometry_image::TerrainSettings;
 use crate::texturing::page_table::{PageEntry, PageTable};
 use crate::texturing::reference::{srgb8, ReferenceSurface};

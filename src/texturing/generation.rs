@@ -32,12 +32,12 @@ use crate::error::{Error, Result};
 use crate::graph::{BufferId, BufferInfo, ImageId, RenderGraph, UploadRegion};
 use crate::io::heightmap::HeightField;
 use crate::profile::FrameProfile;
+use crate::surface::input_maps::InputMaps;
+use crate::surface::layers::LayerTree;
 #[cfg(doc)]
 use crate::texturing::atlas::GenerationBudget;
 use crate::texturing::atlas::{TileCache, TilePlan};
 use crate::texturing::fit::{select_to_fit, Coarsening};
-use crate::texturing::input_maps::InputMaps;
-use crate::texturing::layers::LayerTree;
 use crate::texturing::pacing::GenerationPacer;
 #[cfg(test)]
 use crate::texturing::pacing::GpuTimeBudget;

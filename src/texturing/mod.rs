@@ -29,15 +29,10 @@
 
 pub mod atlas;
 pub mod atlas_settings;
-pub mod blurred_height;
 pub mod bounds;
-pub mod dominant;
 pub mod fit;
 pub mod from_image;
 pub mod generation;
-pub mod gpu_layout;
-pub mod input_maps;
-pub mod layers;
 pub mod pacing;
 pub mod page_table;
 mod passes;

@@ -1,21 +1,21 @@
 //! The CPU twin of the GPU's layer evaluation (dissertation §8.2): the
-//! tree of [`crate::texturing::layers`] evaluated with the same base
+//! tree of [`crate::surface::layers`] evaluated with the same base
 //! surface (the height field's cubic B-spline), the same band-limited
 //! wavelet-noise fBm, the same per-layer noise offsets and the same input
 //! map sampling as `glsl/include/surface_layers.glsl`, in f64, and the same
 //! blurred height fields for `height_blur` layers
-//! ([`crate::texturing::blurred_height`]). Tests compare the atlas's texels
+//! ([`crate::surface::blurred_height`]). Tests compare the atlas's texels
 //! with it.
 
 use glam::{DVec2, Vec3};
 
 use crate::error::Result;
 use crate::io::heightmap::HeightField;
-use crate::terrain::bspline::{sample_bspline, sample_bspline_gradient};
-use crate::terrain::geometry_image::NOISE_TILE;
-use crate::terrain::wavelet_noise::{evaluate_gradient, noise_tile};
-use crate::texturing::blurred_height::blurred_height;
-use crate::texturing::layers::{evaluate, BasePoint, LayerTree, Surface, MAX_BLUR_RADII};
+use crate::surface::blurred_height::blurred_height;
+use crate::surface::bspline::{sample_bspline, sample_bspline_gradient};
+use crate::surface::layers::{evaluate, BasePoint, LayerTree, Surface, MAX_BLUR_RADII};
+use crate::surface::wavelet_noise::NOISE_TILE;
+use crate::surface::wavelet_noise::{evaluate_gradient, noise_tile};
 
 /// Offsets of the coverage noise N and the displacement noise D of layer
 /// `i`, per octave `k` multiplied by `k + 1` (as in the shader).

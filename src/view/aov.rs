@@ -26,7 +26,7 @@
 //! `C_k · Π_{j>k} (1 − C_j)` (the later layers blend over it), and the
 //! first of equal shares wins. Atlas texturing stores it per texel in the
 //! normal texture's alpha (read with nearest filtering); direct texturing
-//! evaluates it per pixel (`crate::texturing::dominant`). Classic
+//! evaluates it per pixel (`crate::surface::dominant`). Classic
 //! texturing (§7.4.3) has four surface types, reported as the same-named
 //! layers of the built-in tree (`crate::terrain::shading::CLASSIC_LAYERS`)
 //! so that classes mean the same in every mode.

@@ -162,16 +162,20 @@ impl CommandRecorder {
     /// Starts dynamic rendering into the attachments; viewport and scissor cover
     /// the first attachment.
     pub fn begin_rendering(&mut self, colors: &[(&Image, LoadOp)], depth: Option<(&Image, Option<f32>)>) {
-        let (width, height) = colors
-            .first()
-            .map(|(i, _)| (i.desc().width, i.desc().height))
-            .or(depth.map(|(i, _)| (i.desc().width, i.desc().height)))
-            .unwrap_or((1, 1));
-        // On the stack (no allocation per pass); more attachments than any
-        // device offers spill to the heap.
-        let color_info = |(image, load): &(&Image, LoadOp)| {
+        self.begin_rendering_from(colors.iter().copied(), depth)
+    }
+
+    /// [`CommandRecorder::begin_rendering`] from an iterator of colour
+    /// attachments (what the render graph calls): at most 8, on the stack,
+    /// so beginning a pass allocates nothing; more are ignored.
+    pub fn begin_rendering_from<'i>(
+        &mut self,
+        colors: impl IntoIterator<Item = (&'i Image, LoadOp)>,
+        depth: Option<(&Image, Option<f32>)>,
+    ) {
+        let color_info = |(image, load): (&Image, LoadOp)| {
             let (op, clear) = match load {
-                LoadOp::Clear(c) => (vk::AttachmentLoadOp::CLEAR, *c),
+                LoadOp::Clear(c) => (vk::AttachmentLoadOp::CLEAR, c),
                 LoadOp::Load => (vk::AttachmentLoadOp::LOAD, [0.0; 4]),
                 LoadOp::DontCare => (vk::AttachmentLoadOp::DONT_CARE, [0.0; 4]),
             };
@@ -185,16 +189,17 @@ impl CommandRecorder {
                 })
         };
         let mut inline = [vk::RenderingAttachmentInfo::default(); 8];
-        let spilled: Vec<vk::RenderingAttachmentInfo<'_>>;
-        let color_infos: &[vk::RenderingAttachmentInfo<'_>] = if colors.len() <= inline.len() {
-            for (slot, color) in inline.iter_mut().zip(colors) {
-                *slot = color_info(color);
+        let mut count = 0;
+        let mut size = depth.map(|(i, _)| (i.desc().width, i.desc().height));
+        for (slot, color) in inline.iter_mut().zip(colors) {
+            if count == 0 {
+                size = Some((color.0.desc().width, color.0.desc().height));
             }
-            &inline[..colors.len()]
-        } else {
-            spilled = colors.iter().map(color_info).collect();
-            &spilled
-        };
+            *slot = color_info(color);
+            count += 1;
+        }
+        let (width, height) = size.unwrap_or((1, 1));
+        let color_infos = &inline[..count];
         let depth_info = depth.map(|(image, clear)| {
             // A depth buffer the graph declared read-only is neither cleared nor stored.
             let read_only = image.state().layout == vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL;

@@ -130,6 +130,127 @@ impl std::fmt::Debug for Context {
     }
 }
 
+/// The physical device `options` choose among the instance's.
+fn select_device(instance: &ash::Instance, options: &ContextOptions) -> Result<device_select::Candidate> {
+    // SAFETY: plain query on a live instance.
+    let physicals = unsafe { instance.enumerate_physical_devices() }.map_err(vk_err("vkEnumeratePhysicalDevices"))?;
+    let candidates = physicals
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| device_select::inspect(instance, p, i))
+        .collect();
+    device_select::choose(candidates, &options.device)
+}
+
+/// Creates the logical device of `candidate` with one graphics+compute
+/// queue, the required features (Vulkan 1.2 descriptor indexing and
+/// timeline semaphores, 1.3 dynamic rendering and synchronization2) and
+/// the optional ones it offers; returns them and whether it reports its
+/// memory budget.
+fn open_device(
+    instance: &ash::Instance,
+    candidate: device_select::Candidate,
+) -> Result<(device_select::Candidate, ash::Device, OptionalFeatures, bool)> {
+    let priorities = [1.0f32];
+    let queue_infos = [vk::DeviceQueueCreateInfo::default()
+        .queue_family_index(candidate.queue_family.unwrap_or(0))
+        .queue_priorities(&priorities)];
+    let mut v12 = vk::PhysicalDeviceVulkan12Features::default()
+        .timeline_semaphore(true)
+        .descriptor_indexing(true)
+        .runtime_descriptor_array(true)
+        .descriptor_binding_partially_bound(true)
+        .descriptor_binding_sampled_image_update_after_bind(true)
+        .descriptor_binding_storage_image_update_after_bind(true)
+        .descriptor_binding_storage_buffer_update_after_bind(true)
+        .shader_sampled_image_array_non_uniform_indexing(true)
+        .shader_storage_image_array_non_uniform_indexing(true)
+        .shader_storage_buffer_array_non_uniform_indexing(true);
+    let mut v13 = vk::PhysicalDeviceVulkan13Features::default()
+        .dynamic_rendering(true)
+        .synchronization2(true)
+        .maintenance4(true);
+    // SAFETY: plain query on a physical device of this instance.
+    let offered = unsafe { instance.get_physical_device_features(candidate.physical) };
+    let (int64_atomics, pixel_interlock) = offered_single_pass_features(instance, candidate.physical);
+    let optional = OptionalFeatures {
+        large_points: offered.large_points == vk::TRUE,
+        vertex_pipeline_stores_and_atomics: offered.vertex_pipeline_stores_and_atomics == vk::TRUE,
+        shader_buffer_int64_atomics: offered.shader_int64 == vk::TRUE && int64_atomics,
+        fragment_shader_pixel_interlock: pixel_interlock,
+        fragment_stores_and_atomics: offered.fragment_stores_and_atomics == vk::TRUE,
+    };
+    let base = vk::PhysicalDeviceFeatures::default()
+        .independent_blend(true)
+        .large_points(optional.large_points)
+        .vertex_pipeline_stores_and_atomics(optional.vertex_pipeline_stores_and_atomics)
+        .shader_int64(optional.shader_buffer_int64_atomics)
+        .fragment_stores_and_atomics(optional.fragment_stores_and_atomics);
+    v12 = v12.shader_buffer_int64_atomics(optional.shader_buffer_int64_atomics);
+    let mut interlock =
+        vk::PhysicalDeviceFragmentShaderInterlockFeaturesEXT::default().fragment_shader_pixel_interlock(true);
+    let memory_budget = super::device_memory::offers_memory_budget(instance, candidate.physical);
+    let mut extensions = Vec::new();
+    if optional.fragment_shader_pixel_interlock {
+        extensions.push(ash::ext::fragment_shader_interlock::NAME.as_ptr());
+    }
+    if memory_budget {
+        extensions.push(ash::ext::memory_budget::NAME.as_ptr());
+    }
+    let mut device_info = vk::DeviceCreateInfo::default()
+        .queue_create_infos(&queue_infos)
+        .enabled_features(&base)
+        .enabled_extension_names(&extensions)
+        .push_next(&mut v12)
+        .push_next(&mut v13);
+    if optional.fragment_shader_pixel_interlock {
+        device_info = device_info.push_next(&mut interlock);
+    }
+    // SAFETY: the features were checked as supported by `inspect`; pointers are to locals.
+    let device =
+        unsafe { instance.create_device(candidate.physical, &device_info, None) }.map_err(vk_err("vkCreateDevice"))?;
+    Ok((candidate, device, optional, memory_budget))
+}
+
+/// What [`Context::info`] reports of the device opened from `candidate`.
+fn describe_device(
+    candidate: &device_select::Candidate,
+    optional: &OptionalFeatures,
+    memory: &super::device_memory::DeviceMemory,
+    memory_budget: bool,
+    validation: bool,
+) -> DeviceInfo {
+    let props = &candidate.properties;
+    DeviceInfo {
+        name: candidate.name.clone(),
+        device_type: device_select::device_type_name(candidate.device_type).into(),
+        vendor_id: props.vendor_id,
+        device_id: props.device_id,
+        driver_name: candidate.driver_name.clone(),
+        driver_info: candidate.driver_info.clone(),
+        api_version: format!(
+            "{}.{}.{}",
+            vk::api_version_major(props.api_version),
+            vk::api_version_minor(props.api_version),
+            vk::api_version_patch(props.api_version)
+        ),
+        index: candidate.index,
+        timestamp_period_ns: props.limits.timestamp_period,
+        max_image_dimension_2d: props.limits.max_image_dimension2_d,
+        memory_heap_bytes: memory.heap,
+        max_allocation_bytes: memory.allocation,
+        memory_budget,
+        features: REQUIRED_FEATURES.iter().map(|s| s.to_string()).collect(),
+        optional_features: optional.names(),
+        max_point_size: if optional.large_points {
+            props.limits.point_size_range[1]
+        } else {
+            1.0
+        },
+        validation,
+    }
+}
+
 /// What the device offers for single-pass splatting (§10.4):
 /// `shaderBufferInt64Atomics`, and `fragmentShaderPixelInterlock` with its
 /// extension VK_EXT_fragment_shader_interlock.
@@ -266,97 +387,15 @@ impl Context {
                 instance.destroy_instance(None);
             }
         };
-        // SAFETY: plain query on a live instance.
-        let physicals = match unsafe { instance.enumerate_physical_devices() } {
-            Ok(p) => p,
-            Err(e) => {
-                destroy_instance(&instance);
-                return Err(Error::Vulkan {
-                    call: "vkEnumeratePhysicalDevices",
-                    result: e,
-                });
-            }
-        };
-        let candidates = physicals
-            .iter()
-            .enumerate()
-            .map(|(i, &p)| device_select::inspect(&instance, p, i))
-            .collect();
-        let candidate = match device_select::choose(candidates, &options.device) {
-            Ok(c) => c,
+        let opened = select_device(&instance, options).and_then(|c| open_device(&instance, c));
+        let (candidate, device, optional, memory_budget) = match opened {
+            Ok(opened) => opened,
             Err(e) => {
                 destroy_instance(&instance);
                 return Err(e);
             }
         };
         let queue_family = candidate.queue_family.unwrap_or(0);
-
-        let priorities = [1.0f32];
-        let queue_infos = [vk::DeviceQueueCreateInfo::default()
-            .queue_family_index(queue_family)
-            .queue_priorities(&priorities)];
-        let mut v12 = vk::PhysicalDeviceVulkan12Features::default()
-            .timeline_semaphore(true)
-            .descriptor_indexing(true)
-            .runtime_descriptor_array(true)
-            .descriptor_binding_partially_bound(true)
-            .descriptor_binding_sampled_image_update_after_bind(true)
-            .descriptor_binding_storage_image_update_after_bind(true)
-            .descriptor_binding_storage_buffer_update_after_bind(true)
-            .shader_sampled_image_array_non_uniform_indexing(true)
-            .shader_storage_image_array_non_uniform_indexing(true)
-            .shader_storage_buffer_array_non_uniform_indexing(true);
-        let mut v13 = vk::PhysicalDeviceVulkan13Features::default()
-            .dynamic_rendering(true)
-            .synchronization2(true)
-            .maintenance4(true);
-        // SAFETY: plain query on a physical device of this instance.
-        let offered = unsafe { instance.get_physical_device_features(candidate.physical) };
-        let (int64_atomics, pixel_interlock) = offered_single_pass_features(&instance, candidate.physical);
-        let optional = OptionalFeatures {
-            large_points: offered.large_points == vk::TRUE,
-            vertex_pipeline_stores_and_atomics: offered.vertex_pipeline_stores_and_atomics == vk::TRUE,
-            shader_buffer_int64_atomics: offered.shader_int64 == vk::TRUE && int64_atomics,
-            fragment_shader_pixel_interlock: pixel_interlock,
-            fragment_stores_and_atomics: offered.fragment_stores_and_atomics == vk::TRUE,
-        };
-        let base = vk::PhysicalDeviceFeatures::default()
-            .independent_blend(true)
-            .large_points(optional.large_points)
-            .vertex_pipeline_stores_and_atomics(optional.vertex_pipeline_stores_and_atomics)
-            .shader_int64(optional.shader_buffer_int64_atomics)
-            .fragment_stores_and_atomics(optional.fragment_stores_and_atomics);
-        v12 = v12.shader_buffer_int64_atomics(optional.shader_buffer_int64_atomics);
-        let mut interlock =
-            vk::PhysicalDeviceFragmentShaderInterlockFeaturesEXT::default().fragment_shader_pixel_interlock(true);
-        let memory_budget = super::device_memory::offers_memory_budget(&instance, candidate.physical);
-        let mut extensions = Vec::new();
-        if optional.fragment_shader_pixel_interlock {
-            extensions.push(ash::ext::fragment_shader_interlock::NAME.as_ptr());
-        }
-        if memory_budget {
-            extensions.push(ash::ext::memory_budget::NAME.as_ptr());
-        }
-        let mut device_info = vk::DeviceCreateInfo::default()
-            .queue_create_infos(&queue_infos)
-            .enabled_features(&base)
-            .enabled_extension_names(&extensions)
-            .push_next(&mut v12)
-            .push_next(&mut v13);
-        if optional.fragment_shader_pixel_interlock {
-            device_info = device_info.push_next(&mut interlock);
-        }
-        // SAFETY: the features were checked as supported by `inspect`; pointers are to locals.
-        let device = match unsafe { instance.create_device(candidate.physical, &device_info, None) } {
-            Ok(d) => d,
-            Err(e) => {
-                destroy_instance(&instance);
-                return Err(Error::Vulkan {
-                    call: "vkCreateDevice",
-                    result: e,
-                });
-            }
-        };
         // SAFETY: the queue family and index were requested at device creation.
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let debug_device = debug_instance
@@ -386,35 +425,7 @@ impl Context {
         let heap = DescriptorHeap::new(&device)?;
 
         let memory = super::device_memory::query(&instance, candidate.physical, memory_budget);
-        let props = &candidate.properties;
-        let info = DeviceInfo {
-            name: candidate.name.clone(),
-            device_type: device_select::device_type_name(candidate.device_type).into(),
-            vendor_id: props.vendor_id,
-            device_id: props.device_id,
-            driver_name: candidate.driver_name.clone(),
-            driver_info: candidate.driver_info.clone(),
-            api_version: format!(
-                "{}.{}.{}",
-                vk::api_version_major(props.api_version),
-                vk::api_version_minor(props.api_version),
-                vk::api_version_patch(props.api_version)
-            ),
-            index: candidate.index,
-            timestamp_period_ns: props.limits.timestamp_period,
-            max_image_dimension_2d: props.limits.max_image_dimension2_d,
-            memory_heap_bytes: memory.heap,
-            max_allocation_bytes: memory.allocation,
-            memory_budget,
-            features: REQUIRED_FEATURES.iter().map(|s| s.to_string()).collect(),
-            optional_features: optional.names(),
-            max_point_size: if optional.large_points {
-                props.limits.point_size_range[1]
-            } else {
-                1.0
-            },
-            validation: report.is_some(),
-        };
+        let info = describe_device(&candidate, &optional, &memory, memory_budget, report.is_some());
         let shared = Shared {
             _entry: entry,
             instance,
@@ -430,7 +441,7 @@ impl Context {
             garbage: Mutex::new(Vec::new()),
             heap: ManuallyDrop::new(heap),
             info,
-            limits: props.limits,
+            limits: candidate.properties.limits,
             memory,
             report,
         };

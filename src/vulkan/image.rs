@@ -151,12 +151,12 @@ impl Image {
     }
 
     /// Heap index for sampling (layout SHADER_READ_ONLY_OPTIMAL).
-    pub fn sampled_handle(&self) -> Option<u32> {
+    pub(crate) fn sampled_handle(&self) -> Option<u32> {
         self.sampled_handle
     }
 
     /// Heap index for storage access (layout GENERAL).
-    pub fn storage_handle(&self) -> Option<u32> {
+    pub(crate) fn storage_handle(&self) -> Option<u32> {
         self.storage_handle
     }
 

@@ -250,7 +250,7 @@ impl Buffer {
     }
 
     /// The descriptor-heap index of this storage buffer.
-    pub fn storage_handle(&self) -> Option<u32> {
+    pub(crate) fn storage_handle(&self) -> Option<u32> {
         self.storage_handle
     }
 
@@ -258,7 +258,7 @@ impl Buffer {
     /// storage buffer (shaders index the range from 0); `offset` must be a
     /// multiple of the device's storage-buffer offset alignment
     /// ([`Context::storage_buffer_alignment`]). Released with the buffer.
-    pub fn range_handle(&self, offset: u64, size: u64) -> Result<u32> {
+    pub(crate) fn range_handle(&self, offset: u64, size: u64) -> Result<u32> {
         let align = self.ctx.storage_buffer_alignment();
         if self.storage_handle.is_none() || offset % align != 0 || size == 0 || offset + size > self.desc.size {
             return Err(Error::invalid(

@@ -164,6 +164,9 @@ impl GraphicsPipelineDesc {
 pub struct GraphicsPipeline {
     ctx: Context,
     pub(crate) raw: vk::Pipeline,
+    name: &'static str,
+    color_formats: Vec<vk::Format>,
+    depth_format: Option<vk::Format>,
 }
 
 impl GraphicsPipeline {
@@ -242,31 +245,7 @@ impl GraphicsPipeline {
             .depth_test_enable(desc.depth_test)
             .depth_write_enable(desc.depth_write)
             .depth_compare_op(desc.depth_compare);
-        let attachment = match desc.blend {
-            Blend::None => vk::PipelineColorBlendAttachmentState::default(),
-            Blend::Additive => vk::PipelineColorBlendAttachmentState::default()
-                .blend_enable(true)
-                .src_color_blend_factor(vk::BlendFactor::ONE)
-                .dst_color_blend_factor(vk::BlendFactor::ONE)
-                .color_blend_op(vk::BlendOp::ADD)
-                .src_alpha_blend_factor(vk::BlendFactor::ONE)
-                .dst_alpha_blend_factor(vk::BlendFactor::ONE)
-                .alpha_blend_op(vk::BlendOp::ADD),
-            Blend::PremultipliedOver => vk::PipelineColorBlendAttachmentState::default()
-                .blend_enable(true)
-                .src_color_blend_factor(vk::BlendFactor::ONE)
-                .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-                .color_blend_op(vk::BlendOp::ADD)
-                .src_alpha_blend_factor(vk::BlendFactor::ONE)
-                .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-                .alpha_blend_op(vk::BlendOp::ADD),
-        }
-        .color_write_mask(vk::ColorComponentFlags::RGBA);
-        // Integer attachments (ids) cannot blend: they are always replaced.
-        let replace = vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA);
-        let attachments: Vec<_> = (desc.color_formats.iter())
-            .map(|&f| if is_integer_format(f) { replace } else { attachment })
-            .collect();
+        let attachments = blend_attachments(desc);
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
@@ -295,8 +274,59 @@ impl GraphicsPipeline {
         destroy_module(ctx, fragment);
         let raw = result.map_err(|(_, e)| vk_err("vkCreateGraphicsPipelines")(e))?[0];
         ctx.name_object(raw, desc.name);
-        Ok(GraphicsPipeline { ctx: ctx.clone(), raw })
+        Ok(GraphicsPipeline {
+            ctx: ctx.clone(),
+            raw,
+            name: desc.name,
+            color_formats: desc.color_formats.clone(),
+            depth_format: desc.depth_format,
+        })
     }
+
+    /// The pipeline's name (its debug name).
+    pub fn name(&self) -> &'static str {
+        self.name
+    }
+
+    /// The colour attachment formats the pipeline renders into, in order.
+    pub fn color_formats(&self) -> &[vk::Format] {
+        &self.color_formats
+    }
+
+    /// The depth attachment format, if the pipeline has one.
+    pub fn depth_format(&self) -> Option<vk::Format> {
+        self.depth_format
+    }
+}
+
+/// The colour blend state of each of `desc`'s attachments: its blend
+/// mode, except on integer attachments (ids), which cannot blend and are
+/// always replaced.
+fn blend_attachments(desc: &GraphicsPipelineDesc) -> Vec<vk::PipelineColorBlendAttachmentState> {
+    let attachment = match desc.blend {
+        Blend::None => vk::PipelineColorBlendAttachmentState::default(),
+        Blend::Additive => vk::PipelineColorBlendAttachmentState::default()
+            .blend_enable(true)
+            .src_color_blend_factor(vk::BlendFactor::ONE)
+            .dst_color_blend_factor(vk::BlendFactor::ONE)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+            .alpha_blend_op(vk::BlendOp::ADD),
+        Blend::PremultipliedOver => vk::PipelineColorBlendAttachmentState::default()
+            .blend_enable(true)
+            .src_color_blend_factor(vk::BlendFactor::ONE)
+            .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+            .alpha_blend_op(vk::BlendOp::ADD),
+    }
+    .color_write_mask(vk::ColorComponentFlags::RGBA);
+    let replace = vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA);
+    (desc.color_formats.iter())
+        .map(|&f| if is_integer_format(f) { replace } else { attachment })
+        .collect()
 }
 
 impl Drop for GraphicsPipeline {

@@ -41,10 +41,18 @@ pub fn run<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
     run_as_is(&args)
 }
 
-/// [`run`] without any added option.
+/// [`run`] without any added option but `--validation`: every command
+/// that renders (`render`, `bench`, `fly`) runs under the Khronos
+/// validation layers and synchronization validation, and exits non-zero on
+/// any message (issue 27: no test renders unvalidated).
 pub fn run_as_is<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
+    let mut args: Vec<&std::ffi::OsStr> = args.iter().map(AsRef::as_ref).collect();
+    let renders = (args.first()).is_some_and(|a| ["render", "bench", "fly"].iter().any(|c| a == c));
+    if renders && !args.iter().any(|a| *a == "--validation") {
+        args.push(std::ffi::OsStr::new("--validation"));
+    }
     Command::new(bin())
-        .args(args)
+        .args(&args)
         .env(
             "XDG_CACHE_HOME",
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-cache"),

@@ -24,10 +24,10 @@ use std::time::Instant;
 use crate::io::image_out::write_png_rgba8;
 use crate::lighting::solar::SkyPreset;
 use crate::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
+use crate::surface::gpu_layout::TexturingMode;
 use crate::test_support::{
     assert_validation_clean, jacksboro_field, jacksboro_valley_camera, mean_flip, validated_context,
 };
-use crate::texturing::gpu_layout::TexturingMode;
 use crate::view::{Exposure, Lighting, SkyLightMode};
 use crate::vulkan::Context;
 

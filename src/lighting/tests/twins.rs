@@ -3,9 +3,9 @@
 //! formulas, aerial perspective against its CPU twin, the lighting AOVs.
 
 use crate::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
+use crate::surface::gpu_layout::TexturingMode;
 use crate::terrain::procedural::ProceduralTerrain;
 use crate::test_support::{assert_validation_clean, validated_context};
-use crate::texturing::gpu_layout::TexturingMode;
 use crate::view::{Lighting, SkyModel, SunPosition};
 use crate::vulkan::Context;
 use glam::{DVec2, DVec3};
@@ -115,7 +115,7 @@ fn pixel_world(camera: &Camera, (w, h): (u32, u32), (x, y): (u32, u32), depth: f
 
 #[test]
 fn sun_visibility_agrees_with_a_cpu_ray_cast_on_the_real_dem() {
-    use crate::terrain::bspline::sample_bspline_gradient;
+    use crate::surface::bspline::sample_bspline_gradient;
     use crate::terrain::raycast::Raycaster;
     use crate::view::{ShadowMode, SkyLightMode};
 

@@ -764,26 +764,7 @@ pub fn build_spt(
             format!("{} surfels exceed the limit of {}", surfels.len(), u32::MAX / 2),
         ));
     }
-    let mut positions = Vec::with_capacity(surfels.len());
-    let mut normals = Vec::with_capacity(surfels.len());
-    for (i, s) in surfels.iter().enumerate() {
-        if !s.position.is_finite() {
-            return Err(Error::invalid(format!("surfel {i}"), "position is not finite"));
-        }
-        let n = s.normal.as_dvec3();
-        let len = n.length();
-        if !(len.is_finite() && len > 1e-6) {
-            return Err(Error::invalid(format!("surfel {i}"), "normal is zero or not finite"));
-        }
-        if !(s.radius.is_finite() && s.radius > 0.0) {
-            return Err(Error::invalid(
-                format!("surfel {i}"),
-                format!("radius {} is not positive and finite", s.radius),
-            ));
-        }
-        positions.push(s.position.as_dvec3());
-        normals.push(n / len);
-    }
+    let (positions, normals) = checked_surfels(surfels)?;
     progress(0.0);
 
     let (mut lo, mut hi) = (positions[0], positions[0]);
@@ -809,8 +790,64 @@ pub fn build_spt(
     let progress = builder.progress;
     debug_assert_eq!(root, work.len() - 1);
 
-    // Top-down: r_min, r_max and depth (parents follow their children in
-    // `work`, so a reverse sweep sees every parent first).
+    let nodes = top_down(&work, options)?;
+
+    // Bounding sphere of all node disks (so of all node centres too), a
+    // little enlarged to stay conservative after rounding to f32.
+    let centre = ((lo + hi) * 0.5).as_vec3();
+    let mut radius = 0.0f64;
+    for n in &nodes {
+        radius = radius.max((n.position.as_dvec3() - centre.as_dvec3()).length() + 0.5 * f64::from(n.diameter));
+    }
+    let bounds_radius = f32_round_up(radius * (1.0 + 1e-6));
+    if !bounds_radius.is_finite() {
+        return Err(Error::invalid(
+            "surfels",
+            "coordinates too large: the bounding sphere overflows f32",
+        ));
+    }
+
+    let sorted = sequentialise(nodes);
+    progress(1.0);
+
+    Ok(SequentialPointTree {
+        nodes: sorted,
+        bounds_centre: centre,
+        bounds_radius,
+        epsilon: options.epsilon,
+    })
+}
+
+/// The surfels' positions and unit normals, after checking that every
+/// position is finite, every normal non-zero and every radius positive.
+fn checked_surfels(surfels: &[Surfel]) -> Result<(Vec<DVec3>, Vec<DVec3>)> {
+    let mut positions = Vec::with_capacity(surfels.len());
+    let mut normals = Vec::with_capacity(surfels.len());
+    for (i, s) in surfels.iter().enumerate() {
+        if !s.position.is_finite() {
+            return Err(Error::invalid(format!("surfel {i}"), "position is not finite"));
+        }
+        let n = s.normal.as_dvec3();
+        let len = n.length();
+        if !(len.is_finite() && len > 1e-6) {
+            return Err(Error::invalid(format!("surfel {i}"), "normal is zero or not finite"));
+        }
+        if !(s.radius.is_finite() && s.radius > 0.0) {
+            return Err(Error::invalid(
+                format!("surfel {i}"),
+                format!("radius {} is not positive and finite", s.radius),
+            ));
+        }
+        positions.push(s.position.as_dvec3());
+        normals.push(n / len);
+    }
+    Ok((positions, normals))
+}
+
+/// The tree's nodes from the built cells, top-down: r_min, r_max and depth
+/// (parents follow their children in `work`, so a reverse sweep sees every
+/// parent first); an error when a value overflows f32.
+fn top_down(work: &[Work], options: &SptOptions) -> Result<Vec<SptNode>> {
     let eps = f64::from(options.epsilon);
     let mut nodes: Vec<SptNode> = Vec::with_capacity(work.len());
     nodes.resize(
@@ -876,30 +913,7 @@ pub fn build_spt(
         nodes[i] = node;
     }
 
-    // Bounding sphere of all node disks (so of all node centres too), a
-    // little enlarged to stay conservative after rounding to f32.
-    let centre = ((lo + hi) * 0.5).as_vec3();
-    let mut radius = 0.0f64;
-    for n in &nodes {
-        radius = radius.max((n.position.as_dvec3() - centre.as_dvec3()).length() + 0.5 * f64::from(n.diameter));
-    }
-    let bounds_radius = f32_round_up(radius * (1.0 + 1e-6));
-    if !bounds_radius.is_finite() {
-        return Err(Error::invalid(
-            "surfels",
-            "coordinates too large: the bounding sphere overflows f32",
-        ));
-    }
-
-    let sorted = sequentialise(nodes);
-    progress(1.0);
-
-    Ok(SequentialPointTree {
-        nodes: sorted,
-        bounds_centre: centre,
-        bounds_radius,
-        epsilon: options.epsilon,
-    })
+    Ok(nodes)
 }
 
 #[cfg(test)]

@@ -190,8 +190,9 @@ pub fn plan_frame_into(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::points::build::plants::{build_plant_tree, PlantModel};
+    use crate::points::build::plants::build_plant_tree;
     use crate::points::build::spt::SptOptions;
+    use crate::surface::plants::PlantModel;
 
     #[test]
     fn thinning_keeps_large_instances_and_a_nested_share_of_small_ones() {

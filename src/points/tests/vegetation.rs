@@ -12,16 +12,17 @@
 //!   vegetation.
 
 use crate::io::heightmap::HeightField;
-use crate::points::build::plants::{generate_plant, PlantModel};
+use crate::points::build::plants::generate_plant;
 use crate::points::render::SplatSettings;
 use crate::points::scene::{PointScene, PointTransform};
 use crate::points::vegetation::{plant_prototype, prototype_seed, VegetationOptions};
 use crate::renderer::{Camera, RenderSettings, Renderer, Scene};
+use crate::surface::layers::vegetation::subtree_shares;
+use crate::surface::layers::LayerTree;
+use crate::surface::plants::PlantModel;
 use crate::terrain::procedural::ProceduralTerrain;
 use crate::test_support::points::render_points;
 use crate::test_support::{assert_validation_clean, validated_context};
-use crate::texturing::layers::vegetation::subtree_shares;
-use crate::texturing::layers::LayerTree;
 use crate::texturing::reference::ReferenceSurface;
 use crate::view::aov::CLASS_VEGETATION;
 use crate::view::View;

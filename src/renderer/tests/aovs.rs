@@ -21,12 +21,12 @@ use crate::points::build::spt::{epsilon_from_pixels, SptOptions};
 use crate::points::render::{SplatMode, SplatSettings};
 use crate::points::scene::{scatter_rocks, PointClass, PointObject, PointScene, PointTransform};
 use crate::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
+use crate::surface::dominant::dominant_layer;
+use crate::surface::gpu_layout::TexturingMode;
 use crate::terrain::geometry_image::TerrainSettings;
 use crate::terrain::procedural::ProceduralTerrain;
 use crate::terrain::shading::CLASSIC_LAYERS;
 use crate::test_support::{assert_validation_clean, validated_context};
-use crate::texturing::dominant::dominant_layer;
-use crate::texturing::gpu_layout::TexturingMode;
 use crate::texturing::page_table::PageTable;
 use crate::texturing::reference::ReferenceSurface;
 use crate::view::aov::{CLASS_LAYER_BASE, CLASS_ROCK, CLASS_SCAN, CLASS_SKY};
@@ -419,7 +419,7 @@ fn a_rock_on_the_terrain_keeps_its_ids_where_it_is_seen() {
         .expect("terrain");
     let mut scene = Scene::new(field);
     let (object, scale) = rock(60.0);
-    let ground = crate::terrain::bspline::sample_bspline(&scene.heights, 1280.0, 1280.0);
+    let ground = crate::surface::bspline::sample_bspline(&scene.heights, 1280.0, 1280.0);
     place(
         &mut scene.points,
         object,

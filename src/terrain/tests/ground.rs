@@ -34,7 +34,7 @@
 use crate::io::heightmap::{load_heightmap, HeightmapOptions, RowOrder};
 use crate::random::SplitMix64;
 use crate::renderer::{Camera, RenderSettings, Renderer, Scene};
-use crate::terrain::bspline::sample_bspline;
+use crate::surface::bspline::sample_bspline;
 use crate::terrain::geometry_image::TerrainSettings;
 use crate::terrain::ground::{octave_weight, DrawnSurface, Ground};
 use crate::terrain::lod::{DebugScalar, LodFrame, LodMode};
@@ -98,7 +98,7 @@ fn rendered_points(camera: &Camera, depth: &[f32]) -> Vec<DVec3> {
 }
 
 /// Standard deviation of the evaluated wavelet noise (0.210–0.215 over
-/// 64 seeds: `crate::terrain::wavelet_noise::TILE_STD`'s docs).
+/// 64 seeds: `crate::surface::wavelet_noise::TILE_STD`'s docs).
 const NOISE_STD: f64 = 0.215;
 
 /// RMS of the detail octaves a vertex of split octave `split` leaves out

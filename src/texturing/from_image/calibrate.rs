@@ -9,7 +9,7 @@
 //! simple heuristic; here each level-1 layer's coverage-noise bias c_S
 //! (with n_S in proportion) is scaled, a few fixed-point steps, until the
 //! share of the terrain where it is the dominant layer
-//! (`crate::texturing::dominant`) matches its class's share of the image
+//! (`crate::surface::dominant`) matches its class's share of the image
 //! — c_S acts as the class's prior. The prediction is the CPU twin of the
 //! renderer (`crate::texturing::reference`) at every [`STRIDE`]-th pixel
 //! of every [`STRIDE`]-th row of the class map.
@@ -19,8 +19,8 @@ use glam::DVec2;
 use super::tree::GeneratedLayer;
 use crate::error::Result;
 use crate::io::heightmap::HeightField;
-use crate::texturing::dominant::dominant_layer;
-use crate::texturing::layers::{LayerTree, MAX_NOISE_TERM};
+use crate::surface::dominant::dominant_layer;
+use crate::surface::layers::{LayerTree, MAX_NOISE_TERM};
 use crate::texturing::reference::ReferenceSurface;
 
 /// Image pixels between the points the calibration evaluates, each way.
@@ -39,12 +39,7 @@ pub fn layer_fractions(
     positions: &[DVec2],
     footprint: f64,
 ) -> Result<Vec<f64>> {
-    let reference = ReferenceSurface::new(
-        field,
-        tree,
-        maps,
-        crate::terrain::geometry_image::TerrainSettings::default().noise_seed,
-    )?;
+    let reference = ReferenceSurface::new(field, tree, maps, crate::surface::wavelet_noise::DEFAULT_NOISE_SEED)?;
     let mut counts = vec![0usize; tree.layers.len()];
     for &xy in positions {
         if let Some(k) = dominant_layer(&reference.evaluate(xy, footprint).coverage) {

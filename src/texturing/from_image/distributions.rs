@@ -25,8 +25,8 @@ use glam::DVec2;
 use super::classify::{Classification, PixelStatus};
 use crate::error::Result;
 use crate::io::heightmap::HeightField;
-use crate::terrain::bspline::{sample_bspline, sample_bspline_gradient};
-use crate::texturing::layers::{LayerTree, SampledFunction, INPUT_NAMES};
+use crate::surface::bspline::{sample_bspline, sample_bspline_gradient};
+use crate::surface::layers::{LayerTree, SampledFunction, INPUT_NAMES};
 use crate::texturing::reference::ReferenceSurface;
 
 /// The input quantities at every pixel.

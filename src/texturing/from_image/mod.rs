@@ -137,13 +137,13 @@ impl FromImageOptions {
         if self.snow_min_altitude.is_some_and(|a| !a.is_finite()) {
             return Err(Error::invalid("from_image.snow_min_altitude", "must be finite"));
         }
-        if !(1..=crate::texturing::layers::MAX_SAMPLES).contains(&self.bins) {
+        if !(1..=crate::surface::layers::MAX_SAMPLES).contains(&self.bins) {
             return Err(Error::invalid(
                 "from_image.bins",
                 format!(
                     "{} is out of range 1..={}",
                     self.bins,
-                    crate::texturing::layers::MAX_SAMPLES
+                    crate::surface::layers::MAX_SAMPLES
                 ),
             ));
         }
@@ -231,7 +231,7 @@ pub fn load_rgb_image(path: &std::path::Path, limits: &crate::io::limits::InputL
 
 /// Surface layers estimated from `image` over `field` (module docs): the
 /// layer tree as TOML with the classification behind it. `maps` are the
-/// extra input maps ([`crate::texturing::layers::INPUT_NAMES`] order),
+/// extra input maps ([`crate::surface::layers::INPUT_NAMES`] order),
 /// each spanning the field corner to corner; every present map becomes a
 /// constraint of every child layer.
 pub fn build_layers(
@@ -313,7 +313,7 @@ mod tests {
         let generated = build_layers(&image, &field, &[Some(rain), None, None], &options).unwrap();
         let tree = generated.tree().unwrap();
         assert!(tree.uses_input(0) && !tree.uses_input(1));
-        let Some(crate::texturing::layers::Constraint::Sampled(f)) = &tree.layers[1].layer.inputs[0] else {
+        let Some(crate::surface::layers::Constraint::Sampled(f)) = &tree.layers[1].layer.inputs[0] else {
             panic!("no sampled rainfall constraint");
         };
         assert_eq!((f.min, f.max), (0.0, 100.0));

@@ -21,7 +21,7 @@
 use glam::DVec2;
 
 use crate::io::heightmap::HeightField;
-use crate::terrain::bspline::{sample_bspline, sample_bspline_gradient};
+use crate::surface::bspline::{sample_bspline, sample_bspline_gradient};
 
 /// Direction towards the sun (east, north, up) for azimuth and elevation in degrees.
 pub fn sun_direction(azimuth_deg: f64, elevation_deg: f64) -> glam::DVec3 {

@@ -1,6 +1,6 @@
 //! The surface-layer hierarchy of the estimated classes (§8.3, "Surface
 //! Layer Hierarchy"), written in the layer tree's TOML format
-//! (`crate::texturing::layers`).
+//! (`crate::surface::layers`).
 //!
 //! Decisions (the text's simple heuristic, its "fixed values for further
 //! surface parameters" chosen here):
@@ -25,7 +25,7 @@ use glam::{DVec2, Vec3};
 use super::classify::Classification;
 use super::distributions::{map_name, Distributions};
 use super::{ClassCount, FromImageOptions};
-use crate::texturing::layers::{LayerTree, SampledFunction};
+use crate::surface::layers::{LayerTree, SampledFunction};
 
 /// c_S of every level-1 layer.
 pub const NOISE_BIAS: f32 = 1.0;

@@ -14,14 +14,14 @@
 
 use crate::io::heightmap::{load_heightmap, HeightmapOptions};
 use crate::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
+use crate::surface::gpu_layout::TexturingMode;
+use crate::surface::layers::LayerTree;
 use crate::test_support::{
     assert_validation_clean, data, dump_pngs, flip_errors, jacksboro_field, jacksboro_valley_camera, mean_flip,
     validated_context,
 };
 use crate::texturing::atlas::{AtlasSettings, GenerationBudget};
 use crate::texturing::generation::{TextureFrameStats, TextureStreaming};
-use crate::texturing::gpu_layout::TexturingMode;
-use crate::texturing::layers::LayerTree;
 use crate::texturing::page_table::PageTable;
 use glam::{DVec2, DVec3};
 
@@ -162,7 +162,7 @@ fn real_dem_atlas_matches_direct_reference() {
 fn ground_level_view_settles_and_matches_direct_reference() {
     let scene = Scene::new(jacksboro_field());
     let (x, y) = (15000.0, 12000.0);
-    let ground = |x: f64, y: f64| crate::terrain::bspline::sample_bspline(&scene.heights, x, y);
+    let ground = |x: f64, y: f64| crate::surface::bspline::sample_bspline(&scene.heights, x, y);
     let camera = Camera {
         eye: DVec3::new(x, y, ground(x, y) + 2.0),
         target: DVec3::new(x + 100.0, y + 60.0, ground(x + 100.0, y + 60.0) + 1.0),

@@ -19,10 +19,10 @@ use std::sync::OnceLock;
 use crate::io::heightmap::{load_heightmap, HeightField, HeightmapOptions, RowOrder};
 use crate::io::limits::InputLimits;
 use crate::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
+use crate::surface::layers::{Constraint, LayerTree};
 use crate::test_support::{assert_validation_clean, data, dump_pngs, validated_context};
 use crate::texturing::from_image::classify::hsv;
 use crate::texturing::from_image::{build_layers, load_rgb_image, ClassCount, FromImageOptions, GeneratedLayers};
-use crate::texturing::layers::{Constraint, LayerTree};
 use crate::view::aov::CLASS_LAYER_BASE;
 use crate::view::{Lighting, SunPosition};
 use glam::{DVec2, DVec3};
@@ -94,7 +94,7 @@ fn the_region_classifies_into_forest_tundra_water_rock_and_snow() {
     let mean_altitude = |class: usize| {
         let heights: Vec<f64> = (0..positions.len())
             .filter(|&i| usize::from(c.labels[i]) == class)
-            .map(|i| crate::terrain::bspline::sample_bspline(field, positions[i].x, positions[i].y))
+            .map(|i| crate::surface::bspline::sample_bspline(field, positions[i].x, positions[i].y))
             .collect();
         heights.iter().sum::<f64>() / heights.len() as f64
     };

@@ -15,11 +15,11 @@
 
 use crate::io::heightmap::HeightField;
 use crate::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
+use crate::surface::gpu_layout::TexturingMode;
 use crate::test_support::{assert_validation_clean, dump_pngs, mean_flip, validated_context};
 use crate::texturing::atlas::TileCache;
 use crate::texturing::fit::select_to_fit;
 use crate::texturing::generation::{TextureStreaming, PAGE_TABLE_WORDS};
-use crate::texturing::gpu_layout::TexturingMode;
 use crate::texturing::page_table::PageTable;
 use crate::texturing::quadtree::{HeightBounds, NeededTile, MAX_SELECTED};
 use crate::texturing::streaming::{MAX_ATLAS_TEXTURES, MAX_TILE_BUDGET};

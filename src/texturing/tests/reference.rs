@@ -1,7 +1,7 @@
 //! The GPU's tile generation (`texturing.upsample`, one `texturing.layer*`
 //! pass per layer, `texturing.finish`; dissertation §8.2) against its CPU
 //! twin (`src/texturing/reference.rs`, which evaluates the tree with
-//! `texturing::layers::evaluate`): the atlas's colour texels, read back, equal
+//! `surface::layers::evaluate`): the atlas's colour texels, read back, equal
 //! the CPU's sRGB-encoded colour at the same world positions within
 //! `MAX_CODE_DIFFERENCE` (src/test_support/atlas.rs) code values, for the default tree and for a tree
 //! driven by a rainfall input map, under validation; and a tree of sampled
@@ -10,12 +10,12 @@
 
 use crate::io::heightmap::{load_heightmap, HeightmapOptions};
 use crate::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
+use crate::surface::gpu_layout::TexturingMode;
+use crate::surface::layers::LayerTree;
 use crate::terrain::geometry_image::TerrainSettings;
 use crate::test_support::atlas::check_texels_against_cpu;
 use crate::test_support::{assert_validation_clean, data, dump_pngs, jacksboro_field, mean_flip, validated_context};
 use crate::texturing::generation::TextureStreaming;
-use crate::texturing::gpu_layout::TexturingMode;
-use crate::texturing::layers::LayerTree;
 use crate::texturing::reference::ReferenceSurface;
 use glam::DVec2;
 

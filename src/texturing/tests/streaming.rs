@@ -14,13 +14,13 @@
 
 use crate::graph::{BakedGraph, FrameOutcome, RenderGraph};
 use crate::renderer::Scene;
+use crate::surface::gpu_layout::TexturingMode;
 use crate::terrain::geometry_image::TerrainSettings;
 use crate::terrain::{Terrain, TerrainTexturing};
 use crate::test_support::atlas::{check_texels_against_cpu, ground_camera};
 use crate::test_support::{assert_validation_clean, jacksboro_field, validated_context};
 use crate::texturing::atlas::{AtlasSettings, GpuTimeBudget};
 use crate::texturing::generation::{TextureAtlas, TextureFrameStats, TextureStreaming};
-use crate::texturing::gpu_layout::TexturingMode;
 use crate::texturing::quadtree::{select_tiles, HeightBounds};
 use crate::view::{Frame, Lighting, View};
 use crate::vulkan::{Context, FrameRing, FRAMES_IN_FLIGHT};

@@ -25,35 +25,9 @@ use super::spt::{build_spt, SequentialPointTree, SptOptions};
 use crate::error::{Error, Result};
 use crate::points::build::hybrid::HybridMesh;
 use crate::points::TriangleMesh;
-
-/// A procedural plant model.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum PlantModel {
-    /// A spruce-like tree, about 12 m at scale 1 ([`conifer`]).
-    Conifer,
-    /// A broadleaf bush, about 1.8 m at scale 1 ([`shrub`]).
-    Shrub,
-    /// A tuft of grass blades, about 0.5 m at scale 1 ([`grass`]).
-    GrassTuft,
-}
+use crate::surface::plants::PlantModel;
 
 impl PlantModel {
-    pub const ALL: [PlantModel; 3] = [PlantModel::Conifer, PlantModel::Shrub, PlantModel::GrassTuft];
-
-    /// The name in layer files (`model = "conifer"`).
-    pub fn name(self) -> &'static str {
-        match self {
-            PlantModel::Conifer => "conifer",
-            PlantModel::Shrub => "shrub",
-            PlantModel::GrassTuft => "grass_tuft",
-        }
-    }
-
-    /// The model called `name` ([`PlantModel::name`]).
-    pub fn from_name(name: &str) -> Option<PlantModel> {
-        PlantModel::ALL.into_iter().find(|m| m.name() == name)
-    }
-
     /// Height in metres at scale 1.
     pub fn nominal_height(self) -> f32 {
         match self {

@@ -21,9 +21,9 @@
 
 use glam::DVec2;
 
-use super::PlantModel;
 use crate::error::{Error, Result};
 use crate::random::SplitMix64;
+use crate::surface::plants::PlantModel;
 
 /// Candidate budget per allowed plant before densities are scaled down.
 pub const CANDIDATES_PER_PLANT: f64 = 4.0;

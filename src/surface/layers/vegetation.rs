@@ -17,13 +17,13 @@
 //! colour that comes from the layer or one of its sub-layers (a grass
 //! layer's dark and dry grass children are still grass), i.e. the sum of
 //! `C_k · Π_{j>k} (1 − C_j)` over the layer's subtree
-//! ([`crate::texturing::dominant::layer_shares`]).
+//! ([`crate::surface::dominant::layer_shares`]).
 
 use serde::Deserialize;
 
 use super::LayerTree;
-use crate::points::build::plants::PlantModel;
-use crate::texturing::dominant::layer_shares;
+use crate::surface::dominant::layer_shares;
+use crate::surface::plants::PlantModel;
 
 /// Largest `density` in plants per m².
 pub const MAX_DENSITY: f64 = 100.0;
@@ -104,7 +104,7 @@ impl LayerTree {
 
 #[cfg(test)]
 mod tests {
-    use crate::texturing::layers::LayerTree;
+    use crate::surface::layers::LayerTree;
 
     const BASE: &str = "[root]\nname = \"rock\"\ncolor = [0.3, 0.3, 0.3]\n\n[[root.children]]\nname = \"grass\"\ncolor = [0.1, 0.3, 0.1]\n";
 
@@ -172,7 +172,7 @@ mod tests {
         let tree = LayerTree::parse(&text, "t").unwrap();
         // rock 1, grass 0.8, dark 0.5 (of grass), snow 0.25.
         let shares = super::subtree_shares(&tree, &[1.0, 0.8, 0.5, 0.25]);
-        let own = crate::texturing::dominant::layer_shares(&[1.0, 0.8, 0.5, 0.25]);
+        let own = crate::surface::dominant::layer_shares(&[1.0, 0.8, 0.5, 0.25]);
         assert!((shares[0] - 1.0).abs() < 1e-6, "the root's subtree is everything");
         assert!((shares[1] - (own[1] + own[2])).abs() < 1e-6);
         // After dark grass: rock 0.1, grass 0.4, dark 0.5; snow then covers a quarter.

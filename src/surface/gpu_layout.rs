@@ -83,7 +83,7 @@ pub fn pack_constraint(c: Option<&Constraint>, layer_count: usize, samples: &mut
 
 /// The tree in evaluation order, with the samples of its sampled functions;
 /// `blurred`: the sampled handle of the blurred height field of each
-/// `height_blur` radius ([`crate::texturing::input_maps::InputMaps::blurred_handles`]).
+/// `height_blur` radius ([`crate::surface::input_maps::InputMaps::blurred_handles`]).
 pub fn pack_layers(tree: &LayerTree, blurred: &[(f32, u32)]) -> PackedLayers {
     let count = tree.layers.len();
     let mut samples = Vec::new();

@@ -1,7 +1,7 @@
 //! Sampled functions (§8.3): parsing, validation, evaluation and packing.
 
 use super::*;
-use crate::texturing::gpu_layout::{pack_layers, GpuLayer};
+use crate::surface::gpu_layout::{pack_layers, GpuLayer};
 
 fn sampled(min: f32, max: f32, samples: &[f32]) -> SampledFunction {
     SampledFunction {

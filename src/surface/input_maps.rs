@@ -4,7 +4,7 @@
 //! any resolution. Uploaded once as R32F textures; the layer shaders sample
 //! them bilinearly (`input_maps` in `glsl/include/surface_layers.glsl`).
 //! Also the blurred height fields of `height_blur` layers
-//! ([`crate::texturing::blurred_height`]), R32F as well, which the shaders
+//! ([`crate::surface::blurred_height`]), R32F as well, which the shaders
 //! sample with the base height's cubic B-spline.
 
 use std::path::Path;
@@ -13,8 +13,8 @@ use std::sync::Arc;
 use crate::error::{Error, Result};
 use crate::graph::{ImageId, RenderGraph};
 use crate::io::heightmap::HeightField;
-use crate::texturing::blurred_height::blurred_height;
-use crate::texturing::layers::{LayerTree, INPUT_NAMES, MAX_BLUR_RADII};
+use crate::surface::blurred_height::blurred_height;
+use crate::surface::layers::{LayerTree, INPUT_NAMES, MAX_BLUR_RADII};
 use crate::vulkan::{Context, Format, Image, ImageDesc, ImageUsageFlags};
 
 /// The input maps as graph resources with their sampled heap handles

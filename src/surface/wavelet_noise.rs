@@ -57,6 +57,12 @@ use glam::DVec2;
 use crate::error::{Error, Result};
 use crate::random::SplitMix64;
 
+/// Side of the wavelet noise tile the terrain and the surface layers
+/// evaluate (also `NOISE_TILE` in the shader).
+pub const NOISE_TILE: usize = 128;
+/// Seed of that tile by default (the terrain's `noise_seed` setting).
+pub const DEFAULT_NOISE_SEED: u64 = 7;
+
 /// Default tile size (texels per side), as in the paper.
 #[cfg(test)]
 pub const TILE: usize = 128;

@@ -6,7 +6,7 @@
 //! samples per axis, truncated at 3σ and normalised, the border sample
 //! repeated outside the field. The CPU computes it once per distinct radius;
 //! the GPU samples the result with the same cubic B-spline as the base
-//! height ([`crate::texturing::input_maps`] uploads it), and the CPU
+//! height ([`crate::surface::input_maps`] uploads it), and the CPU
 //! reference ([`crate::texturing::reference`]) reads the same samples.
 
 use crate::error::{Error, Result};

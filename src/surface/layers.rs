@@ -43,7 +43,7 @@
 //!   simulates snow "deposited in furrows by wind ... when a blurred
 //!   elevation data serves as input for the slope constraint evaluation".
 //!   Such a layer's constraints read the height field blurred with a
-//!   Gaussian of σ = R ([`crate::texturing::blurred_height`]), upsampled
+//!   Gaussian of σ = R ([`crate::surface::blurred_height`]), upsampled
 //!   with the same cubic B-spline as the base: its slope is that of the
 //!   blurred surface (as the text says), and its altitude and elevation are
 //!   the blurred height plus the displacement the layers before added
