@@ -13,26 +13,8 @@ use crate::post::motion_blur::{MotionBlur, MotionBlurImages, MotionBlurSettings}
 use crate::post::resample::{ImageKind, ResampleImage};
 use crate::post::resolve::{supersampled_size, Resolve, ResolveDesc, ResolveFilter};
 use crate::view::rig::ViewSpec;
-use crate::view::{pass_name, Intrinsics, SceneTargets};
+use crate::view::{pass_name, SceneTargets};
 use crate::vulkan::Context;
-
-fn to_post(k: Intrinsics) -> distortion::Intrinsics {
-    distortion::Intrinsics {
-        fx: k.fx,
-        fy: k.fy,
-        cx: k.cx,
-        cy: k.cy,
-    }
-}
-
-fn from_post(k: distortion::Intrinsics) -> Intrinsics {
-    Intrinsics {
-        fx: k.fx,
-        fy: k.fy,
-        cx: k.cx,
-        cy: k.cy,
-    }
-}
 
 /// One view's chain from what is rendered to what is output.
 pub(super) struct ViewChain {
@@ -62,14 +44,8 @@ fn distortion_source(output: &ViewSpec) -> Result<Option<(DistortedCamera, disto
         )
     })?;
     let camera = DistortedCamera {
-        intrinsics: to_post(k),
-        lens: distortion::BrownConrady {
-            k1: d.k1,
-            k2: d.k2,
-            k3: d.k3,
-            p1: d.p1,
-            p2: d.p2,
-        },
+        intrinsics: k,
+        lens: d,
         width: output.width,
         height: output.height,
     };
@@ -92,7 +68,7 @@ impl ViewChain {
             None => None,
             Some((camera, source)) => {
                 size = (source.width, source.height);
-                intrinsics = Some(from_post(source.intrinsics));
+                intrinsics = Some(source.intrinsics);
                 Some(LensDistortion::new(ctx, &camera, &source)?)
             }
         };

@@ -303,7 +303,7 @@ impl Technique for Terrain {
                 .uploads
                 .write(state.warp, bytemuck::cast_slice(&state.lod.upload))?;
             let camera = &view.camera;
-            let pixel_footprint = view.pixel_angle();
+            let pixel_footprint = view.pixel_footprint();
             let draw = TerrainDrawPush {
                 view_proj: view.view_proj().to_cols_array(),
                 eye: camera.eye.as_vec3().extend(self.geometry.atlas_spacing()).to_array(),

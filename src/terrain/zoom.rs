@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
 use crate::surface::bspline::sample_bspline;
 use crate::terrain::warp::bilinear;
-use crate::view::Camera;
+use crate::view::View;
 
 /// Vertex positions of the `side×side` output grid: `Φ` (the `n×n` warped
 /// sketch map, world `(x, y, ·)`) bilinearly interpolated, clamped onto the
@@ -47,13 +47,13 @@ pub fn zoom_xy(warped: &[DVec3], n: usize, side: usize, extent: DVec2, i: usize,
 
 /// Projected area in pixels of every grid quad of `positions`
 /// (`side×side`) that lies wholly in front of the near plane and inside the
-/// `width×height` image.
-pub fn projected_quad_areas(positions: &[DVec3], side: usize, camera: &Camera, width: u32, height: u32) -> Vec<f64> {
-    let (w, h) = (f64::from(width), f64::from(height));
-    let view_proj = camera.view_proj(w / h).as_dmat4();
+/// image of `view` (projected as the GPU does, [`View::view_proj`]).
+pub fn projected_quad_areas(positions: &[DVec3], side: usize, view: &View) -> Vec<f64> {
+    let (w, h) = (f64::from(view.width), f64::from(view.height));
+    let view_proj = view.view_proj().as_dmat4();
     let project = |p: DVec3| -> Option<DVec2> {
         let clip = view_proj * p.extend(1.0);
-        if clip.w <= camera.near {
+        if clip.w <= view.camera.near {
             return None;
         }
         let ndc = clip.truncate().truncate() / clip.w;
@@ -92,6 +92,7 @@ pub fn quantile(values: &[f64], q: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::terrain::procedural::ProceduralTerrain;
+    use crate::view::Camera;
 
     #[test]
     fn identity_warp_reproduces_the_sketch_grid() {
@@ -124,7 +125,7 @@ mod tests {
             DVec3::new(1.0, 1.0, 0.0),
         ];
         // 1 m at 10 m with a 90° field of view over 200 px: 10 px per metre.
-        let areas = projected_quad_areas(&positions, 2, &camera, 200, 200);
+        let areas = projected_quad_areas(&positions, 2, &View::new(camera, 200, 200));
         assert_eq!(areas.len(), 1);
         assert!((areas[0] - 100.0).abs() < 1e-6, "{}", areas[0]);
         assert_eq!(quantile(&[3.0, 1.0, 2.0], 0.5), 2.0);

@@ -360,13 +360,14 @@ mod tests {
     use glam::{DVec2, DVec3};
 
     use super::*;
-    use crate::texturing::quadtree::{select_tiles, NodeBounds, QuadtreeSettings, View};
+    use crate::texturing::quadtree::{select_tiles, NodeBounds, QuadtreeSettings};
+    use crate::view::Footprint;
 
     const EXTENT: DVec2 = DVec2::new(8000.0, 4000.0);
 
     fn needed_from(eye: DVec3) -> Vec<NeededTile> {
-        let pixel_footprint = View::pixel_footprint_for(1.0, 1080);
-        let view = View {
+        let pixel_footprint = Footprint::pixel_footprint_for(1.0, 1080);
+        let view = Footprint {
             eye,
             pixel_footprint,
             frustum: None,

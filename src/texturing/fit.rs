@@ -29,8 +29,9 @@ use crate::error::Result;
 use crate::texturing::atlas::AtlasSettings;
 use crate::texturing::generation::PAGE_TABLE_WORDS;
 use crate::texturing::page_table::PageTable;
-use crate::texturing::quadtree::{select_tiles_for_views, selection_order, HeightBounds, NeededTile, NodeId, View};
+use crate::texturing::quadtree::{select_tiles_for_views, selection_order, HeightBounds, NeededTile, NodeId};
 use crate::texturing::streaming::TextureStreaming;
+use crate::view::Footprint;
 
 /// What fitting did to a selection.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -105,7 +106,7 @@ pub fn fit_to_atlas(needed: &mut Vec<NeededTile>, atlas: &AtlasSettings, max_til
 /// tiles, halved until the table fits).
 pub fn select_to_fit(
     extent: DVec2,
-    views: &[View],
+    views: &[Footprint],
     streaming: &TextureStreaming,
     bounds: &HeightBounds,
 ) -> Result<(Vec<NeededTile>, Coarsening)> {
@@ -150,7 +151,8 @@ mod tests {
     use glam::{DVec2, DVec3};
 
     use super::*;
-    use crate::texturing::quadtree::{select_tiles, NodeBounds, QuadtreeSettings, View};
+    use crate::texturing::quadtree::{select_tiles, NodeBounds, QuadtreeSettings};
+    use crate::view::Footprint;
 
     const EXTENT: DVec2 = DVec2::new(8000.0, 4000.0);
 
@@ -167,9 +169,9 @@ mod tests {
     }
 
     fn ground_view_tiles() -> Vec<NeededTile> {
-        let view = View {
+        let view = Footprint {
             eye: DVec3::new(4000.0, 2000.0, 2.0),
-            pixel_footprint: View::pixel_footprint_for(1.0, 180),
+            pixel_footprint: Footprint::pixel_footprint_for(1.0, 180),
             frustum: None,
         };
         let flat = |_| NodeBounds {

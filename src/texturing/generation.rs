@@ -44,10 +44,10 @@ use crate::texturing::pacing::GenerationPacer;
 use crate::texturing::pacing::GpuTimeBudget;
 use crate::texturing::page_table::PageTable;
 use crate::texturing::passes::{add_atlas_readback, base_push, GenerationPasses};
-use crate::texturing::quadtree::{HeightBounds, NeededTile, NodeId, View};
+use crate::texturing::quadtree::{HeightBounds, NeededTile, NodeId};
 pub use crate::texturing::stats::TextureFrameStats;
 pub use crate::texturing::streaming::{TextureStreaming, MAX_VIEWS};
-use crate::view::{frustum_planes, Frame, FrameContext, Provides, Technique};
+use crate::view::{Footprint, Frame, FrameContext, Provides, Technique, View};
 use crate::vulkan::{Buffer, Context, Format, Image, ImageDesc, ImageUsageFlags, MemoryLocation};
 
 /// Bytes of one texel's state in the scratch buffer (`TexelState`).
@@ -323,13 +323,13 @@ impl TextureAtlas {
     }
 
     /// The tiles `views` need, coarsened to fit the atlas and the page table.
-    fn select(&self, views: &[View]) -> Result<(Vec<NeededTile>, Coarsening)> {
+    fn select(&self, views: &[Footprint]) -> Result<(Vec<NeededTile>, Coarsening)> {
         select_to_fit(self.extent, views, &self.streaming, &self.bounds)
     }
 
     /// Selects the tiles `views` need, plans the frame within the budget,
     /// builds the page table and the jobs of the dirty tiles.
-    fn plan(&mut self, frame: u64, views: &[View]) -> Result<PlannedFrame> {
+    fn plan(&mut self, frame: u64, views: &[Footprint]) -> Result<PlannedFrame> {
         let extent = self.extent;
         let (needed, coarsening) = self.select(views)?;
         let mut budget = self.streaming.budget;
@@ -368,17 +368,6 @@ struct PlannedFrame {
     texel_cap: u64,
 }
 
-/// What the quadtree measures of a frame's view: its eye, the pixel
-/// footprint of its image rows, its frustum.
-pub fn quadtree_view(view: &crate::view::View) -> View {
-    let camera = &view.camera;
-    View {
-        eye: camera.eye,
-        pixel_footprint: View::pixel_footprint_for(camera.fov_y_deg.to_radians(), view.height),
-        frustum: Some(frustum_planes(camera.view_proj_f64(view.aspect()))),
-    }
-}
-
 impl Technique for TextureAtlas {
     type Prepared = TextureFrame;
     type Needs<'a> = ();
@@ -402,7 +391,7 @@ impl Technique for TextureAtlas {
                 ),
             ));
         }
-        let views: Vec<View> = frame.views.iter().map(quadtree_view).collect();
+        let views: Vec<Footprint> = frame.views.iter().map(View::footprint).collect();
         let planned = self.plan(frame.index, &views).and_then(|p| {
             let words = p.table.words();
             if words.len() > PAGE_TABLE_WORDS {

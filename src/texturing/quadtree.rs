@@ -44,6 +44,7 @@ use glam::{DVec2, DVec3, DVec4};
 
 use crate::error::{Error, Result};
 pub use crate::texturing::bounds::HeightBounds;
+use crate::view::Footprint;
 
 /// Smallest eye-to-node distance in metres, so nodes around the eye need a
 /// finite number of texels.
@@ -179,26 +180,6 @@ pub struct NeededTile {
     pub distance: f64,
 }
 
-/// What the view needs this frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct View {
-    /// Eye position in world metres.
-    pub eye: DVec3,
-    /// Image-space size of one pixel at 1 m: `2·tan(fov_y/2)/rows`
-    /// (see [`View::pixel_footprint_for`]).
-    pub pixel_footprint: f64,
-    /// World planes `(n, d)` with `n·x + d ≥ 0` inside; `None`: no culling.
-    pub frustum: Option<[DVec4; 6]>,
-}
-
-impl View {
-    /// The pixel footprint `2·tan(fov_y/2)/rows` of a pinhole camera with
-    /// vertical field of view `fov_y` (radians) and `rows` image rows.
-    pub fn pixel_footprint_for(fov_y: f64, rows: u32) -> f64 {
-        2.0 * (fov_y / 2.0).tan() / f64::from(rows.max(1))
-    }
-}
-
 /// Height range and error of one node's terrain.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NodeBounds {
@@ -215,7 +196,7 @@ pub struct NodeBounds {
 #[cfg(test)]
 pub fn select_tiles(
     extent: DVec2,
-    view: &View,
+    view: &Footprint,
     settings: &QuadtreeSettings,
     bounds: &dyn Fn(NodeId) -> NodeBounds,
 ) -> Result<Vec<NeededTile>> {
@@ -223,7 +204,7 @@ pub fn select_tiles(
 }
 
 /// Checks a view: finite eye, finite positive footprint, finite planes.
-fn check_view(view: &View) -> Result<()> {
+fn check_view(view: &Footprint) -> Result<()> {
     let footprint = view.pixel_footprint;
     let why = if !(view.eye.is_finite() && footprint.is_finite() && footprint > 0.0) {
         format!(
@@ -260,7 +241,7 @@ struct Measure {
 /// that are not finite with `z_min ≤ z_max` and `geometric_error ≥ 0`.
 pub fn select_tiles_for_views(
     extent: DVec2,
-    views: &[View],
+    views: &[Footprint],
     settings: &QuadtreeSettings,
     bounds: &dyn Fn(NodeId) -> NodeBounds,
 ) -> Result<Vec<NeededTile>> {
@@ -345,7 +326,7 @@ pub const MAX_SELECTED: usize = 1 << 16;
 /// One selection's inputs (rules 1–4 of the module documentation).
 struct Selector<'a> {
     extent: DVec2,
-    views: &'a [View],
+    views: &'a [Footprint],
     settings: &'a QuadtreeSettings,
     bounds: &'a dyn Fn(NodeId) -> NodeBounds,
 }

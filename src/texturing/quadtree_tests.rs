@@ -14,10 +14,10 @@ fn flat(_: NodeId) -> NodeBounds {
     }
 }
 
-fn view(eye: DVec3) -> View {
-    View {
+fn view(eye: DVec3) -> Footprint {
+    Footprint {
         eye,
-        pixel_footprint: View::pixel_footprint_for(1.0, 1080),
+        pixel_footprint: Footprint::pixel_footprint_for(1.0, 1080),
         frustum: None,
     }
 }
@@ -125,20 +125,20 @@ fn density_map(tiles: &[NeededTile]) -> Vec<Option<f64>> {
 fn views_looking_apart_get_the_union_finest_first() {
     let eye = DVec3::new(4000.0, 2000.0, 50.0);
     let keep = DVec4::new(0.0, 0.0, 0.0, 1.0);
-    let facing = |sign: f64| View {
+    let facing = |sign: f64| Footprint {
         frustum: Some([DVec4::new(sign, 0.0, 0.0, -sign * eye.x), keep, keep, keep, keep, keep]),
         ..view(eye)
     };
     // East looks from the eye, west from 500 m west of it: different needs.
     let (east, west) = (
         facing(1.0),
-        View {
+        Footprint {
             eye: eye - DVec3::new(500.0, 0.0, 0.0),
             ..facing(-1.0)
         },
     );
     let s = QuadtreeSettings::default();
-    let one = |v: &View| select_tiles(EXTENT, v, &s, &flat).unwrap();
+    let one = |v: &Footprint| select_tiles(EXTENT, v, &s, &flat).unwrap();
     let (a, b) = (density_map(&one(&east)), density_map(&one(&west)));
     let both = select_tiles_for_views(EXTENT, &[east, west], &s, &flat).unwrap();
     let union = density_map(&both);
@@ -180,7 +180,7 @@ fn overlapping_views_do_not_duplicate_tiles() {
     let twice = select_tiles_for_views(EXTENT, &[v, v], &s, &flat).unwrap();
     assert_eq!(single, twice);
     // A view a little to the side shares most of the tiles.
-    let near = View {
+    let near = Footprint {
         eye: v.eye + DVec3::new(50.0, 0.0, 0.0),
         ..v
     };
@@ -199,7 +199,7 @@ fn selection_is_bounded() {
         max_depth: 12,
         ..QuadtreeSettings::default()
     };
-    let v = View {
+    let v = Footprint {
         pixel_footprint: 1e-9,
         ..view(DVec3::new(10.0, 10.0, 50.0))
     };
@@ -245,7 +245,7 @@ fn invalid_settings_and_inputs_are_errors() {
         assert!(s.validate().is_err(), "{s:?}");
         assert!(select_tiles(EXTENT, &view(DVec3::ZERO), &s, &flat).is_err());
     }
-    let v = View {
+    let v = Footprint {
         pixel_footprint: 0.0,
         ..view(DVec3::ZERO)
     };

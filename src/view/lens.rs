@@ -1,7 +1,16 @@
 //! Camera models beyond the vertical field of view: pinhole intrinsics in
 //! pixels (off-centre principal points and non-square pixels, as projector
 //! channels and calibrated simulator cameras need) and the projection they
-//! give, in Vulkan's conventions (depth 0..1, image row 0 at the top).
+//! give, in Vulkan's conventions (depth 0..1, image row 0 at the top); the
+//! Brown–Conrady lens model in OpenCV's convention and its inversion (what
+//! `post.distortion` resamples with, [`crate::post::distortion`]).
+//!
+//! A camera ray with normalised coordinates (x, y) = (X/Z, Y/Z) is imaged at
+//! x_d = x·(1 + k1 r² + k2 r⁴ + k3 r⁶) + 2 p1 x y + p2 (r² + 2x²),
+//! y_d = y·(1 + k1 r² + k2 r⁴ + k3 r⁶) + p1 (r² + 2y²) + 2 p2 x y, r² = x² + y²,
+//! pixel (u, v) = (fx x_d + cx, fy y_d + cy), pixel (i, j)'s centre at
+//! (u, v) = (i, j) (OpenCV's convention, so calibrations apply unchanged;
+//! a centred principal point is ((W − 1)/2, (H − 1)/2)).
 
 use glam::{DMat4, DVec4};
 
@@ -24,12 +33,38 @@ impl Intrinsics {
     /// `fov_y_deg` and square pixels.
     pub fn from_fov_y(fov_y_deg: f64, width: u32, height: u32) -> Intrinsics {
         let fy = 0.5 * f64::from(height) / (0.5 * fov_y_deg.to_radians()).tan();
+        Intrinsics::centred(fy, fy, width, height)
+    }
+
+    /// Focal lengths `fx`, `fy` and the principal point at the centre of a
+    /// `width`×`height` image.
+    pub fn centred(fx: f64, fy: f64, width: u32, height: u32) -> Intrinsics {
         Intrinsics {
-            fx: fy,
+            fx,
             fy,
             cx: 0.5 * f64::from(width) - 0.5,
             cy: 0.5 * f64::from(height) - 0.5,
         }
+    }
+
+    /// Checks only that the focal lengths are finite and positive and the
+    /// principal point finite; errors name `parameter.fx` and so on.
+    pub fn check_finite(&self, parameter: &str) -> Result<()> {
+        for (name, v, positive) in [
+            ("fx", self.fx, true),
+            ("fy", self.fy, true),
+            ("cx", self.cx, false),
+            ("cy", self.cy, false),
+        ] {
+            if !v.is_finite() || (positive && v <= 0.0) {
+                let need = if positive { "positive and finite" } else { "finite" };
+                return Err(Error::invalid(
+                    format!("{parameter}.{name}"),
+                    format!("{v}; must be {need}"),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Checks that the intrinsics describe a forward-looking pinhole whose
@@ -123,11 +158,10 @@ impl Intrinsics {
     }
 }
 
-/// Brown–Conrady lens distortion (OpenCV's convention) on normalised
-/// coordinates `x = (u − cx)/fx`, `y = (v − cy)/fy`, `r² = x² + y²`:
-/// `x_d = x(1 + k1 r² + k2 r⁴ + k3 r⁶) + 2 p1 x y + p2 (r² + 2x²)`,
-/// `y_d = y(1 + k1 r² + k2 r⁴ + k3 r⁶) + p1 (r² + 2y²) + 2 p2 x y`.
-/// The renderer draws an undistorted image and resamples it.
+/// Brown–Conrady lens distortion (OpenCV's k1, k2, k3, p1, p2 and
+/// convention, see the module) on normalised coordinates
+/// `x = (u − cx)/fx`, `y = (v − cy)/fy`. The renderer draws an undistorted
+/// image and resamples it (`post.distortion`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Distortion {
     pub k1: f64,
@@ -137,23 +171,93 @@ pub struct Distortion {
     pub p2: f64,
 }
 
-/// Largest accepted |k| (radial) and |p| (tangential) coefficient.
+/// Largest accepted |k1|, |k2|, |k3|.
 pub const MAX_RADIAL: f64 = 10.0;
+/// Largest accepted |p1|, |p2|.
 pub const MAX_TANGENTIAL: f64 = 1.0;
 
 impl Distortion {
-    /// The distorted normalised coordinates of the ideal ones `(x, y)`.
-    pub fn apply(&self, x: f64, y: f64) -> (f64, f64) {
+    /// The distorted normalised coordinates of the ray (x, y).
+    pub fn distort(&self, [x, y]: [f64; 2]) -> [f64; 2] {
         let r2 = x * x + y * y;
         let radial = 1.0 + r2 * (self.k1 + r2 * (self.k2 + r2 * self.k3));
-        (
+        [
             x * radial + 2.0 * self.p1 * x * y + self.p2 * (r2 + 2.0 * x * x),
             y * radial + self.p1 * (r2 + 2.0 * y * y) + 2.0 * self.p2 * x * y,
-        )
+        ]
     }
 
-    /// Checks that every coefficient is finite and bounded.
+    /// The Jacobian ∂(x_d, y_d)/∂(x, y), rows x_d and y_d.
+    pub fn jacobian(&self, [x, y]: [f64; 2]) -> [[f64; 2]; 2] {
+        let r2 = x * x + y * y;
+        let radial = 1.0 + r2 * (self.k1 + r2 * (self.k2 + r2 * self.k3));
+        let slope = self.k1 + r2 * (2.0 * self.k2 + r2 * 3.0 * self.k3);
+        let off = 2.0 * x * y * slope + 2.0 * self.p1 * x + 2.0 * self.p2 * y;
+        [
+            [
+                radial + 2.0 * x * x * slope + 2.0 * self.p1 * y + 6.0 * self.p2 * x,
+                off,
+            ],
+            [
+                off,
+                radial + 2.0 * y * y * slope + 6.0 * self.p1 * y + 2.0 * self.p2 * x,
+            ],
+        ]
+    }
+
+    /// The ray (x, y) imaged at (x_d, y_d): damped Newton iterations from
+    /// (x_d, y_d); None when they do not converge (to 1e-12) in 100 steps or
+    /// meet a Jacobian that is not positive.
+    pub fn undistort(&self, target: [f64; 2]) -> Option<[f64; 2]> {
+        let residual = |p: [f64; 2]| {
+            let d = self.distort(p);
+            [d[0] - target[0], d[1] - target[1]]
+        };
+        let size = |e: [f64; 2]| e[0].abs().max(e[1].abs());
+        let tolerance = 1e-12 * (1.0 + size(target));
+        let (mut p, mut e) = (target, residual(target));
+        for _ in 0..100 {
+            let error = size(e);
+            if error.is_nan() {
+                return None;
+            }
+            if error <= tolerance {
+                return Some(p);
+            }
+            let j = self.jacobian(p);
+            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+            if det.is_nan() || det <= 0.0 {
+                return None;
+            }
+            let step = [
+                (j[1][1] * e[0] - j[0][1] * e[1]) / det,
+                (j[0][0] * e[1] - j[1][0] * e[0]) / det,
+            ];
+            let mut lambda = 1.0;
+            loop {
+                let q = [p[0] - lambda * step[0], p[1] - lambda * step[1]];
+                let eq = residual(q);
+                if size(eq) < size(e) {
+                    (p, e) = (q, eq);
+                    break;
+                }
+                lambda *= 0.5;
+                if lambda < 1e-9 {
+                    return None;
+                }
+            }
+        }
+        None
+    }
+
+    /// Checks that every coefficient is finite and within [`MAX_RADIAL`]
+    /// (k) or [`MAX_TANGENTIAL`] (p); errors name `distortion.k1` and so on.
     pub fn validate(&self) -> Result<()> {
+        self.check_as("distortion")
+    }
+
+    /// [`Distortion::validate`] with errors naming `parameter.k1` and so on.
+    pub fn check_as(&self, parameter: &str) -> Result<()> {
         let coefficients = [
             ("k1", self.k1, MAX_RADIAL),
             ("k2", self.k2, MAX_RADIAL),
@@ -164,12 +268,35 @@ impl Distortion {
         for (name, v, max) in coefficients {
             if !(v.is_finite() && v.abs() <= max) {
                 return Err(Error::invalid(
-                    format!("distortion.{name}"),
+                    format!("{parameter}.{name}"),
                     format!("{v}; must be finite with |{name}| ≤ {max}"),
                 ));
             }
         }
         Ok(())
+    }
+
+    /// The coefficient whose term is largest at radius² `r2` (named in
+    /// errors as `lens.k1` and so on).
+    pub fn dominant(&self, r2: f64) -> &'static str {
+        let terms = [
+            ("lens.k1", (self.k1 * r2).abs()),
+            ("lens.k2", (self.k2 * r2 * r2).abs()),
+            ("lens.k3", (self.k3 * r2 * r2 * r2).abs()),
+            ("lens.p1", (3.0 * self.p1 * r2).abs()),
+            ("lens.p2", (3.0 * self.p2 * r2).abs()),
+        ];
+        terms.iter().fold(terms[0], |a, &b| if b.1 > a.1 { b } else { a }).0
+    }
+
+    /// The first radius in [0, `r_max`] where the radial mapping
+    /// r·(1 + k1 r² + k2 r⁴ + k3 r⁶) stops increasing (the lens folds).
+    pub fn radial_fold(&self, r_max: f64) -> Option<f64> {
+        const STEPS: u32 = 4096;
+        (0..=STEPS).map(|i| r_max * f64::from(i) / f64::from(STEPS)).find(|&r| {
+            let r2 = r * r;
+            1.0 + r2 * (3.0 * self.k1 + r2 * (5.0 * self.k2 + r2 * 7.0 * self.k3)) <= 0.0
+        })
     }
 }
 

@@ -3,7 +3,13 @@
 //!
 //! * [`View`]: a camera and the size of the image it renders into. A frame
 //!   carries a list of views; techniques prepare per view and declare their
-//!   per-view passes in a loop over the views.
+//!   per-view passes in a loop over the views. The view is read one way by
+//!   every technique: [`View::view_proj`] (the projection, with intrinsics),
+//!   [`View::frustum`] (its exact planes), [`View::culling_camera`] (the
+//!   symmetric frustum enclosing it, for planners that need a camera),
+//!   [`View::pixel_footprint`] (the size of a pixel at 1 m) and
+//!   [`View::footprint`] (all a tile or LOD planner measures). Motion reads
+//!   the previous frame's [`View::view_proj_f64`].
 //! * [`SceneTargets`]: the images every technique draws into, one set per
 //!   view, with their formats (pipelines take their formats from here).
 //! * [`Frame`]: the frame's views, its lighting, and every technique's
@@ -28,7 +34,7 @@ pub use lens::Intrinsics;
 pub use lighting::{Exposure, FrameLighting, Lighting, LightingSetup, ShadowMode, SkyLightMode, SkyModel, SunPosition};
 pub use targets::{LightingBindings, LightingMap, SceneTargets, TargetFormats};
 
-use glam::{DMat4, Mat4, Vec3};
+use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 
 use crate::error::{Error, Result};
 
@@ -131,9 +137,31 @@ impl View {
         (right.as_vec3(), up.as_vec3(), forward.as_vec3())
     }
 
-    /// The angle one pixel spans at the optical axis (radians, vertical).
-    pub fn pixel_angle(&self) -> f64 {
-        1.0 / self.intrinsics().fy
+    /// The world planes of the view's exact frustum (off-axis with
+    /// intrinsics), `(n, d)` with `n·x + d ≥ 0` inside.
+    pub fn frustum(&self) -> [DVec4; 6] {
+        frustum_planes(self.view_proj_f64())
+    }
+
+    /// The size of one pixel at 1 m along the optical axis (metres, or
+    /// radians at the axis), the finer of its two sides: `1/max(fx, fy)`;
+    /// `2·tan(fov_y/2)/height` without intrinsics. Texture tiles and the
+    /// per-pixel filtering of the surface take their detail from it.
+    pub fn pixel_footprint(&self) -> f64 {
+        match self.intrinsics {
+            None => Footprint::pixel_footprint_for(self.camera.fov_y_deg.to_radians(), self.height),
+            Some(k) => 1.0 / k.fx.max(k.fy),
+        }
+    }
+
+    /// What a planner measures of the view: its eye, its pixel footprint
+    /// and its exact frustum.
+    pub fn footprint(&self) -> Footprint {
+        Footprint {
+            eye: self.camera.eye,
+            pixel_footprint: self.pixel_footprint(),
+            frustum: Some(self.frustum()),
+        }
     }
 
     /// Checks the camera, the image size and the intrinsics.
@@ -144,6 +172,27 @@ impl View {
             Some(k) => k.validate(self.width, self.height),
             None => Ok(()),
         }
+    }
+}
+
+/// What a planner (the texture quadtree) measures of a view
+/// ([`View::footprint`]): how much detail it needs where.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Footprint {
+    /// Eye position in world metres.
+    pub eye: DVec3,
+    /// Size of one pixel at 1 m ([`View::pixel_footprint`]).
+    pub pixel_footprint: f64,
+    /// World planes `(n, d)` with `n·x + d ≥ 0` inside; `None`: no culling.
+    pub frustum: Option<[DVec4; 6]>,
+}
+
+impl Footprint {
+    /// The pixel footprint `2·tan(fov_y/2)/rows` of a centred pinhole with
+    /// vertical field of view `fov_y` (radians), square pixels and `rows`
+    /// image rows.
+    pub fn pixel_footprint_for(fov_y: f64, rows: u32) -> f64 {
+        2.0 * (fov_y / 2.0).tan() / f64::from(rows.max(1))
     }
 }
 
@@ -163,4 +212,88 @@ pub fn validate_size(width: u32, height: u32) -> Result<()> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera() -> Camera {
+        Camera {
+            eye: DVec3::new(100.0, 200.0, 50.0),
+            target: DVec3::new(900.0, 700.0, 0.0),
+            up: DVec3::Z,
+            fov_y_deg: 50.0,
+            near: 1.0,
+            far: 10000.0,
+        }
+    }
+
+    /// Whether the world point `p` lies inside every plane of `planes`.
+    fn inside(planes: &[DVec4; 6], p: DVec3) -> bool {
+        planes.iter().all(|q| q.truncate().dot(p) + q.w >= -1e-9)
+    }
+
+    /// The world point at depth `depth` on the ray through pixel (u, v)
+    /// (OpenCV's convention) of `view`.
+    fn through_pixel(view: &View, (u, v): (f64, f64), depth: f64) -> DVec3 {
+        let k = view.intrinsics();
+        let c = &view.camera;
+        let (x, y) = ((u - k.cx) / k.fx, (v - k.cy) / k.fy);
+        c.eye + depth * (c.forward() + x * c.right() - y * c.image_up())
+    }
+
+    #[test]
+    fn a_view_by_field_of_view_reads_as_its_camera() {
+        let view = View::new(camera(), 320, 200);
+        let c = view.camera;
+        let footprint = view.footprint();
+        assert_eq!(footprint.eye, c.eye);
+        assert_eq!(
+            footprint.pixel_footprint,
+            2.0 * (c.fov_y_deg.to_radians() / 2.0).tan() / 200.0
+        );
+        assert_eq!(footprint.frustum, Some(frustum_planes(c.view_proj_f64(1.6))));
+        assert!((view.pixel_footprint() * view.intrinsics().fy - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_view_by_intrinsics_reads_its_own_frustum_and_footprint() {
+        // Telephoto: the footprint of fx, fy, not of the camera's 50°.
+        let tele = View {
+            intrinsics: Some(Intrinsics {
+                fx: 1600.0,
+                fy: 1500.0,
+                cx: 120.0,
+                cy: 80.0,
+            }),
+            ..View::new(camera(), 240, 160)
+        };
+        assert_eq!(tele.pixel_footprint(), 1.0 / 1600.0);
+        // Off-axis: the image sees 14°–40° right of the optical axis, which
+        // the camera's symmetric 50° frustum (±35° across) does not enclose.
+        let off = View {
+            intrinsics: Some(Intrinsics {
+                fx: 400.0,
+                fy: 400.0,
+                cx: -100.0,
+                cy: -60.0,
+            }),
+            ..View::new(camera(), 240, 160)
+        };
+        let symmetric = frustum_planes(off.camera.view_proj_f64(off.aspect()));
+        let planes = off.footprint().frustum.expect("a frustum");
+        for depth in [10.0, 500.0, 5000.0] {
+            for corner in [(-0.49, -0.49), (239.49, -0.49), (-0.49, 159.49), (239.49, 159.49)] {
+                assert!(
+                    inside(&planes, through_pixel(&off, corner, depth)),
+                    "{corner:?} at {depth}"
+                );
+            }
+            // Left of the image (on the optical axis) and beyond its right edge.
+            assert!(!inside(&planes, through_pixel(&off, (-20.0, 80.0), depth)));
+            assert!(!inside(&planes, through_pixel(&off, (260.0, 80.0), depth)));
+        }
+        assert!(!inside(&symmetric, through_pixel(&off, (239.0, 80.0), 500.0)));
+    }
 }

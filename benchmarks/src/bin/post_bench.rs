@@ -15,7 +15,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use alpenglow::bench::{
-    source_intrinsics, supersampled_size, BrownConrady, DistortedCamera, Format, FrameRing, Image, ImageDesc, ImageId,
+    source_intrinsics, supersampled_size, DistortedCamera, Distortion, Format, FrameRing, Image, ImageDesc, ImageId,
     ImageInfo, ImageKind, ImageUsageFlags, Intrinsics, LensDistortion, MotionBlur, MotionBlurImages, RenderGraph,
     ResampleImage, Resolve, ResolveDesc, ResolveFilter,
 };
@@ -112,7 +112,7 @@ fn main() -> alpenglow::Result<()> {
 
     let camera = DistortedCamera {
         intrinsics: Intrinsics::centred(0.6 * f64::from(w), 0.6 * f64::from(w), w, h),
-        lens: BrownConrady {
+        lens: Distortion {
             k1: -0.28,
             k2: 0.07,
             k3: 0.0,

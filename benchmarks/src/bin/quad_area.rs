@@ -6,7 +6,7 @@
 //!
 //! `cargo run --release -p alpenglow-bench --bin quad_area`
 
-use alpenglow::bench::{projected_quad_areas, zoom_positions, DebugScalar, LodFrame};
+use alpenglow::bench::{projected_quad_areas, zoom_positions, DebugScalar, LodFrame, View};
 use alpenglow::files::load_heightmap;
 use alpenglow::tools::profile::quantile;
 use alpenglow::{Camera, HeightmapOptions, LodMode, LodSettings, Scene};
@@ -53,7 +53,7 @@ fn main() -> alpenglow::Result<()> {
                 DebugScalar::None,
             )?;
             let positions = zoom_positions(&scene.heights, &frame.warp.positions, settings.sketch_side, SIDE)?;
-            let areas = projected_quad_areas(&positions, SIDE, &camera, WIDTH, HEIGHT);
+            let areas = projected_quad_areas(&positions, SIDE, &View::new(camera, WIDTH, HEIGHT));
             let (median, p90) = (quantile(&areas, 0.5), quantile(&areas, 0.9));
             println!(
                 "  {name:<34} {:<8} quads in view {:>7}  median {median:>8.3}  p90 {p90:>8.3}  p90/median {:>6.1}",

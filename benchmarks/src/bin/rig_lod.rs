@@ -12,7 +12,7 @@
 
 use std::time::Instant;
 
-use alpenglow::bench::{projected_quad_areas, zoom_positions, DebugScalar, LodFrame};
+use alpenglow::bench::{projected_quad_areas, zoom_positions, DebugScalar, LodFrame, View};
 use alpenglow::files::load_heightmap;
 use alpenglow::tools::profile::quantile;
 use alpenglow::{Camera, HeightmapOptions, LodSettings, Rig, Scene, SketchAlignment};
@@ -94,8 +94,9 @@ fn main() -> alpenglow::Result<()> {
         "view", "per-view: quads, median/p90 px", "union: quads, median/p90 px"
     );
     for ((camera, grid), spec) in cameras.iter().zip(&per_view).zip(&rig.views) {
-        let mine = projected_quad_areas(grid, GRID, camera, w, h);
-        let shared = projected_quad_areas(&union, GRID, camera, w, h);
+        let view = View::new(*camera, w, h);
+        let mine = projected_quad_areas(grid, GRID, &view);
+        let shared = projected_quad_areas(&union, GRID, &view);
         println!(
             "{:<12} {:>8} {:>7.2} {:>7.2} {:>8} {:>7.2} {:>7.2}",
             spec.name,

@@ -1,192 +1,17 @@
-//! The Brown–Conrady lens model in OpenCV's convention and its inversion,
-//! on the CPU: what `post.distortion` samples where.
-//!
-//! A camera ray with normalised coordinates (x, y) = (X/Z, Y/Z) is imaged at
-//! x_d = x·(1 + k1 r² + k2 r⁴ + k3 r⁶) + 2 p1 x y + p2 (r² + 2x²),
-//! y_d = y·(1 + k1 r² + k2 r⁴ + k3 r⁶) + p1 (r² + 2y²) + 2 p2 x y, r² = x² + y²,
-//! pixel (u, v) = (fx x_d + cx, fy y_d + cy), pixel (i, j)'s centre at
-//! (u, v) = (i, j) (OpenCV's convention, so calibrations apply unchanged;
-//! a centred principal point is ((W − 1)/2, (H − 1)/2)).
+//! What `post.distortion` samples where, on the CPU: the real camera's
+//! rays through the lens model of [`crate::view::lens`] (Brown–Conrady in
+//! OpenCV's convention, [`Distortion`], inverted by Newton iterations), the
+//! undistorted render that covers them and the source map.
 
 use crate::error::{Error, Result};
+use crate::view::lens::{Distortion, Intrinsics};
 use crate::view::MAX_IMAGE_SIDE;
-
-/// Largest accepted |k1|, |k2|, |k3|.
-pub const MAX_RADIAL: f64 = 10.0;
-/// Largest accepted |p1|, |p2|.
-pub const MAX_TANGENTIAL: f64 = 1.0;
-
-/// Pinhole intrinsics in pixels (OpenCV's convention, see the module).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Intrinsics {
-    pub fx: f64,
-    pub fy: f64,
-    pub cx: f64,
-    pub cy: f64,
-}
-
-impl Intrinsics {
-    /// Focal lengths `fx`, `fy` and the principal point at the centre of a
-    /// `width`×`height` image.
-    pub fn centred(fx: f64, fy: f64, width: u32, height: u32) -> Intrinsics {
-        Intrinsics {
-            fx,
-            fy,
-            cx: (f64::from(width) - 1.0) / 2.0,
-            cy: (f64::from(height) - 1.0) / 2.0,
-        }
-    }
-
-    fn check(&self, parameter: &str) -> Result<()> {
-        for (name, v, positive) in [
-            ("fx", self.fx, true),
-            ("fy", self.fy, true),
-            ("cx", self.cx, false),
-            ("cy", self.cy, false),
-        ] {
-            if !v.is_finite() || (positive && v <= 0.0) {
-                let need = if positive { "positive and finite" } else { "finite" };
-                return Err(Error::invalid(
-                    format!("{parameter}.{name}"),
-                    format!("{v}; must be {need}"),
-                ));
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Brown–Conrady distortion coefficients (OpenCV's k1, k2, p1, p2, k3).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct BrownConrady {
-    pub k1: f64,
-    pub k2: f64,
-    pub k3: f64,
-    pub p1: f64,
-    pub p2: f64,
-}
-
-impl BrownConrady {
-    /// The distorted normalised coordinates of the ray (x, y).
-    pub fn distort(&self, [x, y]: [f64; 2]) -> [f64; 2] {
-        let r2 = x * x + y * y;
-        let radial = 1.0 + r2 * (self.k1 + r2 * (self.k2 + r2 * self.k3));
-        [
-            x * radial + 2.0 * self.p1 * x * y + self.p2 * (r2 + 2.0 * x * x),
-            y * radial + self.p1 * (r2 + 2.0 * y * y) + 2.0 * self.p2 * x * y,
-        ]
-    }
-
-    /// The Jacobian ∂(x_d, y_d)/∂(x, y), rows x_d and y_d.
-    pub fn jacobian(&self, [x, y]: [f64; 2]) -> [[f64; 2]; 2] {
-        let r2 = x * x + y * y;
-        let radial = 1.0 + r2 * (self.k1 + r2 * (self.k2 + r2 * self.k3));
-        let slope = self.k1 + r2 * (2.0 * self.k2 + r2 * 3.0 * self.k3);
-        let off = 2.0 * x * y * slope + 2.0 * self.p1 * x + 2.0 * self.p2 * y;
-        [
-            [
-                radial + 2.0 * x * x * slope + 2.0 * self.p1 * y + 6.0 * self.p2 * x,
-                off,
-            ],
-            [
-                off,
-                radial + 2.0 * y * y * slope + 6.0 * self.p1 * y + 2.0 * self.p2 * x,
-            ],
-        ]
-    }
-
-    /// The ray (x, y) imaged at (x_d, y_d): damped Newton iterations from
-    /// (x_d, y_d); None when they do not converge (to 1e-12) in 100 steps or
-    /// meet a Jacobian that is not positive.
-    pub fn undistort(&self, target: [f64; 2]) -> Option<[f64; 2]> {
-        let residual = |p: [f64; 2]| {
-            let d = self.distort(p);
-            [d[0] - target[0], d[1] - target[1]]
-        };
-        let size = |e: [f64; 2]| e[0].abs().max(e[1].abs());
-        let tolerance = 1e-12 * (1.0 + size(target));
-        let (mut p, mut e) = (target, residual(target));
-        for _ in 0..100 {
-            let error = size(e);
-            if error.is_nan() {
-                return None;
-            }
-            if error <= tolerance {
-                return Some(p);
-            }
-            let j = self.jacobian(p);
-            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-            if det.is_nan() || det <= 0.0 {
-                return None;
-            }
-            let step = [
-                (j[1][1] * e[0] - j[0][1] * e[1]) / det,
-                (j[0][0] * e[1] - j[1][0] * e[0]) / det,
-            ];
-            let mut lambda = 1.0;
-            loop {
-                let q = [p[0] - lambda * step[0], p[1] - lambda * step[1]];
-                let eq = residual(q);
-                if size(eq) < size(e) {
-                    (p, e) = (q, eq);
-                    break;
-                }
-                lambda *= 0.5;
-                if lambda < 1e-9 {
-                    return None;
-                }
-            }
-        }
-        None
-    }
-
-    /// Coefficients finite and within [`MAX_RADIAL`] and [`MAX_TANGENTIAL`].
-    pub fn check(&self) -> Result<()> {
-        for (name, v, max) in [
-            ("k1", self.k1, MAX_RADIAL),
-            ("k2", self.k2, MAX_RADIAL),
-            ("k3", self.k3, MAX_RADIAL),
-            ("p1", self.p1, MAX_TANGENTIAL),
-            ("p2", self.p2, MAX_TANGENTIAL),
-        ] {
-            if !v.is_finite() || v.abs() > max {
-                return Err(Error::invalid(
-                    format!("lens.{name}"),
-                    format!("{v}; must be within ±{max}"),
-                ));
-            }
-        }
-        Ok(())
-    }
-
-    /// The coefficient whose term is largest at radius² `r2` (named in errors).
-    fn dominant(&self, r2: f64) -> &'static str {
-        let terms = [
-            ("lens.k1", (self.k1 * r2).abs()),
-            ("lens.k2", (self.k2 * r2 * r2).abs()),
-            ("lens.k3", (self.k3 * r2 * r2 * r2).abs()),
-            ("lens.p1", (3.0 * self.p1 * r2).abs()),
-            ("lens.p2", (3.0 * self.p2 * r2).abs()),
-        ];
-        terms.iter().fold(terms[0], |a, &b| if b.1 > a.1 { b } else { a }).0
-    }
-
-    /// The first radius in [0, `r_max`] where the radial mapping
-    /// r·(1 + k1 r² + k2 r⁴ + k3 r⁶) stops increasing (the lens folds).
-    fn radial_fold(&self, r_max: f64) -> Option<f64> {
-        const STEPS: u32 = 4096;
-        (0..=STEPS).map(|i| r_max * f64::from(i) / f64::from(STEPS)).find(|&r| {
-            let r2 = r * r;
-            1.0 + r2 * (3.0 * self.k1 + r2 * (5.0 * self.k2 + r2 * 7.0 * self.k3)) <= 0.0
-        })
-    }
-}
 
 /// The real camera: its intrinsics, lens and image size (the output).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DistortedCamera {
     pub intrinsics: Intrinsics,
-    pub lens: BrownConrady,
+    pub lens: Distortion,
     pub width: u32,
     pub height: u32,
 }
@@ -195,8 +20,8 @@ impl DistortedCamera {
     fn check(&self) -> Result<()> {
         check_side("distortion width", self.width)?;
         check_side("distortion height", self.height)?;
-        self.intrinsics.check("distortion intrinsics")?;
-        self.lens.check()
+        self.intrinsics.check_finite("distortion intrinsics")?;
+        self.lens.check_as("lens")
     }
 
     /// The normalised undistorted ray of every output pixel (rows top to
@@ -331,7 +156,7 @@ pub struct SourceMap {
 /// The source map of `camera` rendered from `source`; an error naming the
 /// source view when it does not contain every ray the output needs.
 pub fn source_map(camera: &DistortedCamera, source: &SourceView) -> Result<SourceMap> {
-    source.intrinsics.check("distortion source")?;
+    source.intrinsics.check_finite("distortion source")?;
     check_side("distortion source width", source.width)?;
     check_side("distortion source height", source.height)?;
     let k = source.intrinsics;

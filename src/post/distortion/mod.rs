@@ -1,10 +1,10 @@
 //! `post.distortion` (§3.3: the cameras of a driving simulator; the images
 //! a real camera would see): Brown–Conrady lens distortion (OpenCV's model
-//! and convention, [`lens`]) as a resampling pass. The renderer renders the
+//! and convention, [`crate::view::lens::Distortion`]) as a resampling pass. The renderer renders the
 //! view with the undistorted pinhole camera of [`source_intrinsics`]; the
 //! pass makes every output pixel of the real camera from the render at the
 //! pixel's ray, found once on the CPU by inverting the distortion (damped
-//! Newton iterations, [`BrownConrady::undistort`]) and uploaded as a buffer
+//! Newton iterations, [`crate::view::lens::Distortion::undistort`]) and uploaded as a buffer
 //! of source positions ([`SourceMap`]). Per image by its [`ImageKind`]:
 //! Filtered bilinear, Exact the nearest texel, Motion the nearest texel with
 //! its displacement carried into output pixels by the mapping's derivative
@@ -18,7 +18,7 @@ use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 
-pub use lens::{source_intrinsics, source_map, BrownConrady, DistortedCamera, Intrinsics, SourceMap, SourceView};
+pub use lens::{source_intrinsics, source_map, DistortedCamera, SourceMap, SourceView};
 
 #[cfg(test)]
 use super::resample::{bilinear, ImageKind, Plane};

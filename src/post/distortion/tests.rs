@@ -1,6 +1,7 @@
 use super::*;
+use crate::view::lens::{Distortion, Intrinsics};
 
-fn camera(lens: BrownConrady) -> DistortedCamera {
+fn camera(lens: Distortion) -> DistortedCamera {
     DistortedCamera {
         intrinsics: Intrinsics::centred(150.0, 150.0, 64, 48),
         lens,
@@ -9,7 +10,7 @@ fn camera(lens: BrownConrady) -> DistortedCamera {
     }
 }
 
-const BARREL: BrownConrady = BrownConrady {
+const BARREL: Distortion = Distortion {
     k1: -0.28,
     k2: 0.07,
     k3: 0.0,
@@ -17,7 +18,7 @@ const BARREL: BrownConrady = BrownConrady {
     p2: -0.0005,
 };
 
-const PINCUSHION: BrownConrady = BrownConrady {
+const PINCUSHION: Distortion = Distortion {
     k1: 0.22,
     k2: 0.05,
     k3: 0.01,
@@ -27,7 +28,7 @@ const PINCUSHION: BrownConrady = BrownConrady {
 
 #[test]
 fn zero_coefficients_give_the_identity() {
-    let camera = camera(BrownConrady::default());
+    let camera = camera(Distortion::default());
     let source = source_intrinsics(&camera).unwrap();
     assert_eq!((source.width, source.height), (64, 48));
     assert_eq!(source.intrinsics, camera.intrinsics);
@@ -111,8 +112,8 @@ fn error_of(result: Result<SourceView>) -> String {
 
 #[test]
 fn bad_lenses_are_errors_naming_the_coefficient() {
-    let with = |f: fn(&mut BrownConrady)| {
-        let mut lens = BrownConrady::default();
+    let with = |f: fn(&mut Distortion)| {
+        let mut lens = Distortion::default();
         f(&mut lens);
         source_intrinsics(&camera(lens))
     };
@@ -120,17 +121,17 @@ fn bad_lenses_are_errors_naming_the_coefficient() {
     assert!(error_of(with(|l| l.p1 = 2.0)).contains("lens.p1"));
     assert!(error_of(with(|l| l.k3 = -11.0)).contains("lens.k3"));
     // Strong barrel on a wide lens: the radial mapping peaks inside the image.
-    let wide = |lens: BrownConrady| DistortedCamera {
+    let wide = |lens: Distortion| DistortedCamera {
         intrinsics: Intrinsics::centred(40.0, 40.0, 64, 48),
         ..camera(lens)
     };
-    let fold = BrownConrady {
+    let fold = Distortion {
         k1: -0.5,
         ..Default::default()
     };
     assert!(error_of(source_intrinsics(&wide(fold))).contains("lens.k1"));
     // Folds and comes back (k2 > 0): a wrong root past the fold is rejected.
-    let back = BrownConrady {
+    let back = Distortion {
         k1: -0.6,
         k2: 0.1,
         ..Default::default()

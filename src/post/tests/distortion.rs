@@ -3,16 +3,17 @@
 //! with OpenCV's formulas land where the pass samples the pinhole render.
 
 use crate::post::distortion::{
-    distortion_cpu, distortion_exact_cpu, source_intrinsics, BrownConrady, DistortedCamera, Intrinsics, LensDistortion,
+    distortion_cpu, distortion_exact_cpu, source_intrinsics, DistortedCamera, LensDistortion,
 };
 use crate::post::resample::{bilinear, ImageKind, Plane, ResampleImage};
+use crate::view::lens::{Distortion, Intrinsics};
 use crate::vulkan::Format;
 
 use super::{as_fetched, assert_close, synthetic, with_gpu, OneFrame, Texels};
 
 const SIZE: (u32, u32) = (96, 64);
 
-fn camera(lens: BrownConrady) -> DistortedCamera {
+fn camera(lens: Distortion) -> DistortedCamera {
     DistortedCamera {
         // About 70° across: strong enough for the edges to move many pixels.
         intrinsics: Intrinsics {
@@ -26,7 +27,7 @@ fn camera(lens: BrownConrady) -> DistortedCamera {
     }
 }
 
-const BARREL: BrownConrady = BrownConrady {
+const BARREL: Distortion = Distortion {
     k1: -0.31,
     k2: 0.09,
     k3: -0.01,
@@ -34,7 +35,7 @@ const BARREL: BrownConrady = BrownConrady {
     p2: -0.001,
 };
 
-const PINCUSHION: BrownConrady = BrownConrady {
+const PINCUSHION: Distortion = Distortion {
     k1: 0.18,
     k2: 0.04,
     k3: 0.0,
@@ -50,7 +51,7 @@ const FLOAT_IMAGES: [(Format, ImageKind); 3] = [
 ];
 
 /// Runs the pass for `lens` on the test images; returns GPU and CPU results.
-fn run(lens: BrownConrady) -> (Vec<Texels>, Vec<Texels>) {
+fn run(lens: Distortion) -> (Vec<Texels>, Vec<Texels>) {
     let camera = camera(lens);
     let source = source_intrinsics(&camera).expect("source intrinsics");
     let size = (source.width, source.height);
@@ -85,7 +86,7 @@ fn run(lens: BrownConrady) -> (Vec<Texels>, Vec<Texels>) {
 fn zero_coefficients_are_the_identity() {
     let centred = DistortedCamera {
         intrinsics: Intrinsics::centred(68.0, 68.0, SIZE.0, SIZE.1),
-        ..camera(BrownConrady::default())
+        ..camera(Distortion::default())
     };
     let source = source_intrinsics(&centred).unwrap();
     assert_eq!(
@@ -117,7 +118,7 @@ fn zero_coefficients_are_the_identity() {
     }
 }
 
-fn check_twin(name: &str, lens: BrownConrady) {
+fn check_twin(name: &str, lens: Distortion) {
     let (gpu, cpu) = run(lens);
     let mut worst = 0.0f32;
     for (n, (g, c)) in gpu.iter().zip(&cpu).enumerate() {

@@ -14,6 +14,7 @@ use crate::terrain::lod::{DebugScalar, LodFrame, LodMode, LodSettings};
 use crate::terrain::raycast::Raycaster;
 use crate::terrain::zoom::{projected_quad_areas, quantile, zoom_positions};
 use crate::test_support::{assert_validation_clean, jacksboro_field, validated_context};
+use crate::view::View;
 use glam::DVec3;
 
 const WIDTH: u32 = 192;
@@ -191,7 +192,7 @@ fn warped_quads_are_more_uniform_on_screen_than_uniform_ones() {
                 .plan(&scene.heights, &camera, aspect, &settings, DebugScalar::None)
                 .expect("plan");
             let p = zoom_positions(&scene.heights, &frame.warp.positions, settings.sketch_side, 256).expect("zoom");
-            let areas = projected_quad_areas(&p, 256, &camera, 1280, 720);
+            let areas = projected_quad_areas(&p, 256, &View::new(camera, 1280, 720));
             quantile(&areas, 0.9) / quantile(&areas, 0.5)
         };
         let (uniform, warped) = (spread(LodMode::Uniform), spread(LodMode::Warped));

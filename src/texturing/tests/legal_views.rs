@@ -19,7 +19,7 @@ use crate::surface::gpu_layout::TexturingMode;
 use crate::test_support::{assert_validation_clean, dump_pngs, mean_flip, validated_context};
 use crate::texturing::atlas::TileCache;
 use crate::texturing::fit::select_to_fit;
-use crate::texturing::generation::{quadtree_view, TextureStreaming, PAGE_TABLE_WORDS};
+use crate::texturing::generation::{TextureStreaming, PAGE_TABLE_WORDS};
 use crate::texturing::page_table::PageTable;
 use crate::texturing::quadtree::{HeightBounds, NeededTile, MAX_SELECTED};
 use crate::texturing::streaming::{MAX_ATLAS_TEXTURES, MAX_TILE_BUDGET};
@@ -204,7 +204,7 @@ fn tiny_field_of_view_and_tall_image_render() {
 fn select(scene: &Scene, cameras: &[(Camera, u32, u32)], streaming: &TextureStreaming) -> Vec<NeededTile> {
     let views: Vec<_> = cameras
         .iter()
-        .map(|&(camera, w, h)| quadtree_view(&crate::view::View::new(camera, w, h)))
+        .map(|&(camera, w, h)| crate::view::View::new(camera, w, h).footprint())
         .collect();
     let bounds = HeightBounds::new(&scene.heights, streaming.quadtree.max_depth).expect("bounds");
     let (needed, _) = select_to_fit(scene.heights.extent(), &views, streaming, &bounds).expect("selection");

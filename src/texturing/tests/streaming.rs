@@ -20,7 +20,7 @@ use crate::terrain::{Terrain, TerrainFrame, TerrainTexturing};
 use crate::test_support::atlas::{check_texels_against_cpu, ground_camera};
 use crate::test_support::{assert_validation_clean, jacksboro_field, validated_context};
 use crate::texturing::atlas::{AtlasSettings, GpuTimeBudget};
-use crate::texturing::generation::{quadtree_view, TextureAtlas, TextureFrame, TextureFrameStats, TextureStreaming};
+use crate::texturing::generation::{TextureAtlas, TextureFrame, TextureFrameStats, TextureStreaming};
 use crate::texturing::quadtree::{select_tiles, HeightBounds};
 use crate::view::{frame_slots, Frame, FrameLighting, View};
 use crate::vulkan::{Context, FrameRing, FRAMES_IN_FLIGHT};
@@ -169,7 +169,7 @@ fn two_views_share_one_atlas_and_page_table() {
     let extent = scene.heights.extent();
     let bounds = HeightBounds::new(&scene.heights, streaming.quadtree.max_depth).expect("bounds");
     for v in [&east, &west] {
-        let alone = select_tiles(extent, &quadtree_view(v), &streaming.quadtree, &|n| bounds.bounds(n)).expect("tiles");
+        let alone = select_tiles(extent, &v.footprint(), &streaming.quadtree, &|n| bounds.bounds(n)).expect("tiles");
         for t in &alone {
             let (min, max) = t.node.rect(extent);
             let e = table.lookup((min + max) / 2.0, extent).expect("an entry");
