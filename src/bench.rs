@@ -5,7 +5,7 @@
 
 pub use crate::graph::{Binding, ImageId, ImageInfo, PassContext, RenderGraph, Stage};
 pub use crate::lighting::constants::LightingFrame;
-pub use crate::lighting::reference::{MonteCarloReference, ReferenceSettings};
+pub use crate::lighting::reference::{MonteCarloReference, ReferenceSettings, ReferenceWork};
 pub use crate::lighting::sky_light::{BakeSettings, SkyLightBake};
 pub use crate::points::build::clip::{ClipLine, ClipLines};
 pub use crate::points::build::spt::ROOT_R_MAX;

@@ -14,8 +14,8 @@
 use std::time::Instant;
 
 use alpenglow::bench::{
-    sun_direction, BakeSettings, FrameRing, LightingFrame, MonteCarloReference, ReferenceSettings, RenderGraph,
-    SkyLightBake,
+    sun_direction, BakeSettings, FrameRing, LightingFrame, MonteCarloReference, ReferenceSettings, ReferenceWork,
+    RenderGraph, SkyLightBake,
 };
 use alpenglow::{Context, ContextOptions, DeviceSelector, HeightField};
 use bytemuck::Zeroable;
@@ -85,8 +85,8 @@ fn reference(ctx: &Context) -> alpenglow::Result<()> {
                 bounces: 1,
                 ..ReferenceSettings::default()
             };
-            let reference = MonteCarloReference::new(ctx, &field, settings)?;
-            let mut graph: RenderGraph<()> = RenderGraph::new();
+            let mut reference = MonteCarloReference::new(ctx, &field, settings)?;
+            let mut graph: RenderGraph<ReferenceWork> = RenderGraph::new();
             let region = graph.upload_region("lighting", std::mem::size_of::<LightingFrame>() as u64);
             reference.declare(&mut graph, region, &[]);
             let mut baked = graph.bake(ctx)?;
@@ -94,10 +94,10 @@ fn reference(ctx: &Context) -> alpenglow::Result<()> {
             let start = Instant::now();
             let index = ring.wait_for_next()?;
             let mut constants = frame;
-            reference.fill(&mut constants)?;
+            reference.fill(&mut constants);
             baked.uploads(index).write_pod(region, &constants)?;
-            reference.prepare(&frame)?;
-            baked.execute(&mut ring, &(), &[])?;
+            let (work, _) = reference.prepare(&frame);
+            baked.execute(&mut ring, &work, &[])?;
             baked.finish(&mut ring)?;
             println!(
                 "{n}² field, {samples} paths per texel, 1 bounce: {:.2} s",
