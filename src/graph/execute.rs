@@ -162,6 +162,20 @@ impl<'a> PassContext<'a> {
         self.arena()?.writer(self.frame).write(region, bytes)
     }
 
+    /// Writes `bytes` at byte `offset` of this frame's copy of the upload
+    /// region of `binding` ([`PassContext::write_upload`]), e.g. to patch
+    /// one handle into constants written whole (no allocation).
+    pub fn write_upload_at(&mut self, binding: Binding, offset: u64, bytes: &[u8]) -> Result<()> {
+        self.own(binding)?;
+        let BindingTarget::Upload(region) = binding.target else {
+            return Err(Error::Graph(format!(
+                "pass '{}' writes a binding that is not an upload region",
+                self.name
+            )));
+        };
+        self.arena()?.writer(self.frame).write_at(region, offset, bytes)
+    }
+
     /// [`PassContext::write_upload`] of one plain value.
     pub fn write_upload_pod<T: bytemuck::Pod>(&mut self, binding: Binding, value: &T) -> Result<()> {
         self.write_upload(binding, bytemuck::bytes_of(value))

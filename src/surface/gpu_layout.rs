@@ -127,10 +127,11 @@ pub fn pack_layers(tree: &LayerTree, blurred: &[(f32, u32)]) -> PackedLayers {
 #[derive(Clone, Debug)]
 pub struct LayerTable {
     region: UploadRegion,
-    /// The table with every blurred handle 0.
-    packed: Arc<PackedLayers>,
-    /// Per layer, its `height_blur` radius.
-    radii: Arc<[Option<f32>]>,
+    /// The packed table with every blurred handle 0, made once.
+    bytes: Arc<[u8]>,
+    /// Per `height_blur` layer: the byte offset of its handle (`tree.z`)
+    /// and its radius.
+    blurred: Arc<[(u64, f32)]>,
 }
 
 impl LayerTable {
@@ -138,12 +139,16 @@ impl LayerTable {
     pub fn declare<P: 'static>(graph: &mut RenderGraph<P>, tree: &LayerTree) -> LayerTable {
         let radii = tree.blur_radii().into_iter().take(MAX_BLUR_RADII);
         let blurred: Vec<(f32, u32)> = radii.map(|r| (r, 0)).collect();
-        let packed = pack_layers(tree, &blurred);
-        let bytes = std::mem::size_of_val(packed.layers.as_slice()) + std::mem::size_of_val(packed.samples.as_slice());
+        let bytes = pack_layers(tree, &blurred).bytes();
+        let handle_in_layer = std::mem::offset_of!(GpuLayer, tree) + 2 * std::mem::size_of::<u32>();
+        let offsets = (tree.layers.iter().enumerate())
+            .filter_map(|(k, l)| l.layer.height_blur.map(|r| (k, r)))
+            .map(|(k, r)| ((k * std::mem::size_of::<GpuLayer>() + handle_in_layer) as u64, r))
+            .collect();
         LayerTable {
-            region: graph.upload_region("surface layers", bytes as u64),
-            packed: Arc::new(packed),
-            radii: tree.layers.iter().map(|l| l.layer.height_blur).collect(),
+            region: graph.upload_region("surface layers", bytes.len() as u64),
+            bytes: bytes.into(),
+            blurred: offsets,
         }
     }
 
@@ -154,16 +159,14 @@ impl LayerTable {
 
     /// Writes this frame's table through `table` (the recording pass's
     /// [`LayerTable::read_in`]) with the handles of the blurred height
-    /// fields it declared in `maps`.
+    /// fields it declared in `maps`, without allocating.
     pub fn write(&self, ctx: &mut PassContext<'_>, table: Binding, maps: &MapBindings) -> Result<()> {
-        let blurred = maps.blurred_handles(ctx)?;
-        let mut packed = (*self.packed).clone();
-        for (layer, radius) in packed.layers.iter_mut().zip(self.radii.iter()) {
-            if let Some(r) = radius {
-                layer.tree[2] = blurred.iter().find(|(radius, _)| radius == r).map_or(0, |b| b.1);
-            }
+        ctx.write_upload(table, &self.bytes)?;
+        for &(offset, radius) in self.blurred.iter() {
+            let handle = maps.blurred_handle(ctx, radius)?;
+            ctx.write_upload_at(table, offset, bytemuck::bytes_of(&handle))?;
         }
-        ctx.write_upload(table, &packed.bytes())
+        Ok(())
     }
 }
 

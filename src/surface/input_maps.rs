@@ -98,11 +98,13 @@ impl InputMaps {
 }
 
 impl MapBindings {
-    /// Radii and sampled handles of the blurred height fields.
-    pub fn blurred_handles(&self, ctx: &PassContext<'_>) -> Result<Vec<(f32, u32)>> {
-        (self.blurred.iter().flatten())
-            .map(|&(radius, binding)| Ok((radius, ctx.handle(binding)?)))
-            .collect()
+    /// The sampled handle of the height field blurred by `radius` (0 when
+    /// none was declared).
+    pub fn blurred_handle(&self, ctx: &PassContext<'_>, radius: f32) -> Result<u32> {
+        match self.blurred.iter().flatten().find(|(r, _)| *r == radius) {
+            Some(&(_, binding)) => ctx.handle(binding),
+            None => Ok(0),
+        }
     }
 
     /// `maps` of the shaders: sampled handles, and in w bit k when map k is

@@ -158,20 +158,17 @@ impl GenerationPasses {
             .collect();
         pass.record(move |ctx, frame| {
             let tiles = frame.prepared::<TextureFrame>()?;
-            let storage = (textures.iter())
-                .map(|&[color, normal]| Ok([ctx.handle(color)?, ctx.handle(normal)?]))
-                .collect::<Result<Vec<[u32; 2]>>>()?;
-            let with_handles = (tiles.tile_jobs.iter())
-                .map(|job| {
-                    let [color, normal] = *(storage.get(job.images[0] as usize))
-                        .ok_or_else(|| Error::Graph(format!("texturing: no atlas texture {}", job.images[0])))?;
-                    Ok(TileJob {
-                        images: [color, normal, 0, 0],
-                        ..*job
-                    })
-                })
-                .collect::<Result<Vec<TileJob>>>()?;
-            ctx.write_upload(jobs, bytemuck::cast_slice(&with_handles))?;
+            // Job by job, with its texture's storage handles (no allocation).
+            for (k, job) in tiles.tile_jobs.iter().enumerate() {
+                let [color, normal] = *(textures.get(job.images[0] as usize))
+                    .ok_or_else(|| Error::Graph(format!("texturing: no atlas texture {}", job.images[0])))?;
+                let job = TileJob {
+                    images: [ctx.handle(color)?, ctx.handle(normal)?, 0, 0],
+                    ..*job
+                };
+                let offset = (k * std::mem::size_of::<TileJob>()) as u64;
+                ctx.write_upload_at(jobs, offset, bytemuck::bytes_of(&job))?;
+            }
             let push = TileGenerationPush {
                 handles: [ctx.handle(jobs)?, ctx.handle(scratch)?, 0, 0],
                 counts: [tiles.jobs, tiles.texels as u32, 0, 0],
