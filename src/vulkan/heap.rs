@@ -6,6 +6,9 @@
 //! created; shaders index the arrays with handles passed in push constants.
 //! A released handle is reused only after the GPU has completed every
 //! submission that could still read it (tracked on the timeline semaphore).
+//! Handle 0 of every array is never given out: shaders read 0 as "none"
+//! (e.g. no sky-light map), so a resource that happened to get slot 0
+//! would be taken for a missing one.
 //!
 //! GLSL side (`glsl/include/heap.glsl`): binding 0 `texture2D[]`, 1 storage
 //! `image2D[]`, 2 storage `buffer[]`, 3 `sampler[]`; push constants up to
@@ -29,16 +32,28 @@ pub enum HeapKind {
     StorageBuffer = 2,
 }
 
-#[derive(Default)]
 struct HandleAllocator {
     capacity: u32,
+    /// The next never-used handle (from [`FIRST_HANDLE`]).
     next: u32,
     free: Vec<u32>,
     /// Released handles and the timeline value after which they are free.
     pending: Vec<(u64, u32)>,
 }
 
+/// The first handle given out: 0 means "none" to the shaders.
+const FIRST_HANDLE: u32 = 1;
+
 impl HandleAllocator {
+    fn new(capacity: u32) -> HandleAllocator {
+        HandleAllocator {
+            capacity,
+            next: FIRST_HANDLE,
+            free: Vec::new(),
+            pending: Vec::new(),
+        }
+    }
+
     fn allocate(&mut self, what: &str) -> Result<u32> {
         if let Some(h) = self.free.pop() {
             return Ok(h);
@@ -46,7 +61,7 @@ impl HandleAllocator {
         if self.next >= self.capacity {
             return Err(Error::Device(format!(
                 "descriptor heap is full: all {} {what} handles are in use",
-                self.capacity
+                self.capacity - FIRST_HANDLE
             )));
         }
         self.next += 1;
@@ -152,10 +167,7 @@ impl DescriptorHeap {
         // SAFETY: the set is not in use yet; the samplers are live.
         unsafe { device.update_descriptor_sets(&[write], &[]) };
 
-        let handles = [0, 1, 2].map(|i| HandleAllocator {
-            capacity: counts[i],
-            ..Default::default()
-        });
+        let handles = [0, 1, 2].map(|i| HandleAllocator::new(counts[i]));
         Ok(DescriptorHeap {
             layout,
             pipeline_layout,
@@ -269,5 +281,24 @@ impl DescriptorHeap {
             device.destroy_descriptor_pool(self.pool, None);
             device.destroy_descriptor_set_layout(self.layout, None);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn handle_zero_is_never_given_out() {
+        let mut handles = HandleAllocator::new(3);
+        assert_eq!(handles.allocate("test").ok(), Some(1));
+        assert_eq!(handles.allocate("test").ok(), Some(2));
+        let full = handles.allocate("test").err().map(|e| e.to_string());
+        assert!(
+            full.is_some_and(|e| e.contains("all 2 test handles")),
+            "a full array is an error"
+        );
+        handles.free.push(1);
+        assert_eq!(handles.allocate("test").ok(), Some(1));
     }
 }

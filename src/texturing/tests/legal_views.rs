@@ -147,6 +147,11 @@ fn a_render_does_not_depend_on_earlier_renderers() {
         (WIDTH, HEIGHT),
     );
     let after = direct(&small);
+    dump_pngs(
+        &[("direct-alone", &alone.rgba8), ("direct-after", &after.rgba8)],
+        WIDTH,
+        HEIGHT,
+    );
     let differ = alone.rgba8.iter().zip(&after.rgba8).filter(|(a, b)| a != b).count();
     assert_eq!(
         differ, 0,
