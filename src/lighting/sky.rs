@@ -10,10 +10,10 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
-use crate::graph::{LoadOp, RenderGraph, Stage};
+use crate::graph::{LoadOp, Stage};
 use crate::lighting::technique::PreparedLighting;
 use crate::shaders;
-use crate::view::{pass_name, Declare, Frame, Provides, SceneTargets, TargetFormats, View, ViewIndex};
+use crate::view::{pass_name, Declare, Provides, SceneTargets, TargetFormats, ViewGraph};
 use crate::vulkan::{Context, GraphicsPipeline, GraphicsPipelineDesc};
 
 /// Push constants of `sky` (`glsl/lighting/sky.frag`): the view ray basis
@@ -56,17 +56,19 @@ impl Sky {
             pipeline: std::sync::Arc::new(pipeline),
         })
     }
+}
+
+/// `sky` of a view: its targets in, nothing out.
+impl<S: Provides<PreparedLighting> + 'static> Declare<S> for Sky {
+    type Inputs<'a> = &'a SceneTargets;
+    type Outputs = ();
 
     /// Declares `sky` for view `index`: writes its radiance, view depth,
     /// lighting AOVs, normal and ids, and the view's lighting constants
     /// (the values the lighting prepared, with the heap handles of the
     /// lighting maps this pass declares).
-    pub fn declare<S: Provides<PreparedLighting> + 'static>(
-        &self,
-        graph: &mut RenderGraph<Frame<S>>,
-        (index, view): (ViewIndex, &View),
-        targets: &SceneTargets,
-    ) {
+    fn declare(&mut self, at: ViewGraph<'_, S>, targets: &SceneTargets) -> Result<()> {
+        let ViewGraph { graph, index, view, .. } = at;
         let pipeline = self.pipeline.clone();
         let mut pass = graph.pass(&pass_name("sky", &view.name)).graphics();
         let lighting = targets.lighting.read_in(&mut pass, Stage::Fragment);
@@ -90,22 +92,6 @@ impl Sky {
                 };
                 ctx.draw_full_screen(&pipeline, &push)
             });
-    }
-}
-
-/// `sky` of a view: its targets in, nothing out.
-impl<S: Provides<PreparedLighting> + 'static> Declare<S> for Sky {
-    type Inputs<'a> = &'a SceneTargets;
-    type Outputs = ();
-
-    fn declare(
-        &mut self,
-        _: &Context,
-        graph: &mut RenderGraph<Frame<S>>,
-        view: (ViewIndex, &View),
-        targets: &SceneTargets,
-    ) -> Result<()> {
-        Sky::declare(self, graph, view, targets);
         Ok(())
     }
 }

@@ -27,9 +27,11 @@ use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
 
 use crate::error::{Error, Result};
-use crate::graph::{LoadOp, RenderGraph, Stage, UploadRegion};
+use crate::graph::{LoadOp, Stage, UploadRegion};
 use crate::shaders;
-use crate::view::{pass_name, Declare, Frame, FrameContext, SceneTargets, TargetFormats, Technique, View, ViewIndex};
+use crate::view::{
+    pass_name, Declare, FrameContext, SceneTargets, TargetFormats, Technique, View, ViewGraph, ViewIndex,
+};
 use crate::vulkan::{Context, GraphicsPipeline, GraphicsPipelineDesc};
 
 /// Per-view constants of `aovs` (`AovConstants` in glsl/post/aovs.frag).
@@ -123,14 +125,22 @@ impl Aovs {
         })
     }
 
+    /// Forgets every view's previous camera: the next frame's motion is 0
+    /// (a cut, or a camera that jumped).
+    pub fn reset(&mut self) {
+        self.previous.iter_mut().for_each(|p| *p = None);
+    }
+}
+
+/// `aovs` of a view: its targets in, nothing out.
+impl<S: 'static> Declare<S> for Aovs {
+    type Inputs<'a> = &'a SceneTargets;
+    type Outputs = ();
+
     /// Declares `aovs` for view `index`: reads its view depth, writes its
     /// motion and distance.
-    pub fn declare<S: 'static>(
-        &mut self,
-        graph: &mut RenderGraph<Frame<S>>,
-        (index, view): (ViewIndex, &View),
-        targets: &SceneTargets,
-    ) {
+    fn declare(&mut self, at: ViewGraph<'_, S>, targets: &SceneTargets) -> Result<()> {
+        let ViewGraph { graph, index, view, .. } = at;
         let constants = graph.upload_region(&pass_name("aov constants", &view.name), AOV_CONSTANTS_BYTES);
         let pipeline = self.pipeline.clone();
         let (view_depth, motion, distance) = (targets.view_depth, targets.motion, targets.distance);
@@ -150,28 +160,6 @@ impl Aovs {
             });
         self.views.push(AovView { index, constants });
         self.previous.push(None);
-    }
-
-    /// Forgets every view's previous camera: the next frame's motion is 0
-    /// (a cut, or a camera that jumped).
-    pub fn reset(&mut self) {
-        self.previous.iter_mut().for_each(|p| *p = None);
-    }
-}
-
-/// `aovs` of a view: its targets in, nothing out.
-impl<S: 'static> Declare<S> for Aovs {
-    type Inputs<'a> = &'a SceneTargets;
-    type Outputs = ();
-
-    fn declare(
-        &mut self,
-        _: &Context,
-        graph: &mut RenderGraph<Frame<S>>,
-        view: (ViewIndex, &View),
-        targets: &SceneTargets,
-    ) -> Result<()> {
-        Aovs::declare(self, graph, view, targets);
         Ok(())
     }
 }

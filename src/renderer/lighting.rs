@@ -15,7 +15,7 @@ use crate::lighting::technique::{FieldInfo, SceneLighting};
 use crate::points::render::shadow::PointShadows;
 use crate::points::render::PointRenderer;
 use crate::terrain::Terrain;
-use crate::view::{LightingMap, LightingSetup, SceneTargets, View};
+use crate::view::{Declare, LightingMap, LightingSetup, SceneTargets, View, ViewGraph};
 use crate::vulkan::Context;
 
 use super::{RenderFrame, Scene};
@@ -95,7 +95,13 @@ pub(super) fn declare_shadows(
             terrain.declare_shadow(ctx, graph, (k, view), target)?;
         }
         if let Some(casters) = &mut casters {
-            casters.declare(ctx, graph, (k, view), target)?;
+            let at = ViewGraph {
+                ctx,
+                graph: &mut *graph,
+                index: k,
+                view,
+            };
+            casters.declare(at, target)?;
         }
     }
     Ok(Some(SunShadows { maps, points: casters }))

@@ -20,7 +20,7 @@ use crate::terrain::lod::LodFrame;
 use crate::terrain::shading::{declare_draw_pass, DrawPass, TerrainDrawPush};
 use crate::texturing::generation::{AtlasBindings, GenerationInputs};
 use crate::view::{
-    pass_name, per_view, Declare, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex,
+    pass_name, per_view, Declare, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewGraph, ViewIndex,
 };
 use crate::vulkan::Context;
 
@@ -161,37 +161,6 @@ impl Terrain {
         Ok(())
     }
 
-    /// Declares `terrain.draw` of view `index` into `targets`, textured from
-    /// `atlas` when given (after [`Terrain::declare_warp`] of that view).
-    pub fn declare_draw<S: Provides<TerrainFrame> + 'static>(
-        &mut self,
-        ctx: &Context,
-        graph: &mut RenderGraph<Frame<S>>,
-        (index, view): (ViewIndex, &View),
-        targets: &SceneTargets,
-        atlas: Option<&AtlasBindings>,
-    ) -> Result<()> {
-        let texturing = self.texturing_constants(atlas);
-        let state = (self.views.iter_mut().find(|v| v.index == index))
-            .ok_or_else(|| Error::Graph(format!("terrain.draw of view {index} before its terrain.warp")))?;
-        state.drawn = true;
-        let side = self.geometry.settings.grid_side;
-        let pass = DrawPass {
-            view: index,
-            vertices: state.vertices,
-            indices: self.indices,
-            index_count: (side - 1) * (side - 1) * 6,
-            noise: self.noise,
-            heights: self.atlas,
-            layers: self.layers.clone(),
-            maps: self.maps,
-            constants: state.constants,
-            texturing,
-            atlas: atlas.cloned(),
-        };
-        declare_draw_pass(ctx, graph, &pass_name("terrain.draw", &view.name), pass, targets)
-    }
-
     /// View `index`'s geometry image (vertex buffer), the grid's index
     /// buffer and its index count, and the height field's box (x, y over
     /// the extent, z over the height range): what `terrain.shadow` draws.
@@ -265,14 +234,29 @@ impl<S: Provides<TerrainFrame> + 'static> Declare<S> for Terrain {
     type Inputs<'a> = (&'a SceneTargets, Option<&'a AtlasBindings>);
     type Outputs = ();
 
-    fn declare(
-        &mut self,
-        ctx: &Context,
-        graph: &mut RenderGraph<Frame<S>>,
-        view: (ViewIndex, &View),
-        (targets, atlas): Self::Inputs<'_>,
-    ) -> Result<()> {
-        self.declare_draw(ctx, graph, view, targets, atlas)
+    /// Declares `terrain.draw` of view `index` into `targets`, textured from
+    /// `atlas` when given (after [`Terrain::declare_warp`] of that view).
+    fn declare(&mut self, at: ViewGraph<'_, S>, (targets, atlas): Self::Inputs<'_>) -> Result<()> {
+        let (ctx, graph, index, view) = (at.ctx, at.graph, at.index, at.view);
+        let texturing = self.texturing_constants(atlas);
+        let state = (self.views.iter_mut().find(|v| v.index == index))
+            .ok_or_else(|| Error::Graph(format!("terrain.draw of view {index} before its terrain.warp")))?;
+        state.drawn = true;
+        let side = self.geometry.settings.grid_side;
+        let pass = DrawPass {
+            view: index,
+            vertices: state.vertices,
+            indices: self.indices,
+            index_count: (side - 1) * (side - 1) * 6,
+            noise: self.noise,
+            heights: self.atlas,
+            layers: self.layers.clone(),
+            maps: self.maps,
+            constants: state.constants,
+            texturing,
+            atlas: atlas.cloned(),
+        };
+        declare_draw_pass(ctx, graph, &pass_name("terrain.draw", &view.name), pass, targets)
     }
 }
 

@@ -235,14 +235,17 @@ pub trait Technique {
 pub trait Declare<S> {
     type Inputs<'a>;
     type Outputs;
-    /// Declares the passes of view `index` (`view`).
-    fn declare(
-        &mut self,
-        ctx: &Context,
-        graph: &mut RenderGraph<Frame<S>>,
-        view: (ViewIndex, &View),
-        inputs: Self::Inputs<'_>,
-    ) -> Result<Self::Outputs>;
+    /// Declares the passes of one view (`at`).
+    fn declare(&mut self, at: ViewGraph<'_, S>, inputs: Self::Inputs<'_>) -> Result<Self::Outputs>;
+}
+
+/// Where [`Declare::declare`] declares: the device, the frame graph, and
+/// the view (its index in the frame and its reading).
+pub struct ViewGraph<'a, S> {
+    pub ctx: &'a Context,
+    pub graph: &'a mut RenderGraph<Frame<S>>,
+    pub index: ViewIndex,
+    pub view: &'a View,
 }
 
 /// Declares `technique`'s passes of every view, view `k` with the `k`-th
@@ -260,7 +263,13 @@ pub fn declare_views<'a, S, T: Declare<S>>(
         let input = inputs
             .next()
             .ok_or_else(|| Error::Graph(format!("view {k} has no inputs to declare with")))?;
-        outputs.push(technique.declare(ctx, graph, (k, view), input)?);
+        let at = ViewGraph {
+            ctx,
+            graph: &mut *graph,
+            index: k,
+            view,
+        };
+        outputs.push(technique.declare(at, input)?);
     }
     Ok(outputs)
 }

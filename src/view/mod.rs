@@ -29,7 +29,7 @@ mod targets;
 
 pub use camera::{frustum_planes, Camera};
 pub(crate) use frame::frame_slots;
-pub use frame::{declare_views, per_view, Declare, Frame, FrameContext, Provides, Technique};
+pub use frame::{declare_views, per_view, Declare, Frame, FrameContext, Provides, Technique, ViewGraph};
 pub use lens::Intrinsics;
 pub use lighting::{Exposure, FrameLighting, Lighting, LightingSetup, ShadowMode, SkyLightMode, SkyModel, SunPosition};
 pub use targets::{LightingBindings, LightingMap, SceneTargets, TargetFormats};

@@ -163,106 +163,13 @@ pub fn generate(id: u64, fixtures: &Fixtures, root: &Path) -> Case {
         outputs: Vec::new(),
         out_dir: out_dir.clone(),
     };
-    let out = |name: &str| out_dir.join(name);
-    let is_varied = |flag: &str| varied.iter().any(|(f, _)| *f == flag);
     let mut base: Vec<String> = Vec::new();
-    let push = |args: &[&str], base: &mut Vec<String>| base.extend(args.iter().map(|s| s.to_string()));
+    let args = (&mut case, &mut base, &varied[..]);
     match command {
-        Command::Render | Command::Bench | Command::Fly => {
-            scene_base(&mut rng, &chosen, fixtures, &mut case, &mut base);
-            match command {
-                Command::Render => {
-                    let (png, exr, json) = (out("o.png"), out("o.exr"), out("p.json"));
-                    for (flag, path) in [("--out", &png), ("--exr", &exr), ("--profile", &json)] {
-                        base.extend([flag.to_string(), path.to_string_lossy().into_owned()]);
-                    }
-                    case.outputs
-                        .extend([Output::Png(png), Output::Exr(exr), Output::Json(json)]);
-                }
-                Command::Bench => {
-                    if !is_varied("--frames") {
-                        push(&["--frames", "1"], &mut base);
-                    }
-                    if !is_varied("--warmup") {
-                        push(&["--warmup", "0"], &mut base);
-                    }
-                    let json = out("p.json");
-                    base.extend(["--profile".into(), json.to_string_lossy().into_owned()]);
-                    case.outputs.push(Output::Json(json));
-                }
-                _ => {
-                    if !is_varied("--frames") {
-                        push(&["--frames", "2"], &mut base);
-                    }
-                    let frames = out("frames");
-                    base.extend(["--out-dir".into(), frames.to_string_lossy().into_owned()]);
-                    case.outputs.push(Output::Frames(frames));
-                }
-            }
-            if rng.chance(0.5) {
-                for arg in *rng.pick(SCENE_EXTRAS) {
-                    if !base.iter().any(|a| a == arg) {
-                        base.push(arg.to_string());
-                    }
-                }
-            }
-        }
-        Command::SptBuild => {
-            let input = if rng.chance(0.5) {
-                data("points/quad.ply")
-            } else {
-                data("points/colored-points.ply")
-            };
-            let spt = out("o.spt");
-            base.extend([input.clone(), spt.to_string_lossy().into_owned()]);
-            if !is_varied("--samples") {
-                push(&["--samples", "500"], &mut base);
-            }
-            if rng.chance(0.3) {
-                push(&["--sampling", "stratified"], &mut base);
-            }
-            case.files.extend([input, spt.to_string_lossy().into_owned()]);
-            case.outputs.push(Output::Spt(spt));
-        }
-        Command::SynthFill | Command::SynthTransition => {
-            let o = out(if rng.chance(0.5) { "o.exr" } else { "o.png" });
-            if command == Command::SynthFill {
-                let (dem, mask) = (fixtures.path("dem.png"), fixtures.path("mask.png"));
-                base.extend(["--input".into(), dem.clone(), "--mask".into(), mask.clone()]);
-                case.files.extend([dem, mask]);
-            } else {
-                let a = "procedural:fbm,size=33,seed=1".to_string();
-                let b = "procedural:fbm,size=33,seed=2".to_string();
-                base.extend([a.clone(), b.clone()]);
-                if !is_varied("--band") {
-                    push(&["--band", "200"], &mut base);
-                }
-                case.files.extend([a, b]);
-            }
-            base.extend(["--out".into(), o.to_string_lossy().into_owned()]);
-            case.files.push(o.to_string_lossy().into_owned());
-            case.outputs.push(Output::Height(o));
-            let search = if rng.chance(0.5) { "cpu" } else { "gpu" };
-            push(&["--search", search], &mut base);
-        }
-        Command::LayersFromImage => {
-            let (img, dem) = (fixtures.path("rgb.png"), fixtures.path("dem.png"));
-            let toml = out("layers.toml");
-            let map = out("classes.png");
-            base.extend(["--image".into(), img.clone(), "--heightmap".into(), dem.clone()]);
-            if !is_varied("--spacing") {
-                push(&["--spacing", "30"], &mut base);
-            }
-            if !is_varied("--classes") && rng.chance(0.7) {
-                push(&["--classes", "2"], &mut base);
-            }
-            base.extend(["--out".into(), toml.to_string_lossy().into_owned()]);
-            base.extend(["--class-map".into(), map.to_string_lossy().into_owned()]);
-            case.files.extend([img, dem]);
-            case.files
-                .extend([toml.to_string_lossy().into_owned(), map.to_string_lossy().into_owned()]);
-            case.outputs.extend([Output::Layers(toml), Output::Png(map)]);
-        }
+        Command::Render | Command::Bench | Command::Fly => scene_command(&mut rng, (command, &chosen), fixtures, args),
+        Command::SptBuild => spt_build(&mut rng, args),
+        Command::SynthFill | Command::SynthTransition => synth(&mut rng, command, fixtures, args),
+        Command::LayersFromImage => layers_from_image(&mut rng, fixtures, args),
     }
     if command.uses_device() {
         base.push("--validation".into());
@@ -281,6 +188,134 @@ pub fn generate(id: u64, fixtures: &Fixtures, root: &Path) -> Case {
     }
     case.args.extend(base);
     case
+}
+
+/// What a case's command line says beyond the varied options: its base
+/// arguments into `base`, its files and outputs into `case`.
+type CaseParts<'a> = (&'a mut Case, &'a mut Vec<String>, &'a [(&'static str, String)]);
+
+/// `render`, `bench` and `fly`: a scene, the outputs, maybe extras.
+fn scene_command(
+    rng: &mut Rng,
+    (command, chosen): (Command, &[Opt]),
+    fixtures: &Fixtures,
+    (case, base, varied): CaseParts,
+) {
+    let out_dir = case.out_dir.clone();
+    let out = |name: &str| out_dir.join(name);
+    let is_varied = |flag: &str| varied.iter().any(|(f, _)| *f == flag);
+    let push = |args: &[&str], base: &mut Vec<String>| base.extend(args.iter().map(|s| s.to_string()));
+    scene_base(rng, chosen, fixtures, case, base);
+    match command {
+        Command::Render => {
+            let (png, exr, json) = (out("o.png"), out("o.exr"), out("p.json"));
+            for (flag, path) in [("--out", &png), ("--exr", &exr), ("--profile", &json)] {
+                base.extend([flag.to_string(), path.to_string_lossy().into_owned()]);
+            }
+            case.outputs
+                .extend([Output::Png(png), Output::Exr(exr), Output::Json(json)]);
+        }
+        Command::Bench => {
+            if !is_varied("--frames") {
+                push(&["--frames", "1"], base);
+            }
+            if !is_varied("--warmup") {
+                push(&["--warmup", "0"], base);
+            }
+            let json = out("p.json");
+            base.extend(["--profile".into(), json.to_string_lossy().into_owned()]);
+            case.outputs.push(Output::Json(json));
+        }
+        _ => {
+            if !is_varied("--frames") {
+                push(&["--frames", "2"], base);
+            }
+            let frames = out("frames");
+            base.extend(["--out-dir".into(), frames.to_string_lossy().into_owned()]);
+            case.outputs.push(Output::Frames(frames));
+        }
+    }
+    if rng.chance(0.5) {
+        for arg in *rng.pick(SCENE_EXTRAS) {
+            if !base.iter().any(|a| a == arg) {
+                base.push(arg.to_string());
+            }
+        }
+    }
+}
+
+/// `spt build` of one of the PLY fixtures.
+fn spt_build(rng: &mut Rng, (case, base, varied): CaseParts) {
+    let out_dir = case.out_dir.clone();
+    let out = |name: &str| out_dir.join(name);
+    let is_varied = |flag: &str| varied.iter().any(|(f, _)| *f == flag);
+    let push = |args: &[&str], base: &mut Vec<String>| base.extend(args.iter().map(|s| s.to_string()));
+    let input = if rng.chance(0.5) {
+        data("points/quad.ply")
+    } else {
+        data("points/colored-points.ply")
+    };
+    let spt = out("o.spt");
+    base.extend([input.clone(), spt.to_string_lossy().into_owned()]);
+    if !is_varied("--samples") {
+        push(&["--samples", "500"], base);
+    }
+    if rng.chance(0.3) {
+        push(&["--sampling", "stratified"], base);
+    }
+    case.files.extend([input, spt.to_string_lossy().into_owned()]);
+    case.outputs.push(Output::Spt(spt));
+}
+
+/// `synth fill` of the DEM fixture or `synth transition` of two procedural terrains.
+fn synth(rng: &mut Rng, command: Command, fixtures: &Fixtures, (case, base, varied): CaseParts) {
+    let out_dir = case.out_dir.clone();
+    let out = |name: &str| out_dir.join(name);
+    let is_varied = |flag: &str| varied.iter().any(|(f, _)| *f == flag);
+    let push = |args: &[&str], base: &mut Vec<String>| base.extend(args.iter().map(|s| s.to_string()));
+    let o = out(if rng.chance(0.5) { "o.exr" } else { "o.png" });
+    if command == Command::SynthFill {
+        let (dem, mask) = (fixtures.path("dem.png"), fixtures.path("mask.png"));
+        base.extend(["--input".into(), dem.clone(), "--mask".into(), mask.clone()]);
+        case.files.extend([dem, mask]);
+    } else {
+        let a = "procedural:fbm,size=33,seed=1".to_string();
+        let b = "procedural:fbm,size=33,seed=2".to_string();
+        base.extend([a.clone(), b.clone()]);
+        if !is_varied("--band") {
+            push(&["--band", "200"], base);
+        }
+        case.files.extend([a, b]);
+    }
+    base.extend(["--out".into(), o.to_string_lossy().into_owned()]);
+    case.files.push(o.to_string_lossy().into_owned());
+    case.outputs.push(Output::Height(o));
+    let search = if rng.chance(0.5) { "cpu" } else { "gpu" };
+    push(&["--search", search], base);
+}
+
+/// `layers from-image` of the RGB and DEM fixtures.
+fn layers_from_image(rng: &mut Rng, fixtures: &Fixtures, (case, base, varied): CaseParts) {
+    let out_dir = case.out_dir.clone();
+    let out = |name: &str| out_dir.join(name);
+    let is_varied = |flag: &str| varied.iter().any(|(f, _)| *f == flag);
+    let push = |args: &[&str], base: &mut Vec<String>| base.extend(args.iter().map(|s| s.to_string()));
+    let (img, dem) = (fixtures.path("rgb.png"), fixtures.path("dem.png"));
+    let toml = out("layers.toml");
+    let map = out("classes.png");
+    base.extend(["--image".into(), img.clone(), "--heightmap".into(), dem.clone()]);
+    if !is_varied("--spacing") {
+        push(&["--spacing", "30"], base);
+    }
+    if !is_varied("--classes") && rng.chance(0.7) {
+        push(&["--classes", "2"], base);
+    }
+    base.extend(["--out".into(), toml.to_string_lossy().into_owned()]);
+    base.extend(["--class-map".into(), map.to_string_lossy().into_owned()]);
+    case.files.extend([img, dem]);
+    case.files
+        .extend([toml.to_string_lossy().into_owned(), map.to_string_lossy().into_owned()]);
+    case.outputs.extend([Output::Layers(toml), Output::Png(map)]);
 }
 
 /// The scene of `render`, `bench` and `fly` that the chosen options need:

@@ -36,7 +36,9 @@ pub use cascades::{plan_cascades, plan_cascades_into, CascadePlan, SceneBounds, 
 use crate::error::{Error, Result};
 use crate::graph::{ImageId, RenderGraph};
 use crate::shaders;
-use crate::view::{pass_name, per_view, Declare, Frame, FrameContext, ShadowMode, Technique, View, ViewIndex};
+use crate::view::{
+    pass_name, per_view, Declare, Frame, FrameContext, ShadowMode, Technique, View, ViewGraph, ViewIndex,
+};
 use crate::vulkan::{
     Blend, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
     ImageUsageFlags, PrimitiveTopology,
@@ -307,14 +309,8 @@ impl<S: 'static> Declare<S> for ShadowMaps {
     type Inputs<'a> = ();
     type Outputs = ShadowTarget;
 
-    fn declare(
-        &mut self,
-        ctx: &Context,
-        graph: &mut RenderGraph<Frame<S>>,
-        view: (ViewIndex, &View),
-        (): (),
-    ) -> Result<ShadowTarget> {
-        self.declare_view(ctx, graph, view)
+    fn declare(&mut self, at: ViewGraph<'_, S>, (): ()) -> Result<ShadowTarget> {
+        self.declare_view(at.ctx, at.graph, (at.index, at.view))
     }
 }
 

@@ -362,23 +362,7 @@ impl SkyLightBake {
                 params: [spacing[0], spacing[1], settings.bounce_albedo, 0.0],
             };
             let mut graph = RenderGraph::new();
-            let mut import = |buffer: &Arc<Buffer>| graph.import_buffer(buffer.clone());
-            let mut buffers = vec![
-                ChunkBuffer::read(import(&surface), &[Slot::Handle(0)]),
-                ChunkBuffer::read(import(&horizons), &[Slot::Handle(1)]),
-            ];
-            // The previous bounce, and the direct transfer (the same buffer after the first bounce).
-            match b {
-                1 => buffers.push(ChunkBuffer::read(
-                    import(&transfers[0]),
-                    &[Slot::Handle(2), Slot::Handle(3)],
-                )),
-                _ => buffers.extend([
-                    ChunkBuffer::read(import(&transfers[b - 1]), &[Slot::Handle(2)]),
-                    ChunkBuffer::read(import(&transfers[0]), &[Slot::Handle(3)]),
-                ]),
-            }
-            buffers.push(ChunkBuffer::write(import(&transfers[b]), &[Slot::Layout(1)]));
+            let buffers = bounce_buffers(&mut graph, (&surface, &horizons), &transfers, b);
             declare_chunked(&mut graph, "sky_light.bounce", pipeline.clone(), &buffers, push);
             run_chunks(ctx, &mut frames, graph, rows, chunk_rows, progress, (&mut done, total))?;
         }
@@ -531,6 +515,34 @@ impl ChunkBuffer {
             slots: slots.to_vec(),
         }
     }
+}
+
+/// What bounce `b` (≥ 1) reads and writes: the surface and horizons, the
+/// previous bounce and the direct transfer (the same buffer for the first
+/// bounce), and bounce `b`'s transfer.
+fn bounce_buffers(
+    graph: &mut RenderGraph<Chunk>,
+    (surface, horizons): (&Arc<Buffer>, &Arc<Buffer>),
+    transfers: &[Arc<Buffer>],
+    b: usize,
+) -> Vec<ChunkBuffer> {
+    let mut import = |buffer: &Arc<Buffer>| graph.import_buffer(buffer.clone());
+    let mut buffers = vec![
+        ChunkBuffer::read(import(surface), &[Slot::Handle(0)]),
+        ChunkBuffer::read(import(horizons), &[Slot::Handle(1)]),
+    ];
+    match b {
+        1 => buffers.push(ChunkBuffer::read(
+            import(&transfers[0]),
+            &[Slot::Handle(2), Slot::Handle(3)],
+        )),
+        _ => buffers.extend([
+            ChunkBuffer::read(import(&transfers[b - 1]), &[Slot::Handle(2)]),
+            ChunkBuffer::read(import(&transfers[0]), &[Slot::Handle(3)]),
+        ]),
+    }
+    buffers.push(ChunkBuffer::write(import(&transfers[b]), &[Slot::Layout(1)]));
+    buffers
 }
 
 /// Declares a chunked compute pass of `buffers`, whose handles it writes

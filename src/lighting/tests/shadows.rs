@@ -7,7 +7,7 @@
 
 use std::sync::Arc;
 
-use crate::graph::{BufferAccess, RenderGraph, Stage};
+use crate::graph::{BufferAccess, ImageId, RenderGraph, Stage, UploadRegion};
 use crate::lighting::constants::{LightingFrame, SHADOWS_CASCADED, SUN_ANGULAR_RADIUS};
 use crate::lighting::shadows::{record_cascades, SceneBounds, ShadowFrame, ShadowMaps, ShadowSettings};
 use crate::points::render::shadow::PointShadowFrame;
@@ -18,7 +18,9 @@ use crate::shaders;
 use crate::terrain::shadow::shadow_pipeline;
 use crate::test_support::{assert_validation_clean, validated_context};
 use crate::view::lighting::sun_direction;
-use crate::view::{frame_slots, Camera, Frame, FrameLighting, Lighting, LightingMap, SunPosition, View};
+use crate::view::{
+    frame_slots, Camera, Declare, Frame, FrameLighting, Lighting, LightingMap, SunPosition, View, ViewGraph,
+};
 
 frame_slots! {
     /// What the shadow test's techniques prepare.
@@ -155,6 +157,102 @@ fn probes(cam: &Camera, aspect: f64, distance: f64, with_box: bool) -> Vec<(DVec
     out
 }
 
+/// Declares `terrain.shadow`: the test mesh (`mesh(with_box)`) cast into
+/// every cascade of `atlas`.
+fn declare_mesh_caster(ctx: &Context, graph: &mut RenderGraph<Frame<Slots>>, with_box: bool, atlas: ImageId) {
+    let (vertices, indices) = mesh(with_box);
+    let index_count = indices.len() as u32;
+    let vertex_buffer = Buffer::with_data(
+        ctx,
+        "test vertices",
+        BufferUsageFlags::VERTEX_BUFFER,
+        bytemuck::cast_slice(&vertices),
+    )
+    .expect("vertices");
+    let index_buffer = Buffer::with_data(
+        ctx,
+        "test indices",
+        BufferUsageFlags::INDEX_BUFFER,
+        bytemuck::cast_slice(&indices),
+    )
+    .expect("indices");
+    let (vertices, indices) = (
+        graph.import_buffer(Arc::new(vertex_buffer)),
+        graph.import_buffer(Arc::new(index_buffer)),
+    );
+    let pipeline = shadow_pipeline(ctx).expect("caster pipeline");
+    graph
+        .pass("terrain.shadow")
+        .graphics()
+        .read(vertices, BufferAccess::Vertex)
+        .read(indices, BufferAccess::Index)
+        .pipeline(&pipeline)
+        .depth(atlas, None)
+        .record(move |pass, frame| {
+            let plan = frame.prepared::<ShadowFrame>()?.view(0)?;
+            let (image, v, i) = (pass.image(atlas)?, pass.buffer(vertices)?, pass.buffer(indices)?);
+            record_cascades(pass.cmd(), image, plan, |cmd, push| {
+                cmd.bind_graphics(&pipeline);
+                cmd.push_constants(&push)?;
+                cmd.bind_vertex_buffer(v);
+                cmd.bind_index_buffer(i);
+                cmd.draw_indexed(index_count, 1);
+                Ok(())
+            })
+        });
+}
+
+/// Declares `shadow probe`: `sun_visibility` at `count` probes (an upload
+/// region of [`Probe`]s) into a read-back buffer; returns both.
+fn declare_probe(
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame<Slots>>,
+    count: usize,
+    atlas: ImageId,
+) -> (UploadRegion, Arc<Buffer>) {
+    let lighting = graph.upload_region("lighting", std::mem::size_of::<LightingFrame>() as u64);
+    let probe_region = graph.upload_region("probes", (count * 32) as u64);
+    let out = Arc::new(
+        Buffer::new(
+            ctx,
+            BufferDesc {
+                name: "visibility".into(),
+                size: (count * 4) as u64,
+                usage: BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::GpuToCpu,
+            },
+        )
+        .expect("output"),
+    );
+    let out_id = graph.import_buffer(out.clone());
+    let probe = ComputePipeline::new(ctx, shaders::SHADOW_PROBE).expect("probe pipeline");
+    let count = count as u32;
+    let mut pass = graph.pass("shadow probe");
+    let atlas = pass.sample(atlas, Stage::Compute);
+    let lighting = pass.upload(lighting, Stage::Compute);
+    let probe_binding = pass.upload(probe_region, Stage::Compute);
+    let out_binding = pass.storage_buffer(out_id, BufferAccess::StorageWrite(Stage::Compute));
+    pass.record(move |pass, frame: &Frame<Slots>| {
+        // The lighting constants name the atlas: written by the pass that declares it.
+        let plan = frame.prepared::<ShadowFrame>()?.view(0)?;
+        let mut constants = LightingFrame::zeroed();
+        constants.sun = frame.lighting.sun_direction().extend(SUN_ANGULAR_RADIUS).to_array();
+        constants.models = [0, SHADOWS_CASCADED, 0, 0];
+        plan.fill(&mut constants);
+        constants.set_map_handle(LightingMap::ShadowAtlas, pass.handle(atlas)?);
+        pass.write_upload_pod(lighting, &constants)?;
+        let handles = [
+            pass.handle(lighting)?,
+            pass.handle(probe_binding)?,
+            pass.handle(out_binding)?,
+            count,
+        ];
+        pass.dispatch(&probe, &handles, [count.div_ceil(64), 1, 1])
+    });
+    graph.read_back(out_id);
+    (probe_region, out)
+}
+
 /// Renders the atlas of the scene and evaluates `sun_visibility` at every
 /// probe for each sun; returns per sun the probes' visibility and the plan.
 fn run(
@@ -184,89 +282,16 @@ fn run(
     let target = shadows.declare_view(ctx, &mut graph, (0, &view)).expect("atlas");
     let mut point_shadows = renderer.as_ref().map(|r| PointShadows::new(r, &shadows));
     if let Some(p) = point_shadows.as_mut() {
-        p.declare(ctx, &mut graph, (0, &view), target).expect("points.shadow");
-    }
-    let (vertices, indices) = mesh(with_box);
-    let index_count = indices.len() as u32;
-    let vertex_buffer = Buffer::with_data(
-        ctx,
-        "test vertices",
-        BufferUsageFlags::VERTEX_BUFFER,
-        bytemuck::cast_slice(&vertices),
-    )
-    .expect("vertices");
-    let index_buffer = Buffer::with_data(
-        ctx,
-        "test indices",
-        BufferUsageFlags::INDEX_BUFFER,
-        bytemuck::cast_slice(&indices),
-    )
-    .expect("indices");
-    let (vertices, indices) = (
-        graph.import_buffer(Arc::new(vertex_buffer)),
-        graph.import_buffer(Arc::new(index_buffer)),
-    );
-    let pipeline = shadow_pipeline(ctx).expect("caster pipeline");
-    let atlas = target.atlas;
-    graph
-        .pass("terrain.shadow")
-        .graphics()
-        .read(vertices, BufferAccess::Vertex)
-        .read(indices, BufferAccess::Index)
-        .pipeline(&pipeline)
-        .depth(atlas, None)
-        .record(move |pass, frame| {
-            let plan = frame.prepared::<ShadowFrame>()?.view(0)?;
-            let (image, v, i) = (pass.image(atlas)?, pass.buffer(vertices)?, pass.buffer(indices)?);
-            record_cascades(pass.cmd(), image, plan, |cmd, push| {
-                cmd.bind_graphics(&pipeline);
-                cmd.push_constants(&push)?;
-                cmd.bind_vertex_buffer(v);
-                cmd.bind_index_buffer(i);
-                cmd.draw_indexed(index_count, 1);
-                Ok(())
-            })
-        });
-    let lighting = graph.upload_region("lighting", std::mem::size_of::<LightingFrame>() as u64);
-    let probe_region = graph.upload_region("probes", (probes.len() * 32) as u64);
-    let out = Arc::new(
-        Buffer::new(
+        let at = ViewGraph {
             ctx,
-            BufferDesc {
-                name: "visibility".into(),
-                size: (probes.len() * 4) as u64,
-                usage: BufferUsageFlags::STORAGE_BUFFER,
-                location: MemoryLocation::GpuToCpu,
-            },
-        )
-        .expect("output"),
-    );
-    let out_id = graph.import_buffer(out.clone());
-    let probe = ComputePipeline::new(ctx, shaders::SHADOW_PROBE).expect("probe pipeline");
-    let count = probes.len() as u32;
-    let mut pass = graph.pass("shadow probe");
-    let atlas = pass.sample(atlas, Stage::Compute);
-    let lighting = pass.upload(lighting, Stage::Compute);
-    let probe_binding = pass.upload(probe_region, Stage::Compute);
-    let out_binding = pass.storage_buffer(out_id, BufferAccess::StorageWrite(Stage::Compute));
-    pass.record(move |pass, frame: &Frame<Slots>| {
-        // The lighting constants name the atlas: written by the pass that declares it.
-        let plan = frame.prepared::<ShadowFrame>()?.view(0)?;
-        let mut constants = LightingFrame::zeroed();
-        constants.sun = frame.lighting.sun_direction().extend(SUN_ANGULAR_RADIUS).to_array();
-        constants.models = [0, SHADOWS_CASCADED, 0, 0];
-        plan.fill(&mut constants);
-        constants.set_map_handle(LightingMap::ShadowAtlas, pass.handle(atlas)?);
-        pass.write_upload_pod(lighting, &constants)?;
-        let handles = [
-            pass.handle(lighting)?,
-            pass.handle(probe_binding)?,
-            pass.handle(out_binding)?,
-            count,
-        ];
-        pass.dispatch(&probe, &handles, [count.div_ceil(64), 1, 1])
-    });
-    graph.read_back(out_id);
+            graph: &mut graph,
+            index: 0,
+            view: &view,
+        };
+        p.declare(at, target).expect("points.shadow");
+    }
+    declare_mesh_caster(ctx, &mut graph, with_box, target.atlas);
+    let (probe_region, out) = declare_probe(ctx, &mut graph, probes.len(), target.atlas);
     let mut baked = graph.bake(ctx).expect("bake");
     let mut frames = FrameRing::new(ctx).expect("frames");
     let mut results = Vec::new();

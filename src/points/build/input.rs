@@ -427,35 +427,11 @@ fn read_ply(bytes: &[u8], path: &Path) -> Result<PointInput> {
     let colors = layout.colors.then(|| vertices.iter().map(|v| v.color).collect());
 
     if faces.is_empty() && strips.is_empty() {
-        let radii = if layout.radius {
-            let mut radii = Vec::with_capacity(n);
-            for (i, v) in vertices.iter().enumerate() {
-                if !(v.radius.is_finite() && v.radius > 0.0) {
-                    return Err(bad(format!(
-                        "vertex {i} has radius {} (must be positive and finite)",
-                        v.radius
-                    )));
-                }
-                radii.push(v.radius);
-            }
-            Some(radii)
-        } else {
-            None
-        };
-        let clip = if layout.clip.contains(&true) {
-            let mut clip = Vec::with_capacity(n);
-            for (i, v) in vertices.iter().enumerate() {
-                clip.push(clip_lines(v, layout.clip).ok_or_else(|| {
-                    bad(format!(
-                        "vertex {i} has a non-finite clip line ({}, {}, {}, {})",
-                        v.clip[0], v.clip[1], v.clip[2], v.clip[3]
-                    ))
-                })?);
-            }
-            Some(clip)
-        } else {
-            None
-        };
+        let radii = layout.radius.then(|| ply_radii(&vertices)).transpose().map_err(bad)?;
+        let clip = (layout.clip.contains(&true))
+            .then(|| ply_clip_lines(&vertices, layout.clip))
+            .transpose()
+            .map_err(bad)?;
         return Ok(PointInput::Points(PointCloud {
             positions,
             normals,
@@ -476,6 +452,35 @@ fn read_ply(bytes: &[u8], path: &Path) -> Result<PointInput> {
         colors,
         triangles,
     }))
+}
+
+/// The splat radii of PLY vertices; the message names a vertex whose
+/// radius is not positive and finite.
+fn ply_radii(vertices: &[PlyVertex]) -> std::result::Result<Vec<f32>, String> {
+    (vertices.iter().enumerate())
+        .map(|(i, v)| match v.radius.is_finite() && v.radius > 0.0 {
+            true => Ok(v.radius),
+            false => Err(format!(
+                "vertex {i} has radius {} (must be positive and finite)",
+                v.radius
+            )),
+        })
+        .collect()
+}
+
+/// The clip lines of PLY vertices (`present`: which of the two lines the
+/// header has); the message names a vertex with a non-finite line.
+fn ply_clip_lines(vertices: &[PlyVertex], present: [bool; 2]) -> std::result::Result<Vec<ClipLines>, String> {
+    (vertices.iter().enumerate())
+        .map(|(i, v)| {
+            clip_lines(v, present).ok_or_else(|| {
+                format!(
+                    "vertex {i} has a non-finite clip line ({}, {}, {}, {})",
+                    v.clip[0], v.clip[1], v.clip[2], v.clip[3]
+                )
+            })
+        })
+        .collect()
 }
 
 /// The triangles of PLY faces (fanned) and strips (`-1` restarts) over `n`

@@ -399,38 +399,7 @@ fn convex_hull(points: &[DVec3]) -> Result<Hull> {
     }
     let eps = scale * 1e-9;
 
-    // Initial tetrahedron from extreme points.
-    let argmax = |f: &dyn Fn(DVec3) -> f64| {
-        let mut best = (0, f64::NEG_INFINITY);
-        for (i, &p) in points.iter().enumerate() {
-            let v = f(p);
-            if v > best.1 {
-                best = (i, v);
-            }
-        }
-        best
-    };
-    let (i0, _) = argmax(&|p| -p.x);
-    let p0 = points[i0];
-    let (i1, d1) = argmax(&|p| (p - p0).length());
-    if d1 <= eps {
-        return Err(degenerate("all points coincide"));
-    }
-    let axis = (points[i1] - p0) / d1;
-    let (i2, d2) = argmax(&|p| (p - p0).cross(axis).length());
-    if d2 <= eps {
-        return Err(degenerate("all points are collinear"));
-    }
-    let plane = (points[i1] - p0).cross(points[i2] - p0).normalize();
-    let (i3, d3) = argmax(&|p| (p - p0).dot(plane).abs());
-    if d3 <= eps {
-        return Err(degenerate("all points are coplanar"));
-    }
-    // Orient (a, b, c) so that d lies below it; then all four are outward.
-    let (a, mut b, mut c, d) = (i0, i1, i2, i3);
-    if (points[d] - p0).dot(plane) > 0.0 {
-        std::mem::swap(&mut b, &mut c);
-    }
+    let [a, b, c, d] = initial_tetrahedron(points, eps)?;
     let make = |v: [usize; 3]| -> Result<Face> {
         let [pa, pb, pc] = v.map(|i| points[i]);
         let cross = (pb - pa).cross(pc - pa);
@@ -488,7 +457,51 @@ fn convex_hull(points: &[DVec3]) -> Result<Hull> {
     if !is_closed_and_oriented(&triangles) {
         return Err(degenerate("the hull is not a closed, consistently oriented surface"));
     }
-    // Keep only the hull's vertices, in input order.
+    Ok(compact_hull(points, &triangles))
+}
+
+/// The initial tetrahedron of the hull from extreme points, as indices
+/// `[a, b, c, d]` with `d` below the plane of (a, b, c), so that the faces
+/// (a, b, c), (a, d, b), (b, d, c), (c, d, a) face outward. `eps`: the
+/// distance below which points count as coincident, collinear, coplanar.
+fn initial_tetrahedron(points: &[DVec3], eps: f64) -> Result<[usize; 4]> {
+    let argmax = |f: &dyn Fn(DVec3) -> f64| {
+        let mut best = (0, f64::NEG_INFINITY);
+        for (i, &p) in points.iter().enumerate() {
+            let v = f(p);
+            if v > best.1 {
+                best = (i, v);
+            }
+        }
+        best
+    };
+    let (i0, _) = argmax(&|p| -p.x);
+    let p0 = points[i0];
+    let (i1, d1) = argmax(&|p| (p - p0).length());
+    if d1 <= eps {
+        return Err(degenerate("all points coincide"));
+    }
+    let axis = (points[i1] - p0) / d1;
+    let (i2, d2) = argmax(&|p| (p - p0).cross(axis).length());
+    if d2 <= eps {
+        return Err(degenerate("all points are collinear"));
+    }
+    let plane = (points[i1] - p0).cross(points[i2] - p0).normalize();
+    let (i3, d3) = argmax(&|p| (p - p0).dot(plane).abs());
+    if d3 <= eps {
+        return Err(degenerate("all points are coplanar"));
+    }
+    // Orient (a, b, c) so that d lies below it; then all four are outward.
+    let (a, mut b, mut c, d) = (i0, i1, i2, i3);
+    if (points[d] - p0).dot(plane) > 0.0 {
+        std::mem::swap(&mut b, &mut c);
+    }
+    Ok([a, b, c, d])
+}
+
+/// The hull of `triangles` over `points`: only the vertices they use, in
+/// input order, and the triangles re-indexed to them.
+fn compact_hull(points: &[DVec3], triangles: &[[usize; 3]]) -> Hull {
     let mut remap = vec![u32::MAX; points.len()];
     let mut used: Vec<usize> = triangles.iter().flatten().copied().collect();
     used.sort_unstable();
@@ -502,7 +515,7 @@ fn convex_hull(points: &[DVec3]) -> Result<Hull> {
         })
         .collect();
     let faces = triangles.iter().map(|t| t.map(|i| remap[i])).collect();
-    Ok(Hull { vertices, faces })
+    Hull { vertices, faces }
 }
 
 /// Whether every directed edge occurs exactly once and its reverse occurs

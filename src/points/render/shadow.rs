@@ -25,16 +25,14 @@ use glam::DVec3;
 use super::selection::{keeps_instance, ObjectLayout};
 use super::PointRenderer;
 use crate::error::{Error, Result};
-use crate::graph::{BufferAccess, BufferId, RenderGraph, Stage, UploadRegion};
+use crate::graph::{BufferAccess, BufferId, Stage, UploadRegion};
 use crate::lighting::shadows::{
     plan_cascades, plan_cascades_into, record_cascades, splat_caster_desc, CascadePlan, SceneBounds, ShadowFrame,
     ShadowMaps, ShadowSettings, ShadowTarget,
 };
 use crate::points::scene::PointScene;
-use crate::view::{
-    pass_name, per_view, Declare, Frame, FrameContext, Provides, ShadowMode, Technique, View, ViewIndex,
-};
-use crate::vulkan::{Buffer, Context, GraphicsPipeline};
+use crate::view::{pass_name, per_view, Declare, FrameContext, Provides, ShadowMode, Technique, ViewGraph, ViewIndex};
+use crate::vulkan::{Buffer, GraphicsPipeline};
 
 /// Header of a view's shadow records (`ShadowPoints` in shadow_points.vert).
 #[repr(C)]
@@ -149,52 +147,6 @@ impl PointShadows {
             .unwrap_or(1)
     }
 
-    /// Declares `points.shadow` of view `index` into `target` (after
-    /// `shadow.clear`; the cascades come from the frame's [`ShadowFrame`]).
-    pub fn declare<S: Provides<ShadowFrame> + Provides<PointShadowFrame> + 'static>(
-        &mut self,
-        ctx: &Context,
-        graph: &mut RenderGraph<Frame<S>>,
-        (index, view): (ViewIndex, &View),
-        target: ShadowTarget,
-    ) -> Result<()> {
-        let splats = *self
-            .splats_id
-            .get_or_insert_with(|| graph.import_buffer(self.splats.clone()));
-        let records = (self.scene.instances.len() * self.records_per_instance()).max(1) as u64;
-        let region = graph.upload_region(
-            &pass_name("point shadow casters", &view.name),
-            HEADER_BYTES + RECORD_BYTES * records,
-        );
-        let pipeline = GraphicsPipeline::new(ctx, &splat_caster_desc("points.shadow"))?;
-        let atlas = target.atlas;
-        let mut pass = graph.pass(&pass_name("points.shadow", &view.name)).graphics();
-        let handles = [
-            pass.storage_buffer(splats, BufferAccess::StorageRead(Stage::Vertex)),
-            pass.upload(region, Stage::Vertex),
-        ];
-        pass.pipeline(&pipeline).depth(atlas, None).record(move |ctx, frame| {
-            let plan = frame.prepared::<ShadowFrame>()?.view(index)?;
-            let draws = frame.prepared::<PointShadowFrame>()?.view(index)?;
-            if draws.is_empty() {
-                return Ok(());
-            }
-            let handles = [ctx.handle(handles[0])?, ctx.handle(handles[1])?];
-            let image = ctx.image(atlas)?;
-            record_cascades(ctx.cmd(), image, plan, |cmd, mut push| {
-                cmd.bind_graphics(&pipeline);
-                for d in draws {
-                    push.handles = [handles[0], handles[1], d.record, 0];
-                    cmd.push_constants(&push)?;
-                    cmd.draw(d.count * 6, 1);
-                }
-                Ok(())
-            })
-        });
-        self.views.push(ShadowView { index, region });
-        Ok(())
-    }
-
     /// The caster records of one view for `plan`, and its draws.
     /// (`pixel`: the view's pixel width at unit distance, for thinning.)
     fn plan_view(
@@ -253,14 +205,45 @@ impl<S: Provides<ShadowFrame> + Provides<PointShadowFrame> + 'static> Declare<S>
     type Inputs<'a> = ShadowTarget;
     type Outputs = ();
 
-    fn declare(
-        &mut self,
-        ctx: &Context,
-        graph: &mut RenderGraph<Frame<S>>,
-        view: (ViewIndex, &View),
-        target: ShadowTarget,
-    ) -> Result<()> {
-        PointShadows::declare(self, ctx, graph, view, target)
+    /// Declares `points.shadow` of view `index` into `target` (after
+    /// `shadow.clear`; the cascades come from the frame's [`ShadowFrame`]).
+    fn declare(&mut self, at: ViewGraph<'_, S>, target: ShadowTarget) -> Result<()> {
+        let (ctx, graph, index, view) = (at.ctx, at.graph, at.index, at.view);
+        let splats = *self
+            .splats_id
+            .get_or_insert_with(|| graph.import_buffer(self.splats.clone()));
+        let records = (self.scene.instances.len() * self.records_per_instance()).max(1) as u64;
+        let region = graph.upload_region(
+            &pass_name("point shadow casters", &view.name),
+            HEADER_BYTES + RECORD_BYTES * records,
+        );
+        let pipeline = GraphicsPipeline::new(ctx, &splat_caster_desc("points.shadow"))?;
+        let atlas = target.atlas;
+        let mut pass = graph.pass(&pass_name("points.shadow", &view.name)).graphics();
+        let handles = [
+            pass.storage_buffer(splats, BufferAccess::StorageRead(Stage::Vertex)),
+            pass.upload(region, Stage::Vertex),
+        ];
+        pass.pipeline(&pipeline).depth(atlas, None).record(move |ctx, frame| {
+            let plan = frame.prepared::<ShadowFrame>()?.view(index)?;
+            let draws = frame.prepared::<PointShadowFrame>()?.view(index)?;
+            if draws.is_empty() {
+                return Ok(());
+            }
+            let handles = [ctx.handle(handles[0])?, ctx.handle(handles[1])?];
+            let image = ctx.image(atlas)?;
+            record_cascades(ctx.cmd(), image, plan, |cmd, mut push| {
+                cmd.bind_graphics(&pipeline);
+                for d in draws {
+                    push.handles = [handles[0], handles[1], d.record, 0];
+                    cmd.push_constants(&push)?;
+                    cmd.draw(d.count * 6, 1);
+                }
+                Ok(())
+            })
+        });
+        self.views.push(ShadowView { index, region });
+        Ok(())
     }
 }
 

@@ -15,11 +15,10 @@ use super::stats::{PointFrameStats, StatsLog};
 use super::triangles::TriangleBuffer;
 use super::{SplatMode, SplatPrimitive, SplatSettings};
 use crate::error::{Error, Result};
-use crate::graph::RenderGraph;
 use crate::points::build::clusters::{cluster_normals, CLUSTER_COUNT};
 use crate::points::scene::PointScene;
 use crate::view::{
-    pass_name, per_view, Declare, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewIndex,
+    pass_name, per_view, Declare, FrameContext, Provides, SceneTargets, Technique, ViewGraph, ViewIndex,
 };
 use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Context, MemoryLocation};
 
@@ -166,19 +165,32 @@ impl PointRenderer {
         })
     }
 
+    /// The scene, where each object's list is, and the splat buffer: what
+    /// `points.shadow` draws (`super::shadow`).
+    pub(super) fn shadow_sources(&self) -> (&PointScene, &[ObjectLayout], &Arc<Buffer>) {
+        (&self.scene, &self.layouts, &self.resources.splats)
+    }
+
+    /// Statistics of every completed frame not yet taken (call after all
+    /// frames completed).
+    pub fn take_stats(&mut self) -> Result<Vec<PointFrameStats>> {
+        self.stats.take_all_completed()
+    }
+}
+
+/// The points passes of a view: its targets (W required) and whether
+/// they clear the depth buffer (no terrain drew into it) in, nothing out.
+impl<S: Provides<PointsFrame> + 'static> Declare<S> for PointRenderer {
+    type Inputs<'a> = (&'a SceneTargets, bool);
+    type Outputs = ();
+
     /// Declares the points passes of view `index` into `targets` (W
     /// required): `points.visibility`, `points.accumulate`,
     /// `points.normalize` for EWA splats, `points.single_pass*` for
     /// single-pass splats (§10.4), or `points.opaque`.
     /// `clear_depth`: no terrain drew into the depth buffer.
-    pub fn declare<S: Provides<PointsFrame> + 'static>(
-        &mut self,
-        ctx: &Context,
-        graph: &mut RenderGraph<Frame<S>>,
-        (index, view): (ViewIndex, &View),
-        targets: &SceneTargets,
-        clear_depth: bool,
-    ) -> Result<()> {
+    fn declare(&mut self, at: ViewGraph<'_, S>, (targets, clear_depth): Self::Inputs<'_>) -> Result<()> {
+        let (ctx, graph, index, view) = (at.ctx, at.graph, at.index, at.view);
         if targets.width > 0xffff || targets.height > 0xffff {
             return Err(Error::invalid(
                 "image size",
@@ -247,35 +259,6 @@ impl PointRenderer {
         }
         self.views.push(point_view);
         Ok(())
-    }
-
-    /// The scene, where each object's list is, and the splat buffer: what
-    /// `points.shadow` draws (`super::shadow`).
-    pub(super) fn shadow_sources(&self) -> (&PointScene, &[ObjectLayout], &Arc<Buffer>) {
-        (&self.scene, &self.layouts, &self.resources.splats)
-    }
-
-    /// Statistics of every completed frame not yet taken (call after all
-    /// frames completed).
-    pub fn take_stats(&mut self) -> Result<Vec<PointFrameStats>> {
-        self.stats.take_all_completed()
-    }
-}
-
-/// The points passes of a view: its targets (W required) and whether
-/// they clear the depth buffer (no terrain drew into it) in, nothing out.
-impl<S: Provides<PointsFrame> + 'static> Declare<S> for PointRenderer {
-    type Inputs<'a> = (&'a SceneTargets, bool);
-    type Outputs = ();
-
-    fn declare(
-        &mut self,
-        ctx: &Context,
-        graph: &mut RenderGraph<Frame<S>>,
-        view: (ViewIndex, &View),
-        (targets, clear_depth): Self::Inputs<'_>,
-    ) -> Result<()> {
-        PointRenderer::declare(self, ctx, graph, view, targets, clear_depth)
     }
 }
 
