@@ -191,7 +191,7 @@ fn render_settings(args: &SceneArgs, scene: &Scene, views: &[ViewSpec], readback
     settings.motion_blur = args.camera.motion_blur()?;
     settings.readback = readback;
     settings.terrain = terrain_settings(&args.terrain, &args.debug)?;
-    settings.points = points::splat_settings(&args.points, args.fov_y, args.height)?;
+    settings.points = points::splat_settings(&args.points, views, args.fov_y)?;
     settings.texturing = match args.terrain.texturing {
         args::TexturingArg::Classic => TexturingMode::Classic,
         args::TexturingArg::Direct => TexturingMode::Direct,

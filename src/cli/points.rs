@@ -6,9 +6,10 @@ use anyhow::{bail, Context as _, Result};
 
 use alpenglow::files::load_point_object;
 use alpenglow::tools::budget::MemoryLimits;
-use alpenglow::tools::spt::{epsilon_from_pixels, sampling_footprint, SamplingMethod};
+use alpenglow::tools::spt::{sampling_footprint, SamplingMethod};
 use alpenglow::{
     PointLoadOptions, PointTransform, Scene, SplatBackend, SplatMode, SplatPrimitive, SplatSettings, VegetationOptions,
+    ViewSpec,
 };
 
 use super::args::{PointArgs, SplatArg, SplatBackendArg, SplatPrimitiveArg, VegetationArg};
@@ -97,8 +98,18 @@ pub fn add_points(args: &PointArgs, scene: &mut Scene, builtin: bool) -> Result<
     Ok(())
 }
 
-/// Splat settings for an image of `rows` pixel rows seen with `fov_y_deg`.
-pub fn splat_settings(args: &PointArgs, fov_y_deg: f64, rows: u32) -> Result<SplatSettings> {
+/// Splat settings for `views` (seen with `fov_y_deg` where they have no
+/// intrinsics): the angular threshold is `--epsilon` pixels of the finest
+/// view's pixel footprint.
+pub fn splat_settings(args: &PointArgs, views: &[ViewSpec], fov_y_deg: f64) -> Result<SplatSettings> {
+    let finest = (views.iter().map(|v| v.pixel_footprint(fov_y_deg))).fold(f64::INFINITY, f64::min);
+    let epsilon = args.epsilon * finest as f32;
+    if !(args.epsilon.is_finite() && args.epsilon > 0.0 && epsilon.is_finite() && epsilon > 0.0) {
+        bail!(
+            "invalid --epsilon: {} px is not a positive number of pixels",
+            args.epsilon
+        );
+    }
     let settings = SplatSettings {
         mode: match args.splat {
             SplatArg::Opaque => SplatMode::Opaque,
@@ -119,10 +130,7 @@ pub fn splat_settings(args: &PointArgs, fov_y_deg: f64, rows: u32) -> Result<Spl
         shaded: !args.no_shading,
         two_sided: args.two_sided,
         normal_clusters: args.normal_clusters,
-        epsilon: Some(
-            epsilon_from_pixels(args.epsilon, fov_y_deg.to_radians() as f32, rows)
-                .with_context(|| format!("--epsilon {}", args.epsilon))?,
-        ),
+        epsilon: Some(epsilon),
         ..SplatSettings::default()
     };
     settings.validate()?;

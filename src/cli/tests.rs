@@ -133,3 +133,40 @@ fn height_mapping_errors_name_the_flags() {
     };
     assert_eq!((render.scene.height_scale, render.scene.height_offset), (2.5, -100.0));
 }
+
+/// The points' angular threshold is `--epsilon` pixels of the view's own
+/// pixel footprint: `1/fx` for a telephoto given by intrinsics, not the
+/// footprint of `--fov-y` (which the intrinsics override).
+#[test]
+fn the_splat_threshold_follows_the_intrinsics() {
+    let Command::Render(render) = parse(&[
+        "render",
+        "--intrinsics",
+        "1600,1600,120,80",
+        "--width",
+        "240",
+        "--height",
+        "160",
+        "--epsilon",
+        "2",
+    ])
+    .unwrap()
+    .command
+    else {
+        panic!("not render");
+    };
+    let (_, views) = super::views(&render.scene).unwrap();
+    let settings = super::points::splat_settings(&render.scene.points, &views, render.scene.fov_y).unwrap();
+    let epsilon = settings.epsilon.unwrap();
+    assert!((epsilon - 2.0 / 1600.0).abs() < 1e-9, "epsilon {epsilon}, not 2/fx");
+    let Command::Render(render) = parse(&["render", "--height", "160", "--fov-y", "60", "--epsilon", "2"])
+        .unwrap()
+        .command
+    else {
+        panic!("not render");
+    };
+    let (_, views) = super::views(&render.scene).unwrap();
+    let settings = super::points::splat_settings(&render.scene.points, &views, render.scene.fov_y).unwrap();
+    let by_fov = 2.0 * 2.0 * (30f32.to_radians()).tan() / 160.0;
+    assert!((settings.epsilon.unwrap() - by_fov).abs() < 1e-7);
+}

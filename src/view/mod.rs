@@ -148,10 +148,11 @@ impl View {
     /// `2·tan(fov_y/2)/height` without intrinsics. Texture tiles and the
     /// per-pixel filtering of the surface take their detail from it.
     pub fn pixel_footprint(&self) -> f64 {
-        match self.intrinsics {
-            None => Footprint::pixel_footprint_for(self.camera.fov_y_deg.to_radians(), self.height),
-            Some(k) => 1.0 / k.fx.max(k.fy),
-        }
+        let spec = rig::ViewSpec {
+            intrinsics: self.intrinsics,
+            ..rig::ViewSpec::new(self.width, self.height)
+        };
+        spec.pixel_footprint(self.camera.fov_y_deg)
     }
 
     /// What a planner measures of the view: its eye, its pixel footprint

@@ -36,7 +36,7 @@ use glam::{DMat3, DVec3};
 use serde::Deserialize;
 
 use super::lens::{Distortion, Intrinsics};
-use super::{validate_size, Camera, View};
+use super::{validate_size, Camera, Footprint, View};
 use crate::error::{Error, Result};
 
 /// Most views a frame renders.
@@ -121,6 +121,16 @@ impl ViewSpec {
             width: self.width,
             height: self.height,
             intrinsics: self.intrinsics,
+        }
+    }
+
+    /// The angle (radians at the axis) one pixel of this view spans, the
+    /// finer of its two sides ([`View::pixel_footprint`]), seen with
+    /// `fov_y_deg` when it has no intrinsics.
+    pub fn pixel_footprint(&self, fov_y_deg: f64) -> f64 {
+        match self.intrinsics {
+            None => Footprint::pixel_footprint_for(fov_y_deg.to_radians(), self.height),
+            Some(k) => 1.0 / k.fx.max(k.fy),
         }
     }
 
