@@ -11,9 +11,9 @@ use std::sync::Arc;
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
-use crate::graph::{BufferAccess, BufferId, BufferInfo, ImageAccess, RenderGraph, Stage};
+use crate::graph::{BufferAccess, BufferId, BufferInfo, ImageAccess, Stage};
 use crate::shaders;
-use crate::view::{pass_name, Exposure, Frame, SceneTargets, View};
+use crate::view::{pass_name, Declare, Exposure, SceneTargets, ViewGraph};
 use crate::vulkan::{ComputePipeline, Context, MemoryLocation};
 
 /// Bytes of the exposure buffer: multiplier, EV100, mean log2 luminance, pad.
@@ -53,15 +53,18 @@ impl ExposureMeter {
             pipeline: Arc::new(ComputePipeline::new(ctx, shaders::EXPOSURE_METER)?),
         })
     }
+}
 
-    /// Declares `exposure.meter` for `view`: reads its radiance, writes and
-    /// returns the view's exposure buffer (read by `tonemap`).
-    pub fn declare<S: 'static>(
-        &self,
-        graph: &mut RenderGraph<Frame<S>>,
-        view: &View,
-        targets: &SceneTargets,
-    ) -> BufferId {
+/// `exposure.meter` of a view: its (post-processed) targets in, its
+/// exposure buffer out.
+impl<S: 'static> Declare<S> for ExposureMeter {
+    type Inputs<'a> = &'a SceneTargets;
+    type Outputs = BufferId;
+
+    /// Declares `exposure.meter` for the view: reads its radiance, writes
+    /// and returns the view's exposure buffer (read by `tonemap`).
+    fn declare(&mut self, at: ViewGraph<'_, S>, targets: &SceneTargets) -> Result<BufferId> {
+        let (graph, view) = (at.graph, at.view);
         let exposure = graph.create_buffer(
             &pass_name("exposure", &view.name),
             BufferInfo {
@@ -89,7 +92,7 @@ impl ExposureMeter {
             };
             ctx.dispatch(&pipeline, &push, [1, 1, 1])
         });
-        exposure
+        Ok(exposure)
     }
 }
 

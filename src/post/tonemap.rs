@@ -6,9 +6,9 @@ use std::sync::Arc;
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
-use crate::graph::{BufferAccess, BufferId, ImageAccess, RenderGraph, Stage};
+use crate::graph::{BufferAccess, BufferId, ImageAccess, Stage};
 use crate::shaders;
-use crate::view::{pass_name, Frame, SceneTargets, View};
+use crate::view::{pass_name, Declare, SceneTargets, ViewGraph};
 use crate::vulkan::{ComputePipeline, Context};
 
 /// Push constants of `tonemap` (`glsl/post/tonemap.comp`).
@@ -38,16 +38,18 @@ impl Tonemap {
             pipeline: Arc::new(ComputePipeline::new(ctx, shaders::TONEMAP)?),
         })
     }
+}
 
-    /// Declares `tonemap` for `view`: its radiance, exposed by `exposure`,
-    /// into its display image.
-    pub fn declare<S: 'static>(
-        &self,
-        graph: &mut RenderGraph<Frame<S>>,
-        view: &View,
-        targets: &SceneTargets,
-        exposure: BufferId,
-    ) {
+/// `tonemap` of a view: its (post-processed) targets and exposure buffer
+/// in, nothing out.
+impl<S: 'static> Declare<S> for Tonemap {
+    type Inputs<'a> = (&'a SceneTargets, BufferId);
+    type Outputs = ();
+
+    /// Declares `tonemap` for the view: its radiance, exposed by
+    /// `exposure`, into its display image.
+    fn declare(&mut self, at: ViewGraph<'_, S>, (targets, exposure): Self::Inputs<'_>) -> Result<()> {
+        let (graph, view) = (at.graph, at.view);
         let pipeline = self.pipeline.clone();
         let (radiance, display, width, height) = (targets.radiance, targets.display, targets.width, targets.height);
         let mut pass = graph.pass(&pass_name("tonemap", &view.name));
@@ -65,5 +67,6 @@ impl Tonemap {
             };
             ctx.dispatch(&pipeline, &push, [width.div_ceil(8), height.div_ceil(8), 1])
         });
+        Ok(())
     }
 }

@@ -95,13 +95,7 @@ pub(super) fn declare_shadows(
             terrain.declare_shadow(ctx, graph, (k, view), target)?;
         }
         if let Some(casters) = &mut casters {
-            let at = ViewGraph {
-                ctx,
-                graph: &mut *graph,
-                index: k,
-                view,
-            };
-            casters.declare(at, target)?;
+            casters.declare(ViewGraph::new(ctx, graph, (k, view)), target)?;
         }
     }
     Ok(Some(SunShadows { maps, points: casters }))

@@ -62,7 +62,9 @@ use crate::terrain::{Terrain, TerrainFrame, TerrainTexturing};
 use crate::texturing::generation::{TextureAtlas, TextureFrame, TextureFrameStats, TextureStreaming};
 use crate::texturing::page_table::PageTable;
 use crate::view::rig::validate_views;
-use crate::view::{declare_views, frame_slots, Frame, FrameLighting, Lighting, LightingSetup, SceneTargets, View};
+use crate::view::{
+    declare_views, frame_slots, Declare, Frame, FrameLighting, Lighting, LightingSetup, SceneTargets, View, ViewGraph,
+};
 use crate::vulkan::{Context, FrameRing, FRAMES_IN_FLIGHT};
 
 /// The default [`RenderSettings::readback_slots`]: one frame being read,
@@ -681,19 +683,19 @@ fn declare_outputs(
     settings: &RenderSettings,
     (outputs, slots): (Outputs, usize),
 ) -> Result<Vec<Readback>> {
-    let exposure = ExposureMeter::new(ctx)?;
-    let tonemap = Tonemap::new(ctx)?;
+    let mut exposure = ExposureMeter::new(ctx)?;
+    let mut tonemap = Tonemap::new(ctx)?;
     let resolve = Resolve::new(ctx)?;
     let blur = match settings.motion_blur {
         Some(s) if s.shutter_s > 0.0 => Some((MotionBlur::new(ctx)?, s)),
         _ => None,
     };
     let mut readback = Vec::new();
-    for ((view, rendered), chain) in views.iter().zip(targets).zip(chains) {
+    for (index, ((view, rendered), chain)) in views.iter().zip(targets).zip(chains).enumerate() {
         let blur = blur.as_ref().map(|(b, s)| (b, *s));
         let targets = chain.declare(graph, rendered, (&resolve, blur))?;
-        let exposure = exposure.declare(graph, view, &targets);
-        tonemap.declare(graph, view, &targets, exposure);
+        let exposure = exposure.declare(ViewGraph::new(ctx, graph, (index, view)), &targets)?;
+        tonemap.declare(ViewGraph::new(ctx, graph, (index, view)), (&targets, exposure))?;
         match Readback::declare(ctx, graph, view, &targets, (outputs, slots))? {
             Some(rb) => readback.push(rb),
             None => graph.keep(targets.display),

@@ -248,6 +248,18 @@ pub struct ViewGraph<'a, S> {
     pub view: &'a View,
 }
 
+impl<'a, S> ViewGraph<'a, S> {
+    /// Declaring into `graph` for view `index` (`view`).
+    pub fn new(ctx: &'a Context, graph: &'a mut RenderGraph<Frame<S>>, (index, view): (ViewIndex, &'a View)) -> Self {
+        ViewGraph {
+            ctx,
+            graph,
+            index,
+            view,
+        }
+    }
+}
+
 /// Declares `technique`'s passes of every view, view `k` with the `k`-th
 /// of `inputs`; returns each view's outputs.
 pub fn declare_views<'a, S, T: Declare<S>>(
@@ -263,13 +275,7 @@ pub fn declare_views<'a, S, T: Declare<S>>(
         let input = inputs
             .next()
             .ok_or_else(|| Error::Graph(format!("view {k} has no inputs to declare with")))?;
-        let at = ViewGraph {
-            ctx,
-            graph: &mut *graph,
-            index: k,
-            view,
-        };
-        outputs.push(technique.declare(at, input)?);
+        outputs.push(technique.declare(ViewGraph::new(ctx, graph, (k, view)), input)?);
     }
     Ok(outputs)
 }

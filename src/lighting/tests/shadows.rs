@@ -282,13 +282,8 @@ fn run(
     let target = shadows.declare_view(ctx, &mut graph, (0, &view)).expect("atlas");
     let mut point_shadows = renderer.as_ref().map(|r| PointShadows::new(r, &shadows));
     if let Some(p) = point_shadows.as_mut() {
-        let at = ViewGraph {
-            ctx,
-            graph: &mut graph,
-            index: 0,
-            view: &view,
-        };
-        p.declare(at, target).expect("points.shadow");
+        p.declare(ViewGraph::new(ctx, &mut graph, (0, &view)), target)
+            .expect("points.shadow");
     }
     declare_mesh_caster(ctx, &mut graph, with_box, target.atlas);
     let (probe_region, out) = declare_probe(ctx, &mut graph, probes.len(), target.atlas);
