@@ -20,6 +20,16 @@ pub const TERRAIN_WARP: SpirV = spirv!("terrain/warp.comp");
 pub const TERRAIN_DRAW_VERT: SpirV = spirv!("terrain/draw.vert");
 /// terrain.draw: fragment stage.
 pub const TERRAIN_DRAW_FRAG: SpirV = spirv!("terrain/draw.frag");
+/// terrain.raster_clear: empties the compute path's visibility buffer.
+pub const TERRAIN_RASTER_CLEAR: SpirV = spirv!("terrain/raster_clear.comp");
+/// terrain.raster: the compute path's rasterizer, one thread a triangle.
+pub const TERRAIN_RASTER: SpirV = spirv!("terrain/raster.comp");
+/// terrain.raster_big: the triangles terrain.raster lists, one workgroup each.
+pub const TERRAIN_RASTER_BIG: SpirV = spirv!("terrain/raster_big.comp");
+/// terrain.shade: the visibility buffer shaded per pixel.
+pub const TERRAIN_SHADE: SpirV = spirv!("terrain/shade.comp");
+/// terrain.depth: the depth buffer from the compute path's NDC depth.
+pub const TERRAIN_DEPTH_FRAG: SpirV = spirv!("terrain/depth.frag");
 /// Every full-screen pass (sky, points.normalize): one triangle covering the screen.
 pub const FULL_SCREEN_VERT: SpirV = spirv!("post/full_screen.vert");
 /// sky: analytic sky radiance.

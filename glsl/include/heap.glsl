@@ -10,6 +10,9 @@ layout(set = 0, binding = 0) uniform utexture2D g_utextures[];  // the same heap
 layout(set = 0, binding = 1, rgba32f) uniform image2D g_images_rgba32f[];
 layout(set = 0, binding = 1, rgba8) uniform image2D g_images_rgba8[];
 layout(set = 0, binding = 1, r32f) uniform image2D g_images_r32f[];
+layout(set = 0, binding = 1, rg32f) uniform image2D g_images_rg32f[];
+layout(set = 0, binding = 1, rgba16f) uniform image2D g_images_rgba16f[];
+layout(set = 0, binding = 1, rg32ui) uniform uimage2D g_uimages_rg32ui[];
 layout(set = 0, binding = 3) uniform sampler g_samplers[];
 
 #define SAMPLER_LINEAR_CLAMP 0

@@ -36,7 +36,10 @@ float shadow_cascade_pcf(uint lighting, uint i, vec3 p) {
         for (int x = -radius; x <= radius + 1; ++x) {
             float w = wy * max(extent - abs(float(x) - f.x), 0.0);
             ivec2 texel = clamp(ivec2(base) + ivec2(x, y), q0, q1);
-            float depth = texelFetch(sampler2D(g_textures[nonuniformEXT(sh.x)], g_samplers[SAMPLER_NEAREST_CLAMP]),
+            // sh.x is the view's atlas, uniform over the dispatch: no
+            // nonuniformEXT (lavapipe 25.0's compute shaders crash on a
+            // non-uniform texelFetch of a depth image).
+            float depth = texelFetch(sampler2D(g_textures[sh.x], g_samplers[SAMPLER_NEAREST_CLAMP]),
                                      texel, 0).r;
             lit += reference <= depth ? w : 0.0;
             total += w;

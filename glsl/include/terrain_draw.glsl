@@ -13,11 +13,4 @@ layout(push_constant) uniform Push {
     uint texturing_frame;  // storage handle of the frame's TerrainTexturing constants
 } pc;
 
-// TerrainTexturing.draw.x: what terrain.draw shows.
-const uint VIEW_SHADED = 0u;
-const uint VIEW_IMPORTANCE = 1u;
-const uint VIEW_DENSITY_RATIO = 2u;
-const uint VIEW_SPLIT_OCTAVE = 3u;
-const uint VIEW_WIREFRAME = 4u;
-
 #endif

@@ -58,6 +58,7 @@ use crate::post::tonemap::Tonemap;
 use crate::profile::FrameProfile;
 use crate::surface::gpu_layout::TexturingMode;
 use crate::terrain::geometry_image::TerrainSettings;
+use crate::terrain::visibility::RasterPath;
 use crate::terrain::{Terrain, TerrainFrame, TerrainTexturing};
 use crate::texturing::generation::{TextureAtlas, TextureFrame, TextureFrameStats, TextureStreaming};
 use crate::texturing::page_table::PageTable;
@@ -107,6 +108,9 @@ pub struct RenderSettings {
     pub texturing: TexturingMode,
     /// Tile streaming of [`TexturingMode::Atlas`].
     pub texture_streaming: TextureStreaming,
+    /// Which rasterizer draws the terrain (`--raster`): the hardware's, or
+    /// compute shaders into a visibility buffer ([`RasterPath`]).
+    pub raster: RasterPath,
     /// The sun's cascaded shadow maps.
     pub shadows: ShadowSettings,
     /// Where the sky-light bake is cached (None: baked every time). Optional:
@@ -134,6 +138,7 @@ impl RenderSettings {
             points: SplatSettings::default(),
             texturing: TexturingMode::default(),
             texture_streaming: TextureStreaming::for_image(width, height),
+            raster: RasterPath::default(),
             shadows: ShadowSettings {
                 atlas_size: 2048,
                 ..ShadowSettings::default()
@@ -538,6 +543,12 @@ impl Renderer {
         })
     }
 
+    /// The rasterizer the terrain is drawn with ([`RenderSettings::raster`]
+    /// resolved on this device; hardware without terrain).
+    pub fn raster_path(&self) -> RasterPath {
+        (self.techniques.terrain.as_ref()).map_or(RasterPath::Hardware, |t| t.raster_path())
+    }
+
     /// The texture page table of the last recorded frame (which atlas tile
     /// colours which part of the terrain); None unless texturing from the atlas.
     pub fn texture_page_table(&self) -> Result<Option<PageTable>> {
@@ -748,6 +759,10 @@ fn warped_terrain(
     };
     let field = Arc::new(scene.heights.clone());
     let mut terrain = Terrain::new(ctx, graph, field, settings.terrain, &texturing)?;
+    if settings.raster.uses_compute(ctx)? {
+        // The points depth-test against the terrain's depth buffer.
+        terrain.use_compute_raster(ctx, !scene.points.is_empty())?;
+    }
     for (k, view) in views.iter().enumerate() {
         terrain.declare_warp(ctx, graph, (k, view))?;
     }

@@ -19,6 +19,7 @@ pub mod shading;
 pub mod shadow;
 pub mod sketch_map;
 pub mod technique;
+pub mod visibility;
 pub mod warp;
 pub mod zoom;
 

@@ -16,7 +16,7 @@ use crate::graph::{
 };
 use crate::shaders;
 use crate::surface::gpu_layout::{LayerTable, TexturingFrame};
-use crate::surface::input_maps::InputMaps;
+use crate::surface::input_maps::{InputMaps, MapBindings};
 use crate::terrain::geometry_image::VERTEX_STRIDE;
 use crate::terrain::TerrainFrame;
 use crate::texturing::generation::AtlasBindings;
@@ -60,6 +60,13 @@ pub struct DrawPass {
     pub vertices: BufferId,
     pub indices: BufferId,
     pub index_count: u32,
+    pub surface: SurfaceInputs,
+}
+
+/// What the terrain's surface shading reads besides the geometry
+/// (`glsl/include/terrain_shade.glsl`), in either path.
+#[derive(Clone, Debug)]
+pub struct SurfaceInputs {
     /// Noise tile and sketch atlas (sampled by direct texturing).
     pub noise: ImageId,
     pub heights: ImageId,
@@ -73,6 +80,65 @@ pub struct DrawPass {
     pub atlas: Option<AtlasBindings>,
 }
 
+/// The bindings of [`SurfaceInputs`] on a shading pass.
+pub struct SurfaceBindings {
+    noise: Binding,
+    heights: Binding,
+    table: Binding,
+    maps: MapBindings,
+    constants: Binding,
+    atlas: Option<AtlasSamples>,
+    lighting: Binding,
+}
+
+/// The heap handles the surface shading reads (`TerrainParams`).
+pub struct SurfaceHandles {
+    pub lighting: u32,
+    pub noise_tile: u32,
+    pub texturing_frame: u32,
+}
+
+impl SurfaceInputs {
+    /// Declares that `builder` (shading at `stage`) reads the surface
+    /// inputs and the view's lighting (`targets`).
+    pub fn read_in<P: 'static>(
+        &self,
+        builder: &mut PassBuilder<'_, P>,
+        targets: &SceneTargets,
+        stage: Stage,
+    ) -> SurfaceBindings {
+        SurfaceBindings {
+            noise: builder.sample(self.noise, stage),
+            heights: builder.sample(self.heights, stage),
+            table: self.layers.read_in(builder, stage),
+            maps: self.maps.sample_in(builder, stage),
+            constants: builder.upload(self.constants, stage),
+            atlas: (self.atlas.as_ref()).map(|atlas| AtlasSamples::declare(builder, atlas, stage)),
+            lighting: targets.lighting.read_in(builder, stage).constants,
+        }
+    }
+
+    /// Writes the frame's layers table and texturing constants (with the
+    /// handles of `bindings`) while recording; returns what the shaders
+    /// take in their push constants.
+    pub fn write(&self, ctx: &mut PassContext<'_>, bindings: &SurfaceBindings) -> Result<SurfaceHandles> {
+        let b = bindings;
+        self.layers.write(ctx, b.table, &b.maps)?;
+        let mut texturing = self.texturing;
+        texturing.handles[..3].copy_from_slice(&[ctx.handle(b.table)?, ctx.handle(b.heights)?, ctx.handle(b.noise)?]);
+        texturing.maps = b.maps.handles(ctx)?;
+        if let Some(atlas) = &b.atlas {
+            atlas.set_handles(ctx, &mut texturing)?;
+        }
+        ctx.write_upload_pod(b.constants, &texturing)?;
+        Ok(SurfaceHandles {
+            lighting: ctx.handle(b.lighting)?,
+            noise_tile: ctx.handle(b.noise)?,
+            texturing_frame: ctx.handle(b.constants)?,
+        })
+    }
+}
+
 /// What `terrain.draw` samples of the texture atlas.
 struct AtlasSamples {
     page_table: Binding,
@@ -81,9 +147,8 @@ struct AtlasSamples {
 }
 
 impl AtlasSamples {
-    /// Declares that `builder` reads `atlas`.
-    fn declare<P: 'static>(builder: &mut PassBuilder<'_, P>, atlas: &AtlasBindings) -> AtlasSamples {
-        let stage = Stage::Fragment;
+    /// Declares that `builder` reads `atlas` at `stage`.
+    fn declare<P: 'static>(builder: &mut PassBuilder<'_, P>, atlas: &AtlasBindings, stage: Stage) -> AtlasSamples {
         AtlasSamples {
             page_table: builder.upload(atlas.page_table, stage),
             colors: atlas.colors.iter().map(|&image| builder.sample(image, stage)).collect(),
@@ -156,13 +221,7 @@ pub fn declare_draw_pass<S: Provides<TerrainFrame> + 'static>(
         .graphics()
         .read(pass.vertices, BufferAccess::Vertex)
         .read(pass.indices, BufferAccess::Index);
-    let noise = builder.sample(pass.noise, Stage::Fragment);
-    let heights = builder.sample(pass.heights, Stage::Fragment);
-    let table = pass.layers.read_in(&mut builder, Stage::Fragment);
-    let maps = pass.maps.sample_in(&mut builder, Stage::Fragment);
-    let constants = builder.upload(pass.constants, Stage::Graphics);
-    let atlas = (pass.atlas.as_ref()).map(|atlas| AtlasSamples::declare(&mut builder, atlas));
-    let lighting = targets.lighting.read_in(&mut builder, Stage::Fragment).constants;
+    let surface = pass.surface.read_in(&mut builder, targets, Stage::Fragment);
     let load = LoadOp::Load;
     builder
         .pipeline(&pipeline)
@@ -174,18 +233,11 @@ pub fn declare_draw_pass<S: Provides<TerrainFrame> + 'static>(
         .depth(targets.depth, Some(1.0))
         .record(move |ctx, frame| {
             let prepared = frame.prepared::<crate::terrain::TerrainFrame>()?.view(pass.view)?.draw;
-            pass.layers.write(ctx, table, &maps)?;
-            let mut texturing = pass.texturing;
-            texturing.handles[..3].copy_from_slice(&[ctx.handle(table)?, ctx.handle(heights)?, ctx.handle(noise)?]);
-            texturing.maps = maps.handles(ctx)?;
-            if let Some(atlas) = &atlas {
-                atlas.set_handles(ctx, &mut texturing)?;
-            }
-            ctx.write_upload_pod(constants, &texturing)?;
+            let handles = pass.surface.write(ctx, &surface)?;
             let push = TerrainDrawPush {
-                lighting: [ctx.handle(lighting)?, 0, 0, 0],
-                noise_tile: ctx.handle(noise)?,
-                texturing_frame: ctx.handle(constants)?,
+                lighting: [handles.lighting, 0, 0, 0],
+                noise_tile: handles.noise_tile,
+                texturing_frame: handles.texturing_frame,
                 ..prepared
             };
             let (vertices, indices) = (ctx.buffer(pass.vertices)?, ctx.buffer(pass.indices)?);

@@ -17,7 +17,8 @@ use crate::surface::input_maps::InputMaps;
 use crate::surface::layers::LayerTree;
 use crate::terrain::geometry_image::{declare_warp_pass, GeometryImage, TerrainSettings, WarpPass};
 use crate::terrain::lod::LodFrame;
-use crate::terrain::shading::{declare_draw_pass, DrawPass, TerrainDrawPush};
+use crate::terrain::shading::{declare_draw_pass, DrawPass, SurfaceInputs, TerrainDrawPush};
+use crate::terrain::visibility::{ComputePass, ComputeRaster, ComputeView, RasterPath};
 use crate::texturing::generation::{AtlasBindings, GenerationInputs};
 use crate::view::{
     pass_name, per_view, Declare, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewGraph, ViewIndex,
@@ -41,8 +42,16 @@ struct TerrainViewState {
     /// The texturing constants `terrain.draw` writes and reads (per frame).
     constants: UploadRegion,
     vertices: BufferId,
+    /// The compute path's view constants (per frame; compute path only).
+    compute: Option<UploadRegion>,
     /// Whether `terrain.draw` of the view was declared.
     drawn: bool,
+}
+
+/// The compute path's pipelines and whether it writes the depth buffer.
+struct ComputePath {
+    raster: ComputeRaster,
+    write_depth: bool,
 }
 
 /// The terrain: persistent GPU state, `terrain.warp` and `terrain.draw` per
@@ -59,6 +68,8 @@ pub struct Terrain {
     views: Vec<TerrainViewState>,
     /// The previous frame's prepared views, reused ([`Technique::recycle`]).
     spare: Vec<TerrainViewFrame>,
+    /// None: the hardware path (`terrain.draw`).
+    compute: Option<ComputePath>,
 }
 
 /// What the terrain passes read this frame.
@@ -109,7 +120,31 @@ impl Terrain {
             maps,
             views: Vec::new(),
             spare: Vec::new(),
+            compute: None,
         })
+    }
+
+    /// Rasterizes and shades the terrain in compute shaders (the visibility
+    /// buffer, [`crate::terrain::visibility`]) instead of `terrain.draw`;
+    /// `write_depth`: later passes depth-test against it. Before any
+    /// [`Terrain::declare_warp`].
+    pub fn use_compute_raster(&mut self, ctx: &Context, write_depth: bool) -> Result<()> {
+        if !self.views.is_empty() {
+            return Err(Error::Graph("terrain: the raster path is chosen before the views are declared".into()));
+        }
+        self.compute = Some(ComputePath {
+            raster: ComputeRaster::new(ctx)?,
+            write_depth,
+        });
+        Ok(())
+    }
+
+    /// The rasterizer the terrain is drawn with (for profiles).
+    pub fn raster_path(&self) -> RasterPath {
+        match self.compute {
+            Some(_) => RasterPath::Compute,
+            None => RasterPath::Hardware,
+        }
     }
 
     /// What the texture atlas's generation passes read.
@@ -150,12 +185,17 @@ impl Terrain {
             push: self.geometry.warp_push(),
         };
         declare_warp_pass(ctx, graph, &pass_name("terrain.warp", &view.name), pass)?;
+        let compute = self.compute.as_ref().map(|_| {
+            let name = pass_name("terrain compute view", &view.name);
+            graph.upload_region(&name, std::mem::size_of::<ComputeView>() as u64)
+        });
         self.views.push(TerrainViewState {
             index,
             lod: LodFrame::default(),
             warp,
             constants,
             vertices,
+            compute,
             drawn: false,
         });
         Ok(())
@@ -243,11 +283,7 @@ impl<S: Provides<TerrainFrame> + 'static> Declare<S> for Terrain {
             .ok_or_else(|| Error::Graph(format!("terrain.draw of view {index} before its terrain.warp")))?;
         state.drawn = true;
         let side = self.geometry.settings.grid_side;
-        let pass = DrawPass {
-            view: index,
-            vertices: state.vertices,
-            indices: self.indices,
-            index_count: (side - 1) * (side - 1) * 6,
+        let surface = SurfaceInputs {
             noise: self.noise,
             heights: self.atlas,
             layers: self.layers.clone(),
@@ -255,6 +291,23 @@ impl<S: Provides<TerrainFrame> + 'static> Declare<S> for Terrain {
             constants: state.constants,
             texturing,
             atlas: atlas.cloned(),
+        };
+        if let (Some(path), Some(constants)) = (&self.compute, state.compute) {
+            let pass = ComputePass {
+                vertices: state.vertices,
+                grid_side: side,
+                constants,
+                surface,
+                write_depth: path.write_depth,
+            };
+            return path.raster.declare(ctx, graph, view, pass, targets);
+        }
+        let pass = DrawPass {
+            view: index,
+            vertices: state.vertices,
+            indices: self.indices,
+            index_count: (side - 1) * (side - 1) * 6,
+            surface,
         };
         declare_draw_pass(ctx, graph, &pass_name("terrain.draw", &view.name), pass, targets)
     }
@@ -298,6 +351,10 @@ impl Technique for Terrain {
                 noise_tile: 0,
                 texturing_frame: 0,
             };
+            if let Some(region) = state.compute {
+                let constants = ComputeView::new(view, settings.grid_side, &draw);
+                frame.uploads.write(region, bytemuck::bytes_of(&constants))?;
+            }
             views.push(TerrainViewFrame {
                 view: state.index,
                 draw,

@@ -4,3 +4,4 @@
 mod ground;
 mod terrain;
 mod warp;
+mod compute_raster;
