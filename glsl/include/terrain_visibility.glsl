@@ -51,9 +51,12 @@ vec4 grid_normal(uint vertices, uint i) {
 }
 
 // Clip coordinates of vertex `i` (eye-relative, so large worlds keep precision).
+// `precise`: a vertex shared by several triangles must land on the same
+// fixed-point position in each (no contraction that differs by call site).
 vec4 grid_clip(ComputeView view, uint vertices, uint i) {
-    vec3 rel = grid_position(vertices, i).xyz - view.eye.xyz;
-    return view.view_proj_rel * vec4(rel, 1.0);
+    precise vec3 rel = grid_position(vertices, i).xyz - view.eye.xyz;
+    precise vec4 clip = view.view_proj_rel * vec4(rel, 1.0);
+    return clip;
 }
 
 // Fixed-point screen position (SUBPIXEL_BITS below the pixel) of a clip
@@ -65,7 +68,8 @@ const float SUBPIXELS = 256.0;
 const float FIXED_LIMIT = 1048576.0;
 
 vec2 screen_position(vec4 clip, vec2 size) {
-    return (clip.xy / clip.w * 0.5 + 0.5) * size;
+    precise vec2 screen = (clip.xy / clip.w * 0.5 + 0.5) * size;
+    return screen;
 }
 
 i64vec2 fixed_point(vec2 screen) {
@@ -119,6 +123,17 @@ bool setup_fixed(vec4 c[3], vec2 size, out FixedTriangle tri) {
     tri.bias[2] = edge_bias(a, b);
     tri.area = area;
     return true;
+}
+
+// The pixels whose centres may lie in `tri`, clamped to the `size` image:
+// from the fixed-point vertices themselves (the float positions round by
+// up to half a sub-pixel, and a box from them could drop an edge's pixel).
+void fixed_bounds(FixedTriangle tri, ivec2 size, out ivec2 first, out ivec2 last) {
+    i64vec2 lo = min(tri.v[0], min(tri.v[1], tri.v[2])) - int64_t(SUBPIXELS / 2.0);
+    i64vec2 hi = max(tri.v[0], max(tri.v[1], tri.v[2])) - int64_t(SUBPIXELS / 2.0);
+    // ceil(lo / 256) and floor(hi / 256) by arithmetic shifts.
+    first = max(ivec2(-((-lo) >> SUBPIXEL_BITS)), ivec2(0));
+    last = min(ivec2(hi >> SUBPIXEL_BITS), size - 1);
 }
 
 // The view depth of the triangle at pixel `pixel` if it covers the pixel's

@@ -46,19 +46,23 @@ void main() {
         hi = max(s0, max(s1, s2));
         big = any(lessThan(lo, vec2(-FIXED_LIMIT))) || any(greaterThan(hi, size + FIXED_LIMIT));
     }
-    // Pixels whose centres may lie inside: centre x + 0.5 in [lo.x, hi.x].
-    ivec2 first = max(ivec2(ceil(lo - 0.5)), ivec2(0));
-    ivec2 last = min(ivec2(floor(hi - 0.5)), ivec2(view.size.xy) - 1);
-    if (!big && (any(lessThan(last, first)))) {
-        return;
-    }
-    if (big || uint(last.x - first.x + 1) * uint(last.y - first.y + 1) > BIG_PIXELS) {
+    if (big) {
         uint slot = atomicAdd(g_big_triangles[pc.handles.w].count, 1u);
         g_big_triangles[pc.handles.w].ids[slot] = t;
         return;
     }
     FixedTriangle tri;
     if (!setup_fixed(c, size, tri)) {
+        return;
+    }
+    ivec2 first, last;
+    fixed_bounds(tri, ivec2(view.size.xy), first, last);
+    if (any(lessThan(last, first))) {
+        return;
+    }
+    if (uint(last.x - first.x + 1) * uint(last.y - first.y + 1) > BIG_PIXELS) {
+        uint slot = atomicAdd(g_big_triangles[pc.handles.w].count, 1u);
+        g_big_triangles[pc.handles.w].ids[slot] = t;
         return;
     }
     for (int y = first.y; y <= last.y; ++y) {

@@ -75,6 +75,9 @@ void main() {
         }
         ivec2 first = max(ivec2(ceil(clamp(lo, vec2(-1.0), size) - 0.5)), ivec2(0));
         ivec2 last = min(ivec2(floor(clamp(hi, vec2(-1.0), size) - 0.5)), ivec2(view.size.xy) - 1);
+        if (fixed_path) {
+            fixed_bounds(tri, ivec2(view.size.xy), first, last);
+        }
         if (any(lessThan(last, first))) {
             continue;
         }

@@ -339,6 +339,13 @@ pub struct TerrainArgs {
     /// height-sample spacing (0.15: 15 cm for 1 m samples).
     #[arg(long = "detail-amplitude", default_value_t = 0.15, value_name = "FRACTION")]
     pub detail_amplitude: f32,
+    /// Which rasterizer draws the terrain: compute shaders into a visibility
+    /// buffer, then one shading pass per pixel (compute; needs the device
+    /// feature shaderBufferInt64Atomics), the hardware rasterizer
+    /// (hardware, the text's path), or compute where the device has the
+    /// feature (auto).
+    #[arg(long, value_enum, default_value = "hardware", value_name = "PATH")]
+    pub raster: RasterArg,
     /// Geometry-image side in vertices (the terrain mesh has GRID² vertices).
     #[arg(long, default_value_t = 512, value_name = "VERTICES", value_parser = clap::value_parser!(u32).range(2..))]
     pub grid: u32,
@@ -399,6 +406,17 @@ pub enum RowsArg {
     SouthUp,
     /// Image row 0 is the north edge (rows flipped).
     NorthUp,
+}
+
+/// The terrain's rasterizer (`--raster`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RasterArg {
+    /// Compute where the device has 64-bit buffer atomics, else hardware.
+    Auto,
+    /// The visibility buffer and deferred shading in compute shaders.
+    Compute,
+    /// The hardware rasterizer.
+    Hardware,
 }
 
 /// Terrain colouring.

@@ -123,9 +123,11 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     let device = ctx.info().name.clone();
     let mut wall = vec![Duration::ZERO; args.frames as usize];
     let texture_stats;
+    let raster;
     let profiles = {
         let settings = render_settings(&args.scene, &scene, &specs, staging.is_some())?;
         let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
+        raster = renderer.raster_path().name();
         // Every frame's profile is reported (the history is bounded by default).
         renderer.set_profile_history(args.frames as usize);
         let bar = ProgressBar::new(u64::from(args.frames));
@@ -178,6 +180,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     check_validation(report)?;
     let run = FlyRun {
         device: &device,
+        raster,
         profiles: &profiles,
         wall: &wall,
         writes: staging.is_some(),
@@ -194,6 +197,8 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
 /// time, and whether frames were written.
 struct FlyRun<'a> {
     device: &'a str,
+    /// The terrain's rasterizer.
+    raster: &'static str,
     profiles: &'a [FrameProfile],
     wall: &'a [Duration],
     writes: bool,
@@ -243,6 +248,7 @@ fn report_fly(
         let (passes, frame) = summarize(profiles);
         let value = serde_json::json!({
             "device": run.device,
+            "raster": run.raster,
             "frames": profiles.len(),
             "gpu_ms": {"min": gmin, "median": gmed, "max": gmax, "per_frame": gpu},
             "wall_ms": {"min": wmin, "median": wmed, "max": wmax, "first": wall_ms[0]},

@@ -198,6 +198,11 @@ fn render_settings(args: &SceneArgs, scene: &Scene, views: &[ViewSpec], readback
         args::TexturingArg::Atlas => TexturingMode::Atlas,
     };
     settings.texture_streaming = texture_streaming(args, views)?;
+    settings.raster = match args.terrain.raster {
+        args::RasterArg::Auto => alpenglow::RasterPath::Auto,
+        args::RasterArg::Compute => alpenglow::RasterPath::Compute,
+        args::RasterArg::Hardware => alpenglow::RasterPath::Hardware,
+    };
     settings.lighting = Some(lighting);
     // Only a terrain is baked: no cache (nor a warning about it) without one.
     settings.cache_dir = scene
@@ -413,9 +418,11 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     let point_stats;
     let texture_stats;
     let settle_frames;
+    let raster;
     let profiles = {
         let settings = render_settings(&args.scene, &scene, &specs, false)?;
         let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
+        raster = renderer.raster_path();
         // Every frame's profile is reported (the history is bounded by default).
         renderer.set_profile_history((args.warmup + args.frames + MAX_SETTLE_FRAMES) as usize);
         // A still view: first every texture tile (untimed), then warm-up and timed frames.
@@ -476,6 +483,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
         let value = serde_json::json!({
             "textures": textures,
             "device": device,
+            "raster": raster.name(),
             "width": args.scene.width,
             "height": args.scene.height,
             "views": specs.iter().map(|v| serde_json::json!({"name": v.name, "width": v.width, "height": v.height})).collect::<Vec<_>>(),
