@@ -21,7 +21,7 @@
  * Version of the C ABI: bumped whenever a struct's layout or a function's
  * signature changes incompatibly.
  */
-#define AG_ABI_VERSION 1
+#define AG_ABI_VERSION 2
 
 /**
  * What a function of the C API returns. `AG_OK` (0) is success; errors
@@ -107,6 +107,11 @@ typedef struct ag_context_options {
 } ag_context_options;
 
 /**
+ * Which rasterizer draws the terrain (`ag_settings.raster`). Values of `ag_raster`.
+ */
+typedef uint32_t ag_raster;
+
+/**
  * How a renderer renders. Start from `ag_settings_default()` and change
  * fields: later ABI versions only add fields at the end.
  */
@@ -135,6 +140,10 @@ typedef struct ag_settings {
    * until this many later frames were submitted.
    */
   uint32_t readback_slots;
+  /**
+   * Which rasterizer draws the terrain: `AG_RASTER_*` (ABI 2).
+   */
+  ag_raster raster;
 } ag_settings;
 
 /**
@@ -257,6 +266,22 @@ typedef struct ag_heightmap_options {
  * Motion from the previous frame in pixels, 2 × float per pixel (+x right, +y down).
  */
 #define AG_OUTPUT_MOTION 7
+
+/**
+ * The hardware rasterizer (the default).
+ */
+#define AG_RASTER_HARDWARE 0
+
+/**
+ * Compute shaders into a visibility buffer, then one shading pass per
+ * pixel; needs the device feature shaderBufferInt64Atomics.
+ */
+#define AG_RASTER_COMPUTE 1
+
+/**
+ * Compute where the device has the feature, else hardware.
+ */
+#define AG_RASTER_AUTO 2
 
 #ifdef __cplusplus
 extern "C" {

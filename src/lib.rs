@@ -216,9 +216,9 @@ pub use renderer::RenderSettings as Settings;
 pub use renderer::Renderer;
 pub use surface::gpu_layout::TexturingMode;
 pub use terrain::geometry_image::{TerrainSettings, TerrainView};
-pub use terrain::visibility::RasterPath;
 pub use terrain::lod::{ImportanceFactors, LodMode, LodSettings};
 pub use terrain::sketch_map::SketchAlignment;
+pub use terrain::visibility::RasterPath;
 pub use texturing::generation::TextureStreaming;
 pub use texturing::streaming::MAX_TILE_BUDGET;
 

@@ -45,13 +45,14 @@ pub unsafe extern "C" fn ag_renderer_create(
             // SAFETY: not NULL; the caller guarantees a valid struct.
             false => *unsafe { arg(settings, "settings") }?,
         };
-        let rust = adapter::render_settings(
+        let mut rust = adapter::render_settings(
             settings.width,
             settings.height,
             settings.msaa,
             settings.terrain_detail,
             settings.readback_slots,
         );
+        rust.raster = crate::types::raster(settings.raster)?;
         let pipe = FramePipe::new(&ctx.ctx, &scene.scene, rust)?;
         let renderer = ag_renderer {
             sizes: pipe.view_sizes(),

@@ -8,7 +8,7 @@ use crate::status::{Failure, Outcome};
 
 /// Version of the C ABI: bumped whenever a struct's layout or a function's
 /// signature changes incompatibly.
-pub const AG_ABI_VERSION: u32 = 1;
+pub const AG_ABI_VERSION: u32 = 2;
 
 /// Which output of a frame (`ag_renderer_output_bytes`). Values of `ag_output`.
 #[allow(non_camel_case_types)]
@@ -35,6 +35,30 @@ pub const AG_OUTPUT_MOTION: ag_output = 7;
 pub(crate) fn output(value: ag_output) -> Outcome<Output> {
     (Output::ALL.get(value as usize).copied())
         .ok_or_else(|| Failure::invalid("output", format!("{value}; expected 0 to {}", Output::ALL.len() - 1)))
+}
+
+/// Which rasterizer draws the terrain (`ag_settings.raster`). Values of `ag_raster`.
+#[allow(non_camel_case_types)]
+pub type ag_raster = u32;
+/// The hardware rasterizer (the default).
+pub const AG_RASTER_HARDWARE: ag_raster = 0;
+/// Compute shaders into a visibility buffer, then one shading pass per
+/// pixel; needs the device feature shaderBufferInt64Atomics.
+pub const AG_RASTER_COMPUTE: ag_raster = 1;
+/// Compute where the device has the feature, else hardware.
+pub const AG_RASTER_AUTO: ag_raster = 2;
+
+/// The library's rasterizer of a C value.
+pub(crate) fn raster(value: ag_raster) -> Outcome<alpenglow::RasterPath> {
+    match value {
+        AG_RASTER_HARDWARE => Ok(alpenglow::RasterPath::Hardware),
+        AG_RASTER_COMPUTE => Ok(alpenglow::RasterPath::Compute),
+        AG_RASTER_AUTO => Ok(alpenglow::RasterPath::Auto),
+        _ => Err(Failure::invalid(
+            "raster",
+            format!("{value}; expected 0 (hardware), 1 (compute) or 2 (auto)"),
+        )),
+    }
 }
 
 /// A pinhole camera looking from `eye` at `target`, world coordinates in
@@ -92,6 +116,8 @@ pub struct ag_settings {
     /// slots, 1 to 16; 0: the library's default (3). A ticket can be read
     /// until this many later frames were submitted.
     pub readback_slots: u32,
+    /// Which rasterizer draws the terrain: `AG_RASTER_*` (ABI 2).
+    pub raster: ag_raster,
 }
 
 /// The default settings: 640×360, no anti-aliasing, terrain detail on,
@@ -105,6 +131,7 @@ pub extern "C" fn ag_settings_default() -> ag_settings {
         terrain_detail: true,
         settle_frames: 64,
         readback_slots: 0,
+        raster: AG_RASTER_HARDWARE,
     }
 }
 

@@ -278,3 +278,53 @@ fn no_buffers() -> ag_frame_buffers {
         motion: none,
     }
 }
+
+/// `ag_settings.raster`: an unknown value is an invalid argument naming
+/// it; the compute path (lavapipe has 64-bit buffer atomics) renders the
+/// terrain's depth under validation.
+#[test]
+fn the_raster_setting_is_checked_and_the_compute_path_renders() {
+    let mut ctx = null_mut();
+    let options = ag_context_options {
+        validation: true,
+        device: null(),
+    };
+    // SAFETY (every call below): valid options and structs, live handles,
+    // writable outs, buffers as long as their sizes.
+    unsafe {
+        let status = ag_context_create(&options, &mut ctx);
+        assert_eq!(status, ag_status::AG_OK, "{}", last_error());
+        let heights = hills(33, 25);
+        let mut scene = null_mut();
+        let status = ag_scene_from_heights(heights.as_ptr(), 33, 25, 30.0, 30.0, &mut scene);
+        assert_eq!(status, ag_status::AG_OK, "{}", last_error());
+        let mut settings = ag_settings_default();
+        (settings.width, settings.height, settings.raster) = (32, 24, 9);
+        let mut renderer = null_mut();
+        let status = ag_renderer_create(ctx, scene, &settings, &mut renderer);
+        expect(status, ag_status::AG_ERROR_INVALID_ARGUMENT, &["raster", "9"]);
+        settings.raster = AG_RASTER_COMPUTE;
+        let status = ag_renderer_create(ctx, scene, &settings, &mut renderer);
+        assert_eq!(status, ag_status::AG_OK, "{}", last_error());
+        let mut camera = std::mem::MaybeUninit::<ag_camera>::uninit();
+        assert_eq!(ag_scene_default_camera(scene, camera.as_mut_ptr()), ag_status::AG_OK);
+        let camera = camera.assume_init();
+        let mut depth = vec![0f32; 32 * 24];
+        let mut buffers = no_buffers();
+        buffers.depth = ag_buffer {
+            data: depth.as_mut_ptr().cast(),
+            bytes: depth.len() * 4,
+        };
+        let status = ag_renderer_render(renderer, &camera, 1, &buffers, 1);
+        assert_eq!(status, ag_status::AG_OK, "{}", last_error());
+        assert!(
+            depth.iter().filter(|d| d.is_finite()).count() > 100,
+            "terrain in the compute path"
+        );
+        ag_renderer_destroy(renderer);
+        ag_scene_destroy(scene);
+        let mut messages = u64::MAX;
+        let status = ag_context_destroy(ctx, &mut messages);
+        assert_eq!((status, messages), (ag_status::AG_OK, 0), "{}", last_error());
+    }
+}

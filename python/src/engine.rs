@@ -19,8 +19,9 @@ use alpenglow::files::{encode_exr_height, encode_exr_samples, encode_png_rgba8, 
 pub use alpenglow::tools::solar::{parse_date, parse_time, solar_position, Clock};
 pub use alpenglow::{
     Camera, Context, ContextOptions, DeviceSelector, Distortion, Error, Exposure, FrameImages, HeightField,
-    HeightmapOptions, Intrinsics, Lighting, ProceduralTerrain, Renderer, Result, Rig, RowOrder, Scene, Settings,
-    ShadowMode, SkyLightMode, SkyModel, SunPosition, TerrainModel, TexturingMode, VegetationOptions, ViewSpec,
+    HeightmapOptions, Intrinsics, Lighting, ProceduralTerrain, RasterPath, Renderer, Result, Rig, RowOrder, Scene,
+    Settings, ShadowMode, SkyLightMode, SkyModel, SunPosition, TerrainModel, TexturingMode, VegetationOptions,
+    ViewSpec,
 };
 use alpenglow::{FrameData, Output, Ticket as RingTicket, ViewData};
 

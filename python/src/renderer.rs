@@ -22,6 +22,8 @@ use crate::{arg_err, invalid, lib_err};
 /// `msaa` (1, 2, 4, 8, 16 samples per pixel), `terrain_detail`
 /// (procedural displacement and bump mapping), `grid` (the terrain's
 /// geometry-image side), `texturing` ("atlas", "direct", "classic"),
+/// `raster` ("hardware", "compute": a visibility buffer in compute
+/// shaders, "auto": compute where the device can),
 /// `lighting` (a `Lighting`; default: the scene's), `cache_dir` (where the
 /// sky-light bake is cached), `readback_slots` (frames that can be
 /// submitted before the oldest unread one is lost; default 3).
@@ -41,6 +43,18 @@ fn texturing(name: &str) -> PyResult<engine::TexturingMode> {
         _ => Err(invalid(
             "texturing",
             format!("{name:?}; expected \"atlas\", \"direct\" or \"classic\""),
+        )),
+    }
+}
+
+fn raster(name: &str) -> PyResult<engine::RasterPath> {
+    match name {
+        "hardware" => Ok(engine::RasterPath::Hardware),
+        "compute" => Ok(engine::RasterPath::Compute),
+        "auto" => Ok(engine::RasterPath::Auto),
+        _ => Err(invalid(
+            "raster",
+            format!("{name:?}; expected \"hardware\", \"compute\" or \"auto\""),
         )),
     }
 }
@@ -122,7 +136,7 @@ impl Renderer {
 #[pymethods]
 impl Renderer {
     #[new]
-    #[pyo3(signature = (ctx, scene, width = 640, height = 360, *, rig = None, intrinsics = None, distortion = None, msaa = 1, terrain_detail = true, grid = None, texturing = "atlas", lighting = None, cache_dir = None, readback_slots = None))]
+    #[pyo3(signature = (ctx, scene, width = 640, height = 360, *, rig = None, intrinsics = None, distortion = None, msaa = 1, terrain_detail = true, grid = None, texturing = "atlas", raster = "hardware", lighting = None, cache_dir = None, readback_slots = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -137,6 +151,7 @@ impl Renderer {
         terrain_detail: bool,
         grid: Option<u32>,
         texturing: &str,
+        raster: &str,
         lighting: Option<Lighting>,
         cache_dir: Option<PathBuf>,
         readback_slots: Option<usize>,
@@ -167,6 +182,7 @@ impl Renderer {
         }
         settings.terrain.validate().map_err(arg_err)?;
         settings.texturing = self::texturing(texturing)?;
+        settings.raster = self::raster(raster)?;
         settings.lighting = lighting.map(|l| l.inner);
         settings.cache_dir = cache_dir;
         if let Some(n) = readback_slots {

@@ -85,6 +85,8 @@ def test_a_bad_pose_names_the_parameter():
 def test_bad_renderer_settings_name_the_parameter(ctx, scene):
     with pytest.raises(ValueError, match="texturing"):
         ag.Renderer(ctx, scene, width=32, height=32, texturing="bogus")
+    with pytest.raises(ValueError, match="raster"):
+        ag.Renderer(ctx, scene, width=32, height=32, raster="bogus")
     with pytest.raises(ValueError, match="width|size|image"):
         ag.Renderer(ctx, scene, width=0, height=32)
     with pytest.raises(ValueError, match="distortion"):

@@ -154,3 +154,11 @@ def test_readback_slots_bound_the_unread_frames(ctx, scene, camera):
     with pytest.raises(ag.Error, match="readback_slots"):
         r.wait(old)
     assert r.wait(new)["rgba8"].shape == (24, 32, 4)
+
+
+def test_the_compute_raster_path_matches_the_hardware_path(ctx, scene, camera, renderer):
+    compute = ag.Renderer(ctx, scene, width=WIDTH, height=HEIGHT, terrain_detail=False, raster="compute")
+    a, b = compute.render(camera), renderer.render(camera)
+    both = np.isfinite(a["depth"]) & np.isfinite(b["depth"])
+    assert both.mean() > 0.2
+    np.testing.assert_allclose(a["depth"][both], b["depth"][both], rtol=1e-3)

@@ -130,7 +130,9 @@ impl Terrain {
     /// [`Terrain::declare_warp`].
     pub fn use_compute_raster(&mut self, ctx: &Context, write_depth: bool) -> Result<()> {
         if !self.views.is_empty() {
-            return Err(Error::Graph("terrain: the raster path is chosen before the views are declared".into()));
+            return Err(Error::Graph(
+                "terrain: the raster path is chosen before the views are declared".into(),
+            ));
         }
         self.compute = Some(ComputePath {
             raster: ComputeRaster::new(ctx)?,

@@ -314,7 +314,12 @@ impl ComputeRaster {
             let push = ShadePush {
                 handles: [ctx.handle(constants)?, ctx.handle(vertices)?, ctx.handle(keys)?, 0],
                 images: [image(0)?, image(1)?, image(2)?, image(3)?],
-                more: [image(4)?, ndc.map(|b| ctx.handle(b)).transpose()?.unwrap_or(NO_DEPTH), 0, 0],
+                more: [
+                    image(4)?,
+                    ndc.map(|b| ctx.handle(b)).transpose()?.unwrap_or(NO_DEPTH),
+                    0,
+                    0,
+                ],
                 surface: [handles.lighting, handles.noise_tile, handles.texturing_frame, 0],
             };
             ctx.dispatch(&pipeline, &push, [width.div_ceil(8), height.div_ceil(8), 1])
@@ -344,7 +349,9 @@ fn declare_depth<S: 'static>(
     };
     let pipeline = Arc::new(GraphicsPipeline::new(ctx, &desc)?);
     let fragment = ImageAccess::StorageRead(Stage::Fragment);
-    let mut pass = graph.pass(&crate::view::pass_name("terrain.depth", &view.name)).graphics();
+    let mut pass = graph
+        .pass(&crate::view::pass_name("terrain.depth", &view.name))
+        .graphics();
     let ndc = pass.storage_image(ndc_depth, fragment);
     let view_depth = pass.storage_image(targets.view_depth, fragment);
     pass.pipeline(&pipeline)

@@ -10,10 +10,10 @@ use crate::points::build::spt::{epsilon_from_pixels, SptOptions};
 use crate::points::scene::scatter_rocks;
 use crate::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
 use crate::surface::gpu_layout::TexturingMode;
-use crate::view::aov::CLASS_ROCK;
-use crate::view::rig::ViewSpec;
 use crate::terrain::visibility::RasterPath;
 use crate::test_support::{assert_validation_clean, dump_pngs, jacksboro_field, mean_flip, validated_context};
+use crate::view::aov::CLASS_ROCK;
+use crate::view::rig::ViewSpec;
 use glam::DVec3;
 
 const WIDTH: u32 = 192;
@@ -133,7 +133,10 @@ fn points_and_rig_views_occlude_alike_in_both_paths() {
 fn compare(cameras: &[(&str, Camera)], hardware: &[FrameImages], compute: &[FrameImages]) {
     for (((name, _), h), c) in cameras.iter().zip(hardware).zip(compute) {
         dump_pngs(
-            &[(&format!("{name}-hardware"), &h.rgba8), (&format!("{name}-compute"), &c.rgba8)],
+            &[
+                (&format!("{name}-hardware"), &h.rgba8),
+                (&format!("{name}-compute"), &c.rgba8),
+            ],
             WIDTH,
             HEIGHT,
         );
@@ -156,8 +159,14 @@ fn compare(cameras: &[(&str, Camera)], hardware: &[FrameImages], compute: &[Fram
         );
         assert!(both > 0, "{name}: no terrain");
         assert!(flip <= MAX_MEAN_FLIP, "{name}: mean FLIP {flip:.4}");
-        assert!(agreement >= MIN_DEPTH_AGREEMENT, "{name}: depth agrees on {agreement:.4}");
-        assert!(one as f64 / pixels <= MAX_COVERAGE_DIFFERENCE, "{name}: {one} pixels covered by one path");
+        assert!(
+            agreement >= MIN_DEPTH_AGREEMENT,
+            "{name}: depth agrees on {agreement:.4}"
+        );
+        assert!(
+            one as f64 / pixels <= MAX_COVERAGE_DIFFERENCE,
+            "{name}: {one} pixels covered by one path"
+        );
     }
 }
 
@@ -255,7 +264,10 @@ fn the_coverage_rule_covers_every_pixel_of_a_tessellation_once() {
         .filter(|(_, &n)| n != 1)
         .map(|(p, &n)| (p as i64 % width, p as i64 / width, n))
         .collect();
-    assert!(wrong.is_empty(), "pixels not covered exactly once (x, y, times): {wrong:?}");
+    assert!(
+        wrong.is_empty(),
+        "pixels not covered exactly once (x, y, times): {wrong:?}"
+    );
 }
 
 /// The twin can fail: without the tie rule (every edge inclusive) the same
@@ -295,5 +307,10 @@ fn a_field_from_above_has_no_crack_in_the_compute_path() {
         .filter(|(_, d)| !d.is_finite())
         .map(|(p, _)| (p as u32 % WIDTH, p as u32 / WIDTH))
         .collect();
-    assert!(holes.is_empty(), "{} pixels without terrain: {:?}", holes.len(), &holes[..holes.len().min(20)]);
+    assert!(
+        holes.is_empty(),
+        "{} pixels without terrain: {:?}",
+        holes.len(),
+        &holes[..holes.len().min(20)]
+    );
 }

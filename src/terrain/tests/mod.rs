@@ -1,7 +1,7 @@
 //! White-box tests of the terrain technique on a validated device and against its CPU twins.
 //! (Moved from `tests/` in issue 26: integration tests use only the front door.)
 
+mod compute_raster;
 mod ground;
 mod terrain;
 mod warp;
-mod compute_raster;
