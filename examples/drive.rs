@@ -5,7 +5,7 @@
 //! procedural detail, §7.4.3), looking along the path; every step renders
 //! through [`Renderer`].
 //!
-//! `cargo run --release --example drive -- [--steps N] [--width W] [--height H] [--views 6|1]`
+//! `cargo run --release --example drive -- [--steps N] [--width W] [--height H] [--views 6|1] [--raster PATH]`
 //! (default: a `ring6` rig of 320×240 views, 300 steps). Prints the median, p99 and largest
 //! frame time per step: wall-clock (CPU: ground query, prepare, record,
 //! submit, and any wait for a free frame slot) and GPU (the sum of the
@@ -17,7 +17,8 @@ use alpenglow::files::load_heightmap;
 use alpenglow::glam::{DVec2, DVec3};
 use alpenglow::tools::profile::{median, quantile, summarize};
 use alpenglow::{
-    Camera, Context, ContextOptions, DeviceSelector, Ground, HeightmapOptions, Renderer, Rig, Scene, Settings, ViewSpec,
+    Camera, Context, ContextOptions, DeviceSelector, Ground, HeightmapOptions, RasterPath, Renderer, Rig, Scene,
+    Settings, ViewSpec,
 };
 
 /// Car speed (m/s) and the fixed step (s).
@@ -39,6 +40,8 @@ struct Args {
     height: u32,
     /// 6: the `ring6` rig (each view --width wide, 4:3); 1: one view.
     views: u32,
+    /// The terrain's rasterizer (`--raster hardware|compute|auto`).
+    raster: RasterPath,
 }
 
 /// `--steps N --width W --height H`; errors name the argument.
@@ -48,6 +51,7 @@ fn parse_args() -> Result<Args, String> {
         width: 320,
         height: 200,
         views: 6,
+        raster: RasterPath::Hardware,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -63,6 +67,14 @@ fn parse_args() -> Result<Args, String> {
                 6 => args.views = 6,
                 _ => return Err(format!("{flag}: {value} is not 1 or 6 (ring6)")),
             },
+            "--raster" => {
+                args.raster = match value.as_str() {
+                    "hardware" => RasterPath::Hardware,
+                    "compute" => RasterPath::Compute,
+                    "auto" => RasterPath::Auto,
+                    _ => return Err(format!("{flag}: {value:?} is not hardware, compute or auto")),
+                }
+            }
             "--width" => {
                 args.width = number(1)?
                     .try_into()
@@ -75,7 +87,7 @@ fn parse_args() -> Result<Args, String> {
             }
             _ => {
                 return Err(format!(
-                    "unknown argument {flag:?} (use --steps, --width, --height, --views)"
+                    "unknown argument {flag:?} (use --steps, --width, --height, --views, --raster)"
                 ))
             }
         }
@@ -159,6 +171,7 @@ fn run(args: &Args) -> alpenglow::Result<()> {
     };
     let mut settings = Settings::for_views(specs.clone());
     settings.readback = false;
+    settings.raster = args.raster;
     let ground = scene.ground(&settings.terrain)?;
     let started = Instant::now();
     let mut renderer = Renderer::new(&ctx, &scene, settings)?;
