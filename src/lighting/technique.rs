@@ -36,6 +36,80 @@ pub struct PreparedLighting {
     pub views: Vec<LightingFrame>,
     /// What `lighting.reference` dispatches this frame (the reference mode).
     pub reference: Option<ReferenceWork>,
+    /// Which sky tables this frame recomputes.
+    pub refresh: SkyRefresh,
+}
+
+/// Which of the sky's tables a frame recomputes (issue 28): only those
+/// whose inputs changed since the last frame that computed them. The
+/// transmittance and multiple-scattering tables depend on the atmosphere
+/// and the sky model; a view's sky-view table also on the sun and the
+/// eye's altitude; the environment and the sky-light map on everything the
+/// first view's sky shows and on the sky-light mode. A simulator moving
+/// the sun every frame still gets all of them every frame.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SkyRefresh {
+    pub tables: bool,
+    /// Per view.
+    pub sky_views: Vec<bool>,
+    pub environment: bool,
+}
+
+impl SkyRefresh {
+    /// Whether view `index`'s sky-view table is recomputed (a view it does
+    /// not know: yes).
+    pub fn sky_view(&self, index: usize) -> bool {
+        self.sky_views.get(index).copied().unwrap_or(true)
+    }
+}
+
+/// What the sky tables of the last frame were computed from.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct SkyKeys {
+    tables: Vec<u32>,
+    sky_views: Vec<Vec<u32>>,
+    environment: Vec<u32>,
+}
+
+impl SkyKeys {
+    /// The keys of a frame whose views have the constants `views`.
+    fn of(views: &[LightingFrame], lighting: &FrameLighting) -> SkyKeys {
+        let bits = |rows: &[[f32; 4]]| rows.iter().flatten().map(|v| v.to_bits()).collect::<Vec<u32>>();
+        let tables = |f: &LightingFrame| {
+            let mut key = bits(&[f.rayleigh, f.mie, f.planet]);
+            key.push(f.models[0]);
+            key
+        };
+        let sky_view = |f: &LightingFrame| {
+            let mut key = tables(f);
+            key.extend(bits(&[f.sun]));
+            key.push(f.atmosphere[3]);
+            key
+        };
+        let environment = views.first().map_or_else(Vec::new, |f| {
+            let mut key = sky_view(f);
+            key.extend(bits(&[f.sun_radiance, f.sun_irradiance, f.zenith, f.perez_norm]));
+            key.extend(bits(&f.perez));
+            key.extend([f.models[2], f.models[3], lighting.sh_bands, lighting.sky_patches]);
+            key
+        });
+        SkyKeys {
+            tables: views.first().map_or_else(Vec::new, tables),
+            sky_views: views.iter().map(sky_view).collect(),
+            environment,
+        }
+    }
+
+    /// What a frame with these keys recomputes after one with `last`.
+    fn refresh(&self, last: Option<&SkyKeys>) -> SkyRefresh {
+        SkyRefresh {
+            tables: last.map_or(true, |l| l.tables != self.tables),
+            sky_views: (self.sky_views.iter().enumerate())
+                .map(|(k, key)| last.and_then(|l| l.sky_views.get(k)) != Some(key))
+                .collect(),
+            environment: last.map_or(true, |l| l.environment != self.environment),
+        }
+    }
 }
 
 impl PreparedLighting {
@@ -61,6 +135,8 @@ pub struct SceneLighting {
     pub atmosphere: Option<PhysicalAtmosphere>,
     /// The previous frame's prepared data, reused ([`Technique::recycle`]).
     spare: Vec<LightingFrame>,
+    /// What the sky tables were last computed from.
+    sky_keys: Option<SkyKeys>,
 }
 
 impl SceneLighting {
@@ -73,6 +149,7 @@ impl SceneLighting {
             reference: None,
             atmosphere: None,
             spare: Vec::new(),
+            sky_keys: None,
         }
     }
 
@@ -194,13 +271,80 @@ impl Technique for SceneLighting {
             }
             views.push(constants);
         }
+        let keys = SkyKeys::of(&views, frame.lighting);
+        let refresh = keys.refresh(self.sky_keys.as_ref());
+        self.sky_keys = Some(keys);
         Ok(PreparedLighting {
             views,
             reference: reference_work,
+            refresh,
         })
     }
 
     fn recycle(&mut self, previous: PreparedLighting) {
         self.spare = previous.views;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::view::{Lighting, SunPosition};
+
+    fn frames(elevation_deg: f32, altitudes: &[f32]) -> (Vec<LightingFrame>, FrameLighting) {
+        let lighting = FrameLighting::new(Lighting {
+            sun: SunPosition::Angles {
+                elevation_deg,
+                azimuth_deg: 150.0,
+            },
+            ..Lighting::default()
+        })
+        .expect("lighting");
+        let field = FieldInfo {
+            extent: [1000.0, 1000.0],
+            texels: [10.0, 10.0],
+            ground: 0.0,
+        };
+        let lit = SceneLighting::new(Vec::new(), field);
+        let shared = lit.constants(&lighting).expect("constants");
+        let views = (altitudes.iter())
+            .map(|&a| {
+                let mut f = shared;
+                f.atmosphere[3] = a.to_bits();
+                f
+            })
+            .collect();
+        (views, lighting)
+    }
+
+    #[test]
+    fn sky_tables_are_recomputed_only_when_their_inputs_change() {
+        let (views, lighting) = frames(30.0, &[100.0, 100.0]);
+        let first = SkyKeys::of(&views, &lighting);
+        let all = SkyRefresh {
+            tables: true,
+            sky_views: vec![true, true],
+            environment: true,
+        };
+        assert_eq!(first.refresh(None), all, "the first frame computes every table");
+        assert_eq!(
+            first.refresh(Some(&first)),
+            SkyRefresh {
+                tables: false,
+                sky_views: vec![false, false],
+                environment: false,
+            },
+            "an unchanged frame keeps them"
+        );
+        // The second view climbs: its sky view only.
+        let (climbed, _) = frames(30.0, &[100.0, 400.0]);
+        let keys = SkyKeys::of(&climbed, &lighting);
+        assert_eq!(keys.refresh(Some(&first)).sky_views, vec![false, true]);
+        assert!(!keys.refresh(Some(&first)).environment && !keys.refresh(Some(&first)).tables);
+        // The sun moves: every sky view and the environment, not the atmosphere's tables.
+        let (moved, lighting) = frames(31.0, &[100.0, 100.0]);
+        let refresh = SkyKeys::of(&moved, &lighting).refresh(Some(&first));
+        assert_eq!(refresh.sky_views, vec![true, true]);
+        assert!(refresh.environment && !refresh.tables);
     }
 }

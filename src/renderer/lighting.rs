@@ -11,7 +11,7 @@ use crate::lighting::atmosphere::{AtmosphereParameters, LutSizes, PhysicalAtmosp
 use crate::lighting::reference::{MonteCarloReference, ReferenceSettings};
 use crate::lighting::shadows::{ShadowAtlas, ShadowMaps, ShadowSettings};
 use crate::lighting::sky_light::{BakeSettings, SkyLight, SkyLightBake};
-use crate::lighting::technique::{FieldInfo, SceneLighting};
+use crate::lighting::technique::{FieldInfo, PreparedLighting, SceneLighting};
 use crate::points::render::shadow::PointShadows;
 use crate::points::render::PointRenderer;
 use crate::terrain::Terrain;
@@ -123,7 +123,8 @@ pub(super) fn declare_sky_light(
         progress,
     )?;
     let sky_light = SkyLight::new(ctx, bake)?;
-    let ids = sky_light.declare(graph, region, &sky_inputs);
+    let refresh = |frame: &RenderFrame| (frame.prepared::<PreparedLighting>()).map_or(true, |p| p.refresh.environment);
+    let ids = sky_light.declare(graph, region, &sky_inputs, refresh);
     for t in targets.iter_mut() {
         (t.lighting.images).extend([(LightingMap::SkyLight, ids.map), (LightingMap::Horizon, ids.horizon)]);
         (t.lighting.buffers).push((LightingMap::Environment, ids.environment));
@@ -166,7 +167,13 @@ pub(super) fn declare_atmosphere(
     let regions: Vec<(&str, _)> = (views.iter().zip(targets.iter()))
         .map(|(v, t)| (v.name.as_str(), t.lighting.constants))
         .collect();
-    let luts = atmosphere.declare(graph, &regions)?;
+    let refresh = |frame: &RenderFrame, table: Option<usize>| {
+        (frame.prepared::<PreparedLighting>()).map_or(true, |p| match table {
+            None => p.refresh.tables,
+            Some(k) => p.refresh.sky_view(k),
+        })
+    };
+    let luts = atmosphere.declare(graph, &regions, refresh)?;
     for (k, t) in targets.iter_mut().enumerate() {
         let [transmittance, multiscattering, sky_view] = luts.reads(k)?;
         t.lighting.images.extend([

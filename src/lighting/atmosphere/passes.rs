@@ -194,10 +194,15 @@ impl PhysicalAtmosphere {
     /// `lighting.transmittance` and `lighting.multiscattering` once, and
     /// `lighting.sky_view[@name]` per view. `views`: per view (by
     /// [`ViewIndex`]), its name and the upload region of its LightingFrame.
+    /// `refresh(frame, table)` says whether a frame recomputes a table
+    /// (None: the transmittance and multiple-scattering tables, Some(k):
+    /// view k's sky view); the tables persist across frames, so a frame
+    /// may keep them.
     pub fn declare<P: 'static>(
         &self,
         graph: &mut RenderGraph<P>,
         views: &[(&str, UploadRegion)],
+        refresh: fn(&P, Option<usize>) -> bool,
     ) -> Result<AtmosphereLuts> {
         let Some(&(_, first)) = views.first() else {
             return Err(Error::Graph("the atmosphere needs at least one view".into()));
@@ -227,6 +232,7 @@ impl PhysicalAtmosphere {
             (pipelines.clone(), |p| &p.transmittance),
             (first, &[], transmittance),
             (self.sizes.transmittance, push),
+            (refresh, None),
         );
         declare_table(
             graph,
@@ -234,14 +240,16 @@ impl PhysicalAtmosphere {
             (pipelines.clone(), |p| &p.multiscattering),
             (first, &[transmittance], multiscattering),
             (self.sizes.multiscattering, push),
+            (refresh, None),
         );
-        for (&(name, region), &sky_view) in views.iter().zip(&luts.sky_views) {
+        for (k, (&(name, region), &sky_view)) in views.iter().zip(&luts.sky_views).enumerate() {
             declare_table(
                 graph,
                 &pass_name("lighting.sky_view", name),
                 (pipelines.clone(), |p| &p.sky_view),
                 (region, &[transmittance, multiscattering], sky_view),
                 (self.sizes.sky_view, push),
+                (refresh, Some(k)),
             );
         }
         Ok(luts)
@@ -250,7 +258,8 @@ impl PhysicalAtmosphere {
 
 /// Declares the table pass `name`: reads the LightingFrame in `region`,
 /// samples `inputs` (handles 2, 3), writes the `size` table `output` with
-/// the pipeline `pick` chooses.
+/// the pipeline `pick` chooses, on the frames `refresh` says (the table
+/// `table`); other frames keep it (read-write: its contents stay).
 #[allow(clippy::type_complexity)]
 fn declare_table<P: 'static>(
     graph: &mut RenderGraph<P>,
@@ -258,13 +267,17 @@ fn declare_table<P: 'static>(
     (pipelines, pick): (Arc<Pipelines>, fn(&Pipelines) -> &ComputePipeline),
     (region, inputs, output): (UploadRegion, &[ImageId], ImageId),
     ((w, h), push): ((u32, u32), AtmospherePush),
+    (refresh, table): (fn(&P, Option<usize>) -> bool, Option<usize>),
 ) {
     let compute = Stage::Compute;
     let mut pass = graph.pass(name);
     let lighting = pass.upload(region, compute);
     let inputs: Vec<_> = inputs.iter().map(|&image| pass.sample(image, compute)).collect();
-    let output = pass.storage_image(output, ImageAccess::StorageWrite(compute));
-    pass.record(move |ctx, _| {
+    let output = pass.storage_image(output, ImageAccess::StorageReadWrite(compute));
+    pass.record(move |ctx, frame| {
+        if !refresh(frame, table) {
+            return Ok(());
+        }
         let mut handles = [ctx.handle(lighting)?, ctx.handle(output)?, 0, 0];
         for (slot, &input) in handles[2..].iter_mut().zip(&inputs) {
             *slot = ctx.handle(input)?;

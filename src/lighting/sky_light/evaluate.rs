@@ -133,12 +133,14 @@ impl SkyLight {
     /// Declares `lighting.environment` (reading the frame's lighting
     /// constants in `lighting` and the sampled images in `sky_inputs`, e.g.
     /// the atmosphere's lookup tables) and `lighting.sky_light`; imports
-    /// the persistent resources. Once per graph.
+    /// the persistent resources. Once per graph. Both run on the frames
+    /// `refresh` says; other frames keep the environment and the map.
     pub fn declare<S: 'static>(
         &self,
         graph: &mut RenderGraph<Frame<S>>,
         lighting: UploadRegion,
         sky_inputs: &[ImageId],
+        refresh: fn(&Frame<S>) -> bool,
     ) -> SkyLightIds {
         let ids = SkyLightIds {
             map: graph.import_image(self.map.clone()),
@@ -156,8 +158,11 @@ impl SkyLight {
         for &image in sky_inputs {
             pass.sample(image, compute);
         }
-        let output = pass.storage_buffer(environment, BufferAccess::StorageWrite(compute));
-        pass.record(move |ctx, _frame| {
+        let output = pass.storage_buffer(environment, BufferAccess::StorageReadWrite(compute));
+        pass.record(move |ctx, frame| {
+            if !refresh(frame) {
+                return Ok(());
+            }
             let push = EnvironmentPush {
                 handles: [ctx.handle(constants)?, ctx.handle(output)?, 0, 0],
             };
@@ -172,11 +177,11 @@ impl SkyLight {
             pass.storage_buffer(surface, BufferAccess::StorageRead(compute)),
             pass.storage_buffer(transfer, BufferAccess::StorageRead(compute)),
             pass.storage_buffer(environment, BufferAccess::StorageRead(compute)),
-            pass.storage_image(ids.map, ImageAccess::StorageWrite(compute)),
+            pass.storage_image(ids.map, ImageAccess::StorageReadWrite(compute)),
         ];
         pass.record(move |ctx, frame: &Frame<S>| {
             let lighting = &frame.lighting;
-            if lighting.sky_light == SkyLightMode::Reference {
+            if lighting.sky_light == SkyLightMode::Reference || !refresh(frame) {
                 return Ok(());
             }
             let bands = lighting.sh_bands.min(baked.sh_bands);

@@ -64,13 +64,21 @@ fn render(cases: &[Case]) -> Vec<Tables> {
         let mut graph: RenderGraph<()> = RenderGraph::new();
         let region = graph.upload_region("lighting", std::mem::size_of::<LightingFrame>() as u64);
         // Errors, not panics: no view, more views than tables, an unknown view.
-        assert!(atmosphere.declare(&mut RenderGraph::<()>::new(), &[]).is_err());
         assert!(atmosphere
-            .declare(&mut RenderGraph::<()>::new(), &[("a", region), ("b", region)])
+            .declare(&mut RenderGraph::<()>::new(), &[], |_, _| true)
+            .is_err());
+        assert!(atmosphere
+            .declare(
+                &mut RenderGraph::<()>::new(),
+                &[("a", region), ("b", region)],
+                |_, _| true
+            )
             .is_err());
         let mut scratch: LightingFrame = bytemuck::Zeroable::zeroed();
         assert!(atmosphere.fill_altitude(1, EYE_Z, &mut scratch).is_err());
-        let luts = atmosphere.declare(&mut graph, &[("", region)]).expect("declare");
+        let luts = atmosphere
+            .declare(&mut graph, &[("", region)], |_, _| true)
+            .expect("declare");
         let readback = |name: &str, (w, h): (u32, u32)| {
             Arc::new(
                 Buffer::new(

@@ -5,5 +5,6 @@ mod atmosphere;
 mod figures;
 mod reference;
 mod shadows;
+mod sky_cache;
 mod sky_light;
 mod twins;

@@ -85,7 +85,7 @@ fn run_frames(ctx: &Context, sky: &SkyLight, frames_in: &[(LightingFrame, Lighti
     for (constants, lighting) in frames_in {
         let mut graph: RenderGraph<Frame<()>> = RenderGraph::new();
         let region = graph.upload_region("lighting", std::mem::size_of::<LightingFrame>() as u64);
-        let ids = sky.declare(&mut graph, region, &[]);
+        let ids = sky.declare(&mut graph, region, &[], |_| true);
         let env = host_buffer(ctx, "environment readback", u64::from(ENVIRONMENT_VEC4S) * 16);
         let map = host_buffer(ctx, "map readback", texels * 16);
         let (env_id, map_id) = (graph.import_buffer(env.clone()), graph.import_buffer(map.clone()));
