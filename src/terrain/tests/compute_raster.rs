@@ -25,29 +25,13 @@ const MIN_DEPTH_AGREEMENT: f64 = 0.99;
 /// Share of the pixels only one path covers.
 const MAX_COVERAGE_DIFFERENCE: f64 = 0.002;
 
+/// The terrain tests' views, and the valley view with a near plane of
+/// 0.5 m (triangles crossing it take the homogeneous path).
 fn cameras(scene: &Scene) -> Vec<(&'static str, Camera)> {
-    let base = scene.default_camera();
-    vec![
-        ("default", base),
-        (
-            "low-grazing",
-            Camera {
-                eye: DVec3::new(2000.0, 3000.0, 1150.0),
-                target: DVec3::new(20000.0, 20000.0, 600.0),
-                near: 10.0,
-                ..base
-            },
-        ),
-        (
-            "near-ground",
-            Camera {
-                eye: DVec3::new(13600.0, 9600.0, 750.0),
-                target: DVec3::new(18500.0, 21500.0, 350.0),
-                near: 0.5,
-                ..base
-            },
-        ),
-    ]
+    let mut cameras = super::terrain::views(scene);
+    let valley = cameras[2].1;
+    cameras.push(("near-plane", Camera { near: 0.5, ..valley }));
+    cameras
 }
 
 fn render(scene: &Scene, cameras: &[(&str, Camera)], raster: RasterPath) -> Vec<FrameImages> {
@@ -102,7 +86,7 @@ fn points_and_rig_views_occlude_alike_in_both_paths() {
     };
     let mut scene = Scene::new(field);
     scene.points = scatter_rocks(&scene.heights, 2, 2000, 400, (30.0, 80.0), 7, &spt).expect("rocks");
-    let base = cameras(&scene)[2].1;
+    let base = cameras(&scene)[4].1;
     let right = Camera {
         eye: base.eye + DVec3::new(400.0, -300.0, 0.0),
         ..base

@@ -20,7 +20,9 @@ use glam::DVec3;
 const WIDTH: u32 = 192;
 const HEIGHT: u32 = 108;
 
-fn views(scene: &Scene) -> Vec<(&'static str, Camera)> {
+/// The terrain tests' views of the Jacksboro DEM (shared with the compute
+/// path's tests).
+pub(super) fn views(scene: &Scene) -> Vec<(&'static str, Camera)> {
     let base = scene.default_camera();
     vec![
         ("high oblique", base),
