@@ -258,6 +258,7 @@ pub const SCENE_OTHER: &[&str] = &[
     "--heightmap",
     "--rows",
     "--texturing",
+    "--raster",
     "--layers",
     "--input-map",
     "--points",
