@@ -47,68 +47,105 @@ pub struct PreparedLighting {
 /// eye's altitude; the environment and the sky-light map on everything the
 /// first view's sky shows and on the sky-light mode. A simulator moving
 /// the sun every frame still gets all of them every frame.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SkyRefresh {
     pub tables: bool,
-    /// Per view.
-    pub sky_views: Vec<bool>,
+    /// Bit k: view k's sky-view table.
+    pub sky_views: u32,
     pub environment: bool,
 }
 
 impl SkyRefresh {
-    /// Whether view `index`'s sky-view table is recomputed (a view it does
-    /// not know: yes).
+    /// Whether view `index`'s sky-view table is recomputed (a view beyond
+    /// the mask: yes).
     pub fn sky_view(&self, index: usize) -> bool {
-        self.sky_views.get(index).copied().unwrap_or(true)
+        index >= 32 || self.sky_views & (1 << index) != 0
     }
 }
 
-/// What the sky tables of the last frame were computed from.
-#[derive(Clone, Debug, Default, PartialEq)]
+/// The inputs of the transmittance and multiple-scattering tables: the
+/// atmosphere's coefficients and planet, the sky model.
+type TablesKey = [u32; 13];
+/// A view's sky-view table's: the tables' and the sun and eye altitude.
+type ViewKey = [u32; 18];
+/// The environment's and the sky-light map's: the first view's sky and the
+/// sky-light mode, flags, bands and patches.
+type EnvironmentKey = [u32; 58];
+
+fn bits<const N: usize>(rows: &[[f32; 4]]) -> [u32; N] {
+    let mut key = [0; N];
+    for (k, v) in rows.iter().flatten().enumerate().take(N) {
+        key[k] = v.to_bits();
+    }
+    key
+}
+
+fn tables_key(f: &LightingFrame) -> TablesKey {
+    let mut key: TablesKey = bits(&[f.rayleigh, f.mie, f.planet]);
+    key[12] = f.models[0];
+    key
+}
+
+fn view_key(f: &LightingFrame) -> ViewKey {
+    let mut key = [0; 18];
+    key[..13].copy_from_slice(&tables_key(f));
+    key[13..17].copy_from_slice(&f.sun.map(f32::to_bits));
+    key[17] = f.atmosphere[3];
+    key
+}
+
+fn environment_key(f: &LightingFrame, lighting: &FrameLighting) -> EnvironmentKey {
+    let mut key = [0; 58];
+    key[..18].copy_from_slice(&view_key(f));
+    let sky: [u32; 36] = bits(&[
+        f.sun_radiance,
+        f.sun_irradiance,
+        f.zenith,
+        f.perez_norm,
+        f.perez[0],
+        f.perez[1],
+        f.perez[2],
+        f.perez[3],
+        f.perez[4],
+    ]);
+    key[18..54].copy_from_slice(&sky);
+    key[54..].copy_from_slice(&[f.models[2], f.models[3], lighting.sh_bands, lighting.sky_patches]);
+    key
+}
+
+/// What the sky tables of the last frame were computed from (updated in
+/// place: a steady frame allocates nothing).
+#[derive(Clone, Debug, Default)]
 struct SkyKeys {
-    tables: Vec<u32>,
-    sky_views: Vec<Vec<u32>>,
-    environment: Vec<u32>,
+    /// None before the first frame.
+    tables: Option<TablesKey>,
+    sky_views: Vec<ViewKey>,
+    environment: Option<EnvironmentKey>,
 }
 
 impl SkyKeys {
-    /// The keys of a frame whose views have the constants `views`.
-    fn of(views: &[LightingFrame], lighting: &FrameLighting) -> SkyKeys {
-        let bits = |rows: &[[f32; 4]]| rows.iter().flatten().map(|v| v.to_bits()).collect::<Vec<u32>>();
-        let tables = |f: &LightingFrame| {
-            let mut key = bits(&[f.rayleigh, f.mie, f.planet]);
-            key.push(f.models[0]);
-            key
+    /// What a frame whose views have the constants `views` recomputes
+    /// after the frames so far; remembers its keys.
+    fn update(&mut self, views: &[LightingFrame], lighting: &FrameLighting) -> SkyRefresh {
+        let mut refresh = SkyRefresh::default();
+        let Some(first) = views.first() else {
+            return refresh;
         };
-        let sky_view = |f: &LightingFrame| {
-            let mut key = tables(f);
-            key.extend(bits(&[f.sun]));
-            key.push(f.atmosphere[3]);
-            key
-        };
-        let environment = views.first().map_or_else(Vec::new, |f| {
-            let mut key = sky_view(f);
-            key.extend(bits(&[f.sun_radiance, f.sun_irradiance, f.zenith, f.perez_norm]));
-            key.extend(bits(&f.perez));
-            key.extend([f.models[2], f.models[3], lighting.sh_bands, lighting.sky_patches]);
-            key
-        });
-        SkyKeys {
-            tables: views.first().map_or_else(Vec::new, tables),
-            sky_views: views.iter().map(sky_view).collect(),
-            environment,
+        let tables = Some(tables_key(first));
+        refresh.tables = self.tables != tables;
+        self.tables = tables;
+        self.sky_views.resize(views.len(), [u32::MAX; 18]);
+        for (k, (view, last)) in views.iter().zip(&mut self.sky_views).enumerate() {
+            let key = view_key(view);
+            if *last != key || self.environment.is_none() {
+                refresh.sky_views |= 1u32.checked_shl(k as u32).unwrap_or(0);
+                *last = key;
+            }
         }
-    }
-
-    /// What a frame with these keys recomputes after one with `last`.
-    fn refresh(&self, last: Option<&SkyKeys>) -> SkyRefresh {
-        SkyRefresh {
-            tables: last.map_or(true, |l| l.tables != self.tables),
-            sky_views: (self.sky_views.iter().enumerate())
-                .map(|(k, key)| last.and_then(|l| l.sky_views.get(k)) != Some(key))
-                .collect(),
-            environment: last.map_or(true, |l| l.environment != self.environment),
-        }
+        let environment = Some(environment_key(first, lighting));
+        refresh.environment = self.environment != environment;
+        self.environment = environment;
+        refresh
     }
 }
 
@@ -136,7 +173,7 @@ pub struct SceneLighting {
     /// The previous frame's prepared data, reused ([`Technique::recycle`]).
     spare: Vec<LightingFrame>,
     /// What the sky tables were last computed from.
-    sky_keys: Option<SkyKeys>,
+    sky_keys: SkyKeys,
 }
 
 impl SceneLighting {
@@ -149,7 +186,7 @@ impl SceneLighting {
             reference: None,
             atmosphere: None,
             spare: Vec::new(),
-            sky_keys: None,
+            sky_keys: SkyKeys::default(),
         }
     }
 
@@ -271,9 +308,7 @@ impl Technique for SceneLighting {
             }
             views.push(constants);
         }
-        let keys = SkyKeys::of(&views, frame.lighting);
-        let refresh = keys.refresh(self.sky_keys.as_ref());
-        self.sky_keys = Some(keys);
+        let refresh = self.sky_keys.update(&views, frame.lighting);
         Ok(PreparedLighting {
             views,
             reference: reference_work,
@@ -320,31 +355,42 @@ mod tests {
     #[test]
     fn sky_tables_are_recomputed_only_when_their_inputs_change() {
         let (views, lighting) = frames(30.0, &[100.0, 100.0]);
-        let first = SkyKeys::of(&views, &lighting);
+        let mut keys = SkyKeys::default();
         let all = SkyRefresh {
             tables: true,
-            sky_views: vec![true, true],
+            sky_views: 0b11,
             environment: true,
         };
-        assert_eq!(first.refresh(None), all, "the first frame computes every table");
         assert_eq!(
-            first.refresh(Some(&first)),
-            SkyRefresh {
-                tables: false,
-                sky_views: vec![false, false],
-                environment: false,
-            },
+            keys.update(&views, &lighting),
+            all,
+            "the first frame computes every table"
+        );
+        assert_eq!(
+            keys.update(&views, &lighting),
+            SkyRefresh::default(),
             "an unchanged frame keeps them"
         );
         // The second view climbs: its sky view only.
         let (climbed, _) = frames(30.0, &[100.0, 400.0]);
-        let keys = SkyKeys::of(&climbed, &lighting);
-        assert_eq!(keys.refresh(Some(&first)).sky_views, vec![false, true]);
-        assert!(!keys.refresh(Some(&first)).environment && !keys.refresh(Some(&first)).tables);
+        let refresh = keys.update(&climbed, &lighting);
+        assert_eq!(
+            (refresh.sky_views, refresh.tables, refresh.environment),
+            (0b10, false, false)
+        );
+        assert!(!refresh.sky_view(0) && refresh.sky_view(1));
         // The sun moves: every sky view and the environment, not the atmosphere's tables.
-        let (moved, lighting) = frames(31.0, &[100.0, 100.0]);
-        let refresh = SkyKeys::of(&moved, &lighting).refresh(Some(&first));
-        assert_eq!(refresh.sky_views, vec![true, true]);
-        assert!(refresh.environment && !refresh.tables);
+        let (moved, lighting) = frames(
+            31.0,
+            &climbed
+                .iter()
+                .map(|f| f32::from_bits(f.atmosphere[3]))
+                .collect::<Vec<_>>(),
+        );
+        let refresh = keys.update(&moved, &lighting);
+        assert_eq!(
+            (refresh.sky_views, refresh.tables, refresh.environment),
+            (0b11, false, true)
+        );
     }
 }
