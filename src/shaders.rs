@@ -26,6 +26,12 @@ pub const TERRAIN_RASTER_CLEAR: SpirV = spirv!("terrain/raster_clear.comp");
 pub const TERRAIN_RASTER: SpirV = spirv!("terrain/raster.comp");
 /// terrain.raster_big: the triangles terrain.raster lists, one workgroup each.
 pub const TERRAIN_RASTER_BIG: SpirV = spirv!("terrain/raster_big.comp");
+/// terrain.shadow_clear: the compute casters' depth buffer at 1, their lists empty (§9.5).
+pub const TERRAIN_SHADOW_CLEAR: SpirV = spirv!("terrain/shadow_clear.comp");
+/// terrain.shadow (compute path): the warped grid into a cascade, one thread a triangle (§9.5).
+pub const TERRAIN_SHADOW_RASTER: SpirV = spirv!("terrain/shadow_raster.comp");
+/// terrain.shadow_big: the casters terrain.shadow lists, one workgroup each (§9.5).
+pub const TERRAIN_SHADOW_RASTER_BIG: SpirV = spirv!("terrain/shadow_raster_big.comp");
 /// terrain.shade: the visibility buffer shaded per pixel.
 pub const TERRAIN_SHADE: SpirV = spirv!("terrain/shade.comp");
 /// terrain.depth: the depth buffer from the compute path's NDC depth.

@@ -90,12 +90,14 @@ int64_t edge_bias(i64vec2 a, i64vec2 b) {
 }
 
 // A triangle set up in fixed point: vertices (wound positively), biases,
-// twice its area, the clip w of each vertex.
+// twice its area, the clip w of each vertex; `flipped`: the second and third
+// vertex were swapped for the winding.
 struct FixedTriangle {
     i64vec2 v[3];
     int64_t bias[3];
     int64_t area;
     vec3 inv_w;
+    bool flipped;
 };
 
 // Sets up the triangle of clip positions `c`; false when it has no area.
@@ -105,6 +107,7 @@ bool setup_fixed(vec4 c[3], vec2 size, out FixedTriangle tri) {
     i64vec2 d = fixed_point(screen_position(c[2], size));
     int64_t area = edge_function(a, b, d);
     tri.inv_w = vec3(1.0 / c[0].w, 1.0 / c[1].w, 1.0 / c[2].w);
+    tri.flipped = area < 0;
     if (area == 0) {
         return false;
     }
@@ -136,18 +139,25 @@ void fixed_bounds(FixedTriangle tri, ivec2 size, out ivec2 first, out ivec2 last
     last = min(ivec2(hi >> SUBPIXEL_BITS), size - 1);
 }
 
-// The view depth of the triangle at pixel `pixel` if it covers the pixel's
-// centre, else a negative value.
-float fixed_coverage(FixedTriangle tri, ivec2 pixel) {
+// Whether the triangle covers the centre of pixel `pixel`, and there its
+// screen-space barycentrics (of the wound vertices `tri.v`).
+bool fixed_barycentrics(FixedTriangle tri, ivec2 pixel, out vec3 lambda) {
     i64vec2 p = i64vec2(pixel) * int64_t(SUBPIXELS) + int64_t(SUBPIXELS / 2.0);
     int64_t e0 = edge_function(tri.v[1], tri.v[2], p);
     int64_t e1 = edge_function(tri.v[2], tri.v[0], p);
     int64_t e2 = edge_function(tri.v[0], tri.v[1], p);
-    if (e0 + tri.bias[0] < 0 || e1 + tri.bias[1] < 0 || e2 + tri.bias[2] < 0) {
+    lambda = vec3(float(e0), float(e1), float(e2)) / float(tri.area);
+    return e0 + tri.bias[0] >= 0 && e1 + tri.bias[1] >= 0 && e2 + tri.bias[2] >= 0;
+}
+
+// The view depth of the triangle at pixel `pixel` if it covers the pixel's
+// centre, else a negative value.
+float fixed_coverage(FixedTriangle tri, ivec2 pixel) {
+    vec3 lambda;
+    if (!fixed_barycentrics(tri, pixel, lambda)) {
         return -1.0;
     }
     // Perspective-correct: 1/w is linear in screen space.
-    vec3 lambda = vec3(float(e0), float(e1), float(e2)) / float(tri.area);
     return 1.0 / dot(lambda, tri.inv_w);
 }
 

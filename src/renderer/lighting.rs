@@ -90,7 +90,11 @@ pub(super) fn declare_shadows(
         return Err(crate::error::Error::Graph("shadows: a view has no atlas".into()));
     }
     for (k, (view, atlas)) in views.iter().zip(atlases).enumerate() {
-        let target = maps.declare_clear(ctx, graph, atlas)?;
+        // The compute casters write every texel: no clear.
+        let target = match terrain.is_some_and(Terrain::casts_in_compute) {
+            true => maps.adopt(atlas)?,
+            false => maps.declare_clear(ctx, graph, atlas)?,
+        };
         if let Some(terrain) = terrain {
             terrain.declare_shadow(ctx, graph, (k, view), target)?;
         }

@@ -18,6 +18,7 @@ use crate::surface::layers::LayerTree;
 use crate::terrain::geometry_image::{declare_warp_pass, GeometryImage, TerrainSettings, WarpPass};
 use crate::terrain::lod::LodFrame;
 use crate::terrain::shading::{declare_draw_pass, DrawPass, SurfaceInputs, TerrainDrawPush};
+use crate::terrain::shadow::ComputeCasters;
 use crate::terrain::visibility::{ComputePass, ComputeRaster, ComputeView, RasterPath};
 use crate::texturing::generation::{AtlasBindings, GenerationInputs};
 use crate::view::{
@@ -51,7 +52,16 @@ struct TerrainViewState {
 /// The compute path's pipelines and whether it writes the depth buffer.
 struct ComputePath {
     raster: ComputeRaster,
+    /// The shadow casters in compute (None: `terrain.shadow` draws them).
+    casters: Option<ComputeCasters>,
     write_depth: bool,
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Tests: the compute path keeps the hardware's shadow casters (to
+    /// compare the compute casters against them on otherwise equal frames).
+    pub(crate) static HARDWARE_CASTERS: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 /// The terrain: persistent GPU state, `terrain.warp` and `terrain.draw` per
@@ -134,11 +144,26 @@ impl Terrain {
                 "terrain: the raster path is chosen before the views are declared".into(),
             ));
         }
+        #[cfg(test)]
+        let hardware_casters = HARDWARE_CASTERS.get();
+        #[cfg(not(test))]
+        let hardware_casters = false;
         self.compute = Some(ComputePath {
             raster: ComputeRaster::new(ctx)?,
+            casters: (!hardware_casters).then(|| ComputeCasters::new(ctx)).transpose()?,
             write_depth,
         });
         Ok(())
+    }
+
+    /// The compute path's shadow casters, if it has them.
+    pub(super) fn compute_casters(&self) -> Option<&ComputeCasters> {
+        self.compute.as_ref().and_then(|c| c.casters.as_ref())
+    }
+
+    /// Side of the geometry image's grid.
+    pub(super) fn grid_side(&self) -> u32 {
+        self.geometry.settings.grid_side
     }
 
     /// The rasterizer the terrain is drawn with (for profiles).

@@ -14,8 +14,8 @@
 //!
 //! | pass | declared by | what |
 //! |---|---|---|
-//! | `shadow.clear` | [`ShadowMaps::declare_clear`] | clears the atlas to 1 |
-//! | `terrain.shadow` | `Terrain::declare_shadow` (`src/terrain/shadow.rs`) | the view's warped geometry image, per cascade |
+//! | `shadow.clear` | [`ShadowMaps::declare_clear`] | clears the atlas to 1 (not on the compute path: [`ShadowMaps::adopt`]) |
+//! | `terrain.shadow` | `Terrain::declare_shadow` (`src/terrain/shadow.rs`) | the view's warped geometry image, per cascade (on the compute path compute passes, copied into the atlas) |
 //! | `points.shadow` | `PointShadows::declare` (`src/points/render/shadow.rs`) | splats as depth discs, per cascade |
 //!
 //! The caster passes read the cascade matrices from the frame's prepared
@@ -99,7 +99,10 @@ impl ShadowAtlas {
                 width: size,
                 height: size,
                 format: SHADOW_FORMAT,
-                usage: ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | ImageUsageFlags::SAMPLED,
+                // Transfer: the compute casters copy their depths in.
+                usage: ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                    | ImageUsageFlags::SAMPLED
+                    | ImageUsageFlags::TRANSFER_DST,
             },
         )?);
         let atlas = graph.import_image(image.clone());
@@ -225,20 +228,8 @@ impl ShadowMaps {
         graph: &mut RenderGraph<Frame<S>>,
         atlas: ShadowAtlas,
     ) -> Result<ShadowTarget> {
-        let ShadowAtlas {
-            target,
-            image,
-            view_name,
-        } = atlas;
-        if self.views.iter().any(|v| v.target.view == target.view) {
-            return Err(Error::Graph(format!("shadows: view {} declared twice", target.view)));
-        }
-        if target.size != self.settings.atlas_size {
-            return Err(Error::Graph(format!(
-                "shadows: the atlas is {} texels, the settings {}",
-                target.size, self.settings.atlas_size
-            )));
-        }
+        let view_name = atlas.view_name.clone();
+        let target = self.adopt(atlas)?;
         if self.clear_pipeline.is_none() {
             self.clear_pipeline = Some(GraphicsPipeline::new(ctx, &splat_caster_desc("shadow.clear"))?);
         }
@@ -254,6 +245,23 @@ impl ShadowMaps {
             .pipeline(pipeline)
             .depth(target.atlas, Some(1.0))
             .record(|_, _| Ok(()));
+        Ok(target)
+    }
+
+    /// Takes an atlas created with this graph whose first caster writes
+    /// every texel (the terrain's compute casters,
+    /// `Terrain::casts_in_compute`): no `shadow.clear`.
+    pub fn adopt(&mut self, atlas: ShadowAtlas) -> Result<ShadowTarget> {
+        let ShadowAtlas { target, image, .. } = atlas;
+        if self.views.iter().any(|v| v.target.view == target.view) {
+            return Err(Error::Graph(format!("shadows: view {} declared twice", target.view)));
+        }
+        if target.size != self.settings.atlas_size {
+            return Err(Error::Graph(format!(
+                "shadows: the atlas is {} texels, the settings {}",
+                target.size, self.settings.atlas_size
+            )));
+        }
         self.views.push(ShadowView { target, _image: image });
         Ok(target)
     }
@@ -348,6 +356,21 @@ impl Technique for ShadowMaps {
     }
 }
 
+/// Each cascade of `plan` (as many as it casts: none with the sun below
+/// the horizon) with its index and caster push constants (`handles` left
+/// to the pass).
+pub fn cascade_pushes(plan: &CascadePlan) -> impl Iterator<Item = (u32, ShadowCasterPush)> + '_ {
+    let count = plan.count() as usize;
+    (plan.cascades.iter().take(count).enumerate()).map(|(i, c)| {
+        let push = ShadowCasterPush {
+            view_proj: c.view_proj.as_mat4().to_cols_array(),
+            sun_texel: plan.sun.as_vec3().extend(c.texel as f32).to_array(),
+            handles: [0; 4],
+        };
+        (i as u32, push)
+    })
+}
+
 /// Records a caster pass, which declared `atlas` its depth attachment
 /// (loaded: `.depth(atlas, None)`): per cascade of `plan` sets the scissor
 /// on its quadrant and calls `draw` with the cascade's push constants
@@ -358,24 +381,11 @@ pub fn record_cascades(
     plan: &CascadePlan,
     mut draw: impl FnMut(&mut CommandRecorder, ShadowCasterPush) -> Result<()>,
 ) -> Result<()> {
-    let count = plan.count() as usize;
-    if count == 0 {
-        return Ok(());
-    }
     let quadrant = atlas.desc().width / 2;
-    let mut result = Ok(());
-    for (i, c) in plan.cascades.iter().take(count).enumerate() {
-        let (x, y) = ((i as u32 % 2) * quadrant, (i as u32 / 2) * quadrant);
+    for (i, push) in cascade_pushes(plan) {
+        let (x, y) = ((i % 2) * quadrant, (i / 2) * quadrant);
         cmd.set_scissor(x, y, quadrant, quadrant);
-        let push = ShadowCasterPush {
-            view_proj: c.view_proj.as_mat4().to_cols_array(),
-            sun_texel: plan.sun.as_vec3().extend(c.texel as f32).to_array(),
-            handles: [0; 4],
-        };
-        result = draw(cmd, push);
-        if result.is_err() {
-            break;
-        }
+        draw(cmd, push)?;
     }
-    result
+    Ok(())
 }

@@ -10,10 +10,12 @@ use crate::points::build::spt::{epsilon_from_pixels, SptOptions};
 use crate::points::scene::scatter_rocks;
 use crate::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
 use crate::surface::gpu_layout::TexturingMode;
+use crate::terrain::technique::HARDWARE_CASTERS;
 use crate::terrain::visibility::RasterPath;
 use crate::test_support::{assert_validation_clean, dump_pngs, jacksboro_field, mean_flip, validated_context};
 use crate::view::aov::CLASS_ROCK;
 use crate::view::rig::ViewSpec;
+use crate::view::{Lighting, SunPosition};
 use glam::DVec3;
 
 const WIDTH: u32 = 192;
@@ -73,6 +75,75 @@ fn compute_path_matches_the_hardware_path() {
     let compute = render(&scene, &cameras, RasterPath::Compute);
     compare(&cameras, &hardware, &compute);
 }
+
+/// The compute path's shadow casters (`terrain.shadow` in compute, culled
+/// per cascade, copied into the atlas) against the hardware's on frames
+/// otherwise equal (both on the compute path), under a low sun that puts
+/// a good share of the terrain in shadow: the sun visibility AOV agrees to
+/// 0.1 on at least [`MIN_SUN_AGREEMENT`] of the terrain's pixels.
+#[test]
+fn compute_shadow_casters_match_the_hardware_casters() {
+    let scene = Scene::new(jacksboro_field());
+    let cameras = cameras(&scene);
+    let settings = RenderSettings {
+        raster: RasterPath::Compute,
+        lighting: Some(Lighting {
+            sun: SunPosition::Angles {
+                elevation_deg: 8.0,
+                azimuth_deg: 120.0,
+            },
+            ..Lighting::default()
+        }),
+        ..RenderSettings::new(WIDTH, HEIGHT)
+    };
+    let frames: Vec<Vec<Camera>> = cameras.iter().map(|&(_, c)| vec![c]).collect();
+    HARDWARE_CASTERS.set(true);
+    let hardware = render_with(&scene, &frames, settings.clone());
+    HARDWARE_CASTERS.set(false);
+    let compute = render_with(&scene, &frames, settings);
+    let (mut terrain, mut shadowed, mut agree) = (0usize, 0usize, 0usize);
+    for (((name, _), h), c) in cameras.iter().zip(&hardware).zip(&compute) {
+        dump_pngs(
+            &[
+                (&format!("{name}-hardware-casters"), &h.rgba8),
+                (&format!("{name}-compute-casters"), &c.rgba8),
+            ],
+            WIDTH,
+            HEIGHT,
+        );
+        let mut view_agree = (0usize, 0usize);
+        for (k, depth) in h.depth.iter().enumerate() {
+            if !depth.is_finite() {
+                continue;
+            }
+            let (sun_h, sun_c) = (h.visibility[2 * k], c.visibility[2 * k]);
+            view_agree.0 += 1;
+            view_agree.1 += usize::from((sun_h - sun_c).abs() <= 0.1);
+            shadowed += usize::from(sun_h < 0.5);
+        }
+        eprintln!(
+            "{name}: sun visibility agrees on {} of {} pixels",
+            view_agree.1, view_agree.0
+        );
+        terrain += view_agree.0;
+        agree += view_agree.1;
+    }
+    let share = |n: usize| n as f64 / terrain.max(1) as f64;
+    assert!(
+        share(shadowed) >= 0.05,
+        "only {:.3} of the terrain in shadow",
+        share(shadowed)
+    );
+    assert!(
+        share(agree) >= MIN_SUN_AGREEMENT,
+        "sun visibility agrees on {:.4}",
+        share(agree)
+    );
+}
+
+/// Share of the terrain's pixels whose sun visibility agrees to 0.1 with
+/// the compute casters and the hardware's.
+const MIN_SUN_AGREEMENT: f64 = 0.99;
 
 /// Rocks on the terrain, half hidden behind it, in a two-view rig with
 /// direct texturing: the points depth-test against the compute path's

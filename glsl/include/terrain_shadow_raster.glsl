@@ -1,0 +1,129 @@
+// The terrain's shadow casters in compute (issue 28; §9.5's cascaded shadow
+// maps, src/terrain/shadow.rs): what terrain.shadow_clear, terrain.shadow
+// and terrain.shadow_big share. The casters are the view's warped grid
+// (§7.4.2), biased along the sun as glsl/lighting/shadow_terrain.vert does,
+// rasterized into one cascade's quadrant of an atlas-sized buffer of depth
+// bits (depth in [0, 1] orders as unsigned integers: atomicMin keeps the
+// caster nearest the sun), which terrain.shadow_copy copies into the D32
+// atlas. One dispatch a cascade; a triangle whose box misses the cascade's
+// quadrant or depth range is culled.
+#ifndef ALPENGLOW_TERRAIN_SHADOW_RASTER_GLSL
+#define ALPENGLOW_TERRAIN_SHADOW_RASTER_GLSL
+
+#include "terrain_visibility.glsl"
+
+layout(set = 0, binding = 2, std430) buffer ShadowDepths { uint d[]; } g_shadow_depths[];
+// Per cascade: the count of triangles left to terrain.shadow_big, then the
+// lists, cascade c's at c × triangles.
+layout(set = 0, binding = 2, std430) buffer ShadowBig { uint count[4]; uint ids[]; } g_shadow_big[];
+
+// src/terrain/shadow.rs, CasterRasterPush.
+layout(push_constant) uniform Push {
+    mat4 view_proj;   // world → atlas clip space of the cascade
+    vec4 sun_texel;   // xyz: towards the sun, w: texel size (m)
+    uvec4 handles;    // grid vertices, depth buffer, big-triangle lists, cascade
+    uvec4 grid;       // grid side, triangles, atlas side, texels (clear)
+} pc;
+
+// Bounding boxes larger than this go to terrain.shadow_big.
+const uint SHADOW_BIG_PIXELS = 64u;
+
+// The caster triangle's state.
+const int CASTER_CULLED = 0;
+const int CASTER_FIXED = 1;  // set up in fixed point
+const int CASTER_FLOAT = 2;  // beyond the fixed-point range: float edges
+
+// Atlas clip position of grid vertex `i`, pushed away from the sun by
+// shadow_terrain.vert's slope-scaled bias.
+vec4 caster_clip(uint i) {
+    vec3 sun = pc.sun_texel.xyz;
+    float texel = pc.sun_texel.w;
+    vec3 n = normalize(grid_normal(pc.handles.x, i).xyz);
+    float c = clamp(abs(dot(n, sun)), 1e-3, 1.0);
+    float tan_theta = min(sqrt(1.0 - c * c) / c, 4.0);
+    precise vec3 p = grid_position(pc.handles.x, i).xyz - sun * texel * (0.5 + 0.5 * tan_theta);
+    precise vec4 clip = pc.view_proj * vec4(p, 1.0);
+    return clip;
+}
+
+// The first and last texel of the cascade's quadrant (column c % 2, row c / 2).
+void cascade_quadrant(out ivec2 first, out ivec2 last) {
+    int side = int(pc.grid.z / 2u);
+    int cascade = int(pc.handles.w);
+    first = ivec2(cascade % 2, cascade / 2) * side;
+    last = first + side - 1;
+}
+
+// Sets up caster triangle `t`: its clip positions `c`, depths `z` (in the
+// order of tri.v on the fixed path), the texels to visit; CASTER_CULLED when
+// it misses the cascade.
+int setup_caster(uint t, out vec4 c[3], out FixedTriangle tri, out vec3 z, out ivec2 first, out ivec2 last) {
+    uvec3 i = grid_triangle(t, pc.grid.x);
+    c = vec4[3](caster_clip(i.x), caster_clip(i.y), caster_clip(i.z));
+    z = vec3(c[0].z, c[1].z, c[2].z);
+    if (max(z.x, max(z.y, z.z)) < 0.0 || min(z.x, min(z.y, z.z)) > 1.0) {
+        return CASTER_CULLED;
+    }
+    vec2 size = vec2(pc.grid.z);
+    vec2 s0 = screen_position(c[0], size), s1 = screen_position(c[1], size), s2 = screen_position(c[2], size);
+    vec2 lo = min(s0, min(s1, s2)), hi = max(s0, max(s1, s2));
+    ivec2 quadrant_first, quadrant_last;
+    cascade_quadrant(quadrant_first, quadrant_last);
+    // Per-cascade culling: the box misses the quadrant (its texel centres).
+    if (any(lessThan(hi, vec2(quadrant_first) + 0.5)) || any(greaterThan(lo, vec2(quadrant_last) + 0.5))) {
+        return CASTER_CULLED;
+    }
+    if (any(lessThan(lo, vec2(-FIXED_LIMIT))) || any(greaterThan(hi, size + FIXED_LIMIT))) {
+        first = max(ivec2(ceil(lo - 0.5)), quadrant_first);
+        last = min(ivec2(floor(hi - 0.5)), quadrant_last);
+        return any(lessThan(last, first)) ? CASTER_CULLED : CASTER_FLOAT;
+    }
+    if (!setup_fixed(c, size, tri)) {
+        return CASTER_CULLED;
+    }
+    z = tri.flipped ? z.xzy : z;
+    fixed_bounds(tri, ivec2(pc.grid.z), first, last);
+    first = max(first, quadrant_first);
+    last = min(last, quadrant_last);
+    return any(lessThan(last, first)) ? CASTER_CULLED : CASTER_FIXED;
+}
+
+// The caster's depth at texel `pixel` on the float path (a negative value
+// off the triangle): barycentrics from float edge functions.
+float float_caster_depth(vec4 c[3], vec3 z, ivec2 pixel) {
+    vec2 size = vec2(pc.grid.z);
+    vec2 a = screen_position(c[0], size), b = screen_position(c[1], size), d = screen_position(c[2], size);
+    vec2 p = vec2(pixel) + 0.5;
+    float area = (b.x - a.x) * (d.y - a.y) - (b.y - a.y) * (d.x - a.x);
+    if (area == 0.0) {
+        return -1.0;
+    }
+    vec3 lambda = vec3((d.x - b.x) * (p.y - b.y) - (d.y - b.y) * (p.x - b.x),
+                       (a.x - d.x) * (p.y - d.y) - (a.y - d.y) * (p.x - d.x),
+                       (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x)) / area;
+    return any(lessThan(lambda, vec3(0.0))) ? -1.0 : dot(lambda, z);
+}
+
+// The caster's depth at texel `pixel` on the fixed path, or a negative value.
+float fixed_caster_depth(FixedTriangle tri, vec3 z, ivec2 pixel) {
+    vec3 lambda;
+    return fixed_barycentrics(tri, pixel, lambda) ? dot(lambda, z) : -1.0;
+}
+
+// Keeps the depth nearer the sun at texel `pixel` (depths outside [0, 1]
+// are clipped, as the hardware clips them).
+void store_caster_depth(ivec2 pixel, float depth) {
+    if (depth >= 0.0 && depth <= 1.0) {
+        uint bits = depth > 0.0 ? floatBitsToUint(depth) : 0u;
+        atomicMin(g_shadow_depths[pc.handles.y].d[uint(pixel.y) * pc.grid.z + uint(pixel.x)], bits);
+    }
+}
+
+// Lists triangle `t` for terrain.shadow_big in the cascade's list.
+void list_big_caster(uint t) {
+    uint cascade = pc.handles.w;
+    uint slot = atomicAdd(g_shadow_big[pc.handles.z].count[cascade], 1u);
+    g_shadow_big[pc.handles.z].ids[cascade * pc.grid.y + slot] = t;
+}
+
+#endif
