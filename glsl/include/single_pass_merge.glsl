@@ -28,14 +28,14 @@ struct SplatFragment {
 };
 
 // The fragment of splat `v` sampled as `s` at `pixel`; false when the depth
-// buffer (terrain, hybrid triangles) is nearer (test ≤, as the three-pass
-// accumulation).
+// buffer (terrain, hybrid triangles) is nearer (the three-pass
+// accumulation's test; reversed depth, src/view/depth.rs: nearer is greater).
 bool single_pass_fragment(SplatSetup v, SplatSample s, uvec2 pixel, out SplatFragment frag) {
     uint depth_buffer = pc.single.z;
     if (depth_buffer != NO_HANDLE) {
         float stored = texelFetch(sampler2D(g_textures[depth_buffer], g_samplers[SAMPLER_NEAREST_CLAMP]),
                                   ivec2(pixel), 0).r;
-        if (depth_of(s.position.z) > stored) {
+        if (depth_of(s.position.z) < stored) {
             return false;
         }
     }

@@ -87,7 +87,10 @@ pub struct SceneArgs {
     /// Near plane distance in metres (default: from the terrain size).
     #[arg(long, value_name = "METRES", help_heading = "Camera")]
     pub near: Option<f64>,
-    /// Far plane distance in metres (default: from the terrain size).
+    /// Far plane distance in metres, or `inf` for an infinite far plane
+    /// (default: from the terrain size). Depth is reversed (near 1, far 0,
+    /// 32-bit float), so a near plane of centimetres still orders ridges
+    /// 100 km away.
     #[arg(long, value_name = "METRES", help_heading = "Camera")]
     pub far: Option<f64>,
     /// Height field: 16-bit PNG (value·scale + offset) or EXR (first channel, metres·scale + offset).

@@ -22,8 +22,7 @@ use crate::terrain::TerrainFrame;
 use crate::texturing::generation::AtlasBindings;
 use crate::view::{Frame, Provides, SceneTargets, ViewIndex};
 use crate::vulkan::{
-    Blend, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, PrimitiveTopology,
-    VertexAttribute,
+    Blend, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, PrimitiveTopology, VertexAttribute,
 };
 
 /// The classic surface types (§7.4.3) as the layers of the built-in tree
@@ -198,7 +197,7 @@ fn pipeline(ctx: &Context, targets: &SceneTargets) -> Result<GraphicsPipeline> {
             depth_format: Some(targets.formats.depth),
             depth_test: true,
             depth_write: true,
-            depth_compare: CompareOp::LESS,
+            depth_compare: crate::view::depth::NEARER,
         },
     )
 }
@@ -230,7 +229,7 @@ pub fn declare_draw_pass<S: Provides<TerrainFrame> + 'static>(
         .color(targets.visibility, load)
         .color(targets.normal, load)
         .color(targets.ids, load)
-        .depth(targets.depth, Some(1.0))
+        .depth(targets.depth, Some(crate::view::depth::FAR_DEPTH))
         .record(move |ctx, frame| {
             let prepared = frame.prepared::<crate::terrain::TerrainFrame>()?.view(pass.view)?.draw;
             let handles = pass.surface.write(ctx, &surface)?;

@@ -355,7 +355,7 @@ fn declare_depth<S: 'static>(
     let ndc = pass.storage_image(ndc_depth, fragment);
     let view_depth = pass.storage_image(targets.view_depth, fragment);
     pass.pipeline(&pipeline)
-        .depth(targets.depth, Some(1.0))
+        .depth(targets.depth, Some(crate::view::depth::FAR_DEPTH))
         .record(move |ctx, _| {
             let push = [ctx.handle(ndc)?, ctx.handle(view_depth)?, 0, 0];
             ctx.draw_full_screen(&pipeline, &push)

@@ -101,11 +101,12 @@ impl Camera {
                 ),
             ));
         }
-        if !(self.near > 0.0 && self.near.is_finite() && self.far > self.near && self.far.is_finite()) {
+        let far_ok = self.far.is_finite() || self.far == f64::INFINITY;
+        if !(self.near > 0.0 && self.near.is_finite() && self.far > self.near && far_ok) {
             return Err(Error::invalid(
                 "camera.near/camera.far",
                 format!(
-                    "near {} and far {}; need 0 < near < far, both finite",
+                    "near {} and far {}; need 0 < near < far, near finite (far may be inf: an infinite far plane)",
                     self.near, self.far
                 ),
             ));
@@ -116,13 +117,13 @@ impl Camera {
                 format!("{} m is below the smallest near plane, {MIN_NEAR} m", short(self.near)),
             ));
         }
-        if self.far > MAX_FAR {
+        if self.far > MAX_FAR && self.far.is_finite() {
             return Err(Error::invalid(
                 "camera.far",
                 format!("{} m is beyond the farthest far plane, {MAX_FAR:e} m", short(self.far)),
             ));
         }
-        if self.far / self.near > MAX_DEPTH_RATIO {
+        if self.far / self.near > MAX_DEPTH_RATIO && self.far.is_finite() {
             return Err(Error::invalid(
                 "camera.near/camera.far",
                 format!(
@@ -219,8 +220,9 @@ impl Camera {
         self.right().cross(self.forward())
     }
 
-    /// World → clip transform for Vulkan (depth 0..1, y flipped so image row 0
-    /// is the top). Computed in f64, rounded once.
+    /// World → clip transform for Vulkan (reversed depth, 1 at `near` and 0
+    /// at `far`: [`crate::view::depth`]; y flipped so image row 0 is the
+    /// top). Computed in f64, rounded once.
     pub fn view_proj(&self, aspect: f64) -> Mat4 {
         self.view_proj_f64(aspect).as_mat4()
     }
@@ -228,7 +230,9 @@ impl Camera {
     /// [`Camera::view_proj`] in f64.
     pub fn view_proj_f64(&self, aspect: f64) -> DMat4 {
         let view = DMat4::look_at_rh(self.eye, self.target, self.up);
-        let mut proj = DMat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, self.near, self.far);
+        // The depth row is replaced: any finite far plane will do here.
+        let mut proj = DMat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, self.near, 2.0 * self.near);
+        super::depth::set_reversed_depth(&mut proj, self.near, self.far);
         proj.y_axis.y = -proj.y_axis.y;
         proj * view
     }

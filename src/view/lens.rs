@@ -142,13 +142,13 @@ impl Intrinsics {
 
     /// View space (right-handed, looking down −z, y up) → Vulkan clip space
     /// of a `width`×`height` image: x right, y down (row 0 at the top),
-    /// depth 0 at `near` and 1 at `far` (glam's `perspective_rh` depth).
+    /// reversed depth, 1 at `near` and 0 at `far` ([`crate::view::depth`]).
     pub fn projection(&self, width: u32, height: u32, near: f64, far: f64) -> DMat4 {
         let (w, h) = (f64::from(width), f64::from(height));
         // With d = −z the view-space depth: ndc.x = (2fx/w)·x/d + (2cx/w − 1),
         // ndc.y (down) = (2fy/h)·(−y)/d + (2cy/h − 1).
         let (ox, oy) = self.principal_ndc(width, height);
-        let (a, b) = (far / (near - far), near * far / (near - far));
+        let (a, b) = super::depth::depth_row(near, far);
         DMat4::from_cols(
             DVec4::new(2.0 * self.fx / w, 0.0, 0.0, 0.0),
             DVec4::new(0.0, -2.0 * self.fy / h, 0.0, 0.0),
@@ -305,10 +305,11 @@ mod tests {
     use super::*;
 
     #[test]
-    fn centred_intrinsics_give_glams_projection() {
+    fn centred_intrinsics_give_the_cameras_projection() {
         let (w, h) = (640, 360);
         let k = Intrinsics::from_fov_y(50.0, w, h);
         let mut expected = DMat4::perspective_rh(50f64.to_radians(), 640.0 / 360.0, 0.5, 900.0);
+        crate::view::depth::set_reversed_depth(&mut expected, 0.5, 900.0);
         expected.y_axis.y = -expected.y_axis.y;
         let got = k.projection(w, h, 0.5, 900.0);
         assert!(got.abs_diff_eq(expected, 1e-12), "{got:?} vs {expected:?}");

@@ -21,6 +21,7 @@
 pub mod aov;
 pub mod camera;
 pub mod camera_path;
+pub mod depth;
 mod frame;
 pub mod lens;
 pub mod lighting;

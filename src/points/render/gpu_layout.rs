@@ -148,10 +148,9 @@ pub fn frame_header(view: &View, settings: &SplatSettings, max_point_size: f32) 
         [t.x_axis, t.y_axis, t.z_axis].map(|r| r.as_vec3().extend(0.0).to_array())
     };
     let view3 = DMat3::from_mat4(view);
-    let (near, far) = (camera.near, camera.far);
-    // glam's perspective_rh: depth = (far/(near−far)·z + near·far/(near−far)) / −z.
-    let p22 = far / (near - far);
-    let p32 = near * far / (near - far);
+    let near = camera.near;
+    // Reversed depth (crate::view::depth): depth = (p22·z + p32) / −z.
+    let (p22, p32) = crate::view::depth::depth_row(camera.near, camera.far);
     let header = FrameHeader {
         k: rows(k),
         k_inv: rows(k_inv),

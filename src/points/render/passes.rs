@@ -17,10 +17,9 @@ use crate::graph::{
     Binding, BufferAccess, BufferId, ImageId, LoadOp, PassBuilder, PassContext, RenderGraph, Stage, UploadRegion,
 };
 use crate::shaders;
+use crate::view::depth::{FAR_DEPTH, NEARER, NEARER_OR_EQUAL};
 use crate::view::{Frame, Provides, SceneTargets, ViewIndex};
-use crate::vulkan::{
-    Blend, Buffer, CommandRecorder, CompareOp, Context, GraphicsPipeline, GraphicsPipelineDesc, SpirV,
-};
+use crate::vulkan::{Blend, Buffer, CommandRecorder, Context, GraphicsPipeline, GraphicsPipelineDesc, SpirV};
 
 /// `SplatPush.pass`: which pass the shaders run in.
 const PASS_VISIBILITY: u32 = 0;
@@ -397,7 +396,7 @@ pub(super) fn declare_opaque<S: Provides<PointsFrame> + 'static>(
         shaders: (shaders::SPLAT_VERT, fragment),
         color_formats: formats.clone(),
         blend: Blend::None,
-        depth: (true, CompareOp::LESS),
+        depth: (true, NEARER),
     };
     let pipelines = PassPipelines::new(
         ctx,
@@ -417,7 +416,7 @@ pub(super) fn declare_opaque<S: Provides<PointsFrame> + 'static>(
     let (builder, splat) = buffers.read_by(builder, shading.frame, true);
     let builder = view.write_outputs(pipelines.declare_on(builder), LoadOp::Clear([0.0; 4]));
     builder
-        .depth(view.depth, view.clear_depth.then_some(1.0))
+        .depth(view.depth, view.clear_depth.then_some(FAR_DEPTH))
         .record(move |pass, frame| {
             shading.write_header(pass, frame, view.index)?;
             let plan = plan_of(frame, view.index)?;
@@ -483,7 +482,7 @@ fn declare_visibility<S: Provides<PointsFrame> + 'static>(
         shaders,
         color_formats: vec![targets.formats.ids],
         blend: Blend::None,
-        depth: (true, CompareOp::LESS),
+        depth: (true, NEARER),
     };
     let pipelines = PassPipelines::new(
         ctx,
@@ -507,7 +506,7 @@ fn declare_visibility<S: Provides<PointsFrame> + 'static>(
     pipelines
         .declare_on(builder)
         .color(ids, LoadOp::Clear([0.0; 4]))
-        .depth(view.depth, view.clear_depth.then_some(1.0))
+        .depth(view.depth, view.clear_depth.then_some(FAR_DEPTH))
         .record(move |pass, frame| {
             let plan = plan_of(frame, view.index)?;
             let push = splat.push(pass, PASS_VISIBILITY)?;
@@ -540,7 +539,7 @@ fn declare_accumulate<S: Provides<PointsFrame> + 'static>(
             targets.formats.ids,
         ],
         blend: Blend::Additive,
-        depth: (false, CompareOp::LESS_OR_EQUAL),
+        depth: (false, NEARER_OR_EQUAL),
     };
     let pipelines = PassPipelines::new(
         ctx,

@@ -47,7 +47,7 @@ fn render(scene: &Scene, cameras: &[(&str, Camera)], raster: RasterPath) -> Vec<
 
 /// Each frame of `frames` (a camera per view) rendered and read back, the
 /// views of every frame in a row.
-fn render_with(scene: &Scene, frames: &[Vec<Camera>], settings: RenderSettings) -> Vec<FrameImages> {
+pub(super) fn render_with(scene: &Scene, frames: &[Vec<Camera>], settings: RenderSettings) -> Vec<FrameImages> {
     let (ctx, report) = validated_context();
     let raster = settings.raster;
     let frames = {

@@ -3,5 +3,6 @@
 
 mod compute_raster;
 mod ground;
+mod reversed_depth;
 mod terrain;
 mod warp;

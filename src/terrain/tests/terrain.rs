@@ -77,19 +77,25 @@ fn render(scene: &Scene, cameras: &[Camera], terrain: TerrainSettings) -> Vec<Fr
 
 /// CPU depth per pixel (along the forward axis; +inf on a miss).
 fn raycast_depth(scene: &Scene, camera: &Camera) -> Vec<f32> {
+    raycast_depth_of(scene, camera, (WIDTH, HEIGHT))
+}
+
+/// CPU depth per pixel of a `width`×`height` image (along the forward
+/// axis; +inf on a miss or beyond the far plane).
+pub(super) fn raycast_depth_of(scene: &Scene, camera: &Camera, (width, height): (u32, u32)) -> Vec<f32> {
     let caster = Raycaster::new(&scene.heights).expect("ray caster");
-    let aspect = f64::from(WIDTH) / f64::from(HEIGHT);
+    let aspect = f64::from(width) / f64::from(height);
     let tan_y = (camera.fov_y_deg.to_radians() * 0.5).tan();
     let (right, up, forward) = (
         camera.right() * tan_y * aspect,
         camera.image_up() * tan_y,
         camera.forward(),
     );
-    let mut out = Vec::with_capacity((WIDTH * HEIGHT) as usize);
-    for j in 0..HEIGHT {
-        for i in 0..WIDTH {
-            let sx = 2.0 * (f64::from(i) + 0.5) / f64::from(WIDTH) - 1.0;
-            let sy = 1.0 - 2.0 * (f64::from(j) + 0.5) / f64::from(HEIGHT);
+    let mut out = Vec::with_capacity((width * height) as usize);
+    for j in 0..height {
+        for i in 0..width {
+            let sx = 2.0 * (f64::from(i) + 0.5) / f64::from(width) - 1.0;
+            let sy = 1.0 - 2.0 * (f64::from(j) + 0.5) / f64::from(height);
             // forward·dir = 1, so t is the view depth.
             let dir = forward + sx * right + sy * up;
             let t = caster
