@@ -5,8 +5,9 @@
 // rasterized into one cascade's quadrant of an atlas-sized buffer of depth
 // bits (depth in [0, 1] orders as unsigned integers: atomicMin keeps the
 // caster nearest the sun), which terrain.shadow_copy copies into the D32
-// atlas. One dispatch a cascade; a triangle whose box misses the cascade's
-// quadrant or depth range is culled.
+// atlas. One dispatch a cascade; a triangle whose box misses the texels the
+// cascade's receivers sample (src/lighting/shadows/cascades.rs, receivers)
+// or its depth range is culled.
 #ifndef ALPENGLOW_TERRAIN_SHADOW_RASTER_GLSL
 #define ALPENGLOW_TERRAIN_SHADOW_RASTER_GLSL
 
@@ -23,6 +24,7 @@ layout(push_constant) uniform Push {
     vec4 sun_texel;   // xyz: towards the sun, w: texel size (m)
     uvec4 handles;    // grid vertices, depth buffer, big-triangle lists, cascade
     uvec4 grid;       // grid side, triangles, atlas side, texels (clear)
+    uvec4 receivers;  // the texels the cascade's receivers sample: first x, y, last x, y
 } pc;
 
 // Bounding boxes larger than this go to terrain.shadow_big.
@@ -46,12 +48,11 @@ vec4 caster_clip(uint i) {
     return clip;
 }
 
-// The first and last texel of the cascade's quadrant (column c % 2, row c / 2).
-void cascade_quadrant(out ivec2 first, out ivec2 last) {
-    int side = int(pc.grid.z / 2u);
-    int cascade = int(pc.handles.w);
-    first = ivec2(cascade % 2, cascade / 2) * side;
-    last = first + side - 1;
+// The first and last texel the cascade's casters write: those of its
+// quadrant (column c % 2, row c / 2) its receivers can sample.
+void cascade_texels(out ivec2 first, out ivec2 last) {
+    first = ivec2(pc.receivers.xy);
+    last = ivec2(pc.receivers.zw);
 }
 
 // Sets up caster triangle `t`: its clip positions `c`, depths `z` (in the
@@ -67,15 +68,15 @@ int setup_caster(uint t, out vec4 c[3], out FixedTriangle tri, out vec3 z, out i
     vec2 size = vec2(pc.grid.z);
     vec2 s0 = screen_position(c[0], size), s1 = screen_position(c[1], size), s2 = screen_position(c[2], size);
     vec2 lo = min(s0, min(s1, s2)), hi = max(s0, max(s1, s2));
-    ivec2 quadrant_first, quadrant_last;
-    cascade_quadrant(quadrant_first, quadrant_last);
-    // Per-cascade culling: the box misses the quadrant (its texel centres).
-    if (any(lessThan(hi, vec2(quadrant_first) + 0.5)) || any(greaterThan(lo, vec2(quadrant_last) + 0.5))) {
+    ivec2 region_first, region_last;
+    cascade_texels(region_first, region_last);
+    // Per-cascade culling: the box misses the region (its texel centres).
+    if (any(lessThan(hi, vec2(region_first) + 0.5)) || any(greaterThan(lo, vec2(region_last) + 0.5))) {
         return CASTER_CULLED;
     }
     if (any(lessThan(lo, vec2(-FIXED_LIMIT))) || any(greaterThan(hi, size + FIXED_LIMIT))) {
-        first = max(ivec2(ceil(lo - 0.5)), quadrant_first);
-        last = min(ivec2(floor(hi - 0.5)), quadrant_last);
+        first = max(ivec2(ceil(lo - 0.5)), region_first);
+        last = min(ivec2(floor(hi - 0.5)), region_last);
         return any(lessThan(last, first)) ? CASTER_CULLED : CASTER_FLOAT;
     }
     if (!setup_fixed(c, size, tri)) {
@@ -83,8 +84,8 @@ int setup_caster(uint t, out vec4 c[3], out FixedTriangle tri, out vec3 z, out i
     }
     z = tri.flipped ? z.xzy : z;
     fixed_bounds(tri, ivec2(pc.grid.z), first, last);
-    first = max(first, quadrant_first);
-    last = min(last, quadrant_last);
+    first = max(first, region_first);
+    last = min(last, region_last);
     return any(lessThan(last, first)) ? CASTER_CULLED : CASTER_FIXED;
 }
 

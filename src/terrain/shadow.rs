@@ -87,6 +87,8 @@ struct CasterRasterPush {
     handles: [u32; 4],
     /// Grid side, triangles, atlas side, texels.
     grid: [u32; 4],
+    /// The cascade's receivers' texel box (first x, y, last x, y).
+    receivers: [u32; 4],
 }
 
 /// Workgroups of `terrain.shadow_big` (each loops over the list).
@@ -160,12 +162,13 @@ impl ComputeCasters {
             pass.record(move |ctx, frame| {
                 let plan = frame.prepared::<ShadowFrame>()?.view(index)?;
                 let handles = [ctx.handle(vertices)?, ctx.handle(depths)?, ctx.handle(lists)?];
-                for (cascade, push) in cascade_pushes(plan) {
+                for (cascade, receivers, push) in cascade_pushes(plan) {
                     let push = CasterRasterPush {
                         view_proj: push.view_proj,
                         sun_texel: push.sun_texel,
                         handles: [handles[0], handles[1], handles[2], cascade],
                         grid,
+                        receivers,
                     };
                     ctx.dispatch(&pipeline, &push, [groups, 1, 1])?;
                 }
@@ -255,8 +258,8 @@ impl Terrain {
             .depth(atlas, None)
             .record(move |ctx, frame| {
                 let plan = frame.prepared::<ShadowFrame>()?.view(index)?;
-                let (image, vertices, indices) = (ctx.image(atlas)?, ctx.buffer(vertices)?, ctx.buffer(indices)?);
-                record_cascades(ctx.cmd(), image, plan, |cmd, push| {
+                let (vertices, indices) = (ctx.buffer(vertices)?, ctx.buffer(indices)?);
+                record_cascades(ctx.cmd(), plan, |cmd, push| {
                     cmd.bind_graphics(&pipeline);
                     cmd.push_constants(&push)?;
                     cmd.bind_vertex_buffer(vertices);

@@ -21,7 +21,7 @@
 //! atlas (a single D32 image; quadrant `i` at column `i % 2`, row `i / 2`),
 //! depth 0 nearest the sun.
 
-use glam::{DMat4, DVec3, DVec4, Vec3};
+use glam::{DMat4, DVec2, DVec3, DVec4, Vec3};
 
 use crate::error::{Error, Result};
 use crate::lighting::constants::{LightingFrame, MAX_CASCADES};
@@ -141,6 +141,12 @@ pub struct Cascade {
     pub half: f64,
     /// Sun-space depth range (m along the sun direction): [back, front].
     pub depth: [f64; 2],
+    /// The atlas texels its receivers can sample (first x, first y, last
+    /// x, last y, inclusive): the view's frustum slice, with the previous
+    /// cascade's blend band, projected into the quadrant and grown by the
+    /// PCF and normal-offset margin. The casters draw only there (the rest
+    /// of the quadrant keeps depth 1 and is never read).
+    pub receivers: [u32; 4],
 }
 
 /// The cascades of one view this frame.
@@ -191,6 +197,48 @@ impl CascadePlan {
                 && (y - c.centre[1]).abs() <= c.half + radius
                 && z + radius >= c.depth[0]
         })
+    }
+}
+
+/// Fraction of a cascade's depth range over which it blends into the next
+/// (`SHADOW_BLEND_BAND` in `glsl/include/shadows.glsl`).
+const BLEND_BAND: f64 = 0.1;
+
+/// The view frustum whose slices the cascades cover.
+struct SliceFrustum<'a> {
+    camera: &'a Camera,
+    /// Tangents of the half angles across and up.
+    tan: (f64, f64),
+}
+
+impl SliceFrustum<'_> {
+    /// The texel box of cascade `index`'s quadrant of an `atlas`² atlas
+    /// (through `view_proj`) holding the slice between view depths
+    /// `range`, grown by `margin` texels.
+    fn texels(&self, view_proj: DMat4, range: (f64, f64), (index, atlas): (usize, u32), margin: f64) -> [u32; 4] {
+        let (eye, forward) = (self.camera.eye, self.camera.forward());
+        let (right, up) = (self.camera.right() * self.tan.0, self.camera.image_up() * self.tan.1);
+        let size = f64::from(atlas);
+        let (mut lo, mut hi) = (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN));
+        for d in [range.0, range.1] {
+            for (sx, sy) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
+                let p = eye + d * (forward + sx * right + sy * up);
+                let clip = view_proj * p.extend(1.0);
+                let texel = (clip.truncate().truncate() * 0.5 + 0.5) * size;
+                lo = lo.min(texel);
+                hi = hi.max(texel);
+            }
+        }
+        let side = atlas / 2;
+        let q0 = glam::UVec2::new((index % 2) as u32, (index / 2) as u32) * side;
+        let q1 = q0 + (side - 1);
+        let clamp = |v: f64, lo: u32, hi: u32| (v.max(f64::from(lo)).min(f64::from(hi))) as u32;
+        [
+            clamp((lo.x - margin).floor(), q0.x, q1.x),
+            clamp((lo.y - margin).floor(), q0.y, q1.y),
+            clamp((hi.x + margin).ceil(), q0.x, q1.x),
+            clamp((hi.y + margin).ceil(), q0.y, q1.y),
+        ]
     }
 }
 
@@ -280,6 +328,10 @@ pub fn plan_cascades_into(
     let top = bounds.corners().iter().map(|p| p.dot(sun)).fold(f64::MIN, f64::max);
     let mut cascades = std::mem::take(&mut plan.cascades);
     cascades.clear();
+    let slice = SliceFrustum {
+        camera,
+        tan: (tan_y * aspect, tan_y),
+    };
     for (i, w) in splits.windows(2).enumerate() {
         let (c, r) = slice_sphere(w[0], w[1], k);
         // Quantised so the size does not flicker with rounding.
@@ -308,14 +360,22 @@ pub fn plan_cascades_into(
             DVec4::new(0.0, 0.0, 1.0, 0.0),
             DVec4::new(qx - 0.5, qy - 0.5, 0.0, 1.0),
         );
+        let view_proj = to_quadrant * ortho;
+        // Receivers in the previous cascade's blend band sample this one too.
+        let first = match i {
+            0 => w[0],
+            _ => w[0] - BLEND_BAND * (w[0] - splits[i - 1]),
+        };
+        let receivers = slice.texels(view_proj, (first, w[1]), (i, settings.atlas_size), margin);
         cascades.push(Cascade {
-            view_proj: to_quadrant * ortho,
+            view_proj,
             near: w[0],
             far: w[1],
             texel,
             centre: [sx, sy],
             half,
             depth: [back, front],
+            receivers,
         });
     }
     *plan = CascadePlan {
@@ -364,6 +424,28 @@ mod tests {
     fn frustum_point(cam: &Camera, aspect: f64, d: f64, u: f64, v: f64) -> DVec3 {
         let t = (0.5 * cam.fov_y_deg.to_radians()).tan();
         cam.eye + cam.forward() * d + cam.right() * (u * t * aspect * d) + cam.image_up() * (v * t * d)
+    }
+
+    fn inside_receivers(c: &Cascade, t: DVec3, margin: f64) -> bool {
+        let [x0, y0, x1, y1] = c.receivers.map(f64::from);
+        t.x >= x0 + margin && t.x <= x1 + 1.0 - margin && t.y >= y0 + margin && t.y <= y1 + 1.0 - margin
+    }
+
+    /// The receivers' box is smaller than the quadrant: the casters skip
+    /// the texels no receiver reads.
+    #[test]
+    fn receivers_cover_less_than_the_quadrant() {
+        let settings = ShadowSettings::default();
+        let cam = camera(DVec3::new(100.0, 200.0, 900.0), DVec3::new(5000.0, 9000.0, 400.0));
+        let plan = plan_cascades(&cam, 16.0 / 9.0, sun(), bounds(), &settings).unwrap();
+        let quadrant = f64::from(settings.quadrant()).powi(2);
+        let share: Vec<f64> = (plan.cascades.iter())
+            .map(|c| {
+                f64::from((c.receivers[2] + 1 - c.receivers[0]) * (c.receivers[3] + 1 - c.receivers[1])) / quadrant
+            })
+            .collect();
+        assert!(share.iter().all(|&s| s > 0.0 && s <= 1.0), "{share:?}");
+        assert!(share.iter().sum::<f64>() < 0.8 * share.len() as f64, "{share:?}");
     }
 
     fn inside_quadrant(i: usize, t: DVec3, size: f64, margin: f64) -> bool {
@@ -420,6 +502,17 @@ mod tests {
                 let margin = f64::from(settings.pcf_radius) + 1.5;
                 assert!(inside_quadrant(i, t, size, margin), "cascade {i}: {p} → {t}");
                 assert!(t.z > 0.0 && t.z < 1.0, "depth {}", t.z);
+                // The casters draw every texel its PCF tent reads; in the
+                // blend band the next cascade's too.
+                assert!(
+                    inside_receivers(c, t, margin),
+                    "cascade {i}: {p} → {t}, {:?}",
+                    c.receivers
+                );
+                if let Some(next) = plan.cascades.get(i + 1).filter(|_| d > c.far - 0.1 * (c.far - c.near)) {
+                    let t = atlas_texel(next, p, size);
+                    assert!(inside_receivers(next, t, margin), "blend into {}: {t}", i + 1);
+                }
             }
             // Every corner of every slice.
             for (i, c) in plan.cascades.iter().enumerate() {

@@ -357,9 +357,10 @@ impl Technique for ShadowMaps {
 }
 
 /// Each cascade of `plan` (as many as it casts: none with the sun below
-/// the horizon) with its index and caster push constants (`handles` left
-/// to the pass).
-pub fn cascade_pushes(plan: &CascadePlan) -> impl Iterator<Item = (u32, ShadowCasterPush)> + '_ {
+/// the horizon) with its index, its receivers' texel box
+/// ([`cascades::Cascade::receivers`]) and caster push constants (`handles`
+/// left to the pass).
+pub fn cascade_pushes(plan: &CascadePlan) -> impl Iterator<Item = (u32, [u32; 4], ShadowCasterPush)> + '_ {
     let count = plan.count() as usize;
     (plan.cascades.iter().take(count).enumerate()).map(|(i, c)| {
         let push = ShadowCasterPush {
@@ -367,24 +368,21 @@ pub fn cascade_pushes(plan: &CascadePlan) -> impl Iterator<Item = (u32, ShadowCa
             sun_texel: plan.sun.as_vec3().extend(c.texel as f32).to_array(),
             handles: [0; 4],
         };
-        (i as u32, push)
+        (i as u32, c.receivers, push)
     })
 }
 
-/// Records a caster pass, which declared `atlas` its depth attachment
+/// Records a caster pass, which declared the atlas its depth attachment
 /// (loaded: `.depth(atlas, None)`): per cascade of `plan` sets the scissor
-/// on its quadrant and calls `draw` with the cascade's push constants
-/// (`handles` left to `draw`).
+/// on its receivers' texels in its quadrant and calls `draw` with the
+/// cascade's push constants (`handles` left to `draw`).
 pub fn record_cascades(
     cmd: &mut CommandRecorder,
-    atlas: &Image,
     plan: &CascadePlan,
     mut draw: impl FnMut(&mut CommandRecorder, ShadowCasterPush) -> Result<()>,
 ) -> Result<()> {
-    let quadrant = atlas.desc().width / 2;
-    for (i, push) in cascade_pushes(plan) {
-        let (x, y) = ((i % 2) * quadrant, (i / 2) * quadrant);
-        cmd.set_scissor(x, y, quadrant, quadrant);
+    for (_, [x0, y0, x1, y1], push) in cascade_pushes(plan) {
+        cmd.set_scissor(x0, y0, x1 + 1 - x0, y1 + 1 - y0);
         draw(cmd, push)?;
     }
     Ok(())

@@ -190,8 +190,8 @@ fn declare_mesh_caster(ctx: &Context, graph: &mut RenderGraph<Frame<Slots>>, wit
         .depth(atlas, None)
         .record(move |pass, frame| {
             let plan = frame.prepared::<ShadowFrame>()?.view(0)?;
-            let (image, v, i) = (pass.image(atlas)?, pass.buffer(vertices)?, pass.buffer(indices)?);
-            record_cascades(pass.cmd(), image, plan, |cmd, push| {
+            let (v, i) = (pass.buffer(vertices)?, pass.buffer(indices)?);
+            record_cascades(pass.cmd(), plan, |cmd, push| {
                 cmd.bind_graphics(&pipeline);
                 cmd.push_constants(&push)?;
                 cmd.bind_vertex_buffer(v);

@@ -231,8 +231,7 @@ impl<S: Provides<ShadowFrame> + Provides<PointShadowFrame> + 'static> Declare<S>
                 return Ok(());
             }
             let handles = [ctx.handle(handles[0])?, ctx.handle(handles[1])?];
-            let image = ctx.image(atlas)?;
-            record_cascades(ctx.cmd(), image, plan, |cmd, mut push| {
+            record_cascades(ctx.cmd(), plan, |cmd, mut push| {
                 cmd.bind_graphics(&pipeline);
                 for d in draws {
                     push.handles = [handles[0], handles[1], d.record, 0];
