@@ -111,6 +111,42 @@ float fixed_caster_depth(FixedTriangle tri, vec3 z, ivec2 pixel) {
     return fixed_barycentrics(tri, pixel, lambda) ? dot(lambda, z) : -1.0;
 }
 
+// floor(n / d) and ceil(n / d) for d > 0.
+int64_t floor_div(int64_t n, int64_t d) {
+    return n >= 0 ? n / d : -((-n + d - 1) / d);
+}
+int64_t ceil_div(int64_t n, int64_t d) {
+    return -floor_div(-n, d);
+}
+
+// The columns of row `y`, within [first_x, last_x], whose texel centres
+// `tri` covers: exactly those fixed_barycentrics accepts (each edge
+// function is linear along the row, so its tie-ruled test is a bound on x,
+// solved in integers). False when none.
+bool fixed_span(FixedTriangle tri, int y, int first_x, int last_x, out int x0, out int x1) {
+    int64_t py = int64_t(y) * int64_t(SUBPIXELS) + int64_t(SUBPIXELS / 2.0);
+    int64_t lo = int64_t(first_x), hi = int64_t(last_x);
+    int64_t half_subpixel = int64_t(SUBPIXELS / 2.0);
+    for (int k = 0; k < 3; ++k) {
+        // Edge k runs from v[k + 1] to v[k + 2]: e = C − D·(px − a.x).
+        i64vec2 a = tri.v[(k + 1) % 3], b = tri.v[(k + 2) % 3];
+        int64_t d = b.y - a.y;
+        int64_t r = (b.x - a.x) * (py - a.y) + tri.bias[k];
+        if (d == 0) {
+            if (r < 0) {
+                return false;
+            }
+        } else if (d > 0) {
+            hi = min(hi, floor_div(floor_div(r, d) + a.x - half_subpixel, int64_t(SUBPIXELS)));
+        } else {
+            lo = max(lo, ceil_div(ceil_div(-r, -d) + a.x - half_subpixel, int64_t(SUBPIXELS)));
+        }
+    }
+    x0 = int(lo);
+    x1 = int(hi);
+    return lo <= hi;
+}
+
 // Keeps the depth nearer the sun at texel `pixel` (depths outside [0, 1]
 // are clipped, as the hardware clips them).
 void store_caster_depth(ivec2 pixel, float depth) {
