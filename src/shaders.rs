@@ -38,14 +38,16 @@ pub const TERRAIN_SHADE: SpirV = spirv!("terrain/shade.comp");
 pub const TERRAIN_DEPTH_FRAG: SpirV = spirv!("terrain/depth.frag");
 /// Every full-screen pass (sky, points.normalize): one triangle covering the screen.
 pub const FULL_SCREEN_VERT: SpirV = spirv!("post/full_screen.vert");
-/// sky: analytic sky radiance.
-pub const SKY_FRAG: SpirV = spirv!("lighting/sky.frag");
+/// sky: the sky model and sun disc per pixel (compute).
+pub const SKY: SpirV = spirv!("lighting/sky.comp");
 /// aovs: distance and motion from view depth and the cameras (full-screen fragment stage).
 pub const AOVS_FRAG: SpirV = spirv!("post/aovs.frag");
 /// tonemap: HDR → sRGB8.
 pub const TONEMAP: SpirV = spirv!("post/tonemap.comp");
-/// exposure.meter: mean log luminance → the exposure multiplier.
+/// exposure.meter: sums of log luminance per 128×64-pixel tile.
 pub const EXPOSURE_METER: SpirV = spirv!("post/exposure.comp");
+/// exposure.average: the tiles' sums → the exposure multiplier.
+pub const EXPOSURE_AVERAGE: SpirV = spirv!("post/exposure_average.comp");
 /// points.*: vertex stage of every splat pass (interval test, EWA set-up).
 pub const SPLAT_VERT: SpirV = spirv!("points/splat.vert");
 /// points.visibility: ray–plane depth pushed back by ε.
@@ -64,8 +66,8 @@ pub const SPLAT_SINGLE_PASS_INTERLOCK_FRAG: SpirV = spirv!("points/single_pass_i
 pub const SPLAT_SINGLE_PASS_CLEAR: SpirV = spirv!("points/single_pass_clear.comp");
 /// points.single_pass.resolve: normalisation and shading of the pixel sums.
 pub const SPLAT_SINGLE_PASS_RESOLVE_FRAG: SpirV = spirv!("points/single_pass_resolve.frag");
-/// points.normalize: divide by the weight and shade (full-screen fragment stage).
-pub const SPLAT_NORMALIZE_FRAG: SpirV = spirv!("points/normalize.frag");
+/// points.normalize: divide by the weight and shade (compute, per pixel).
+pub const SPLAT_NORMALIZE: SpirV = spirv!("points/normalize.comp");
 /// points.*, object-space primitives (§10.3): quads in the tangent plane, the interval test.
 pub const OBJECT_SPLAT_VERT: SpirV = spirv!("points/object_splat.vert");
 /// points.visibility, object-space primitives: the pushed-back quad's depth inside the kernel's disk.

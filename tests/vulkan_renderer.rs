@@ -43,8 +43,8 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
             "lighting.sky_view",
             "lighting.environment",
             "lighting.sky_light",
-            "sky",
             "terrain.warp",
+            "sky",
             "texturing.upsample",
         ]
         .map(String::from)
@@ -58,6 +58,7 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
                 "terrain.draw",
                 "aovs",
                 "exposure.meter",
+                "exposure.average",
                 "tonemap",
                 "readback",
             ]

@@ -53,6 +53,10 @@ layout(set = 0, binding = 2, std430) readonly buffer GaussianTable { float g[]; 
 layout(push_constant) uniform Push {
     uvec4 handles;  // splats, point frame, drawn counter (NO_HANDLE: none), Gaussian table
     uvec4 mode;     // pass, primitive, size class, instance index
+#ifdef SPLAT_RESOLVE_COMPUTE
+    uvec4 outputs;  // storage: radiance (rgba32f), view depth (r32f), W (r32f), lighting AOVs (rg32f)
+    uvec4 more;     // storage: normal (rgba16f), ids (rg32ui); width, height
+#endif
 #ifdef SPLAT_SINGLE_PASS
     uvec4 single;   // single-pass (§10.4): pixel words, pixel sums, depth buffer (sampled; NO_HANDLE: cleared), splats of the draw
 #endif

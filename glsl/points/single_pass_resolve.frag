@@ -9,6 +9,13 @@
 
 // Push constants (the splat passes' block, splat.glsl):
 //   handles = (pixel sums (storage), point frame, unused, unused).
+layout(location = 0) out vec4 out_radiance;
+layout(location = 1) out float out_view_depth;
+layout(location = 2) out float out_weight;
+layout(location = 3) out vec2 out_visibility;
+layout(location = 4) out vec4 out_normal;
+layout(location = 5) out uvec2 out_ids;
+
 layout(set = 0, binding = 2, std430) readonly buffer PixelSumsBuffer { PixelSums p[]; } g_pixel_sums[];
 
 void main() {
@@ -18,6 +25,11 @@ void main() {
     if (!(s.color_weight.a > 0.0)) {
         discard;
     }
-    resolve_splats(s.color_weight, s.normal_depth);
+    ResolvedSplats r = resolve_splats(s.color_weight, s.normal_depth, gl_FragCoord.xy);
+    out_radiance = r.radiance;
+    out_view_depth = r.view_depth;
+    out_weight = r.weight;
+    out_visibility = r.visibility;
+    out_normal = r.normal;
     out_ids = s.ids.xy;
 }

@@ -6,9 +6,12 @@
 // varyings do — and shaded once by glsl/include/terrain_shade.glsl (§7.4.3,
 // §8.2, §9). Writes radiance, view depth, the lighting AOVs, normal and ids
 // where the terrain covers the pixel (the sky stays elsewhere), and the
-// depth buffer's NDC depth for terrain.depth when asked.
+// depth buffer's NDC depth for terrain.depth when asked. Pixels the terrain
+// leaves empty get the sky (glsl/include/sky_pixel.glsl): the compute path
+// has no separate sky pass.
 #include "../include/terrain_visibility.glsl"
 #include "../include/terrain_shade.glsl"
+#include "../include/sky_pixel.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -46,7 +49,11 @@ void main() {
         return;
     }
     uint64_t key = g_visibility[pc.handles.z].k[uint(pixel.y) * view.size.x + uint(pixel.x)];
+    vec2 size = vec2(view.size.xy);
+    vec2 ndc = (vec2(pixel) + 0.5) / size * 2.0 - 1.0;
     if (key == NO_HIT) {
+        // (terrain.depth reads no NDC depth where the view depth is +inf.)
+        store_sky_pixel(pc.surface.x, ray_of(view, ndc), pixel, pc.images, pc.more.x);
         return;
     }
     uint t = uint(key & uint64_t(0xffffffffu));
@@ -54,8 +61,6 @@ void main() {
     uvec3 i = grid_triangle(t, side);
     vec4 a = grid_position(pc.handles.y, i.x), b = grid_position(pc.handles.y, i.y), c = grid_position(pc.handles.y, i.z);
     vec3 p0 = a.xyz - view.eye.xyz, p1 = b.xyz - view.eye.xyz, p2 = c.xyz - view.eye.xyz;
-    vec2 size = vec2(view.size.xy);
-    vec2 ndc = (vec2(pixel) + 0.5) / size * 2.0 - 1.0;
     vec3 hit = ray_plane(ray_of(view, ndc), p0, p1, p2);
     vec3 w = vec3(1.0 - hit.x - hit.y, hit.x, hit.y);
     vec4 na = grid_normal(pc.handles.y, i.x), nb = grid_normal(pc.handles.y, i.y), nc = grid_normal(pc.handles.y, i.z);

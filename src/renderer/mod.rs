@@ -613,15 +613,18 @@ impl Wiring<'_> {
                 progress,
             )?;
         }
-        // Each view's shadow atlas before its sky: `sky` writes the view's
-        // lighting constants, which name the atlas.
+        // Each view's shadow atlas before its sky (or terrain.shade): that
+        // pass writes the view's lighting constants, which name the atlas.
         let casters = scene.draw_terrain || points_present;
         let atlases = lighting::shadow_atlases(ctx, graph, (views, &mut targets), casters, &settings.shadows)?;
-        declare_views(&mut Sky::new(ctx, &targets[0].formats)?, ctx, graph, views, &targets)?;
         let mut terrain = match scene.draw_terrain {
             true => Some(warped_terrain(ctx, graph, scene, settings, views)?),
             false => None,
         };
+        // The compute path's `terrain.shade` shades the sky where no terrain is.
+        if !terrain.as_ref().is_some_and(Terrain::shades_sky) {
+            declare_views(&mut Sky::new(ctx)?, ctx, graph, views, &targets)?;
+        }
         let mut points = match points_present {
             true => Some(PointRenderer::new(ctx, &scene.points, settings.points)?),
             false => None,

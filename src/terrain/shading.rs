@@ -20,7 +20,7 @@ use crate::surface::input_maps::{InputMaps, MapBindings};
 use crate::terrain::geometry_image::VERTEX_STRIDE;
 use crate::terrain::TerrainFrame;
 use crate::texturing::generation::AtlasBindings;
-use crate::view::{Frame, Provides, SceneTargets, ViewIndex};
+use crate::view::{Frame, LightingBindings, Provides, SceneTargets, ViewIndex};
 use crate::vulkan::{
     Blend, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, LoadOp, PrimitiveTopology, VertexAttribute,
 };
@@ -87,7 +87,14 @@ pub struct SurfaceBindings {
     maps: MapBindings,
     constants: Binding,
     atlas: Option<AtlasSamples>,
-    lighting: Binding,
+    lighting: LightingBindings,
+}
+
+impl SurfaceBindings {
+    /// The view's lighting constants and maps, as declared on the pass.
+    pub fn lighting(&self) -> &LightingBindings {
+        &self.lighting
+    }
 }
 
 /// The heap handles the surface shading reads (`TerrainParams`).
@@ -113,7 +120,7 @@ impl SurfaceInputs {
             maps: self.maps.sample_in(builder, stage),
             constants: builder.upload(self.constants, stage),
             atlas: (self.atlas.as_ref()).map(|atlas| AtlasSamples::declare(builder, atlas, stage)),
-            lighting: targets.lighting.read_in(builder, stage).constants,
+            lighting: targets.lighting.read_in(builder, stage),
         }
     }
 
@@ -131,7 +138,7 @@ impl SurfaceInputs {
         }
         ctx.write_upload_pod(b.constants, &texturing)?;
         Ok(SurfaceHandles {
-            lighting: ctx.handle(b.lighting)?,
+            lighting: ctx.handle(b.lighting.constants)?,
             noise_tile: ctx.handle(b.noise)?,
             texturing_frame: ctx.handle(b.constants)?,
         })

@@ -12,6 +12,7 @@ use bytemuck::Zeroable;
 use crate::error::{Error, Result};
 use crate::graph::{BufferId, ImageId, RenderGraph, UploadRegion};
 use crate::io::heightmap::HeightField;
+use crate::lighting::technique::PreparedLighting;
 use crate::surface::gpu_layout::{LayerTable, TexturingFrame, TexturingMode};
 use crate::surface::input_maps::InputMaps;
 use crate::surface::layers::LayerTree;
@@ -156,6 +157,12 @@ impl Terrain {
         Ok(())
     }
 
+    /// Whether `terrain.shade` shades the sky too (the compute path): then
+    /// no `sky` pass is declared for the views.
+    pub fn shades_sky(&self) -> bool {
+        self.compute.is_some()
+    }
+
     /// The compute path's shadow casters, if it has them.
     pub(super) fn compute_casters(&self) -> Option<&ComputeCasters> {
         self.compute.as_ref().and_then(|c| c.casters.as_ref())
@@ -297,7 +304,7 @@ impl Terrain {
 
 /// `terrain.draw` of a view (after its `terrain.warp`): its targets and the
 /// texture atlas's bindings (None: texturing in the draw) in, nothing out.
-impl<S: Provides<TerrainFrame> + 'static> Declare<S> for Terrain {
+impl<S: Provides<TerrainFrame> + Provides<PreparedLighting> + 'static> Declare<S> for Terrain {
     type Inputs<'a> = (&'a SceneTargets, Option<&'a AtlasBindings>);
     type Outputs = ();
 
@@ -326,6 +333,7 @@ impl<S: Provides<TerrainFrame> + 'static> Declare<S> for Terrain {
                 constants,
                 surface,
                 write_depth: path.write_depth,
+                view: index,
             };
             return path.raster.declare(ctx, graph, view, pass, targets);
         }

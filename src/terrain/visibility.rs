@@ -11,7 +11,7 @@
 //! | `terrain.raster_clear` | empties the view's visibility buffer and big-triangle list |
 //! | `terrain.raster` | one thread a triangle: culls, rasterizes the small ones (fixed-point edge functions with a tie rule: watertight), lists the rest |
 //! | `terrain.raster_big` | one workgroup a listed triangle, its threads over the bounding box; near-plane crossings in homogeneous coordinates |
-//! | `terrain.shade` | per pixel: the kept triangle, the exact surface sample on the pixel's ray, the shading; writes the view's targets |
+//! | `terrain.shade` | per pixel: the kept triangle, the exact surface sample on the pixel's ray, the shading; the sky where no triangle was kept (no separate `sky` pass on this path); writes every pixel of the view's targets and the view's lighting constants |
 //! | `terrain.depth` | the depth buffer for passes that depth-test with the hardware (points), when there are such |
 //!
 //! Shaders: `glsl/terrain/raster_clear.comp`, `raster.comp`,
@@ -25,10 +25,12 @@ use glam::DMat4;
 
 use crate::error::{Error, Result};
 use crate::graph::{BufferAccess, BufferId, BufferInfo, ImageAccess, ImageInfo, RenderGraph, Stage, UploadRegion};
+use crate::lighting::sky::write_view_lighting;
+use crate::lighting::technique::PreparedLighting;
 use crate::shaders;
 use crate::terrain::shading::SurfaceInputs;
 use crate::terrain::TerrainFrame;
-use crate::view::{Frame, Provides, SceneTargets, View};
+use crate::view::{Frame, Provides, SceneTargets, View, ViewIndex};
 use crate::vulkan::{
     CompareOp, ComputePipeline, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, MemoryLocation,
 };
@@ -169,6 +171,8 @@ pub struct ComputePass {
     pub surface: SurfaceInputs,
     /// Whether later passes depth-test against the terrain (`terrain.depth`).
     pub write_depth: bool,
+    /// The view (`terrain.shade` writes its lighting constants).
+    pub view: ViewIndex,
 }
 
 /// The compute pipelines, shared by every view.
@@ -192,8 +196,8 @@ impl ComputeRaster {
     }
 
     /// Declares the compute passes of one view (`name`: the view's name)
-    /// into `targets`, after the view's `terrain.warp` and `sky`.
-    pub fn declare<S: Provides<TerrainFrame> + 'static>(
+    /// into `targets`, after the view's `terrain.warp`.
+    pub fn declare<S: Provides<TerrainFrame> + Provides<PreparedLighting> + 'static>(
         &self,
         ctx: &Context,
         graph: &mut RenderGraph<Frame<S>>,
@@ -281,7 +285,7 @@ impl ComputeRaster {
 
     /// `terrain.shade`: the visibility buffer shaded into `targets` (and
     /// the NDC depth into `ndc_depth`).
-    fn declare_shade<S: Provides<TerrainFrame> + 'static>(
+    fn declare_shade<S: Provides<TerrainFrame> + Provides<PreparedLighting> + 'static>(
         &self,
         graph: &mut RenderGraph<Frame<S>>,
         view: &View,
@@ -296,20 +300,14 @@ impl ComputeRaster {
         let vertices = shade.storage_buffer(pass.vertices, BufferAccess::StorageRead(compute));
         let keys = shade.storage_buffer(visibility, BufferAccess::StorageRead(compute));
         let surface = pass.surface.read_in(&mut shade, targets, compute);
-        // Read and written: pixels without terrain keep the sky's values.
-        let write = ImageAccess::StorageReadWrite(compute);
-        let images = [
-            targets.radiance,
-            targets.view_depth,
-            targets.visibility,
-            targets.normal,
-            targets.ids,
-        ]
-        .map(|image| shade.storage_image(image, write));
+        // Every pixel written: the terrain's, or the sky where none covers it.
+        let write = ImageAccess::StorageWrite(compute);
+        let images = targets.shaded().map(|image| shade.storage_image(image, write));
         let ndc = ndc_depth.map(|image| shade.storage_image(image, ImageAccess::StorageWrite(compute)));
-        let (inputs, (width, height)) = (pass.surface.clone(), (targets.width, targets.height));
-        shade.record(move |ctx, _| {
+        let (inputs, (width, height), index) = (pass.surface.clone(), (targets.width, targets.height), pass.view);
+        shade.record(move |ctx, frame| {
             let handles = inputs.write(ctx, &surface)?;
+            write_view_lighting(ctx, frame, index, surface.lighting())?;
             let image = |k: usize| ctx.handle(images[k]);
             let push = ShadePush {
                 handles: [ctx.handle(constants)?, ctx.handle(vertices)?, ctx.handle(keys)?, 0],

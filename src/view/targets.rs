@@ -156,6 +156,13 @@ pub struct SceneTargets {
 }
 
 impl SceneTargets {
+    /// What a pass that shades pixels writes, in the order the shaders
+    /// take their storage handles: radiance, view depth, lighting AOVs,
+    /// normal, ids.
+    pub fn shaded(&self) -> [ImageId; 5] {
+        [self.radiance, self.view_depth, self.visibility, self.normal, self.ids]
+    }
+
     /// Declares the targets of `view` (and W when `weight`), lit by the
     /// lighting constants in `lighting` (the lighting technique declares
     /// that region, sized by its own type).

@@ -7,7 +7,7 @@
 //! | (`prepare`) | both | CPU prefix per instance ([`selection`]) and instance records, before recording ([`PointRenderer`]) |
 //! | `points.visibility` | ewa | depth: ray–plane depth pushed back by ε; the ids of the winning surfel |
 //! | `points.accumulate` | ewa | depth test ≤ without writes, additive (w·colour, w), (w·normal, w·depth) into float targets; the ids of the last surfel |
-//! | `points.normalize` | ewa | full screen: divide by w, shade, write radiance, view depth, W, world normal and ids (the winner's, else the last surfel's) |
+//! | `points.normalize` | ewa | compute, per pixel: divide by w, shade, write radiance, view depth, W, world normal and ids (the winner's, else the last surfel's) |
 //! | `points.opaque` | opaque | opaque discs with ray–plane depth, shaded directly, with normal and ids |
 //! | `points.single_pass.triangles` | single-pass | hybrid triangles as opaque shaded triangles with depth, when the scene has any |
 //! | `points.single_pass.clear` | single-pass | compute: every pixel's state unlocked, z_d = +inf, sums 0 |

@@ -14,12 +14,13 @@ use super::triangles::draw_triangles;
 use super::{PointsFrame, SplatPrimitive};
 use crate::error::{Error, Result};
 use crate::graph::{
-    Binding, BufferAccess, BufferId, ImageId, LoadOp, PassBuilder, PassContext, RenderGraph, Stage, UploadRegion,
+    Binding, BufferAccess, BufferId, ImageAccess, ImageId, LoadOp, PassBuilder, PassContext, RenderGraph, Stage,
+    UploadRegion,
 };
 use crate::shaders;
 use crate::view::depth::{FAR_DEPTH, NEARER, NEARER_OR_EQUAL};
 use crate::view::{Frame, Provides, SceneTargets, ViewIndex};
-use crate::vulkan::{Blend, Buffer, CommandRecorder, Context, GraphicsPipeline, GraphicsPipelineDesc, SpirV};
+use crate::vulkan::{Blend, Buffer, CommandRecorder, ComputePipeline, Context, GraphicsPipeline, SpirV};
 
 /// `SplatPush.pass`: which pass the shaders run in.
 const PASS_VISIBILITY: u32 = 0;
@@ -58,7 +59,7 @@ pub(super) struct SplatPush {
     pub record: u32,
 }
 
-/// Push constants of `points.normalize` (`glsl/points/normalize.frag`).
+/// Push constants of `points.normalize` (`glsl/points/normalize.comp`).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct NormalizePush {
@@ -73,6 +74,10 @@ struct NormalizePush {
     nearest_ids: u32,
     any_ids: u32,
     _pad2: [u32; 2],
+    /// Storage: radiance, view depth, W, lighting AOVs.
+    outputs: [u32; 4],
+    /// Storage: normal, ids; width, height.
+    more: [u32; 4],
 }
 
 /// The buffers every points pass reads, and the splat settings they use.
@@ -143,7 +148,7 @@ impl ShadingBindings {
         (view, targets): (&PointView, &SceneTargets),
         stage: Stage,
     ) -> ShadingBindings {
-        let lighting = targets.lighting.read_in(pass, Stage::Fragment).constants;
+        let lighting = targets.lighting.read_in(pass, stage).constants;
         let frame = pass.upload(view.frame, stage);
         ShadingBindings { frame, lighting }
     }
@@ -579,9 +584,10 @@ fn declare_accumulate<S: Provides<PointsFrame> + 'static>(
     Ok(())
 }
 
-/// `points.normalize`: full screen, divide by w, shade (sun, sky, haze),
-/// write radiance, view depth, W, the world normal and the ids (the
-/// nearest surfel's, else the last accumulated one's).
+/// `points.normalize`: a compute pass over the view's pixels: divide by w,
+/// shade (sun, sky, haze), write radiance, view depth, W, the world normal
+/// and the ids (the nearest surfel's, else the last accumulated one's)
+/// where splats were accumulated, and W = 0 elsewhere (§10.2.3 pass 3).
 fn declare_normalize<S: Provides<PointsFrame> + 'static>(
     ctx: &Context,
     graph: &mut RenderGraph<Frame<S>>,
@@ -590,42 +596,37 @@ fn declare_normalize<S: Provides<PointsFrame> + 'static>(
     targets: &SceneTargets,
     accumulation: Accumulation,
 ) -> Result<()> {
-    let formats = &targets.formats;
-    let pipeline = Arc::new(GraphicsPipeline::new(
-        ctx,
-        &GraphicsPipelineDesc::full_screen(
-            "points.normalize",
-            (shaders::FULL_SCREEN_VERT, shaders::SPLAT_NORMALIZE_FRAG),
-            vec![
-                formats.radiance,
-                formats.view_depth,
-                formats.weight,
-                formats.visibility,
-                formats.normal,
-                formats.ids,
-            ],
-        ),
-    )?);
-    let mut builder = graph.pass(name).graphics();
-    let shading = ShadingBindings::read_in(&mut builder, (&view, targets), Stage::Fragment);
+    let pipeline = Arc::new(ComputePipeline::new(ctx, shaders::SPLAT_NORMALIZE)?);
+    let compute = Stage::Compute;
+    let mut builder = graph.pass(name);
+    let shading = ShadingBindings::read_in(&mut builder, (&view, targets), compute);
     let sampled = [
         accumulation.color_weight,
         accumulation.normal_depth,
         accumulation.nearest_ids,
         accumulation.any_ids,
     ]
-    .map(|image| builder.sample(image, Stage::Fragment));
-    view.write_outputs(builder.pipeline(&pipeline), LoadOp::Clear([0.0; 4]))
-        .record(move |pass, frame| {
-            let push = NormalizePush {
-                color_weight: pass.handle(sampled[0])?,
-                frame: shading.write_header(pass, frame, view.index)?,
-                normal_depth: pass.handle(sampled[1])?,
-                nearest_ids: pass.handle(sampled[2])?,
-                any_ids: pass.handle(sampled[3])?,
-                ..NormalizePush::zeroed()
-            };
-            pass.draw_full_screen(&pipeline, &push)
-        });
+    .map(|image| builder.sample(image, compute));
+    // Pixels without splats keep the terrain's and the sky's values: read and written.
+    let kept = ImageAccess::StorageReadWrite(compute);
+    let outputs = [view.radiance, view.view_depth, view.visibility, view.normal, view.ids]
+        .map(|image| builder.storage_image(image, kept));
+    let weight = builder.storage_image(view.weight, ImageAccess::StorageWrite(compute));
+    let (width, height) = (targets.width, targets.height);
+    builder.record(move |pass, frame| {
+        let frame = shading.write_header(pass, frame, view.index)?;
+        let output = |k: usize| pass.handle(outputs[k]);
+        let push = NormalizePush {
+            color_weight: pass.handle(sampled[0])?,
+            frame,
+            normal_depth: pass.handle(sampled[1])?,
+            nearest_ids: pass.handle(sampled[2])?,
+            any_ids: pass.handle(sampled[3])?,
+            outputs: [output(0)?, output(1)?, pass.handle(weight)?, output(2)?],
+            more: [output(3)?, output(4)?, width, height],
+            ..NormalizePush::zeroed()
+        };
+        pass.dispatch(&pipeline, &push, [width.div_ceil(8), height.div_ceil(8), 1])
+    });
     Ok(())
 }
