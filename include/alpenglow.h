@@ -268,7 +268,7 @@ typedef struct ag_heightmap_options {
 #define AG_OUTPUT_MOTION 7
 
 /**
- * The hardware rasterizer (the default).
+ * The hardware rasterizer.
  */
 #define AG_RASTER_HARDWARE 0
 
@@ -279,7 +279,7 @@ typedef struct ag_heightmap_options {
 #define AG_RASTER_COMPUTE 1
 
 /**
- * Compute where the device has the feature, else hardware.
+ * Compute where the device has the feature, else hardware (the default).
  */
 #define AG_RASTER_AUTO 2
 

@@ -156,19 +156,21 @@ fn json_text(value: &Value) -> Result<String> {
 }
 
 /// The text of [`write_profile_json`].
-pub fn profile_json(device_name: &str, frames: &[FrameProfile]) -> Result<String> {
+pub fn profile_json(device_name: &str, raster: &str, frames: &[FrameProfile]) -> Result<String> {
     let (passes, frame) = summarize(frames);
     json_text(&json!({
         "device": device_name,
+        "raster": raster,
         "frames": frames,
         "summary": { "passes": passes, "frame": frame },
     }))
 }
 
-/// Writes `{"device", "frames": [...], "summary": {"passes": [...], "frame": {...}}}`
-/// (see [`summarize`]). Non-finite numbers become `null`.
-pub fn write_profile_json(path: &Path, device_name: &str, frames: &[FrameProfile]) -> Result<()> {
-    write_bytes_atomically(path, profile_json(device_name, frames)?.as_bytes())
+/// Writes `{"device", "raster", "frames": [...], "summary": {"passes": [...],
+/// "frame": {...}}}` (see [`summarize`]; `raster`: the terrain's path,
+/// [`crate::RasterPath::name`]). Non-finite numbers become `null`.
+pub fn write_profile_json(path: &Path, device_name: &str, raster: &str, frames: &[FrameProfile]) -> Result<()> {
+    write_bytes_atomically(path, profile_json(device_name, raster, frames)?.as_bytes())
 }
 
 /// Milliseconds to whole nanoseconds; NaN, negative or infinite become 0.
@@ -360,10 +362,13 @@ mod tests {
     #[test]
     fn profile_json_parses_back() {
         let path = temp("profile.json");
-        write_profile_json(&path, "Test GPU", &frames()).unwrap();
+        write_profile_json(&path, "Test GPU", "compute", &frames()).unwrap();
         let v: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
         std::fs::remove_file(&path).unwrap();
-        assert_eq!(v["device"], "Test GPU");
+        assert_eq!(
+            (v["device"].as_str(), v["raster"].as_str()),
+            (Some("Test GPU"), Some("compute"))
+        );
         let back: Vec<FrameProfile> = serde_json::from_value(v["frames"].clone()).unwrap();
         assert_eq!(back.len(), 3);
         assert_eq!(back[2].passes[0].gpu_ms, 3.0);

@@ -40,8 +40,8 @@ pub const TERRAIN_DEPTH_FRAG: SpirV = spirv!("terrain/depth.frag");
 pub const FULL_SCREEN_VERT: SpirV = spirv!("post/full_screen.vert");
 /// sky: the sky model and sun disc per pixel (compute).
 pub const SKY: SpirV = spirv!("lighting/sky.comp");
-/// aovs: distance and motion from view depth and the cameras (full-screen fragment stage).
-pub const AOVS_FRAG: SpirV = spirv!("post/aovs.frag");
+/// aovs: distance and motion from view depth and the cameras (compute).
+pub const AOVS: SpirV = spirv!("post/aovs.comp");
 /// tonemap: HDR → sRGB8.
 pub const TONEMAP: SpirV = spirv!("post/tonemap.comp");
 /// exposure.meter: sums of log luminance per 128×64-pixel tile.

@@ -7,6 +7,12 @@
 //! Stanford bunny as a sequential point tree with opaque, EWA and
 //! single-pass EWA splats (§10.1–10.2, §10.4).
 //!
+//! Every scene with terrain renders in both rasterizer paths (issue 28:
+//! the hardware rasterizer, the text's, and the compute path's visibility
+//! buffer), each checked against the golden, and the two against each
+//! other: mean FLIP ≤ 0.02 and the view depth within 1e-4 relative on at
+//! least 99.5 % of the pixels both hit.
+//!
 //! Threshold: mean FLIP ≤ [`MEAN_FLIP_THRESHOLD`] (0.02; override with
 //! `ALPENGLOW_FLIP_THRESHOLD`). On the lavapipe that made the goldens the
 //! error is 0; other drivers rasterize, interpolate and round transcendental
@@ -24,8 +30,8 @@ mod common;
 use alpenglow::files::{load_point_object, write_png_rgba8};
 use alpenglow::glam::DVec3;
 use alpenglow::{
-    Camera, Lighting, PointLoadOptions, PointScene, PointTransform, Renderer, Scene, Settings, SplatMode,
-    SplatSettings, SunPosition, TexturingMode,
+    Camera, FrameImages, Lighting, PointLoadOptions, PointScene, PointTransform, RasterPath, Renderer, Scene, Settings,
+    SplatMode, SplatSettings, SunPosition, TexturingMode,
 };
 use common::{
     assert_validation_clean, data, failure_dir, golden_dir, jacksboro_field, jacksboro_valley_camera, mean_flip,
@@ -50,25 +56,44 @@ fn check_golden(name: &str, scene: &Scene, camera: &Camera) {
     check_golden_with(name, scene, camera, SplatSettings::default(), TexturingMode::default());
 }
 
+/// The fraction of the pixels where both frames hit a surface whose view
+/// depths agree within [`DEPTH_TOLERANCE`] relative must be at least this
+/// (the rest: silhouettes, where the two rasterizers' sample positions
+/// meet a ridge's edge differently).
+const DEPTH_AGREEMENT: f64 = 0.995;
+const DEPTH_TOLERANCE: f32 = 1e-4;
+
+/// Checks `scene` through `camera` against golden `name` in both terrain
+/// rasterizer paths (issue 28: the compute path's images match the
+/// hardware path's), and the two paths against each other: mean FLIP and
+/// view depth. Scenes without terrain render once.
 fn check_golden_with(name: &str, scene: &Scene, camera: &Camera, points: SplatSettings, texturing: TexturingMode) {
     let (ctx, report) = validated_context();
-    let frame = {
-        let mut settings = Settings::new(WIDTH, HEIGHT);
-        settings.points = points;
-        settings.texturing = texturing;
-        let mut renderer = Renderer::new(&ctx, scene, settings).expect("renderer");
-        let frame = (renderer.render_settled(camera, SETTLE_FRAMES))
-            .and_then(|f| renderer.read(&f))
-            .expect("frame");
-        renderer.finish().expect("finish");
-        frame
+    let paths: &[RasterPath] = match scene.draw_terrain {
+        true => &[RasterPath::Hardware, RasterPath::Compute],
+        false => &[RasterPath::Auto],
     };
+    let frames: Vec<FrameImages> = (paths.iter())
+        .map(|&raster| {
+            let mut settings = Settings::new(WIDTH, HEIGHT);
+            settings.points = points;
+            settings.texturing = texturing;
+            settings.raster = raster;
+            let mut renderer = Renderer::new(&ctx, scene, settings).expect("renderer");
+            let frame = (renderer.render_settled(camera, SETTLE_FRAMES))
+                .and_then(|f| renderer.read(&f))
+                .expect("frame");
+            renderer.finish().expect("finish");
+            frame
+        })
+        .collect();
     drop(ctx);
     assert_validation_clean(&report);
 
     let golden_path = golden_dir().join(format!("{name}.png"));
     if std::env::var_os("ALPENGLOW_UPDATE_GOLDENS").is_some() {
-        write_png_rgba8(&golden_path, &frame.rgba8, WIDTH, HEIGHT).expect("write golden");
+        // The goldens are the first path's: the hardware rasterizer, the text's.
+        write_png_rgba8(&golden_path, &frames[0].rgba8, WIDTH, HEIGHT).expect("write golden");
         eprintln!("updated {}", golden_path.display());
         return;
     }
@@ -81,19 +106,50 @@ fn check_golden_with(name: &str, scene: &Scene, camera: &Camera, points: SplatSe
         })
         .to_rgba8();
     assert_eq!(golden.dimensions(), (WIDTH, HEIGHT), "golden {name} has another size");
-    let (mean, heatmap) = mean_flip(golden.as_raw(), &frame.rgba8, WIDTH, HEIGHT);
+    for (frame, raster) in frames.iter().zip(paths) {
+        compare(&format!("{name} ({})", raster.name()), golden.as_raw(), frame);
+    }
+    if let [hardware, compute] = &frames[..] {
+        compare(&format!("{name}: compute against hardware"), &hardware.rgba8, compute);
+        let both: Vec<(f32, f32)> = (hardware.depth.iter().zip(&compute.depth))
+            .filter(|(a, b)| a.is_finite() && b.is_finite())
+            .map(|(&a, &b)| (a, b))
+            .collect();
+        let agreeing = both
+            .iter()
+            .filter(|(a, b)| (a - b).abs() <= DEPTH_TOLERANCE * a.abs())
+            .count();
+        let agreement = agreeing as f64 / both.len().max(1) as f64;
+        eprintln!(
+            "{name}: view depth within {DEPTH_TOLERANCE} relative on {agreement:.5} of {} pixels",
+            both.len()
+        );
+        assert!(
+            both.len() > 1000 && agreement >= DEPTH_AGREEMENT,
+            "{name}: the paths' view depths agree within {DEPTH_TOLERANCE} relative on {agreement:.5} of the {} \
+             pixels both hit (at least {DEPTH_AGREEMENT})",
+            both.len()
+        );
+    }
+}
+
+/// Fails when `frame` differs from `reference` (sRGB8) by more than the
+/// mean FLIP threshold; writes the frame and the heat map first.
+fn compare(label: &str, reference: &[u8], frame: &FrameImages) {
+    let (mean, heatmap) = mean_flip(reference, &frame.rgba8, WIDTH, HEIGHT);
     if mean > threshold() {
         let dir = failure_dir();
-        let _ = write_png_rgba8(&dir.join(format!("{name}.actual.png")), &frame.rgba8, WIDTH, HEIGHT);
+        let file = label.replace([' ', ':', '(', ')'], "_");
+        let _ = write_png_rgba8(&dir.join(format!("{file}.actual.png")), &frame.rgba8, WIDTH, HEIGHT);
         let rgba: Vec<u8> = heatmap.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
-        let _ = write_png_rgba8(&dir.join(format!("{name}.flip.png")), &rgba, WIDTH, HEIGHT);
+        let _ = write_png_rgba8(&dir.join(format!("{file}.flip.png")), &rgba, WIDTH, HEIGHT);
         panic!(
-            "{name}: mean FLIP {mean:.4} > {:.4}; see {}",
+            "{label}: mean FLIP {mean:.4} > {:.4}; see {}",
             threshold(),
             dir.display()
         );
     }
-    eprintln!("{name}: mean FLIP {mean:.5}");
+    eprintln!("{label}: mean FLIP {mean:.5}");
 }
 
 #[test]

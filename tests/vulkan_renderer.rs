@@ -7,8 +7,8 @@ mod common;
 
 use alpenglow::glam::DVec3;
 use alpenglow::{
-    Camera, Context, ContextOptions, DeviceSelector, ProceduralTerrain, Renderer, Scene, Settings, ShadowSettings,
-    TextureStreaming,
+    Camera, Context, ContextOptions, DeviceSelector, ProceduralTerrain, RasterPath, Renderer, Scene, Settings,
+    ShadowSettings, TextureStreaming,
 };
 use common::{assert_validation_clean, validated_context};
 
@@ -26,44 +26,62 @@ fn settings(width: u32, height: u32, readback: bool) -> Settings {
     settings
 }
 
+/// The passes of a frame of `scene` drawn by `raster`, in order.
+fn expected_passes(scene: &Scene, raster: RasterPath) -> Vec<String> {
+    let hardware = raster == RasterPath::Hardware;
+    let mut expected: Vec<&str> = vec![
+        "lighting.transmittance",
+        "lighting.multiscattering",
+        "lighting.sky_view",
+        "lighting.environment",
+        "lighting.sky_light",
+        "terrain.warp",
+    ];
+    // The compute path's terrain.shade shades the sky.
+    expected.extend(hardware.then_some("sky"));
+    expected.push("texturing.upsample");
+    let layers = scene.layers.layers.iter().enumerate();
+    let layer_passes = layers.map(|(i, l)| format!("texturing.layer{i}.{}", l.layer.name.replace(' ', "_")));
+    let mut expected: Vec<String> = expected.into_iter().map(String::from).collect();
+    expected.extend(layer_passes);
+    let terrain: &[&str] = match hardware {
+        true => &["shadow.clear", "terrain.shadow", "terrain.draw"],
+        false => &[
+            "terrain.shadow_clear",
+            "terrain.shadow",
+            "terrain.shadow_big",
+            "terrain.shadow_copy",
+            "terrain.raster_clear",
+            "terrain.raster",
+            "terrain.raster_big",
+            "terrain.shade",
+        ],
+    };
+    expected.push("texturing.finish".into());
+    expected.extend(terrain.iter().map(|s| s.to_string()));
+    let post = ["aovs", "exposure.meter", "exposure.average", "tonemap", "readback"];
+    expected.extend(post.map(String::from));
+    expected
+}
+
 #[test]
 fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
+    for raster in [RasterPath::Hardware, RasterPath::Compute] {
+        frames_in_flight_are_validation_clean(raster);
+    }
+}
+
+fn frames_in_flight_are_validation_clean(raster: RasterPath) {
     let (ctx, report) = validated_context();
     {
         let scene = small_scene();
         let mut settings = settings(96, 64, true);
+        settings.raster = raster;
         // Two readback slots: the frame two renders back is overwritten.
         settings.readback_slots = 2;
         let mut renderer = Renderer::new(&ctx, &scene, settings).expect("renderer");
-        let layers = scene.layers.layers.iter().enumerate();
-        let layer_passes = layers.map(|(i, l)| format!("texturing.layer{i}.{}", l.layer.name.replace(' ', "_")));
-        let mut expected: Vec<String> = [
-            "lighting.transmittance",
-            "lighting.multiscattering",
-            "lighting.sky_view",
-            "lighting.environment",
-            "lighting.sky_light",
-            "terrain.warp",
-            "sky",
-            "texturing.upsample",
-        ]
-        .map(String::from)
-        .to_vec();
-        expected.extend(layer_passes);
-        expected.extend(
-            [
-                "texturing.finish",
-                "shadow.clear",
-                "terrain.shadow",
-                "terrain.draw",
-                "aovs",
-                "exposure.meter",
-                "exposure.average",
-                "tonemap",
-                "readback",
-            ]
-            .map(String::from),
-        );
+        assert_eq!(renderer.raster_path(), raster);
+        let expected = expected_passes(&scene, raster);
         assert_eq!(renderer.pass_names(), expected);
         let camera = scene.default_camera();
         // Several frames, two in flight: exercises cross-frame barrier state.
@@ -103,10 +121,17 @@ fn render_to_vertex_buffer_frames_in_flight_are_validation_clean() {
 
 #[test]
 fn renders_are_deterministic() {
+    for raster in [RasterPath::Hardware, RasterPath::Compute] {
+        renders_are_deterministic_in(raster);
+    }
+}
+
+fn renders_are_deterministic_in(raster: RasterPath) {
     let (ctx, report) = validated_context();
     {
         let scene = small_scene();
-        let settings = settings(80, 48, true);
+        let mut settings = settings(80, 48, true);
+        settings.raster = raster;
         let camera = scene.default_camera();
         let mut first = Renderer::new(&ctx, &scene, settings.clone()).expect("renderer");
         let a = first.render(&camera).and_then(|f| first.read(&f)).expect("frame a");

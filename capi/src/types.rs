@@ -40,12 +40,12 @@ pub(crate) fn output(value: ag_output) -> Outcome<Output> {
 /// Which rasterizer draws the terrain (`ag_settings.raster`). Values of `ag_raster`.
 #[allow(non_camel_case_types)]
 pub type ag_raster = u32;
-/// The hardware rasterizer (the default).
+/// The hardware rasterizer.
 pub const AG_RASTER_HARDWARE: ag_raster = 0;
 /// Compute shaders into a visibility buffer, then one shading pass per
 /// pixel; needs the device feature shaderBufferInt64Atomics.
 pub const AG_RASTER_COMPUTE: ag_raster = 1;
-/// Compute where the device has the feature, else hardware.
+/// Compute where the device has the feature, else hardware (the default).
 pub const AG_RASTER_AUTO: ag_raster = 2;
 
 /// The library's rasterizer of a C value.
@@ -131,7 +131,7 @@ pub extern "C" fn ag_settings_default() -> ag_settings {
         terrain_detail: true,
         settle_frames: 64,
         readback_slots: 0,
-        raster: AG_RASTER_HARDWARE,
+        raster: AG_RASTER_AUTO,
     }
 }
 

@@ -77,7 +77,12 @@ bool sample_atlas(uint texturing, vec2 xy, out vec3 color, out vec2 extra, out u
     float inner = uintBitsToFloat(where.z);
     ivec2 nearest = ivec2(clamp(floor(texel), origin, origin + vec2(inner - 1.0)));
     nearest = clamp(nearest, ivec2(0), ivec2(int(atlas.z) - 1));
-    float a = texelFetch(sampler2D(g_textures[nonuniformEXT(normal_handle)], g_samplers[SAMPLER_NEAREST_CLAMP]), nearest, 0).a;
+    // A nearest-filtered lookup at the texel's centre rather than a
+    // texelFetch: lavapipe 25.0's compute shaders return wrong texels for
+    // some invocations of a non-uniformly indexed texelFetch (the compute
+    // path's terrain.shade reported other layers than terrain.draw).
+    vec2 centre = (vec2(nearest) + 0.5) / float(atlas.z);
+    float a = textureLod(sampler2D(g_textures[nonuniformEXT(normal_handle)], g_samplers[SAMPLER_NEAREST_CLAMP]), centre, 0.0).a;
     layer = uint(round(a * 255.0));
     return true;
 }

@@ -19,12 +19,7 @@ layout(push_constant) uniform Push {
 // Bounding boxes larger than this go to terrain.raster_big.
 const uint BIG_PIXELS = 64u;
 
-void main() {
-    ComputeView view = g_compute_views[pc.handles.x].v;
-    uint t = gl_GlobalInvocationID.x;
-    if (t >= view.size.w) {
-        return;
-    }
+void raster_triangle(ComputeView view, uint t) {
     uvec3 i = grid_triangle(t, view.size.z);
     vec4 c[3] = vec4[3](grid_clip(view, pc.handles.y, i.x), grid_clip(view, pc.handles.y, i.y),
                         grid_clip(view, pc.handles.y, i.z));
@@ -72,5 +67,14 @@ void main() {
                 store_hit(pc.handles.z, uint(y) * view.size.x + uint(x), depth, t);
             }
         }
+    }
+}
+
+// A grid-stride loop: the dispatch stays within maxComputeWorkGroupCount
+// (65535 workgroups) at any grid size.
+void main() {
+    ComputeView view = g_compute_views[pc.handles.x].v;
+    for (uint t = gl_GlobalInvocationID.x; t < view.size.w; t += gl_NumWorkGroups.x * gl_WorkGroupSize.x) {
+        raster_triangle(view, t);
     }
 }

@@ -11,11 +11,11 @@ layout(push_constant) uniform Push {
 } pc;
 
 void main() {
-    uint p = gl_GlobalInvocationID.x;
-    if (p == 0u) {
+    if (gl_GlobalInvocationID.x == 0u) {
         g_big_triangles[pc.handles.w].count = 0u;
     }
-    if (p < pc.size.x) {
+    // A grid-stride loop: at most 65535 workgroups at any image size.
+    for (uint p = gl_GlobalInvocationID.x; p < pc.size.x; p += gl_NumWorkGroups.x * gl_WorkGroupSize.x) {
         g_visibility[pc.handles.z].k[p] = NO_HIT;
     }
 }

@@ -7,11 +7,11 @@
 layout(local_size_x = 256) in;
 
 void main() {
-    uint p = gl_GlobalInvocationID.x;
-    if (p < 4u) {
-        g_shadow_big[pc.handles.z].count[p] = 0u;
+    if (gl_GlobalInvocationID.x < 4u) {
+        g_shadow_big[pc.handles.z].count[gl_GlobalInvocationID.x] = 0u;
     }
-    if (p < pc.grid.w) {
+    // A grid-stride loop: at most 65535 workgroups at any atlas size.
+    for (uint p = gl_GlobalInvocationID.x; p < pc.grid.w; p += gl_NumWorkGroups.x * gl_WorkGroupSize.x) {
         g_shadow_depths[pc.handles.y].d[p] = floatBitsToUint(1.0);
     }
 }

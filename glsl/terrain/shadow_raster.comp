@@ -10,11 +10,7 @@
 
 layout(local_size_x = 64) in;
 
-void main() {
-    uint t = gl_GlobalInvocationID.x;
-    if (t >= pc.grid.y) {
-        return;
-    }
+void cast_triangle(uint t) {
     vec4 c[3];
     FixedTriangle tri;
     vec3 z;
@@ -31,5 +27,13 @@ void main() {
         for (int x = first.x; x <= last.x; ++x) {
             store_caster_depth(ivec2(x, y), fixed_caster_depth(tri, z, ivec2(x, y)));
         }
+    }
+}
+
+// A grid-stride loop: the dispatch stays within maxComputeWorkGroupCount
+// (65535 workgroups) at any grid size.
+void main() {
+    for (uint t = gl_GlobalInvocationID.x; t < pc.grid.y; t += gl_NumWorkGroups.x * gl_WorkGroupSize.x) {
+        cast_triangle(t);
     }
 }

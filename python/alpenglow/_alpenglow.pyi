@@ -180,7 +180,7 @@ class Renderer:
         terrain_detail: bool = True,
         grid: Optional[int] = None,
         texturing: str = "atlas",
-        raster: str = "hardware",
+        raster: str = "auto",
         lighting: Optional[Lighting] = None,
         cache_dir: Optional[PathLike] = None,
         readback_slots: Optional[int] = None,

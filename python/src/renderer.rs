@@ -22,8 +22,8 @@ use crate::{arg_err, invalid, lib_err};
 /// `msaa` (1, 2, 4, 8, 16 samples per pixel), `terrain_detail`
 /// (procedural displacement and bump mapping), `grid` (the terrain's
 /// geometry-image side), `texturing` ("atlas", "direct", "classic"),
-/// `raster` ("hardware", "compute": a visibility buffer in compute
-/// shaders, "auto": compute where the device can),
+/// `raster` ("auto", the default: compute where the device can,
+/// "compute": a visibility buffer in compute shaders, "hardware"),
 /// `lighting` (a `Lighting`; default: the scene's), `cache_dir` (where the
 /// sky-light bake is cached), `readback_slots` (frames that can be
 /// submitted before the oldest unread one is lost; default 3).
@@ -136,7 +136,7 @@ impl Renderer {
 #[pymethods]
 impl Renderer {
     #[new]
-    #[pyo3(signature = (ctx, scene, width = 640, height = 360, *, rig = None, intrinsics = None, distortion = None, msaa = 1, terrain_detail = true, grid = None, texturing = "atlas", raster = "hardware", lighting = None, cache_dir = None, readback_slots = None))]
+    #[pyo3(signature = (ctx, scene, width = 640, height = 360, *, rig = None, intrinsics = None, distortion = None, msaa = 1, terrain_detail = true, grid = None, texturing = "atlas", raster = "auto", lighting = None, cache_dir = None, readback_slots = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,

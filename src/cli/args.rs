@@ -346,8 +346,8 @@ pub struct TerrainArgs {
     /// buffer, then one shading pass per pixel (compute; needs the device
     /// feature shaderBufferInt64Atomics), the hardware rasterizer
     /// (hardware, the text's path), or compute where the device has the
-    /// feature (auto).
-    #[arg(long, value_enum, default_value = "hardware", value_name = "PATH")]
+    /// feature (auto, the default).
+    #[arg(long, value_enum, default_value = "auto", value_name = "PATH")]
     pub raster: RasterArg,
     /// Geometry-image side in vertices (the terrain mesh has GRID² vertices).
     #[arg(long, default_value_t = 512, value_name = "VERTICES", value_parser = clap::value_parser!(u32).range(2..))]

@@ -361,9 +361,10 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
     let ctx = context(&args.scene.device)?;
     let report = ctx.validation_report();
     let device = ctx.info().name.clone();
-    let (views, profiles) = {
+    let (views, profiles, raster) = {
         let settings = render_settings(&args.scene, &scene, &specs, true)?;
         let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
+        let raster = renderer.raster_path();
         let frame = renderer.render_views_settled(&cameras, MAX_SETTLE_FRAMES)?;
         let views = renderer.read_views(&frame)?;
         let profiles = renderer.finish()?;
@@ -380,7 +381,7 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
                 last.tiles.resident
             );
         }
-        (views, profiles)
+        (views, profiles, raster)
     };
     drop(ctx);
     check_validation(report)?;
@@ -391,7 +392,7 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
         outputs.stage(path(&args.exr).as_deref(), || exr::encode_frame_exr(images))?;
     }
     outputs.stage(args.profile.as_deref(), || {
-        Ok(profile_json(&device, &profiles)?.into_bytes())
+        Ok(profile_json(&device, raster.name(), &profiles)?.into_bytes())
     })?;
     outputs.stage(args.trace.as_deref(), || {
         Ok(chrome_trace(&device, &profiles)?.into_bytes())

@@ -56,6 +56,14 @@ impl CpuStage {
     }
 }
 
+/// The workgroups of a one-dimensional dispatch over `items` with `local`
+/// invocations a workgroup, at most the 65535 every device takes
+/// (`maxComputeWorkGroupCount`); shaders whose item count may exceed that
+/// loop with a stride of the whole dispatch (`gl_NumWorkGroups`).
+pub fn stride_groups(items: u32, local: u32) -> u32 {
+    items.div_ceil(local).clamp(1, 65535)
+}
+
 impl<'a> PassContext<'a> {
     /// The command recorder.
     pub fn cmd(&mut self) -> &mut CommandRecorder {

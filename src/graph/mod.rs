@@ -49,7 +49,7 @@ pub use access::derive_barrier;
 pub use access::{Access, Stage};
 pub use bake::{BakedGraph, DEFAULT_PROFILE_HISTORY};
 pub use binding::Binding;
-pub use execute::{CpuStage, FrameOutcome, PassContext};
+pub use execute::{stride_groups, CpuStage, FrameOutcome, PassContext};
 pub use typed::{BufferAccess, BufferId, ImageAccess, ImageId, Resource};
 pub use uploads::{UploadRegion, UploadWriter};
 

@@ -16,10 +16,8 @@
 //! frames in `prepare` and uploads the per-view constants: the ray basis
 //! and the previous transform composed with a translation to this frame's
 //! eye, in f64 and rounded once, so `X − eye` (metres, not kilometres)
-//! enters the shader. It is a fragment pass rather than a compute pass
-//! because motion is RG32F, which storage images only take with
-//! `shaderStorageImageExtendedFormats`; the cost is the same one pass over
-//! the pixels. Shader: `glsl/post/aovs.frag`.
+//! enters the shader. A compute pass, one invocation a pixel (issue 28:
+//! full-screen work as compute). Shader: `glsl/post/aovs.comp`.
 
 use std::sync::Arc;
 
@@ -27,12 +25,10 @@ use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
 
 use crate::error::{Error, Result};
-use crate::graph::{LoadOp, Stage, UploadRegion};
+use crate::graph::{ImageAccess, Stage, UploadRegion};
 use crate::shaders;
-use crate::view::{
-    pass_name, Declare, FrameContext, SceneTargets, TargetFormats, Technique, View, ViewGraph, ViewIndex,
-};
-use crate::vulkan::{Context, GraphicsPipeline, GraphicsPipelineDesc};
+use crate::view::{pass_name, Declare, FrameContext, SceneTargets, Technique, View, ViewGraph, ViewIndex};
+use crate::vulkan::{ComputePipeline, Context};
 
 /// Per-view constants of `aovs` (`AovConstants` in glsl/post/aovs.frag).
 #[repr(C)]
@@ -79,6 +75,12 @@ struct AovPush {
     depth: u32,
     /// Storage handle of the view's constants.
     constants: u32,
+    /// Storage handles of motion and distance.
+    motion: u32,
+    distance: u32,
+    /// The targets' size.
+    width: u32,
+    height: u32,
     _pad: [u32; 2],
 }
 
@@ -99,7 +101,7 @@ pub struct AovsFrame {
 /// The depth-derived AOVs: a pipeline, one pass per view, and each view's
 /// previous camera transform.
 pub struct Aovs {
-    pipeline: Arc<GraphicsPipeline>,
+    pipeline: Arc<ComputePipeline>,
     views: Vec<AovView>,
     previous: Vec<Option<DMat4>>,
     /// The previous frame's prepared data, reused ([`Technique::recycle`]).
@@ -107,18 +109,10 @@ pub struct Aovs {
 }
 
 impl Aovs {
-    /// Builds the pipeline for targets of `formats`.
-    pub fn new(ctx: &Context, formats: &TargetFormats) -> Result<Aovs> {
-        let pipeline = GraphicsPipeline::new(
-            ctx,
-            &GraphicsPipelineDesc::full_screen(
-                "aovs",
-                (shaders::FULL_SCREEN_VERT, shaders::AOVS_FRAG),
-                vec![formats.motion, formats.distance],
-            ),
-        )?;
+    /// Builds the pipeline.
+    pub fn new(ctx: &Context) -> Result<Aovs> {
         Ok(Aovs {
-            pipeline: Arc::new(pipeline),
+            pipeline: Arc::new(ComputePipeline::new(ctx, shaders::AOVS)?),
             views: Vec::new(),
             previous: Vec::new(),
             spare: Vec::new(),
@@ -143,21 +137,25 @@ impl<S: 'static> Declare<S> for Aovs {
         let ViewGraph { graph, index, view, .. } = at;
         let constants = graph.upload_region(&pass_name("aov constants", &view.name), AOV_CONSTANTS_BYTES);
         let pipeline = self.pipeline.clone();
-        let (view_depth, motion, distance) = (targets.view_depth, targets.motion, targets.distance);
-        let mut pass = graph.pass(&pass_name("aovs", &view.name)).graphics();
-        let depth = pass.sample(view_depth, Stage::Fragment);
-        let constants_binding = pass.upload(constants, Stage::Fragment);
-        pass.pipeline(&pipeline)
-            .color(motion, LoadOp::DontCare)
-            .color(distance, LoadOp::DontCare)
-            .record(move |ctx, _| {
-                let push = AovPush {
-                    depth: ctx.handle(depth)?,
-                    constants: ctx.handle(constants_binding)?,
-                    _pad: [0; 2],
-                };
-                ctx.draw_full_screen(&pipeline, &push)
-            });
+        let compute = Stage::Compute;
+        let mut pass = graph.pass(&pass_name("aovs", &view.name));
+        let depth = pass.sample(targets.view_depth, compute);
+        let constants_binding = pass.upload(constants, compute);
+        let motion = pass.storage_image(targets.motion, ImageAccess::StorageWrite(compute));
+        let distance = pass.storage_image(targets.distance, ImageAccess::StorageWrite(compute));
+        let (width, height) = (targets.width, targets.height);
+        pass.record(move |ctx, _| {
+            let push = AovPush {
+                depth: ctx.handle(depth)?,
+                constants: ctx.handle(constants_binding)?,
+                motion: ctx.handle(motion)?,
+                distance: ctx.handle(distance)?,
+                width,
+                height,
+                _pad: [0; 2],
+            };
+            ctx.dispatch(&pipeline, &push, [width.div_ceil(8), height.div_ceil(8), 1])
+        });
         self.views.push(AovView { index, constants });
         self.previous.push(None);
         Ok(())

@@ -650,7 +650,7 @@ impl Wiring<'_> {
             let clear_depth = !scene.draw_terrain;
             declare_views(points, ctx, graph, views, targets.iter().map(|t| (t, clear_depth)))?;
         }
-        let mut aovs = Aovs::new(ctx, &targets[0].formats)?;
+        let mut aovs = Aovs::new(ctx)?;
         declare_views(&mut aovs, ctx, graph, views, &targets)?;
         validation_layer_edges(graph);
         let techniques = Techniques {

@@ -31,7 +31,7 @@ use glam::DVec3;
 use super::geometry_image::VERTEX_STRIDE;
 use super::Terrain;
 use crate::error::{Error, Result};
-use crate::graph::{BufferAccess, BufferId, BufferInfo, ImageAccess, RenderGraph, Stage};
+use crate::graph::{stride_groups, BufferAccess, BufferId, BufferInfo, ImageAccess, RenderGraph, Stage};
 use crate::lighting::constants::MAX_CASCADES;
 use crate::lighting::shadows::{
     cascade_pushes, record_cascades, SceneBounds, ShadowFrame, ShadowTarget, SHADOW_FORMAT,
@@ -150,7 +150,7 @@ impl ComputeCasters {
         let grid = [side, triangles, target.size, texels];
         self.declare_clear(graph, view, &buffers, grid);
         let rasters = [
-            ("terrain.shadow", self.raster.clone(), triangles.div_ceil(64)),
+            ("terrain.shadow", self.raster.clone(), stride_groups(triangles, 64)),
             ("terrain.shadow_big", self.big.clone(), BIG_WORKGROUPS),
         ];
         for (base, pipeline, groups) in rasters {
@@ -207,7 +207,7 @@ impl ComputeCasters {
                 grid,
                 ..CasterRasterPush::zeroed()
             };
-            ctx.dispatch(&pipeline, &push, [grid[3].div_ceil(256), 1, 1])
+            ctx.dispatch(&pipeline, &push, [stride_groups(grid[3], 256), 1, 1])
         });
     }
 }

@@ -24,7 +24,9 @@ use bytemuck::{Pod, Zeroable};
 use glam::DMat4;
 
 use crate::error::{Error, Result};
-use crate::graph::{BufferAccess, BufferId, BufferInfo, ImageAccess, ImageInfo, RenderGraph, Stage, UploadRegion};
+use crate::graph::{
+    stride_groups, BufferAccess, BufferId, BufferInfo, ImageAccess, ImageInfo, RenderGraph, Stage, UploadRegion,
+};
 use crate::lighting::sky::write_view_lighting;
 use crate::lighting::technique::PreparedLighting;
 use crate::shaders;
@@ -39,13 +41,13 @@ use crate::vulkan::{
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum RasterPath {
     /// The compute path where the device has 64-bit buffer atomics, the
-    /// hardware path otherwise.
+    /// hardware path otherwise (the default).
+    #[default]
     Auto,
     /// The visibility buffer and deferred shading in compute shaders
     /// (needs `shaderBufferInt64Atomics`).
     Compute,
     /// The text's path: the grid drawn by the hardware rasterizer.
-    #[default]
     Hardware,
 }
 
@@ -256,12 +258,12 @@ impl ComputeRaster {
                 handles: [0, 0, ctx.handle(keys)?, ctx.handle(big)?],
                 size: [pixels, 0, 0, 0],
             };
-            ctx.dispatch(&pipeline, &push, [pixels.div_ceil(256), 1, 1])
+            ctx.dispatch(&pipeline, &push, [stride_groups(pixels, 256), 1, 1])
         });
 
         let count = triangles(pass.grid_side);
         for (base, pipeline, groups) in [
-            ("terrain.raster", self.raster.clone(), count.div_ceil(64)),
+            ("terrain.raster", self.raster.clone(), stride_groups(count, 64)),
             ("terrain.raster_big", self.big.clone(), BIG_WORKGROUPS),
         ] {
             let mut raster = graph.pass(&name(base));

@@ -10,6 +10,10 @@ use std::sync::Arc;
 use crate::io::heightmap::{load_heightmap, HeightField, HeightmapOptions};
 use crate::vulkan::{Context, ContextOptions, DeviceSelector, ValidationReport};
 
+/// Both terrain rasterizer paths (issue 28): the terrain, lighting and AOV
+/// tests that check a rendered frame against a reference run in each.
+pub const RASTER_PATHS: [crate::RasterPath; 2] = [crate::RasterPath::Hardware, crate::RasterPath::Compute];
+
 /// A context with validation and synchronization validation on.
 pub fn validated_context() -> (Context, Arc<ValidationReport>) {
     let ctx = Context::new(&ContextOptions {

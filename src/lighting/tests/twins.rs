@@ -18,10 +18,17 @@ fn small_scene() -> Scene {
 }
 
 /// One frame of `camera` under `lighting` at `w`×`h`.
-fn render(ctx: &Context, scene: &Scene, camera: &Camera, lighting: Lighting, (w, h): (u32, u32)) -> FrameImages {
+fn render(
+    ctx: &Context,
+    scene: &Scene,
+    camera: &Camera,
+    (lighting, raster): (Lighting, crate::RasterPath),
+    (w, h): (u32, u32),
+) -> FrameImages {
     let settings = RenderSettings {
         texturing: TexturingMode::Classic,
         lighting: Some(lighting),
+        raster,
         ..RenderSettings::new(w, h)
     };
     let mut renderer = Renderer::new(ctx, scene, settings).expect("renderer");
@@ -90,7 +97,7 @@ fn preetham_zenith_matches_the_published_formulas() {
                 turbidity,
                 ..scene.default_lighting()
             };
-            let images = render(&ctx, &scene, &camera, lighting, (16, 16));
+            let images = render(&ctx, &scene, &camera, (lighting, crate::RasterPath::Auto), (16, 16));
             let centre = (8 * 16 + 8) * 4;
             let rgb = [images.hdr[centre], images.hdr[centre + 1], images.hdr[centre + 2]];
             let (y, x, yy) = luminance_xy(rgb);
@@ -115,6 +122,12 @@ fn pixel_world(camera: &Camera, (w, h): (u32, u32), (x, y): (u32, u32), depth: f
 
 #[test]
 fn sun_visibility_agrees_with_a_cpu_ray_cast_on_the_real_dem() {
+    for raster in crate::test_support::RASTER_PATHS {
+        sun_visibility_agrees_with_a_cpu_ray_cast_on_the_real_dem_in(raster);
+    }
+}
+
+fn sun_visibility_agrees_with_a_cpu_ray_cast_on_the_real_dem_in(raster: crate::RasterPath) {
     use crate::surface::bspline::sample_bspline_gradient;
     use crate::terrain::raycast::Raycaster;
     use crate::view::{ShadowMode, SkyLightMode};
@@ -138,6 +151,7 @@ fn sun_visibility_agrees_with_a_cpu_ray_cast_on_the_real_dem() {
             let mut settings = RenderSettings {
                 texturing: TexturingMode::Classic,
                 lighting: Some(lighting),
+                raster,
                 ..RenderSettings::new(size.0, size.1)
             };
             settings.terrain.detail = false;
@@ -194,6 +208,12 @@ fn sun_visibility_agrees_with_a_cpu_ray_cast_on_the_real_dem() {
 
 #[test]
 fn aerial_perspective_matches_its_cpu_twin() {
+    for raster in crate::test_support::RASTER_PATHS {
+        aerial_perspective_matches_its_cpu_twin_in(raster);
+    }
+}
+
+fn aerial_perspective_matches_its_cpu_twin_in(raster: crate::RasterPath) {
     use crate::lighting::aerial::{
         aerial_perspective, distant_radiance, optical_depth, AerialCoefficients, SCALE_HEIGHTS_M,
     };
@@ -222,8 +242,8 @@ fn aerial_perspective_matches_its_cpu_twin() {
             aerial_perspective: false,
             ..lighting
         };
-        let on = render(&ctx, &scene, &camera, lighting, size);
-        let off = render(&ctx, &scene, &camera, without, size);
+        let on = render(&ctx, &scene, &camera, (lighting, raster), size);
+        let off = render(&ctx, &scene, &camera, (without, raster), size);
         let sun = lighting.sun_direction();
         let sky = PreethamSky::new(sun, lighting.turbidity).expect("sky");
         let coefficients = AerialCoefficients::for_turbidity(lighting.turbidity).expect("coefficients");

@@ -112,6 +112,12 @@ fn project(camera: &Camera, p: DVec4) -> Option<(f64, f64)> {
 
 #[test]
 fn distance_and_motion_follow_depth_and_the_poses() {
+    for raster in crate::test_support::RASTER_PATHS {
+        distance_and_motion_follow_depth_and_the_poses_in(raster);
+    }
+}
+
+fn distance_and_motion_follow_depth_and_the_poses_in(raster: crate::RasterPath) {
     let scene = Scene::default_terrain().expect("scene");
     let before = scene.default_camera();
     let after = Camera {
@@ -119,7 +125,11 @@ fn distance_and_motion_follow_depth_and_the_poses() {
         target: before.target + DVec3::new(500.0, 0.0, 30.0),
         ..before
     };
-    let (frames, _) = render(&scene, RenderSettings::new(WIDTH, HEIGHT), &[before, after], false);
+    let settings = RenderSettings {
+        raster,
+        ..RenderSettings::new(WIDTH, HEIGHT)
+    };
+    let (frames, _) = render(&scene, settings, &[before, after], false);
     assert!(frames[0].motion.iter().all(|&m| m == 0.0), "the first frame has motion");
     for (frame, camera) in frames.iter().zip([&before, &after]) {
         let sky = check_distance(frame, camera);
@@ -279,6 +289,12 @@ fn cpu_layers(scene: &Scene, camera: &Camera, frame: &FrameImages, table: Option
 
 #[test]
 fn terrain_classes_are_the_dominant_layers_and_normals_face_the_camera() {
+    for raster in crate::test_support::RASTER_PATHS {
+        terrain_classes_are_the_dominant_layers_and_normals_face_the_camera_in(raster);
+    }
+}
+
+fn terrain_classes_are_the_dominant_layers_and_normals_face_the_camera_in(raster: crate::RasterPath) {
     let scene = Scene::default_terrain().expect("scene");
     let camera = scene.default_camera();
     let layer_count = scene.layers.layers.len() as u32;
@@ -290,6 +306,7 @@ fn terrain_classes_are_the_dominant_layers_and_normals_face_the_camera() {
     ] {
         let settings = RenderSettings {
             texturing,
+            raster,
             ..RenderSettings::new(WIDTH, HEIGHT)
         };
         let (frames, table) = render(&scene, settings, &[camera], true);

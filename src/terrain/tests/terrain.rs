@@ -15,6 +15,7 @@ use crate::terrain::raycast::Raycaster;
 use crate::terrain::zoom::{projected_quad_areas, quantile, zoom_positions};
 use crate::test_support::{assert_validation_clean, jacksboro_field, validated_context};
 use crate::view::View;
+use crate::RasterPath;
 use glam::DVec3;
 
 const WIDTH: u32 = 192;
@@ -55,11 +56,12 @@ pub(super) fn views(scene: &Scene) -> Vec<(&'static str, Camera)> {
     ]
 }
 
-fn render(scene: &Scene, cameras: &[Camera], terrain: TerrainSettings) -> Vec<FrameImages> {
+fn render(scene: &Scene, cameras: &[Camera], (terrain, raster): (TerrainSettings, RasterPath)) -> Vec<FrameImages> {
     let (ctx, report) = validated_context();
     let frames = {
         let settings = RenderSettings {
             terrain,
+            raster,
             ..RenderSettings::new(WIDTH, HEIGHT)
         };
         let mut renderer = Renderer::new(&ctx, scene, settings).expect("renderer");
@@ -109,6 +111,12 @@ pub(super) fn raycast_depth_of(scene: &Scene, camera: &Camera, (width, height): 
 
 #[test]
 fn depth_matches_cpu_ray_cast_without_detail_and_has_no_holes() {
+    for raster in crate::test_support::RASTER_PATHS {
+        depth_matches_cpu_ray_cast_without_detail_and_has_no_holes_in(raster);
+    }
+}
+
+fn depth_matches_cpu_ray_cast_without_detail_and_has_no_holes_in(raster: RasterPath) {
     let scene = Scene::new(jacksboro_field());
     let views = views(&scene);
     let cameras: Vec<Camera> = views.iter().map(|v| v.1).collect();
@@ -116,7 +124,7 @@ fn depth_matches_cpu_ray_cast_without_detail_and_has_no_holes() {
         detail: false,
         ..Default::default()
     };
-    let frames = render(&scene, &cameras, terrain);
+    let frames = render(&scene, &cameras, (terrain, raster));
     for ((name, camera), frame) in views.iter().zip(&frames) {
         let cpu = raycast_depth(&scene, camera);
         let (mut considered, mut agree, mut holes, mut extra) = (0usize, 0usize, 0usize, 0usize);
@@ -162,9 +170,15 @@ fn depth_matches_cpu_ray_cast_without_detail_and_has_no_holes() {
 /// the coverage must stay the same: no holes at the borders either.
 #[test]
 fn detail_keeps_the_mesh_closed() {
+    for raster in crate::test_support::RASTER_PATHS {
+        detail_keeps_the_mesh_closed_in(raster);
+    }
+}
+
+fn detail_keeps_the_mesh_closed_in(raster: RasterPath) {
     let scene = Scene::new(jacksboro_field());
     let cameras: Vec<Camera> = views(&scene).iter().map(|v| v.1).collect();
-    let frames = render(&scene, &cameras, TerrainSettings::default());
+    let frames = render(&scene, &cameras, (TerrainSettings::default(), raster));
     for (camera, frame) in cameras.iter().zip(&frames) {
         let cpu = raycast_depth(&scene, camera);
         let holes = frame
