@@ -65,7 +65,7 @@ pub const SPLAT_SINGLE_PASS_INTERLOCK_FRAG: SpirV = spirv!("points/single_pass_i
 /// points.single_pass.clear: every pixel's state reset.
 pub const SPLAT_SINGLE_PASS_CLEAR: SpirV = spirv!("points/single_pass_clear.comp");
 /// points.single_pass.resolve: normalisation and shading of the pixel sums.
-pub const SPLAT_SINGLE_PASS_RESOLVE_FRAG: SpirV = spirv!("points/single_pass_resolve.frag");
+pub const SPLAT_SINGLE_PASS_RESOLVE: SpirV = spirv!("points/single_pass_resolve.comp");
 /// points.normalize: divide by the weight and shade (compute, per pixel).
 pub const SPLAT_NORMALIZE: SpirV = spirv!("points/normalize.comp");
 /// points.*, object-space primitives (§10.3): quads in the tangent plane, the interval test.

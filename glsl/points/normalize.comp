@@ -31,10 +31,5 @@ void main() {
     ResolvedSplats r = resolve_splats(cw, nd, vec2(p) + 0.5);
     uvec2 nearest = texelFetch(usampler2D(g_utextures[pc.mode.x], g_samplers[SAMPLER_NEAREST_CLAMP]), p, 0).xy;
     uvec2 last = texelFetch(usampler2D(g_utextures[pc.mode.y], g_samplers[SAMPLER_NEAREST_CLAMP]), p, 0).xy;
-    imageStore(g_images_rgba32f[pc.outputs.x], p, r.radiance);
-    imageStore(g_images_r32f[pc.outputs.y], p, vec4(r.view_depth));
-    imageStore(g_images_r32f[pc.outputs.z], p, vec4(r.weight));
-    imageStore(g_images_rg32f[pc.outputs.w], p, vec4(r.visibility, 0.0, 0.0));
-    imageStore(g_images_rgba16f[pc.more.x], p, r.normal);
-    imageStore(g_uimages_rg32ui[pc.more.y], p, uvec4(nearest.x != 0u ? nearest : last, 0u, 0u));
+    store_resolved(p, r, nearest.x != 0u ? nearest : last);
 }

@@ -131,6 +131,48 @@ impl PointView {
     }
 }
 
+/// The targets a compute pass that resolves splats writes (storage):
+/// radiance, view depth, lighting AOVs, normal, ids (read and written:
+/// pixels without splats keep what the terrain and sky wrote), and W.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct ResolvedTargets {
+    kept: [Binding; 5],
+    weight: Binding,
+    size: [u32; 2],
+}
+
+impl ResolvedTargets {
+    /// Declares the writes of `view`'s outputs on `builder` (a compute
+    /// pass); `weight`: how W is accessed.
+    pub(super) fn declare<P: 'static>(
+        builder: &mut PassBuilder<'_, P>,
+        (view, targets): (&PointView, &SceneTargets),
+        weight: ImageAccess,
+    ) -> ResolvedTargets {
+        let kept = ImageAccess::StorageReadWrite(Stage::Compute);
+        ResolvedTargets {
+            kept: [view.radiance, view.view_depth, view.visibility, view.normal, view.ids]
+                .map(|image| builder.storage_image(image, kept)),
+            weight: builder.storage_image(view.weight, weight),
+            size: [targets.width, targets.height],
+        }
+    }
+
+    /// The shaders' `outputs` and `more` push constants (`splat.glsl`).
+    pub(super) fn push(&self, ctx: &PassContext<'_>) -> Result<([u32; 4], [u32; 4])> {
+        let kept = |k: usize| ctx.handle(self.kept[k]);
+        Ok((
+            [kept(0)?, kept(1)?, ctx.handle(self.weight)?, kept(2)?],
+            [kept(3)?, kept(4)?, self.size[0], self.size[1]],
+        ))
+    }
+
+    /// The workgroups of an 8×8-pixel dispatch over the targets.
+    pub(super) fn groups(&self) -> [u32; 3] {
+        [self.size[0].div_ceil(8), self.size[1].div_ceil(8), 1]
+    }
+}
+
 /// The heap bindings of a shading pass of the points: the view's point
 /// frame and lighting constants. The pass writes the frame's header (which
 /// names the lighting constants) while recording.
@@ -607,26 +649,21 @@ fn declare_normalize<S: Provides<PointsFrame> + 'static>(
         accumulation.any_ids,
     ]
     .map(|image| builder.sample(image, compute));
-    // Pixels without splats keep the terrain's and the sky's values: read and written.
-    let kept = ImageAccess::StorageReadWrite(compute);
-    let outputs = [view.radiance, view.view_depth, view.visibility, view.normal, view.ids]
-        .map(|image| builder.storage_image(image, kept));
-    let weight = builder.storage_image(view.weight, ImageAccess::StorageWrite(compute));
-    let (width, height) = (targets.width, targets.height);
+    let outputs = ResolvedTargets::declare(&mut builder, (&view, targets), ImageAccess::StorageWrite(compute));
     builder.record(move |pass, frame| {
         let frame = shading.write_header(pass, frame, view.index)?;
-        let output = |k: usize| pass.handle(outputs[k]);
+        let (outputs_push, more) = outputs.push(pass)?;
         let push = NormalizePush {
             color_weight: pass.handle(sampled[0])?,
             frame,
             normal_depth: pass.handle(sampled[1])?,
             nearest_ids: pass.handle(sampled[2])?,
             any_ids: pass.handle(sampled[3])?,
-            outputs: [output(0)?, output(1)?, pass.handle(weight)?, output(2)?],
-            more: [output(3)?, output(4)?, width, height],
+            outputs: outputs_push,
+            more,
             ..NormalizePush::zeroed()
         };
-        pass.dispatch(&pipeline, &push, [width.div_ceil(8), height.div_ceil(8), 1])
+        pass.dispatch(&pipeline, &push, outputs.groups())
     });
     Ok(())
 }

@@ -25,7 +25,7 @@
 //!    each pixel merged under a per-pixel spin lock (64-bit word
 //!    z_d·2³² + lock with `shaderBufferInt64Atomics`, else 32-bit lock and
 //!    z_d words), or the interlock backend's raster pass;
-//! 4. `points.single_pass.resolve`: full screen, divide and shade.
+//! 4. `points.single_pass.resolve`: compute, per pixel: divide and shade.
 //!
 //! The compute backend's merges at fuzzy boundaries follow the invocation
 //! order, which the GPU may vary between runs (the operator is not
@@ -36,12 +36,14 @@ use std::sync::Arc;
 use bytemuck::{Pod, Zeroable};
 
 use super::passes::{
-    declare_opaque, plan_of, PointBuffers, PointView, ShadingBindings, SplatBindings, SplatPush, NO_HANDLE,
-    PASS_OPAQUE, PRIMITIVE_QUAD,
+    declare_opaque, plan_of, PointBuffers, PointView, ResolvedTargets, ShadingBindings, SplatBindings, SplatPush,
+    NO_HANDLE, PASS_OPAQUE, PRIMITIVE_QUAD,
 };
 use super::{PointsFrame, SplatBackend, SplatPrimitive};
 use crate::error::{Error, Result};
-use crate::graph::{Binding, BufferAccess, BufferId, BufferInfo, LoadOp, PassBuilder, PassContext, RenderGraph, Stage};
+use crate::graph::{
+    Binding, BufferAccess, BufferId, BufferInfo, ImageAccess, LoadOp, PassBuilder, PassContext, RenderGraph, Stage,
+};
 use crate::shaders;
 use crate::view::{Frame, Provides, SceneTargets};
 use crate::vulkan::{
@@ -82,6 +84,20 @@ struct StatePush {
     mode: [u32; 4],
 }
 
+/// Push constants of `points.single_pass.resolve` (`Push` in
+/// glsl/include/splat.glsl with `SPLAT_RESOLVE_COMPUTE`).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ResolvePush {
+    /// Pixel sums, point frame, 1 to keep W where no splat is, 0.
+    handles: [u32; 4],
+    mode: [u32; 4],
+    /// Storage: radiance, view depth, W, lighting AOVs.
+    outputs: [u32; 4],
+    /// Storage: normal, ids; width, height.
+    more: [u32; 4],
+}
+
 /// The per-pixel state of a view's single-pass splatting.
 #[derive(Clone, Copy, Debug)]
 struct PixelState {
@@ -94,7 +110,7 @@ struct PixelState {
 struct Pipelines {
     clear: ComputePipeline,
     splats: SplatPipeline,
-    resolve: GraphicsPipeline,
+    resolve: ComputePipeline,
 }
 
 enum SplatPipeline {
@@ -135,7 +151,6 @@ impl Pipelines {
     fn new(ctx: &Context, targets: &SceneTargets, (backend, force_32bit_locks): (SplatBackend, bool)) -> Result<Self> {
         check_backend(ctx, backend)?;
         let f = &targets.formats;
-        let outputs = vec![f.radiance, f.view_depth, f.weight, f.visibility, f.normal, f.ids];
         let splats = match backend {
             SplatBackend::Compute if ctx.has_feature("shaderBufferInt64Atomics") && !force_32bit_locks => {
                 SplatPipeline::Compute(ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS)?)
@@ -158,14 +173,7 @@ impl Pipelines {
         Ok(Pipelines {
             clear: ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS_CLEAR)?,
             splats,
-            resolve: GraphicsPipeline::new(
-                ctx,
-                &GraphicsPipelineDesc::full_screen(
-                    "points.single_pass.resolve",
-                    (shaders::FULL_SCREEN_VERT, shaders::SPLAT_SINGLE_PASS_RESOLVE_FRAG),
-                    outputs,
-                ),
-            )?,
+            resolve: ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS_RESOLVE)?,
         })
     }
 }
@@ -371,32 +379,38 @@ fn declare_interlock<S: Provides<PointsFrame> + 'static>(
         });
 }
 
-/// `points.single_pass.resolve`: full screen, as `points.normalize`, from
-/// the pixel sums; W cleared first unless the triangles pass wrote it.
+/// `points.single_pass.resolve`: a compute pass over the view's pixels, as
+/// `points.normalize`, from the pixel sums; W set to 0 where no splat is
+/// unless the triangles pass wrote it.
 fn declare_resolve<S: Provides<PointsFrame> + 'static>(
     graph: &mut RenderGraph<Frame<S>>,
     name: &str,
     view: PointView,
     targets: &SceneTargets,
     (state, weight_written): (PixelState, bool),
-    pipeline: GraphicsPipeline,
+    pipeline: ComputePipeline,
 ) {
     let pipeline = Arc::new(pipeline);
-    let weight_load = match weight_written {
-        true => LoadOp::Load,
-        false => LoadOp::Clear([0.0; 4]),
+    let compute = Stage::Compute;
+    let weight = match weight_written {
+        true => ImageAccess::StorageReadWrite(compute),
+        false => ImageAccess::StorageWrite(compute),
     };
-    let mut builder = graph.pass(name).graphics();
-    let shading = ShadingBindings::read_in(&mut builder, (&view, targets), Stage::Fragment);
-    let sums = builder.storage_buffer(state.sums, BufferAccess::StorageRead(Stage::Fragment));
-    view.write_outputs(builder.pipeline(&pipeline), weight_load)
-        .record(move |pass, frame| {
-            let push = StatePush {
-                handles: [pass.handle(sums)?, shading.write_header(pass, frame, view.index)?, 0, 0],
-                mode: [0; 4],
-            };
-            pass.draw_full_screen(&pipeline, &push)
-        });
+    let mut builder = graph.pass(name);
+    let shading = ShadingBindings::read_in(&mut builder, (&view, targets), compute);
+    let sums = builder.storage_buffer(state.sums, BufferAccess::StorageRead(compute));
+    let outputs = ResolvedTargets::declare(&mut builder, (&view, targets), weight);
+    builder.record(move |pass, frame| {
+        let frame = shading.write_header(pass, frame, view.index)?;
+        let (outputs_push, more) = outputs.push(pass)?;
+        let push = ResolvePush {
+            handles: [pass.handle(sums)?, frame, u32::from(weight_written), 0],
+            mode: [0; 4],
+            outputs: outputs_push,
+            more,
+        };
+        pass.dispatch(&pipeline, &push, outputs.groups())
+    });
 }
 
 #[cfg(test)]
