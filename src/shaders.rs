@@ -68,6 +68,14 @@ pub const SPLAT_SINGLE_PASS_CLEAR: SpirV = spirv!("points/single_pass_clear.comp
 pub const SPLAT_SINGLE_PASS_RESOLVE: SpirV = spirv!("points/single_pass_resolve.comp");
 /// points.normalize: divide by the weight and shade (compute, per pixel).
 pub const SPLAT_NORMALIZE: SpirV = spirv!("points/normalize.comp");
+/// points.clear (compute path): each pixel's splat state from the depth buffer (§10.2.3).
+pub const SPLAT_COMPUTE_CLEAR: SpirV = spirv!("points/compute_clear.comp");
+/// points.visibility (compute path): pushed-back depth and winner into 64-bit words (§10.2.3).
+pub const SPLAT_COMPUTE_VISIBILITY: SpirV = spirv!("points/compute_visibility.comp");
+/// points.accumulate (compute path): fixed-point weighted sums, order-independent (§10.2.3).
+pub const SPLAT_COMPUTE_ACCUMULATE: SpirV = spirv!("points/compute_accumulate.comp");
+/// points.normalize (compute path): the sums divided and shaded (§10.2.3).
+pub const SPLAT_COMPUTE_NORMALIZE: SpirV = spirv!("points/compute_normalize.comp");
 /// points.*, object-space primitives (§10.3): quads in the tangent plane, the interval test.
 pub const OBJECT_SPLAT_VERT: SpirV = spirv!("points/object_splat.vert");
 /// points.visibility, object-space primitives: the pushed-back quad's depth inside the kernel's disk.

@@ -69,7 +69,8 @@ const DEPTH_TOLERANCE: f32 = 1e-4;
 /// view depth. Scenes without terrain render once.
 fn check_golden_with(name: &str, scene: &Scene, camera: &Camera, points: SplatSettings, texturing: TexturingMode) {
     let (ctx, report) = validated_context();
-    let paths: &[RasterPath] = match scene.draw_terrain {
+    let ewa_points = !scene.points.objects.is_empty() && points.mode == SplatMode::Ewa;
+    let paths: &[RasterPath] = match scene.draw_terrain || ewa_points {
         true => &[RasterPath::Hardware, RasterPath::Compute],
         false => &[RasterPath::Auto],
     };

@@ -57,6 +57,10 @@ layout(push_constant) uniform Push {
     uvec4 outputs;  // storage: radiance (rgba32f), view depth (r32f), W (r32f), lighting AOVs (rg32f)
     uvec4 more;     // storage: normal (rgba16f), ids (rg32ui); width, height
 #endif
+#ifdef SPLAT_COMPUTE
+    uvec4 raster;   // compute three-pass (glsl/include/splat_compute.glsl): nearest words, sums, last records, splats of the frame
+    uvec4 draws;    // the draw table (storage: first splat, instance record per draw), draws, 0, 0
+#endif
 #ifdef SPLAT_SINGLE_PASS
     uvec4 single;   // single-pass (§10.4): pixel words, pixel sums, depth buffer (sampled; NO_HANDLE: cleared), splats of the draw
 #endif

@@ -41,10 +41,10 @@ struct SplatSetup {
 // Smallest |cos| between the view ray and the splat normal (≈ 0.6° from edge-on).
 const float MIN_COS_VIEW = 0.01;
 
-// The set-up of splat `splat_index` of the draw's instance (pc.mode.w).
-uint splat_setup(uint splat_index, out SplatSetup o) {
+// The set-up of splat `splat_index` of instance record `record`.
+uint splat_setup_of(uint record, uint splat_index, out SplatSetup o) {
     uint f = pc.handles.y;
-    Instance inst = g_point_frame[f].instances[pc.mode.w];
+    Instance inst = g_point_frame[f].instances[record];
     float scale = inst.params.x;
     uint first = floatBitsToUint(inst.params.y);
     Splat s = g_splats[pc.handles.x].s[first + splat_index];
@@ -114,6 +114,11 @@ uint splat_setup(uint splat_index, out SplatSetup o) {
     o.clip = s.clip;
     o.color = vec4(unpack_srgb(s.radius_color.y), 1.0);
     return SPLAT_SETUP_READY;
+}
+
+// The set-up of splat `splat_index` of the draw's instance (pc.mode.w).
+uint splat_setup(uint splat_index, out SplatSetup o) {
+    return splat_setup_of(pc.mode.w, splat_index, o);
 }
 
 struct SplatSample {

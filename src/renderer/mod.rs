@@ -543,10 +543,19 @@ impl Renderer {
         })
     }
 
-    /// The rasterizer the terrain is drawn with ([`RenderSettings::raster`]
-    /// resolved on this device; hardware without terrain).
+    /// The rasterizer the frame is drawn with ([`RenderSettings::raster`]
+    /// resolved on this device): compute when the terrain or the EWA splats
+    /// are drawn by compute passes, else hardware.
     pub fn raster_path(&self) -> RasterPath {
-        (self.techniques.terrain.as_ref()).map_or(RasterPath::Hardware, |t| t.raster_path())
+        let terrain = (self.techniques.terrain.as_ref()).map(|t| t.raster_path());
+        let points = (self.techniques.points.as_ref()).map(|p| match p.draws_in_compute() {
+            true => RasterPath::Compute,
+            false => RasterPath::Hardware,
+        });
+        match (terrain, points) {
+            (Some(RasterPath::Compute), _) | (_, Some(RasterPath::Compute)) => RasterPath::Compute,
+            _ => RasterPath::Hardware,
+        }
     }
 
     /// The texture page table of the last recorded frame (which atlas tile
@@ -626,7 +635,12 @@ impl Wiring<'_> {
             declare_views(&mut Sky::new(ctx)?, ctx, graph, views, &targets)?;
         }
         let mut points = match points_present {
-            true => Some(PointRenderer::new(ctx, &scene.points, settings.points)?),
+            true => Some(PointRenderer::new(
+                ctx,
+                &scene.points,
+                settings.points,
+                settings.raster.uses_compute(ctx)?,
+            )?),
             false => None,
         };
         // Edge (validation_layer_edges): the atlas's generation passes before the shadow casters.

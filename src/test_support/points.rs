@@ -6,6 +6,7 @@
 use crate::points::render::{PointFrameStats, SplatSettings};
 use crate::points::scene::{load_point_object, PointLoadOptions, PointObject};
 use crate::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
+use crate::RasterPath;
 use glam::DVec3;
 
 use super::{assert_validation_clean, data, validated_context};
@@ -16,12 +17,24 @@ pub fn render_points(
     scene: &Scene,
     camera: &Camera,
     points: SplatSettings,
+    size: (u32, u32),
+) -> (FrameImages, PointFrameStats) {
+    render_points_on(scene, camera, (points, RasterPath::Auto), size)
+}
+
+/// As [`render_points`], on rasterizer path `raster` (the splats' compute
+/// passes or the hardware rasterizer).
+pub fn render_points_on(
+    scene: &Scene,
+    camera: &Camera,
+    (points, raster): (SplatSettings, RasterPath),
     (width, height): (u32, u32),
 ) -> (FrameImages, PointFrameStats) {
     let (ctx, report) = validated_context();
     let out = {
         let settings = RenderSettings {
             points,
+            raster,
             ..RenderSettings::new(width, height)
         };
         let mut renderer = Renderer::new(&ctx, scene, settings).expect("renderer");

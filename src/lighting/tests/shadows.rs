@@ -272,7 +272,7 @@ fn run(
         min: DVec3::new(-PLANE, -PLANE, 0.0),
         max: DVec3::new(PLANE, PLANE, BOX_MAX.z),
     };
-    let renderer = points.map(|scene| PointRenderer::new(ctx, scene, SplatSettings::default()).expect("points"));
+    let renderer = points.map(|scene| PointRenderer::new(ctx, scene, SplatSettings::default(), false).expect("points"));
     if let Some(b) = renderer.as_ref().and_then(PointShadows::bounds) {
         bounds = bounds.union(b);
     }

@@ -20,6 +20,7 @@
 //!
 //! The graph derives every barrier between them. Shaders: `glsl/points/`.
 
+mod compute;
 pub mod gpu_layout;
 pub mod object_space;
 mod passes;

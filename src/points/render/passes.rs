@@ -110,6 +110,10 @@ pub(super) struct PointView {
     pub ids: ImageId,
     /// Clear the depth buffer first (no terrain drew into it).
     pub clear_depth: bool,
+    /// The draw table of the compute path's splat passes (per draw: its
+    /// first splat counted over the view's draws, its instance record),
+    /// written by `prepare`; None on the hardware path.
+    pub draws: Option<UploadRegion>,
 }
 
 impl PointView {

@@ -6,6 +6,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use super::compute::declare_ewa_compute;
 use super::gpu_layout::{frame_header, gaussian_table, pack_nodes, FrameHeader, HEADER_BYTES, INSTANCE_BYTES};
 use super::object_space::ObjectSpaceResources;
 use super::passes::{declare_ewa, declare_opaque, PointBuffers, PointView};
@@ -15,6 +16,7 @@ use super::stats::{PointFrameStats, StatsLog};
 use super::triangles::TriangleBuffer;
 use super::{SplatMode, SplatPrimitive, SplatSettings};
 use crate::error::{Error, Result};
+use crate::graph::UploadRegion;
 use crate::points::build::clusters::{cluster_normals, CLUSTER_COUNT};
 use crate::points::scene::PointScene;
 use crate::view::{
@@ -72,12 +74,21 @@ pub struct PointRenderer {
     stats: StatsLog,
     /// The previous frame's plans, reused ([`Technique::recycle`]).
     spare: Vec<PointViewFrame>,
+    /// EWA splats drawn by compute passes ([`super::compute`]), not the
+    /// hardware rasterizer.
+    compute: bool,
 }
 
 impl PointRenderer {
+    /// Whether EWA splats are drawn by compute passes.
+    pub fn draws_in_compute(&self) -> bool {
+        self.compute && self.settings.mode == SplatMode::Ewa
+    }
+
     /// Uploads the splat lists of `scene` (re-derived for
-    /// `settings.epsilon`, clustered when asked for).
-    pub fn new(ctx: &Context, scene: &PointScene, settings: SplatSettings) -> Result<PointRenderer> {
+    /// `settings.epsilon`, clustered when asked for); `compute`: draw EWA
+    /// splats with compute passes (the compute raster path).
+    pub fn new(ctx: &Context, scene: &PointScene, settings: SplatSettings, compute: bool) -> Result<PointRenderer> {
         settings.validate()?;
         if settings.mode == SplatMode::SinglePass {
             check_backend(ctx, settings.backend)?;
@@ -162,6 +173,7 @@ impl PointRenderer {
             scene,
             layouts,
             spare: Vec::new(),
+            compute,
         })
     }
 
@@ -233,12 +245,15 @@ impl<S: Provides<PointsFrame> + 'static> Declare<S> for PointRenderer {
             normal: targets.normal,
             ids: targets.ids,
             clear_depth,
+            draws: (self.draws_in_compute())
+                .then(|| graph.upload_region(&pass_name("point draws", &view.name), 8 * records)),
         };
         let name = |base: &str| pass_name(base, &view.name);
         match self.settings.mode {
             SplatMode::Opaque => {
                 declare_opaque(ctx, graph, &name("points.opaque"), (buffers, point_view), targets, true)?
             }
+            SplatMode::Ewa if self.compute => declare_ewa_compute(ctx, graph, &name, (buffers, point_view), targets)?,
             SplatMode::Ewa => {
                 let names = [
                     name("points.visibility"),
@@ -309,6 +324,9 @@ impl Technique for PointRenderer {
             frame
                 .uploads
                 .write_at(point_view.frame, HEADER_BYTES, bytemuck::cast_slice(&plan.records))?;
+            if let Some(region) = point_view.draws {
+                write_draw_table(frame, region, plan)?;
+            }
             stats.instances = plan.instances;
             stats.instances_drawn += plan.instances_drawn;
             stats.list_splats += plan.list_splats;
@@ -323,4 +341,21 @@ impl Technique for PointRenderer {
     fn recycle(&mut self, previous: PointsFrame) {
         self.spare = previous.views;
     }
+}
+
+/// Writes the compute path's draw table of `plan` into `region`: per draw
+/// its first splat counted over the view's draws and its instance record
+/// (`g_splat_draws` in glsl/include/splat_compute.glsl).
+fn write_draw_table(frame: &mut FrameContext<'_, '_>, region: UploadRegion, plan: &FramePlan) -> Result<()> {
+    let mut first = 0u32;
+    for (k, d) in plan.draws.iter().enumerate() {
+        let entry = [first, d.record];
+        frame
+            .uploads
+            .write_at(region, 8 * k as u64, bytemuck::cast_slice(&entry))?;
+        first = first
+            .checked_add(d.count)
+            .ok_or_else(|| Error::invalid("points", "a view's splats exceed 2³² in one frame"))?;
+    }
+    Ok(())
 }

@@ -13,8 +13,9 @@
 use crate::points::render::{SplatMode, SplatSettings};
 use crate::points::scene::{PointScene, PointTransform};
 use crate::renderer::{FrameImages, Scene};
-use crate::test_support::points::{bunny_camera, bunny_object, render_points};
+use crate::test_support::points::{bunny_camera, bunny_object, render_points_on};
 use crate::test_support::{dump_pngs, flip_errors};
+use crate::RasterPath;
 
 const WIDTH: u32 = 320;
 const HEIGHT: u32 = 240;
@@ -24,11 +25,13 @@ const HEIGHT: u32 = 240;
 /// and show the scan's fine relief, aliased, where the splats filter it),
 /// 0.004 at 2 m, 0 at 6 m; opaque discs 0.145, 0.265, 0.001, 0.
 /// Single-pass splats (§10.4; the triangles drawn opaque first, the splats
-/// tested against their depth): 0.23 as EWA.
-const HYBRID_FLIP: [(SplatMode, f32); 3] = [
-    (SplatMode::Ewa, 0.23),
-    (SplatMode::Opaque, 0.3),
-    (SplatMode::SinglePass, 0.23),
+/// tested against their depth) and the compute path's EWA splats (the
+/// triangles drawn the same way): 0.23 as EWA.
+const HYBRID_FLIP: [(SplatMode, RasterPath, f32); 4] = [
+    (SplatMode::Ewa, RasterPath::Hardware, 0.23),
+    (SplatMode::Ewa, RasterPath::Compute, 0.23),
+    (SplatMode::Opaque, RasterPath::Auto, 0.3),
+    (SplatMode::SinglePass, RasterPath::Auto, 0.23),
 ];
 /// Holes allowed: the scan mesh has a crack that the splats' overhang
 /// covers and its triangles do not (1 pixel at 0.25 m).
@@ -98,19 +101,21 @@ fn compare(points: &FrameImages, hybrid: &FrameImages) -> Comparison {
 #[test]
 fn hybrid_bunny_matches_points_only() {
     let (points_scene, hybrid_scene) = (bunny_scene(false), bunny_scene(true));
-    for (mode, flip_bound) in HYBRID_FLIP {
+    for (mode, raster, flip_bound) in HYBRID_FLIP {
         let settings = SplatSettings {
             mode,
             ..SplatSettings::default()
         };
         for distance in [0.25, 1.0, 2.0, 6.0] {
             let camera = bunny_camera(distance);
-            let (points, points_stats) = render_points(&points_scene, &camera, settings, (WIDTH, HEIGHT));
-            let (hybrid, stats) = render_points(&hybrid_scene, &camera, settings, (WIDTH, HEIGHT));
+            let on = (settings, raster);
+            let (points, points_stats) = render_points_on(&points_scene, &camera, on, (WIDTH, HEIGHT));
+            let (hybrid, stats) = render_points_on(&hybrid_scene, &camera, on, (WIDTH, HEIGHT));
             let c = compare(&points, &hybrid);
             eprintln!(
-                "{} at {distance} m: interior FLIP {:.4}, hybrid-only pixels {:.2} %, holes {}\n  points: {}\n  hybrid: {}",
+                "{} ({}) at {distance} m: interior FLIP {:.4}, hybrid-only pixels {:.2} %, holes {}\n  points: {}\n  hybrid: {}",
                 mode.name(),
+                raster.name(),
                 c.interior_flip,
                 c.hybrid_only * 100.0,
                 c.holes,

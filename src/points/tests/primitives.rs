@@ -22,8 +22,9 @@ use crate::test_support::plane::{
     analytic_plane, grazing_camera, holes, plane_flip, plane_scene, point_sampled_flip, unlit, FAR_FIELD_Y,
     HEIGHT as PLANE_HEIGHT, SPACING, WIDTH as PLANE_WIDTH,
 };
-use crate::test_support::points::{bunny_camera, bunny_object, pixels_differing, render_points};
+use crate::test_support::points::{bunny_camera, bunny_object, pixels_differing, render_points_on};
 use crate::test_support::{dump_pngs, flip_errors, linear_to_srgb8};
+use crate::RasterPath;
 
 const WIDTH: u32 = 160;
 const HEIGHT: u32 = 100;
@@ -49,8 +50,10 @@ fn with_primitive(primitive: SplatPrimitive) -> SplatSettings {
     }
 }
 
+/// The primitives (§10.3) are the hardware rasterizer's: the compute path
+/// rasterises the splats' ellipses itself.
 fn render(scene: &Scene, camera: &Camera, settings: SplatSettings) -> (FrameImages, PointFrameStats) {
-    render_points(scene, camera, settings, (WIDTH, HEIGHT))
+    render_points_on(scene, camera, (settings, RasterPath::Hardware), (WIDTH, HEIGHT))
 }
 
 /// Per pixel: covered (W > 0).
@@ -179,8 +182,18 @@ fn object_space_quads_alias_at_grazing_distance_where_ewa_does_not() {
         ..unlit(SplatMode::Ewa)
     };
     let size = (PLANE_WIDTH, PLANE_HEIGHT);
-    let (ewa, _) = render_points(&scene, &camera, settings(SplatPrimitive::Quad), size);
-    let (object, stats) = render_points(&scene, &camera, settings(SplatPrimitive::ObjectQuad), size);
+    let (ewa, _) = render_points_on(
+        &scene,
+        &camera,
+        (settings(SplatPrimitive::Quad), RasterPath::Hardware),
+        size,
+    );
+    let (object, stats) = render_points_on(
+        &scene,
+        &camera,
+        (settings(SplatPrimitive::ObjectQuad), RasterPath::Hardware),
+        size,
+    );
     eprintln!("object-quad: {}", stats.summary());
     let reference = analytic_plane(&camera, 16, 0.1, FAR_FIELD_Y);
     let ewa_flip = plane_flip(&ewa, &reference);

@@ -1,0 +1,299 @@
+//! Three-pass EWA splatting on the compute path (dissertation §10.2.3,
+//! Table 10.1; issue 29): the same perspective-accurate set-up and kernel
+//! as the hardware passes (`glsl/include/splat_setup.glsl`), one invocation
+//! per splat rasterising its bounding box, into per-pixel buffers
+//! (`glsl/include/splat_compute_state.glsl`):
+//!
+//! 1. `points.triangles` (only with hybrid triangles, §10.1.8): the
+//!    triangles opaque and shaded, with depth, so splats test against them
+//!    (as single-pass splatting does);
+//! 2. `points.clear`: each pixel's nearest word from the depth buffer
+//!    (terrain, triangles), sums and last record 0;
+//! 3. `points.visibility`: one dispatch for all the view's draws (a draw
+//!    table written by `prepare` maps each invocation to its draw); the ray–plane depth pushed back by ε, raised into
+//!    the nearest word with the splat's instance record (64-bit `atomicMax`);
+//! 4. `points.accumulate`: fragments at or in front of it add w·(colour, 1)
+//!    and w·(normal, view depth) to fixed-point 64-bit integer sums
+//!    (`atomicAdd`): the sums do not depend on the order of the fragments,
+//!    so frames are the same to the byte;
+//! 5. `points.normalize`: per pixel, divide and shade as the hardware
+//!    path's normalization (`glsl/include/splat_resolve.glsl`).
+//!
+//! The primitive setting (§10.3) belongs to the hardware path: compute
+//! rasterises the screen-space ellipse itself.
+
+use std::sync::Arc;
+
+use bytemuck::{Pod, Zeroable};
+
+use super::passes::{
+    declare_opaque, plan_of, PointBuffers, PointView, ResolvedTargets, ShadingBindings, SplatBindings, SplatPush,
+    NO_HANDLE, PASS_OPAQUE,
+};
+use super::{PointsFrame, SplatPrimitive};
+use crate::error::{Error, Result};
+use crate::graph::{stride_groups, Binding, BufferAccess, BufferId, BufferInfo, ImageAccess, RenderGraph, Stage};
+use crate::shaders;
+use crate::view::{Frame, Provides, SceneTargets};
+use crate::vulkan::{ComputePipeline, Context, MemoryLocation};
+
+/// Bytes per pixel of the nearest word, the sums (8 × i64) and the last record.
+const NEAREST_BYTES: u64 = 8;
+const SUMS_BYTES: u64 = 64;
+const LAST_BYTES: u64 = 4;
+/// Invocations per workgroup of the splat passes (`glsl/include/splat_compute.glsl`).
+const SPLATS_PER_GROUP: u32 = 64;
+
+/// Push constants of `points.visibility` and `points.accumulate` (`Push` in
+/// glsl/include/splat.glsl with `SPLAT_COMPUTE`): the splat passes' block,
+/// then nearest words, sums, last records and the draw's splat count.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ComputeSplatPush {
+    splat: SplatPush,
+    raster: [u32; 4],
+    /// The draw table (storage), draws, 0, 0.
+    draws: [u32; 4],
+}
+
+/// Push constants of `points.clear`: nearest, sums, last, depth buffer
+/// (sampled, [`NO_HANDLE`]: far); width, height.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ClearPush {
+    handles: [u32; 4],
+    size: [u32; 4],
+}
+
+/// Push constants of `points.normalize` (`Push` with `SPLAT_RESOLVE_COMPUTE`).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct NormalizePush {
+    /// Sums, point frame, 1 to keep W where no splat is, nearest words.
+    handles: [u32; 4],
+    /// Last records, 0, 0, 0.
+    mode: [u32; 4],
+    outputs: [u32; 4],
+    more: [u32; 4],
+}
+
+/// A view's per-pixel splat state.
+#[derive(Clone, Copy, Debug)]
+struct SplatState {
+    nearest: BufferId,
+    sums: BufferId,
+    last: BufferId,
+    size: [u32; 2],
+}
+
+/// The bindings of one of the state's buffers in each pass that uses it.
+#[derive(Clone, Copy, Debug)]
+struct StateBindings {
+    nearest: Binding,
+    sums: Option<Binding>,
+    last: Option<Binding>,
+}
+
+/// The pipelines of the compute path's splat passes.
+struct Pipelines {
+    clear: ComputePipeline,
+    visibility: ComputePipeline,
+    accumulate: ComputePipeline,
+    normalize: ComputePipeline,
+}
+
+/// Declares the compute path's EWA passes of one view (see the module's
+/// list); `name` gives a pass's name for the view.
+pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame<S>>,
+    name: &dyn Fn(&str) -> String,
+    (buffers, view): (PointBuffers, PointView),
+    targets: &SceneTargets,
+) -> Result<()> {
+    let pipelines = Pipelines {
+        clear: ComputePipeline::new(ctx, shaders::SPLAT_COMPUTE_CLEAR)?,
+        visibility: ComputePipeline::new(ctx, shaders::SPLAT_COMPUTE_VISIBILITY)?,
+        accumulate: ComputePipeline::new(ctx, shaders::SPLAT_COMPUTE_ACCUMULATE)?,
+        normalize: ComputePipeline::new(ctx, shaders::SPLAT_COMPUTE_NORMALIZE)?,
+    };
+    let pixels = u64::from(targets.width * targets.height).max(1);
+    let mut buffer = |what, bytes: u64| {
+        let info = BufferInfo {
+            size: bytes * pixels,
+            location: MemoryLocation::GpuOnly,
+        };
+        graph.create_buffer(what, info)
+    };
+    let state = SplatState {
+        nearest: buffer("splat nearest depth and record", NEAREST_BYTES),
+        sums: buffer("splat fixed-point sums", SUMS_BYTES),
+        last: buffer("splat last record", LAST_BYTES),
+        size: [targets.width, targets.height],
+    };
+    // Hybrid triangles (§10.1.8) opaque and shaded, with depth and W = 1,
+    // before the splats test against them.
+    let triangles = buffers.triangles.is_some();
+    if triangles {
+        let triangles_only = PointBuffers {
+            primitive: SplatPrimitive::Quad,
+            ..buffers
+        };
+        declare_opaque(
+            ctx,
+            graph,
+            &name("points.triangles"),
+            (triangles_only, view),
+            targets,
+            false,
+        )?;
+    }
+    let depth_written = triangles || !view.clear_depth;
+    declare_clear(
+        graph,
+        &name("points.clear"),
+        (view, state, depth_written),
+        pipelines.clear,
+    );
+    let splats = (buffers, view, state);
+    declare_splats(graph, &name("points.visibility"), splats, true, pipelines.visibility)?;
+    declare_splats(graph, &name("points.accumulate"), splats, false, pipelines.accumulate)?;
+    let normalize = name("points.normalize");
+    let normalize = (normalize.as_str(), pipelines.normalize);
+    declare_normalize(graph, normalize, (view, targets), state, triangles);
+    Ok(())
+}
+
+/// `points.clear`: the nearest words from the depth buffer (when something
+/// drew into it), sums and last records 0.
+fn declare_clear<S: Provides<PointsFrame> + 'static>(
+    graph: &mut RenderGraph<Frame<S>>,
+    name: &str,
+    (view, state, depth_written): (PointView, SplatState, bool),
+    pipeline: ComputePipeline,
+) {
+    let write = BufferAccess::StorageWrite(Stage::Compute);
+    let mut pass = graph.pass(name);
+    let buffers = [state.nearest, state.sums, state.last].map(|b| pass.storage_buffer(b, write));
+    let depth = depth_written.then(|| pass.sample(view.depth, Stage::Compute));
+    pass.record(move |ctx, _| {
+        let depth = depth.map(|d| ctx.handle(d)).transpose()?.unwrap_or(NO_HANDLE);
+        let push = ClearPush {
+            handles: [
+                ctx.handle(buffers[0])?,
+                ctx.handle(buffers[1])?,
+                ctx.handle(buffers[2])?,
+                depth,
+            ],
+            size: [state.size[0], state.size[1], 0, 0],
+        };
+        let groups = [state.size[0].div_ceil(8), state.size[1].div_ceil(8), 1];
+        ctx.dispatch(&pipeline, &push, groups)
+    });
+}
+
+/// `points.visibility` (`visibility`: raises the nearest words, counts the
+/// drawn splats) or `points.accumulate` (reads them, adds to the sums and
+/// raises the last records): one dispatch per planned draw.
+fn declare_splats<S: Provides<PointsFrame> + 'static>(
+    graph: &mut RenderGraph<Frame<S>>,
+    name: &str,
+    (buffers, view, state): (PointBuffers, PointView, SplatState),
+    visibility: bool,
+    pipeline: ComputePipeline,
+) -> Result<()> {
+    let compute = Stage::Compute;
+    let mut builder = graph.pass(name);
+    let frame = builder.upload(view.frame, compute);
+    let buffers = PointBuffers {
+        counter: buffers.counter.filter(|_| visibility),
+        ..buffers
+    };
+    let (mut builder, splat): (_, SplatBindings) = buffers.read_by_at(builder, frame, (compute, compute));
+    let table = view
+        .draws
+        .ok_or_else(|| Error::Graph(format!("{name}: the view has no draw table")))?;
+    let table = builder.upload(table, compute);
+    let written = BufferAccess::StorageReadWrite(compute);
+    let bindings = match visibility {
+        true => StateBindings {
+            nearest: builder.storage_buffer(state.nearest, written),
+            sums: None,
+            last: None,
+        },
+        false => StateBindings {
+            nearest: builder.storage_buffer(state.nearest, BufferAccess::StorageRead(compute)),
+            sums: Some(builder.storage_buffer(state.sums, written)),
+            last: Some(builder.storage_buffer(state.last, written)),
+        },
+    };
+    builder.record(move |pass, frame| {
+        let plan = plan_of(frame, view.index)?;
+        let optional = |b: Option<Binding>| b.map(|b| pass.handle(b)).transpose().map(|h| h.unwrap_or(NO_HANDLE));
+        // The draw table was checked not to overflow when it was written.
+        let splats = plan.draws.iter().map(|d| d.count).fold(0u32, u32::wrapping_add);
+        let draws = u32::try_from(plan.draws.len()).map_err(|_| Error::invalid("points", "too many draws"))?;
+        let push = ComputeSplatPush {
+            splat: splat.push(pass, PASS_OPAQUE)?,
+            raster: [
+                pass.handle(bindings.nearest)?,
+                optional(bindings.sums)?,
+                optional(bindings.last)?,
+                splats,
+            ],
+            draws: [pass.handle(table)?, draws, 0, 0],
+        };
+        if splats == 0 {
+            return Ok(());
+        }
+        pass.dispatch(&pipeline, &push, [stride_groups(splats, SPLATS_PER_GROUP), 1, 1])
+    });
+    Ok(())
+}
+
+/// `points.normalize`: a compute pass over the view's pixels: the sums
+/// divided and shaded into the view's targets; W set to 0 where no splat
+/// is unless the hybrid triangles wrote it (`triangles`).
+fn declare_normalize<S: Provides<PointsFrame> + 'static>(
+    graph: &mut RenderGraph<Frame<S>>,
+    (name, pipeline): (&str, ComputePipeline),
+    (view, targets): (PointView, &SceneTargets),
+    state: SplatState,
+    triangles: bool,
+) {
+    let pipeline = Arc::new(pipeline);
+    let compute = Stage::Compute;
+    let weight = match triangles {
+        true => ImageAccess::StorageReadWrite(compute),
+        false => ImageAccess::StorageWrite(compute),
+    };
+    let mut builder = graph.pass(name);
+    let shading = ShadingBindings::read_in(&mut builder, (&view, targets), compute);
+    let read = BufferAccess::StorageRead(compute);
+    let [nearest, sums, last] = [state.nearest, state.sums, state.last].map(|b| builder.storage_buffer(b, read));
+    let outputs = ResolvedTargets::declare(&mut builder, (&view, targets), weight);
+    builder.record(move |pass, frame| {
+        let frame = shading.write_header(pass, frame, view.index)?;
+        let (outputs_push, more) = outputs.push(pass)?;
+        let push = NormalizePush {
+            handles: [pass.handle(sums)?, frame, u32::from(triangles), pass.handle(nearest)?],
+            mode: [pass.handle(last)?, 0, 0, 0],
+            outputs: outputs_push,
+            more,
+        };
+        pass.dispatch(&pipeline, &push, outputs.groups())
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn push_constants_match_the_shader_blocks() {
+        // handles, mode (SplatPush), raster, draws: 64 bytes; clear and normalize: 32 and 64.
+        assert_eq!(std::mem::size_of::<ComputeSplatPush>(), 64);
+        assert_eq!(std::mem::size_of::<ClearPush>(), 32);
+        assert_eq!(std::mem::size_of::<NormalizePush>(), 64);
+    }
+}
