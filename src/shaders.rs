@@ -92,6 +92,10 @@ pub const HYBRID_VISIBILITY_FRAG: SpirV = spirv!("points/hybrid_visibility.frag"
 pub const HYBRID_ACCUMULATE_FRAG: SpirV = spirv!("points/hybrid_accumulate.frag");
 /// points.opaque, hybrid triangles: shaded directly.
 pub const HYBRID_OPAQUE_FRAG: SpirV = spirv!("points/hybrid_opaque.frag");
+/// points.visibility.triangles (compute path): pushed-back depth into the splats' nearest words (§10.1.8).
+pub const HYBRID_COMPUTE_VISIBILITY_FRAG: SpirV = spirv!("points/hybrid_compute_visibility.frag");
+/// points.accumulate.triangles (compute path): weight-1 sums into the splats' state (§10.1.8).
+pub const HYBRID_COMPUTE_ACCUMULATE_FRAG: SpirV = spirv!("points/hybrid_compute_accumulate.frag");
 /// texturing.upsample: the base surface at every texel of the dirty tiles (§8.2).
 pub const TEXTURING_UPSAMPLE: SpirV = spirv!("texturing/upsample.comp");
 /// texturing.layer*: one surface layer over every texel of the dirty tiles (§8.2).

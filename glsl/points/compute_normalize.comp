@@ -41,7 +41,9 @@ void main() {
         return;
     }
     vec4 cw = vec4(sum_of(base, 0u), sum_of(base, 1u), sum_of(base, 2u), sum_of(base, 3u));
-    vec4 nd = vec4(sum_of(base, 4u), sum_of(base, 5u), sum_of(base, 6u), sum_of(base, 7u));
+    // Σw·view depth from the sum of view depths relative to the nearest word's.
+    float reference = splat_view_depth(splat_nearest_depth(pc.handles.w, index), g_point_frame[pc.handles.y].depth.xy);
+    vec4 nd = vec4(sum_of(base, 4u), sum_of(base, 5u), sum_of(base, 6u), sum_of(base, 7u) * reference);
     uint nearest = uint(g_splat_nearest[pc.handles.w].w[index] & uint64_t(0xffffffffu));
     uint last = g_splat_last[pc.mode.x].r[index];
     store_resolved(p, resolve_splats(cw, nd, vec2(p) + 0.5), record_ids(nearest != 0u ? nearest : last));

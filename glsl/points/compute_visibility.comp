@@ -13,6 +13,5 @@ void splat_pixel(SplatSetup v, uvec2 pixel) {
     }
     float offset = g_point_frame[pc.handles.y].depth.z * v.centre.z;
     vec3 pushed = s.position * (1.0 + offset / length(s.position));
-    uint64_t word = (uint64_t(floatBitsToUint(depth_of(pushed.z))) << 32) | uint64_t(splat_record + 1u);
-    atomicMax(g_splat_nearest[pc.raster.x].w[splat_pixel_index(pixel)], word);
+    splat_raise_nearest(pc.raster.x, splat_pixel_index(pixel), depth_of(pushed.z), splat_record);
 }

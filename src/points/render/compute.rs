@@ -4,11 +4,15 @@
 //! per splat rasterising its bounding box, into per-pixel buffers
 //! (`glsl/include/splat_compute_state.glsl`):
 //!
-//! 1. `points.triangles` (only with hybrid triangles, §10.1.8): the
-//!    triangles opaque and shaded, with depth, so splats test against them
-//!    (as single-pass splatting does);
-//! 2. `points.clear`: each pixel's nearest word from the depth buffer
-//!    (terrain, triangles), sums and last record 0;
+//! 1. `points.clear`: each pixel's nearest word from the depth buffer
+//!    (terrain), sums and last record 0;
+//! 2. `points.visibility.triangles` and `points.accumulate.triangles` (only
+//!    with hybrid triangles, §10.1.8), before the splats' passes 3 and 4:
+//!    the triangles' fragments raise the nearest words and add weight 1 to
+//!    the sums as the hardware path's triangles do (without
+//!    `fragmentStoresAndAtomics`: one `points.triangles` pass first, the
+//!    triangles opaque and shaded with depth, as single-pass splatting
+//!    draws them);
 //! 3. `points.visibility`: one dispatch for all the view's draws (a draw
 //!    table written by `prepare` maps each invocation to its draw); the ray–plane depth pushed back by ε, raised into
 //!    the nearest word with the splat's instance record (64-bit `atomicMax`);
@@ -30,12 +34,17 @@ use super::passes::{
     declare_opaque, plan_of, PointBuffers, PointView, ResolvedTargets, ShadingBindings, SplatBindings, SplatPush,
     NO_HANDLE, PASS_OPAQUE,
 };
+use super::pipeline_spec::PipelineSpec;
+use super::triangles::draw_triangles_with;
 use super::{PointsFrame, SplatPrimitive};
 use crate::error::{Error, Result};
-use crate::graph::{stride_groups, Binding, BufferAccess, BufferId, BufferInfo, ImageAccess, RenderGraph, Stage};
+use crate::graph::{
+    stride_groups, Binding, BufferAccess, BufferId, BufferInfo, ImageAccess, PassContext, RenderGraph, Stage,
+};
 use crate::shaders;
+use crate::view::depth::FAR_DEPTH;
 use crate::view::{Frame, Provides, SceneTargets};
-use crate::vulkan::{ComputePipeline, Context, MemoryLocation};
+use crate::vulkan::{Blend, CompareOp, ComputePipeline, Context, GraphicsPipeline, MemoryLocation};
 
 /// Bytes per pixel of the nearest word, the sums (8 × i64) and the last record.
 const NEAREST_BYTES: u64 = 8;
@@ -94,6 +103,20 @@ struct StateBindings {
     last: Option<Binding>,
 }
 
+impl StateBindings {
+    /// The `raster` push constants: nearest, sums, last ([`NO_HANDLE`]
+    /// where not declared) and `count`.
+    fn handles(&self, pass: &PassContext<'_>, count: u32) -> Result<[u32; 4]> {
+        let optional = |b: Option<Binding>| b.map(|b| pass.handle(b)).transpose().map(|h| h.unwrap_or(NO_HANDLE));
+        Ok([
+            pass.handle(self.nearest)?,
+            optional(self.sums)?,
+            optional(self.last)?,
+            count,
+        ])
+    }
+}
+
 /// The pipelines of the compute path's splat passes.
 struct Pipelines {
     clear: ComputePipeline,
@@ -131,10 +154,16 @@ pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
         last: buffer("splat last record", LAST_BYTES),
         size: [targets.width, targets.height],
     };
-    // Hybrid triangles (§10.1.8) opaque and shaded, with depth and W = 1,
-    // before the splats test against them.
-    let triangles = buffers.triangles.is_some();
-    if triangles {
+    // Hybrid triangles (§10.1.8): in the splats' state, as the hardware
+    // passes blend them (fragment stores and atomics), or else opaque and
+    // shaded first, with depth and W = 1, for the splats to test against.
+    let hybrid = buffers.triangles.is_some();
+    let blended = match hybrid && ctx.has_feature(TRIANGLE_FEATURE) {
+        true => Some(TrianglePipelines::new(ctx, targets)?),
+        false => None,
+    };
+    let opaque = hybrid && blended.is_none();
+    if opaque {
         let triangles_only = PointBuffers {
             primitive: SplatPrimitive::Quad,
             ..buffers
@@ -148,7 +177,7 @@ pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
             false,
         )?;
     }
-    let depth_written = triangles || !view.clear_depth;
+    let depth_written = opaque || !view.clear_depth;
     declare_clear(
         graph,
         &name("points.clear"),
@@ -156,12 +185,107 @@ pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
         pipelines.clear,
     );
     let splats = (buffers, view, state);
+    if let Some(t) = &blended {
+        let pass = (true, t.visibility.clone());
+        declare_triangles(graph, &name("points.visibility.triangles"), splats, pass);
+    }
     declare_splats(graph, &name("points.visibility"), splats, true, pipelines.visibility)?;
+    if let Some(t) = blended {
+        declare_triangles(
+            graph,
+            &name("points.accumulate.triangles"),
+            splats,
+            (false, t.accumulate),
+        );
+    }
     declare_splats(graph, &name("points.accumulate"), splats, false, pipelines.accumulate)?;
     let normalize = name("points.normalize");
-    let normalize = (normalize.as_str(), pipelines.normalize);
-    declare_normalize(graph, normalize, (view, targets), state, triangles);
+    declare_normalize(
+        graph,
+        (normalize.as_str(), pipelines.normalize),
+        (view, targets),
+        state,
+        opaque,
+    );
     Ok(())
+}
+
+/// The device feature the hybrid triangles' passes need on the compute
+/// path (their fragments write the splats' state).
+const TRIANGLE_FEATURE: &str = "fragmentStoresAndAtomics";
+
+/// The hybrid triangles' pipelines (`glsl/points/hybrid.vert` with the
+/// compute path's fragment stages): no attachment written, no depth test
+/// (the depth buffer's depth is in the nearest words).
+struct TrianglePipelines {
+    visibility: Arc<GraphicsPipeline>,
+    accumulate: Arc<GraphicsPipeline>,
+}
+
+impl TrianglePipelines {
+    fn new(ctx: &Context, targets: &SceneTargets) -> Result<Self> {
+        let build = |name, fragment| {
+            let spec = PipelineSpec {
+                name,
+                shaders: (shaders::HYBRID_VERT, fragment),
+                color_formats: Vec::new(),
+                blend: Blend::None,
+                depth: (false, CompareOp::ALWAYS),
+            };
+            spec.build(ctx, targets.formats.depth, false).map(Arc::new)
+        };
+        Ok(TrianglePipelines {
+            visibility: build("points.visibility.triangles", shaders::HYBRID_COMPUTE_VISIBILITY_FRAG)?,
+            accumulate: build("points.accumulate.triangles", shaders::HYBRID_COMPUTE_ACCUMULATE_FRAG)?,
+        })
+    }
+}
+
+/// `points.visibility.triangles` (`visibility`: raises the nearest words,
+/// counts the triangles) or `points.accumulate.triangles` (adds to the
+/// sums): the hybrid triangles of the view's plan (§10.1.8) drawn with the
+/// depth buffer attached but neither tested nor written (cleared first
+/// when nothing drew into it).
+fn declare_triangles<S: Provides<PointsFrame> + 'static>(
+    graph: &mut RenderGraph<Frame<S>>,
+    name: &str,
+    (buffers, view, state): (PointBuffers, PointView, SplatState),
+    (visibility, pipeline): (bool, Arc<GraphicsPipeline>),
+) {
+    let mut builder = graph.pass(name).graphics();
+    let frame = builder.upload(view.frame, Stage::Graphics);
+    let (mut builder, splat) = buffers.read_by(builder, frame, visibility);
+    let fragment = Stage::Fragment;
+    let written = BufferAccess::StorageReadWrite(fragment);
+    let bindings = match visibility {
+        true => StateBindings {
+            nearest: builder.storage_buffer(state.nearest, written),
+            sums: None,
+            last: None,
+        },
+        false => StateBindings {
+            nearest: builder.storage_buffer(state.nearest, BufferAccess::StorageRead(fragment)),
+            sums: Some(builder.storage_buffer(state.sums, written)),
+            last: Some(builder.storage_buffer(state.last, written)),
+        },
+    };
+    let builder = builder.pipeline(&pipeline);
+    let builder = match visibility {
+        true => builder.depth(view.depth, view.clear_depth.then_some(FAR_DEPTH)),
+        false => builder.depth_read(view.depth),
+    };
+    builder.record(move |pass, frame| {
+        let plan = plan_of(frame, view.index)?;
+        let push = ComputeSplatPush {
+            splat: splat.push(pass, PASS_OPAQUE)?,
+            raster: bindings.handles(pass, 0)?,
+            draws: [0; 4],
+        };
+        let Some(triangles) = splat.triangle_handle(pass)? else {
+            return Ok(());
+        };
+        draw_triangles_with(pass.cmd(), &pipeline, plan, (push, |p| &mut p.splat), triangles)
+    });
 }
 
 /// `points.clear`: the nearest words from the depth buffer (when something
@@ -229,18 +353,12 @@ fn declare_splats<S: Provides<PointsFrame> + 'static>(
     };
     builder.record(move |pass, frame| {
         let plan = plan_of(frame, view.index)?;
-        let optional = |b: Option<Binding>| b.map(|b| pass.handle(b)).transpose().map(|h| h.unwrap_or(NO_HANDLE));
         // The draw table was checked not to overflow when it was written.
         let splats = plan.draws.iter().map(|d| d.count).fold(0u32, u32::wrapping_add);
         let draws = u32::try_from(plan.draws.len()).map_err(|_| Error::invalid("points", "too many draws"))?;
         let push = ComputeSplatPush {
             splat: splat.push(pass, PASS_OPAQUE)?,
-            raster: [
-                pass.handle(bindings.nearest)?,
-                optional(bindings.sums)?,
-                optional(bindings.last)?,
-                splats,
-            ],
+            raster: bindings.handles(pass, splats)?,
             draws: [pass.handle(table)?, draws, 0, 0],
         };
         if splats == 0 {

@@ -251,7 +251,7 @@ impl PointBuffers {
     /// Declares the reads every splat pass makes (and the counter's write
     /// when `count`); `frame`: the binding of the view's point frame,
     /// declared by the pass.
-    fn read_by<'g, S: 'static>(
+    pub(super) fn read_by<'g, S: 'static>(
         &self,
         builder: PassBuilder<'g, Frame<S>>,
         frame: Binding,

@@ -7,6 +7,8 @@
 
 use std::sync::Arc;
 
+use bytemuck::Pod;
+
 use super::gpu_layout::{pack_triangles, GpuTriangle};
 use super::passes::SplatPush;
 use super::selection::FramePlan;
@@ -62,16 +64,28 @@ pub(super) fn draw_triangles(
     cmd: &mut CommandRecorder,
     pipeline: &GraphicsPipeline,
     plan: &FramePlan,
-    mut push: SplatPush,
+    push: SplatPush,
+    triangles: u32,
+) -> Result<()> {
+    draw_triangles_with(cmd, pipeline, plan, (push, |p| p), triangles)
+}
+
+/// As [`draw_triangles`] with push constants `P` that begin with the splat
+/// passes' block (`splat` reaches it).
+pub(super) fn draw_triangles_with<P: Pod>(
+    cmd: &mut CommandRecorder,
+    pipeline: &GraphicsPipeline,
+    plan: &FramePlan,
+    (mut push, splat): (P, fn(&mut P) -> &mut SplatPush),
     triangles: u32,
 ) -> Result<()> {
     if plan.triangle_draws.is_empty() {
         return Ok(());
     }
     cmd.bind_graphics(pipeline);
-    push.splats = triangles;
+    splat(&mut push).splats = triangles;
     for d in &plan.triangle_draws {
-        push.record = d.record;
+        splat(&mut push).record = d.record;
         cmd.push_constants(&push)?;
         cmd.draw(d.count * 3, 1);
     }

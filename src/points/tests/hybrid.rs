@@ -25,8 +25,9 @@ const HEIGHT: u32 = 240;
 /// and show the scan's fine relief, aliased, where the splats filter it),
 /// 0.004 at 2 m, 0 at 6 m; opaque discs 0.145, 0.265, 0.001, 0.
 /// Single-pass splats (§10.4; the triangles drawn opaque first, the splats
-/// tested against their depth) and the compute path's EWA splats (the
-/// triangles drawn the same way): 0.23 as EWA.
+/// tested against their depth): 0.23 as EWA. The compute path's EWA splats
+/// (the triangles' fragments in the splats' integer sums) measure exactly
+/// as the hardware path's.
 const HYBRID_FLIP: [(SplatMode, RasterPath, f32); 4] = [
     (SplatMode::Ewa, RasterPath::Hardware, 0.23),
     (SplatMode::Ewa, RasterPath::Compute, 0.23),
