@@ -110,6 +110,8 @@ pub const SHADOW_DEPTH_FRAG: SpirV = spirv!("lighting/shadow_depth.frag");
 pub const SHADOW_POINTS_VERT: SpirV = spirv!("lighting/shadow_points.vert");
 /// points.shadow: discards outside the splat's disc.
 pub const SHADOW_POINTS_FRAG: SpirV = spirv!("lighting/shadow_points.frag");
+/// points.shadow (compute path): splat discs into the atlas's depth bits, a dispatch a cascade (§9.5).
+pub const SHADOW_POINTS_COMPUTE: SpirV = spirv!("lighting/shadow_points.comp");
 /// shadow probe: `sun_visibility` at a list of points (tests and AOV checks of §9.5).
 #[cfg(test)]
 pub const SHADOW_PROBE: SpirV = spirv!("lighting/shadow_probe.comp");

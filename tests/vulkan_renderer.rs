@@ -50,7 +50,7 @@ fn expected_passes(scene: &Scene, raster: RasterPath) -> Vec<String> {
             "terrain.shadow_clear",
             "terrain.shadow",
             "terrain.shadow_big",
-            "terrain.shadow_copy",
+            "shadow.copy",
             "terrain.raster_clear",
             "terrain.raster",
             "terrain.raster_big",

@@ -7,6 +7,7 @@
 #define ALPENGLOW_SPLAT_GLSL
 
 #include "heap.glsl"
+#include "tangent_frame.glsl"
 
 struct Splat {
     vec4 position_rmin;  // object-space centre, r_min
@@ -66,15 +67,6 @@ layout(push_constant) uniform Push {
 #endif
 } pc;
 
-// Orthonormal tangent frame of a unit normal (Duff et al. 2017);
-// src/points/clip.rs::tangent_frame is the same.
-void tangent_frame(vec3 n, out vec3 t, out vec3 b) {
-    float s = n.z >= 0.0 ? 1.0 : -1.0;
-    float a = -1.0 / (s + n.z);
-    float bb = n.x * n.y * a;
-    t = vec3(1.0 + s * n.x * n.x * a, s * bb, -s * n.x);
-    b = vec3(bb, s + n.y * n.y * a, -n.y);
-}
 
 vec3 srgb_to_linear(vec3 c) {
     return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));

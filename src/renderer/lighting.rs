@@ -90,9 +90,11 @@ pub(super) fn declare_shadows(
         return Err(crate::error::Error::Graph("shadows: a view has no atlas".into()));
     }
     for (k, (view, atlas)) in views.iter().zip(atlases).enumerate() {
-        // The compute casters write every texel: no clear.
-        let target = match terrain.is_some_and(Terrain::casts_in_compute) {
-            true => maps.adopt(atlas)?,
+        // The compute casters write every texel (the terrain's clear their
+        // depth bits first): no clear; the bits are copied in after them.
+        let compute = terrain.is_some_and(Terrain::casts_in_compute);
+        let target = match compute {
+            true => maps.adopt_compute(graph, atlas)?,
             false => maps.declare_clear(ctx, graph, atlas)?,
         };
         if let Some(terrain) = terrain {
@@ -100,6 +102,9 @@ pub(super) fn declare_shadows(
         }
         if let Some(casters) = &mut casters {
             casters.declare(ViewGraph::new(ctx, graph, (k, view)), target)?;
+        }
+        if compute {
+            maps.declare_copy(graph, target, view)?;
         }
     }
     Ok(Some(SunShadows { maps, points: casters }))

@@ -10,15 +10,17 @@
 //!
 //! On the compute path ([`Terrain::use_compute_raster`], issue 28) the
 //! casters are rasterized by compute shaders instead ([`ComputeCasters`]),
-//! culled per cascade, into a buffer of depth bits that is then copied
-//! into the atlas (which `shadow.clear` then need not clear):
+//! culled per cascade, into the atlas's buffer of depth bits
+//! ([`ShadowTarget::depths`]), which the point casters write too and
+//! `shadow.copy` then copies into the atlas (which `shadow.clear` need not
+//! clear):
 //!
 //! | pass | does |
 //! |---|---|
 //! | `terrain.shadow_clear` | the depth buffer at 1, the big-triangle lists empty |
 //! | `terrain.shadow` | per cascade, one thread a triangle: culls against the quadrant and depth range, rasterizes the small ones (`atomicMin` of the depth bits), lists the rest |
 //! | `terrain.shadow_big` | per cascade, one workgroup a listed triangle |
-//! | `terrain.shadow_copy` | the depth buffer into the D32 atlas |
+//! | (`points.shadow`, `shadow.copy`) | the point casters; the depth buffer into the D32 atlas |
 //!
 //! Shaders: `glsl/terrain/shadow_clear.comp`, `shadow_raster.comp`,
 //! `shadow_raster_big.comp`; `glsl/include/terrain_shadow_raster.glsl`.
@@ -31,7 +33,7 @@ use glam::DVec3;
 use super::geometry_image::VERTEX_STRIDE;
 use super::Terrain;
 use crate::error::{Error, Result};
-use crate::graph::{stride_groups, BufferAccess, BufferId, BufferInfo, ImageAccess, RenderGraph, Stage};
+use crate::graph::{stride_groups, BufferAccess, BufferId, BufferInfo, RenderGraph, Stage};
 use crate::lighting::constants::MAX_CASCADES;
 use crate::lighting::shadows::{
     cascade_pushes, record_cascades, SceneBounds, ShadowFrame, ShadowTarget, SHADOW_FORMAT,
@@ -136,7 +138,8 @@ impl ComputeCasters {
             let location = MemoryLocation::GpuOnly;
             graph.create_buffer(&pass_name(name, &view.name), BufferInfo { size, location })
         };
-        let depths = buffer(graph, "terrain shadow depths", 4 * u64::from(texels));
+        let depths =
+            (target.depths).ok_or_else(|| Error::Graph("terrain.shadow: the atlas has no depth bits".into()))?;
         let lists = buffer(
             graph,
             "terrain shadow big triangles",
@@ -175,16 +178,6 @@ impl ComputeCasters {
                 Ok(())
             });
         }
-        graph
-            .pass(&pass_name("terrain.shadow_copy", &view.name))
-            .transfer()
-            .read(depths, BufferAccess::TransferSrc)
-            .write(target.atlas, ImageAccess::TransferDst)
-            .record(move |ctx, _| {
-                let (depths, atlas) = (ctx.buffer(depths)?, ctx.image(target.atlas)?);
-                ctx.cmd().copy_buffer_to_image(depths, atlas);
-                Ok(())
-            });
         Ok(())
     }
 

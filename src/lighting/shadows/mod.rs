@@ -34,14 +34,14 @@ use bytemuck::{Pod, Zeroable};
 pub use cascades::{plan_cascades, plan_cascades_into, CascadePlan, SceneBounds, ShadowSettings};
 
 use crate::error::{Error, Result};
-use crate::graph::{ImageId, RenderGraph};
+use crate::graph::{BufferAccess, BufferId, BufferInfo, ImageAccess, ImageId, RenderGraph};
 use crate::shaders;
 use crate::view::{
     pass_name, per_view, Declare, Frame, FrameContext, ShadowMode, Technique, View, ViewGraph, ViewIndex,
 };
 use crate::vulkan::{
     Blend, CommandRecorder, CompareOp, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
-    ImageUsageFlags, PrimitiveTopology,
+    ImageUsageFlags, MemoryLocation, PrimitiveTopology,
 };
 
 /// The depth format of shadow atlases.
@@ -68,6 +68,11 @@ pub struct ShadowTarget {
     pub atlas: ImageId,
     /// Side in texels.
     pub size: u32,
+    /// On the compute path: the atlas-sized buffer of depth bits (depth in
+    /// [0, 1] orders as unsigned integers) the compute casters `atomicMin`
+    /// into, copied into the atlas by `shadow.copy`; None where the casters
+    /// draw into the atlas.
+    pub depths: Option<BufferId>,
 }
 
 /// One view's shadow atlas, created and imported into a graph before its
@@ -111,6 +116,7 @@ impl ShadowAtlas {
                 view: index,
                 atlas,
                 size,
+                depths: None,
             },
             image,
             view_name: view.name.clone(),
@@ -264,6 +270,53 @@ impl ShadowMaps {
         }
         self.views.push(ShadowView { target, _image: image });
         Ok(target)
+    }
+
+    /// Adopts `atlas` for compute casters: creates the buffer of depth bits
+    /// they write ([`ShadowTarget::depths`]; the first caster clears it),
+    /// which [`ShadowMaps::declare_copy`] copies into the atlas after them.
+    pub fn adopt_compute<P: 'static>(
+        &mut self,
+        graph: &mut RenderGraph<P>,
+        atlas: ShadowAtlas,
+    ) -> Result<ShadowTarget> {
+        let name = pass_name("shadow depths", &atlas.view_name);
+        let mut target = self.adopt(atlas)?;
+        let texels = u64::from(target.size) * u64::from(target.size);
+        let info = BufferInfo {
+            size: 4 * texels,
+            location: MemoryLocation::GpuOnly,
+        };
+        target.depths = Some(graph.create_buffer(&name, info));
+        if let Some(v) = self.views.iter_mut().find(|v| v.target.view == target.view) {
+            v.target = target;
+        }
+        Ok(target)
+    }
+
+    /// `shadow.copy`: the compute casters' depth bits into the atlas of
+    /// `target` (adopted with [`ShadowMaps::adopt_compute`]); declare after
+    /// every caster of the view.
+    pub fn declare_copy<P: 'static>(
+        &self,
+        graph: &mut RenderGraph<P>,
+        target: ShadowTarget,
+        view: &View,
+    ) -> Result<()> {
+        let depths = target
+            .depths
+            .ok_or_else(|| Error::Graph("shadow.copy: the atlas has no compute casters".into()))?;
+        graph
+            .pass(&pass_name("shadow.copy", &view.name))
+            .transfer()
+            .read(depths, BufferAccess::TransferSrc)
+            .write(target.atlas, ImageAccess::TransferDst)
+            .record(move |ctx, _| {
+                let (depths, atlas) = (ctx.buffer(depths)?, ctx.image(target.atlas)?);
+                ctx.cmd().copy_buffer_to_image(depths, atlas);
+                Ok(())
+            });
+        Ok(())
     }
 
     /// The atlas of view `index`.

@@ -16,6 +16,11 @@
 //! Instance records (object → world, in f32 world coordinates like the
 //! terrain's vertices) go into one upload region per view, written in
 //! `prepare`.
+//!
+//! On the compute path (the atlas has [`ShadowTarget::depths`]) the discs
+//! are rasterized by a compute pass into the depth bits the terrain's
+//! compute casters write, one dispatch a cascade for all the view's draws
+//! (`glsl/lighting/shadow_points.comp`).
 
 use std::sync::Arc;
 
@@ -25,14 +30,17 @@ use glam::DVec3;
 use super::selection::{keeps_instance, ObjectLayout};
 use super::PointRenderer;
 use crate::error::{Error, Result};
-use crate::graph::{BufferAccess, BufferId, Stage, UploadRegion};
+use crate::graph::{stride_groups, BufferAccess, BufferId, RenderGraph, Stage, UploadRegion};
 use crate::lighting::shadows::{
-    plan_cascades, plan_cascades_into, record_cascades, splat_caster_desc, CascadePlan, SceneBounds, ShadowFrame,
-    ShadowMaps, ShadowSettings, ShadowTarget,
+    cascade_pushes, plan_cascades, plan_cascades_into, record_cascades, splat_caster_desc, CascadePlan, SceneBounds,
+    ShadowFrame, ShadowMaps, ShadowSettings, ShadowTarget,
 };
 use crate::points::scene::PointScene;
-use crate::view::{pass_name, per_view, Declare, FrameContext, Provides, ShadowMode, Technique, ViewGraph, ViewIndex};
-use crate::vulkan::{Buffer, GraphicsPipeline};
+use crate::shaders;
+use crate::view::{
+    pass_name, per_view, Declare, Frame, FrameContext, Provides, ShadowMode, Technique, ViewGraph, ViewIndex,
+};
+use crate::vulkan::{Buffer, ComputePipeline, GraphicsPipeline};
 
 /// Header of a view's shadow records (`ShadowPoints` in shadow_points.vert).
 #[repr(C)]
@@ -217,9 +225,23 @@ impl<S: Provides<ShadowFrame> + Provides<PointShadowFrame> + 'static> Declare<S>
             &pass_name("point shadow casters", &view.name),
             HEADER_BYTES + RECORD_BYTES * records,
         );
+        let name = pass_name("points.shadow", &view.name);
+        if let Some(depths) = target.depths {
+            let pipeline = ComputePipeline::new(ctx, shaders::SHADOW_POINTS_COMPUTE)?;
+            let table = graph.upload_region(&pass_name("point shadow draws", &view.name), 8 * records);
+            declare_compute(
+                graph,
+                &name,
+                (index, target.size),
+                (splats, region, table, depths),
+                pipeline,
+            );
+            self.views.push(ShadowView { index, region });
+            return Ok(());
+        }
         let pipeline = GraphicsPipeline::new(ctx, &splat_caster_desc("points.shadow"))?;
         let atlas = target.atlas;
-        let mut pass = graph.pass(&pass_name("points.shadow", &view.name)).graphics();
+        let mut pass = graph.pass(&name).graphics();
         let handles = [
             pass.storage_buffer(splats, BufferAccess::StorageRead(Stage::Vertex)),
             pass.upload(region, Stage::Vertex),
@@ -244,6 +266,73 @@ impl<S: Provides<ShadowFrame> + Provides<PointShadowFrame> + 'static> Declare<S>
         self.views.push(ShadowView { index, region });
         Ok(())
     }
+}
+
+/// Push constants of the compute path's `points.shadow` (`Push` in
+/// glsl/lighting/shadow_points.comp).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ComputeCasterPush {
+    view_proj: [f32; 16],
+    sun_texel: [f32; 4],
+    /// Splats, shadow records, depth bits, draw table.
+    handles: [u32; 4],
+    /// Draws, splats, atlas side, 0.
+    counts: [u32; 4],
+    /// The cascade's receivers' texel box (first x, y, last x, y).
+    receivers: [u32; 4],
+}
+
+/// `points.shadow` on the compute path: per cascade one dispatch over every
+/// splat of the view's draws, rasterizing the splats' discs into the
+/// atlas's depth bits (`glsl/lighting/shadow_points.comp`); the draw table
+/// (each draw's first splat counted over the draws, and its record) is
+/// written while recording, from the prepared draws.
+fn declare_compute<S: Provides<ShadowFrame> + Provides<PointShadowFrame> + 'static>(
+    graph: &mut RenderGraph<Frame<S>>,
+    name: &str,
+    (index, side): (ViewIndex, u32),
+    (splats, records, table, depths): (BufferId, UploadRegion, UploadRegion, BufferId),
+    pipeline: ComputePipeline,
+) {
+    let compute = Stage::Compute;
+    let mut pass = graph.pass(name);
+    let bindings = [
+        pass.storage_buffer(splats, BufferAccess::StorageRead(compute)),
+        pass.upload(records, compute),
+        pass.storage_buffer(depths, BufferAccess::StorageReadWrite(compute)),
+        pass.upload(table, compute),
+    ];
+    pass.record(move |ctx, frame| {
+        let plan = frame.prepared::<ShadowFrame>()?.view(index)?;
+        let draws = frame.prepared::<PointShadowFrame>()?.view(index)?;
+        let mut first = 0u32;
+        for (k, d) in draws.iter().enumerate() {
+            ctx.write_upload_at(bindings[3], 8 * k as u64, bytemuck::cast_slice(&[first, d.record]))?;
+            first = (first.checked_add(d.count))
+                .ok_or_else(|| Error::invalid("points", "a view's shadow casters exceed 2³² splats"))?;
+        }
+        if first == 0 {
+            return Ok(());
+        }
+        let handles = [
+            ctx.handle(bindings[0])?,
+            ctx.handle(bindings[1])?,
+            ctx.handle(bindings[2])?,
+            ctx.handle(bindings[3])?,
+        ];
+        for (_, receivers, push) in cascade_pushes(plan) {
+            let push = ComputeCasterPush {
+                view_proj: push.view_proj,
+                sun_texel: push.sun_texel,
+                handles,
+                counts: [draws.len() as u32, first, side, 0],
+                receivers,
+            };
+            ctx.dispatch(&pipeline, &push, [stride_groups(first, 64), 1, 1])?;
+        }
+        Ok(())
+    });
 }
 
 impl Technique for PointShadows {

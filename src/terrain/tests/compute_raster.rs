@@ -145,6 +145,68 @@ fn compute_shadow_casters_match_the_hardware_casters() {
 /// the compute casters and the hardware's.
 const MIN_SUN_AGREEMENT: f64 = 0.99;
 
+/// The point objects' compute casters (`points.shadow` in compute, into the
+/// atlas's depth bits with the terrain's) against the hardware casters:
+/// rocks under a low sun, the sun visibility of every pixel agrees to 0.1
+/// on at least [`MIN_SUN_AGREEMENT`] of them, and the rocks' shadows are
+/// there (without the rocks, the compute frame loses sun on fewer pixels).
+#[test]
+fn compute_point_casters_match_the_hardware_casters() {
+    let spt = SptOptions {
+        epsilon: epsilon_from_pixels(1.0, 50f32.to_radians(), HEIGHT).expect("epsilon"),
+        ..SptOptions::default()
+    };
+    let bare = Scene::new(jacksboro_field());
+    let mut scene = bare.clone();
+    scene.points = scatter_rocks(&scene.heights, 2, 2000, 400, (30.0, 80.0), 7, &spt).expect("rocks");
+    let frames = [vec![cameras(&scene)[4].1]];
+    let settings = RenderSettings {
+        raster: RasterPath::Compute,
+        lighting: Some(Lighting {
+            sun: SunPosition::Angles {
+                elevation_deg: 10.0,
+                azimuth_deg: 200.0,
+            },
+            ..Lighting::default()
+        }),
+        ..RenderSettings::new(WIDTH, HEIGHT)
+    };
+    HARDWARE_CASTERS.set(true);
+    let hardware = render_with(&scene, &frames, settings.clone());
+    HARDWARE_CASTERS.set(false);
+    let compute = render_with(&scene, &frames, settings.clone());
+    let without = render_with(&bare, &frames, settings);
+    let sun = |f: &FrameImages, k: usize| f.visibility[2 * k];
+    let (h, c, w) = (&hardware[0], &compute[0], &without[0]);
+    dump_pngs(
+        &[
+            ("rocks-hardware-casters", &h.rgba8),
+            ("rocks-compute-casters", &c.rgba8),
+        ],
+        WIDTH,
+        HEIGHT,
+    );
+    let seen: Vec<usize> = (0..h.depth.len()).filter(|&k| h.depth[k].is_finite()).collect();
+    let agree = seen.iter().filter(|&&k| (sun(h, k) - sun(c, k)).abs() <= 0.1).count();
+    let rock_shadow = |f: &FrameImages| seen.iter().filter(|&&k| sun(w, k) - sun(f, k) > 0.5).count();
+    let share = agree as f64 / seen.len().max(1) as f64;
+    eprintln!(
+        "sun visibility agrees on {agree} of {} pixels; rock shadows: {} pixels (compute), {} (hardware)",
+        seen.len(),
+        rock_shadow(c),
+        rock_shadow(h)
+    );
+    assert!(share >= MIN_SUN_AGREEMENT, "sun visibility agrees on {share:.4}");
+    // Measured on lavapipe: 32 pixels in both (0 if the point casters wrote nothing).
+    assert!(rock_shadow(c) >= 20, "the rocks shadow {} pixels", rock_shadow(c));
+    assert!(
+        rock_shadow(c).abs_diff(rock_shadow(h)) * 5 <= rock_shadow(h),
+        "rock shadows: {} pixels (compute) against {} (hardware)",
+        rock_shadow(c),
+        rock_shadow(h)
+    );
+}
+
 /// Rocks on the terrain, half hidden behind it, in a two-view rig with
 /// direct texturing: the points depth-test against the compute path's
 /// depth buffer (`terrain.depth`) as against `terrain.draw`'s.
