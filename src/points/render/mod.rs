@@ -9,7 +9,7 @@
 //! | `points.accumulate` | ewa | depth test ≤ without writes, additive (w·colour, w), (w·normal, w·depth) into float targets; the ids of the last surfel |
 //! | `points.normalize` | ewa | compute, per pixel: divide by w, shade, write radiance, view depth, W, world normal and ids (the winner's, else the last surfel's) |
 //! | `points.clear`, `points.visibility`, `points.accumulate`, `points.normalize` | ewa, compute path | the same three passes in compute ([`compute`]): 64-bit (depth, record) words and fixed-point integer sums, deterministic to the byte |
-| `points.opaque` | opaque | opaque discs with ray–plane depth, shaded directly, with normal and ids |
+//! | `points.opaque` | opaque | opaque discs with ray–plane depth, shaded directly, with normal and ids |
 //! | `points.single_pass.triangles` | single-pass | hybrid triangles as opaque shaded triangles with depth, when the scene has any |
 //! | `points.single_pass.clear` | single-pass | compute: every pixel's state unlocked, z_d = +inf, sums 0 |
 //! | `points.single_pass` | single-pass | compute (or the interlock backend's raster pass): every splat's pixels merged with the fuzzy depth test (§10.4) |
