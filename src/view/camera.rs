@@ -221,7 +221,7 @@ impl Camera {
     }
 
     /// World → clip transform for Vulkan (reversed depth, 1 at `near` and 0
-    /// at `far`: [`crate::view::depth`]; y flipped so image row 0 is the
+    /// at `far`: `view::depth`; y flipped so image row 0 is the
     /// top). Computed in f64, rounded once.
     pub fn view_proj(&self, aspect: f64) -> Mat4 {
         self.view_proj_f64(aspect).as_mat4()

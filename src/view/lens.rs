@@ -142,7 +142,7 @@ impl Intrinsics {
 
     /// View space (right-handed, looking down −z, y up) → Vulkan clip space
     /// of a `width`×`height` image: x right, y down (row 0 at the top),
-    /// reversed depth, 1 at `near` and 0 at `far` ([`crate::view::depth`]).
+    /// reversed depth, 1 at `near` and 0 at `far` (`view::depth`).
     pub fn projection(&self, width: u32, height: u32, near: f64, far: f64) -> DMat4 {
         let (w, h) = (f64::from(width), f64::from(height));
         // With d = −z the view-space depth: ndc.x = (2fx/w)·x/d + (2cx/w − 1),
@@ -250,8 +250,8 @@ impl Distortion {
         None
     }
 
-    /// Checks that every coefficient is finite and within [`MAX_RADIAL`]
-    /// (k) or [`MAX_TANGENTIAL`] (p); errors name `distortion.k1` and so on.
+    /// Checks that every coefficient is finite and within `MAX_RADIAL`
+    /// (k) or `MAX_TANGENTIAL` (p); errors name `distortion.k1` and so on.
     pub fn validate(&self) -> Result<()> {
         self.check_as("distortion")
     }
