@@ -107,7 +107,7 @@ typedef struct ag_context_options {
 } ag_context_options;
 
 /**
- * Which rasterizer draws the terrain (`ag_settings.raster`). Values of `ag_raster`.
+ * Which rasterizer draws the terrain and the EWA splats (`ag_settings.raster`). Values of `ag_raster`.
  */
 typedef uint32_t ag_raster;
 
@@ -141,7 +141,7 @@ typedef struct ag_settings {
    */
   uint32_t readback_slots;
   /**
-   * Which rasterizer draws the terrain: `AG_RASTER_*` (ABI 2).
+   * Which rasterizer draws the terrain and the EWA splats: `AG_RASTER_*` (ABI 2).
    */
   ag_raster raster;
 } ag_settings;

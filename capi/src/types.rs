@@ -37,7 +37,7 @@ pub(crate) fn output(value: ag_output) -> Outcome<Output> {
         .ok_or_else(|| Failure::invalid("output", format!("{value}; expected 0 to {}", Output::ALL.len() - 1)))
 }
 
-/// Which rasterizer draws the terrain (`ag_settings.raster`). Values of `ag_raster`.
+/// Which rasterizer draws the terrain and the EWA splats (`ag_settings.raster`). Values of `ag_raster`.
 #[allow(non_camel_case_types)]
 pub type ag_raster = u32;
 /// The hardware rasterizer.
@@ -116,7 +116,7 @@ pub struct ag_settings {
     /// slots, 1 to 16; 0: the library's default (3). A ticket can be read
     /// until this many later frames were submitted.
     pub readback_slots: u32,
-    /// Which rasterizer draws the terrain: `AG_RASTER_*` (ABI 2).
+    /// Which rasterizer draws the terrain and the EWA splats: `AG_RASTER_*` (ABI 2).
     pub raster: ag_raster,
 }
 

@@ -342,11 +342,12 @@ pub struct TerrainArgs {
     /// height-sample spacing (0.15: 15 cm for 1 m samples).
     #[arg(long = "detail-amplitude", default_value_t = 0.15, value_name = "FRACTION")]
     pub detail_amplitude: f32,
-    /// Which rasterizer draws the terrain: compute shaders into a visibility
-    /// buffer, then one shading pass per pixel (compute; needs the device
-    /// feature shaderBufferInt64Atomics), the hardware rasterizer
-    /// (hardware, the text's path), or compute where the device has the
-    /// feature (auto, the default).
+    /// Which rasterizer draws the terrain and the EWA splats: compute
+    /// shaders (the terrain into a visibility buffer, then one shading pass
+    /// per pixel; the splats and their shadows with 64-bit atomics; needs
+    /// the device feature shaderBufferInt64Atomics), the hardware
+    /// rasterizer (hardware, the text's path), or compute where the device
+    /// has the feature (auto, the default).
     #[arg(long, value_enum, default_value = "auto", value_name = "PATH")]
     pub raster: RasterArg,
     /// Geometry-image side in vertices (the terrain mesh has GRID² vertices).
@@ -411,7 +412,7 @@ pub enum RowsArg {
     NorthUp,
 }
 
-/// The terrain's rasterizer (`--raster`).
+/// The terrain's and the splats' rasterizer (`--raster`).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RasterArg {
     /// Compute where the device has 64-bit buffer atomics, else hardware.

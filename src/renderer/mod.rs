@@ -108,8 +108,8 @@ pub struct RenderSettings {
     pub texturing: TexturingMode,
     /// Tile streaming of [`TexturingMode::Atlas`].
     pub texture_streaming: TextureStreaming,
-    /// Which rasterizer draws the terrain (`--raster`): the hardware's, or
-    /// compute shaders into a visibility buffer ([`RasterPath`]).
+    /// Which rasterizer draws the terrain and the EWA splats (`--raster`):
+    /// the hardware's, or compute shaders ([`RasterPath`]).
     pub raster: RasterPath,
     /// The sun's cascaded shadow maps.
     pub shadows: ShadowSettings,
