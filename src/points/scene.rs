@@ -191,6 +191,19 @@ impl PointScene {
         });
     }
 
+    /// Draws object `object` (an index into [`PointScene::objects`]) once
+    /// more with `transform`; its splat list is shared, not copied.
+    pub fn add_instance(&mut self, object: usize, transform: PointTransform) -> Result<()> {
+        if object >= self.objects.len() {
+            return Err(Error::invalid(
+                "points instance",
+                format!("object {object} does not exist ({} objects)", self.objects.len()),
+            ));
+        }
+        self.instances.push(PointInstance { object, transform });
+        Ok(())
+    }
+
     /// Moves the objects and instances of `other` into this scene.
     pub fn append(&mut self, other: PointScene) {
         let offset = self.objects.len();

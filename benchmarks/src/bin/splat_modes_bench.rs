@@ -1,6 +1,11 @@
 //! Benchmark of single-pass splatting with a fuzzy depth test (dissertation
-//! §10.4) against the three-pass mode (§10.2), in the same run:
-//! `cargo run --release -p alpenglow-bench --bin splat_modes_bench [-- --quick]`.
+//! §10.4) against the three-pass mode (§10.2), on the hardware rasterizer
+//! and in compute (issue 29), in the same run:
+//! `cargo run --release -p alpenglow-bench --bin splat_modes_bench [-- --quick] [--instances N]`.
+//!
+//! `--instances N` draws N copies of the leaves (sharing one splat list) on
+//! a grid 0.3 m apart, N ≥ 10 for 10⁶ splats and N ≥ 100 for 10⁷, from a
+//! distant view only (pulled back to see the grid).
 //!
 //! The bunny sampled into ~100k surfels, every leaf drawn (a flat list, two
 //! sided: every splat goes through the EWA set-up), in a 512² window, from a
@@ -19,7 +24,7 @@ use alpenglow::tools::profile::median;
 use alpenglow::tools::spt::epsilon_from_pixels;
 use alpenglow::{
     Camera, Context, ContextOptions, DeviceSelector, PointLoadOptions, PointObject, PointScene, PointTransform,
-    Renderer, Scene, Settings, SplatBackend, SplatMode, SplatSettings,
+    RasterPath, Renderer, Scene, Settings, SplatBackend, SplatMode, SplatSettings,
 };
 
 use alpenglow_bench::points::{all_leaves, camera_at};
@@ -39,9 +44,15 @@ struct Measured {
     rgba8: Vec<u8>,
 }
 
-fn measure(ctx: &Context, scene: &Scene, camera: &Camera, points: SplatSettings, frames: usize) -> Measured {
+fn measure(
+    ctx: &Context,
+    (scene, camera): (&Scene, &Camera),
+    (points, raster): (SplatSettings, RasterPath),
+    frames: usize,
+) -> Measured {
     let mut settings = Settings::new(SIDE, SIDE);
     settings.points = points;
+    settings.raster = raster;
     let mut renderer = Renderer::new(ctx, scene, settings).expect("renderer");
     let warmup = 2;
     for _ in 0..warmup + frames - 1 {
@@ -91,8 +102,91 @@ fn mean_flip(reference: &[u8], test: &[u8]) -> f32 {
     nv_flip::FlipPool::from_image(&error).mean()
 }
 
+/// One row of the tables: a splat mode on a rasterizer path.
+struct Mode {
+    name: &'static str,
+    mode: SplatMode,
+    raster: RasterPath,
+    backend: SplatBackend,
+}
+
+/// The modes the device can run: three-pass EWA on the hardware
+/// rasterizer (the reference) and in compute, single-pass in compute and
+/// with the interlock backend.
+fn modes(ctx: &Context) -> Vec<Mode> {
+    let compute = ctx.has_feature("shaderBufferInt64Atomics");
+    let interlock = ctx.has_feature("fragmentShaderPixelInterlock");
+    let mode = |name, mode, raster, backend| Mode {
+        name,
+        mode,
+        raster,
+        backend,
+    };
+    let all = [
+        (
+            mode(
+                "three-pass EWA, hardware",
+                SplatMode::Ewa,
+                RasterPath::Hardware,
+                SplatBackend::Compute,
+            ),
+            true,
+        ),
+        (
+            mode(
+                "three-pass EWA, compute",
+                SplatMode::Ewa,
+                RasterPath::Compute,
+                SplatBackend::Compute,
+            ),
+            compute,
+        ),
+        (
+            mode(
+                "single-pass, compute",
+                SplatMode::SinglePass,
+                RasterPath::Auto,
+                SplatBackend::Compute,
+            ),
+            true,
+        ),
+        (
+            mode(
+                "single-pass, interlock",
+                SplatMode::SinglePass,
+                RasterPath::Auto,
+                SplatBackend::Interlock,
+            ),
+            interlock,
+        ),
+    ];
+    all.into_iter()
+        .filter(|(_, offered)| *offered)
+        .map(|(m, _)| m)
+        .collect()
+}
+
+/// `count` instances of object 0 of `points` on a grid 0.3 m apart (x
+/// across the view, y away from it), the first where the single bunny stands.
+fn instances(points: &mut PointScene, count: usize) -> usize {
+    let side = (count as f64).sqrt().ceil() as usize;
+    for k in 1..count {
+        let (i, j) = ((k % side) as f64, (k / side) as f64);
+        let x = (i - (side as f64 - 1.0) / 2.0) * 0.3;
+        let transform = PointTransform::parse(&format!("t={x},{},0;r=90,0,0", j * 0.3)).unwrap();
+        points.add_instance(0, transform).expect("instance");
+    }
+    side
+}
+
 fn main() {
-    let quick = std::env::args().any(|a| a == "--quick");
+    let args: Vec<String> = std::env::args().collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    let count: usize = (args.iter().position(|a| a == "--instances"))
+        .and_then(|i| args.get(i + 1))
+        .map(|n| n.parse().expect("--instances N"))
+        .unwrap_or(1)
+        .max(1);
     let frames = if quick { 3 } else { 8 };
     let ctx = Context::new(&ContextOptions {
         validation: false,
@@ -117,53 +211,50 @@ fn main() {
     let bunny = load_point_object(&models.join("stanford-bunny.obj"), &options).expect("bunny");
     let mut points = PointScene::default();
     let leaves = PointObject::new("bunny leaves", all_leaves(&bunny.tree));
+    let splats = leaves.tree.nodes.len();
     points.add(leaves, PointTransform::parse("r=90,0,0").unwrap());
+    let side = instances(&mut points, count);
     let scene = Scene::points_only(points);
     println!(
-        "{} leaves as a flat list, {SIDE}² window, two-sided, {frames} timed frames",
-        scene.points.total_splats()
+        "{count} × {splats} leaves as a flat list ({} splats), {SIDE}² window, two-sided, {frames} timed frames",
+        count * splats
     );
-
-    let mut modes = vec![
-        ("three-pass EWA", SplatMode::Ewa, false),
-        ("single-pass, 64-bit locks", SplatMode::SinglePass, false),
-        ("single-pass, 32-bit locks", SplatMode::SinglePass, true),
-    ];
-    if !ctx.has_feature("shaderBufferInt64Atomics") {
-        modes.remove(1);
-    }
-    for (view, distance) in [("distant", 2.0), ("close", 0.25)] {
+    let views: &[(&str, f64)] = match count {
+        1 => &[("distant", 2.0), ("close", 0.25)],
+        _ => &[("distant", 2.0 * (side as f64 / 3.0).max(1.0))],
+    };
+    let modes = modes(&ctx);
+    for &(view, distance) in views {
         let camera = camera_at(distance);
         println!("\n{view} view ({distance} m):");
-        println!("| mode | splats drawn | GPU ms, median (best) | M splats/s, median (best) | × three-pass, median (best) | FLIP vs three-pass |");
+        println!("| mode | splats drawn | GPU ms, median (best) | M splats/s, median (best) | × three-pass hardware, median (best) | FLIP vs three-pass hardware |");
         println!("|---|---|---|---|---|---|");
         let mut reference: Option<(Measured, [f64; 2])> = None;
         let mut breakdown = Vec::new();
-        for &(name, mode, force_32bit_locks) in &modes {
+        for m in &modes {
             let settings = SplatSettings {
-                mode,
-                backend: SplatBackend::Compute,
-                force_32bit_locks,
+                mode: m.mode,
+                backend: m.backend,
                 two_sided: true,
                 ..SplatSettings::default()
             };
-            let m = measure(&ctx, &scene, &camera, settings, frames);
-            let rates = [m.gpu_ms, m.best_ms].map(|ms| m.drawn as f64 / ms / 1e3);
+            let measured = measure(&ctx, (&scene, &camera), (settings, m.raster), frames);
+            let rates = [measured.gpu_ms, measured.best_ms].map(|ms| measured.drawn as f64 / ms / 1e3);
             let (speedup, flip) = match &reference {
                 Some((r, r_rates)) => (
                     [rates[0] / r_rates[0], rates[1] / r_rates[1]],
-                    mean_flip(&r.rgba8, &m.rgba8),
+                    mean_flip(&r.rgba8, &measured.rgba8),
                 ),
                 None => ([1.0; 2], 0.0),
             };
             println!(
-                "| {name} | {} | {:.1} ({:.1}) | {:.2} ({:.2}) | {:.2} ({:.2}) | {flip:.4} |",
-                m.drawn, m.gpu_ms, m.best_ms, rates[0], rates[1], speedup[0], speedup[1]
+                "| {} | {} | {:.1} ({:.1}) | {:.2} ({:.2}) | {:.2} ({:.2}) | {flip:.4} |",
+                m.name, measured.drawn, measured.gpu_ms, measured.best_ms, rates[0], rates[1], speedup[0], speedup[1]
             );
-            let passes: Vec<String> = m.passes.iter().map(|(n, ms)| format!("{n} {ms:.1}")).collect();
-            breakdown.push(format!("  {name}: {}", passes.join(", ")));
+            let passes: Vec<String> = measured.passes.iter().map(|(n, ms)| format!("{n} {ms:.1}")).collect();
+            breakdown.push(format!("  {}: {}", m.name, passes.join(", ")));
             if reference.is_none() {
-                reference = Some((m, rates));
+                reference = Some((measured, rates));
             }
         }
         println!("GPU ms per pass:\n{}", breakdown.join("\n"));
