@@ -13,7 +13,9 @@
 //!    distances: splats in the prefix, splats drawn, GPU time; and the SPT
 //!    rate (splats sent and drawn per second) of a field of 64 bunnies at
 //!    2.7–6.5 m, opaque points as in the text (§10.1.7: ~60 M points/s on a
-//!    Radeon 9700, ~80 M on a GeForce 6800 GT) and EWA quads.
+//!    Radeon 9700, ~80 M on a GeForce 6800 GT) and EWA quads, and EWA
+//!    splats in compute (issue 29). Every other table draws on the hardware
+//!    rasterizer (the primitives are its).
 //! 3. CPU time of the per-frame selection per object instance: the default
 //!    scene's 300 rock instances.
 //! 4. Hybrid point–polygon rendering (§10.1.8) against points only, at
@@ -33,7 +35,7 @@ use alpenglow::tools::profile::median;
 use alpenglow::tools::spt::epsilon_from_pixels;
 use alpenglow::{
     Camera, Context, ContextOptions, DeviceSelector, PointLoadOptions, PointObject, PointScene, PointTransform,
-    Renderer, Scene, Settings, SplatMode, SplatPrimitive, SplatSettings,
+    RasterPath, Renderer, Scene, Settings, SplatMode, SplatPrimitive, SplatSettings,
 };
 
 use alpenglow_bench::points::{all_leaves, camera_at};
@@ -65,9 +67,21 @@ struct Measured {
 }
 
 fn measure(ctx: &Context, scene: &Scene, camera: &Camera, points: SplatSettings, frames: usize) -> Measured {
+    measure_on(ctx, (scene, camera), (points, RasterPath::Hardware), frames)
+}
+
+/// As [`measure`] on rasterizer path `raster` (the primitives are the
+/// hardware rasterizer's: every table but the SPT rate's compute row draws there).
+fn measure_on(
+    ctx: &Context,
+    (scene, camera): (&Scene, &Camera),
+    (points, raster): (SplatSettings, RasterPath),
+    frames: usize,
+) -> Measured {
     let mut settings = Settings::new(SIDE, SIDE);
     settings.readback = false;
     settings.points = points;
+    settings.raster = raster;
     let mut renderer = Renderer::new(ctx, scene, settings).expect("renderer");
     let warmup = 2;
     for _ in 0..warmup + frames {
@@ -247,24 +261,33 @@ fn spt_rate(ctx: &Context, bunny: &PointObject, frames: usize) {
         "| mode | primitive | shaded | splats sent (prefixes) | splats drawn | GPU ms median (best) | M splats/s sent | M splats/s drawn median (best) |"
     );
     println!("|---|---|---|---|---|---|---|---|");
-    // Opaque unlit points are the text's "single-colored point primitives".
-    for (mode, primitive, shaded) in [
-        (SplatMode::Opaque, SplatPrimitive::Point, false),
-        (SplatMode::Opaque, SplatPrimitive::Point, true),
-        (SplatMode::Ewa, SplatPrimitive::Quad, true),
-        (SplatMode::Ewa, SplatPrimitive::ObjectQuad, true),
-    ] {
+    // Opaque unlit points are the text's "single-colored point primitives";
+    // the last row: EWA splats in compute (issue 29), where the device can.
+    let mut rows = vec![
+        (SplatMode::Opaque, SplatPrimitive::Point, false, RasterPath::Hardware),
+        (SplatMode::Opaque, SplatPrimitive::Point, true, RasterPath::Hardware),
+        (SplatMode::Ewa, SplatPrimitive::Quad, true, RasterPath::Hardware),
+        (SplatMode::Ewa, SplatPrimitive::ObjectQuad, true, RasterPath::Hardware),
+    ];
+    if ctx.has_feature("shaderBufferInt64Atomics") {
+        rows.push((SplatMode::Ewa, SplatPrimitive::Quad, true, RasterPath::Compute));
+    }
+    for (mode, primitive, shaded, raster) in rows {
         let settings = SplatSettings {
             mode,
             primitive,
             shaded,
             ..SplatSettings::default()
         };
-        let m = measure(ctx, &scene, &camera, settings, frames);
+        let m = measure_on(ctx, (&scene, &camera), (settings, raster), frames);
+        let primitive = match raster {
+            RasterPath::Compute => "compute",
+            _ => primitive.name(),
+        };
         println!(
             "| {} | {} | {} | {} | {} | {:.1} ({:.1}) | {:.2} | {:.2} ({:.2}) |",
             mode.name(),
-            primitive.name(),
+            primitive,
             if shaded { "yes" } else { "no" },
             m.prefix,
             m.drawn,
