@@ -32,7 +32,7 @@ layout(set = 0, binding = 2, std430) readonly buffer PointFrame {
     vec4 eye;                 // world eye position, w: 1 = two-sided splats, 0 = back faces culled
     Instance instances[];
 } g_point_frame[];
-layout(set = 0, binding = 2, std430) buffer SplatCounter { uint interval_passed; uint drawn; uint triangles; } g_splat_counters[];
+#include "splat_counter.glsl"
 layout(set = 0, binding = 2, std430) readonly buffer GaussianTable { float g[]; } g_gaussian[];
 
 #define SPLAT_PASS_VISIBILITY 0u
@@ -58,7 +58,8 @@ layout(push_constant) uniform Push {
     uvec4 more;     // storage: normal (rgba16f), ids (rg32ui); width, height
 #endif
 #ifdef SPLAT_SINGLE_PASS
-    uvec4 single;   // single-pass (§10.4): pixel words, pixel sums, depth buffer (sampled; NO_HANDLE: cleared), splats of the draw
+    uvec4 single;   // single-pass (§10.4): interlock: pixel words, pixel sums, depth buffer (sampled; NO_HANDLE: cleared), splats of the draw;
+                    // tiles: see glsl/include/single_pass_tiles.glsl
 #endif
 } pc;
 

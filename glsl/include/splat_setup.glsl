@@ -2,7 +2,8 @@
 // (dissertation §10.1.6, §10.2.2–10.2.4; ALGORITHMS.md §8), shared by the
 // vertex/fragment stages of the three-pass mode (glsl/points/splat.vert,
 // glsl/include/splat_fragment.glsl) and by single-pass splatting (§10.4,
-// glsl/include/single_pass.glsl), so every mode draws the same kernels.
+// glsl/include/single_pass_tiles.glsl, glsl/points/single_pass_tile.comp),
+// so every mode draws the same kernels.
 //
 // splat_setup: the exact interval test r_min ≤ r < r_max with r the splat's
 // eye distance (§10.1.6), culling (near plane, near edge-on, back faces unless
@@ -41,10 +42,10 @@ struct SplatSetup {
 // Smallest |cos| between the view ray and the splat normal (≈ 0.6° from edge-on).
 const float MIN_COS_VIEW = 0.01;
 
-// The set-up of splat `splat_index` of the draw's instance (pc.mode.w).
-uint splat_setup(uint splat_index, out SplatSetup o) {
+// The set-up of splat `splat_index` of the instance record `record`.
+uint splat_setup_of(uint record, uint splat_index, out SplatSetup o) {
     uint f = pc.handles.y;
-    Instance inst = g_point_frame[f].instances[pc.mode.w];
+    Instance inst = g_point_frame[f].instances[record];
     float scale = inst.params.x;
     uint first = floatBitsToUint(inst.params.y);
     Splat s = g_splats[pc.handles.x].s[first + splat_index];
@@ -114,6 +115,11 @@ uint splat_setup(uint splat_index, out SplatSetup o) {
     o.clip = s.clip;
     o.color = vec4(unpack_srgb(s.radius_color.y), 1.0);
     return SPLAT_SETUP_READY;
+}
+
+// The set-up of splat `splat_index` of the draw's instance (pc.mode.w).
+uint splat_setup(uint splat_index, out SplatSetup o) {
+    return splat_setup_of(pc.mode.w, splat_index, o);
 }
 
 struct SplatSample {

@@ -101,8 +101,7 @@ fn main() {
     .expect("Vulkan context");
     println!("device: {} ({})", ctx.info().name, ctx.info().driver_info);
     println!(
-        "64-bit buffer atomics: {}, fragment shader interlock: {}",
-        ctx.has_feature("shaderBufferInt64Atomics"),
+        "fragment shader interlock: {}",
         ctx.has_feature("fragmentShaderPixelInterlock")
     );
     let options = PointLoadOptions {
@@ -125,12 +124,15 @@ fn main() {
     );
 
     let mut modes = vec![
-        ("three-pass EWA", SplatMode::Ewa, false),
-        ("single-pass, 64-bit locks", SplatMode::SinglePass, false),
-        ("single-pass, 32-bit locks", SplatMode::SinglePass, true),
+        ("three-pass EWA", SplatMode::Ewa, SplatBackend::Compute),
+        (
+            "single-pass, tiles (compute)",
+            SplatMode::SinglePass,
+            SplatBackend::Compute,
+        ),
     ];
-    if !ctx.has_feature("shaderBufferInt64Atomics") {
-        modes.remove(1);
+    if ctx.has_feature("fragmentShaderPixelInterlock") && ctx.has_feature("fragmentStoresAndAtomics") {
+        modes.push(("single-pass, interlock", SplatMode::SinglePass, SplatBackend::Interlock));
     }
     for (view, distance) in [("distant", 2.0), ("close", 0.25)] {
         let camera = camera_at(distance);
@@ -139,11 +141,10 @@ fn main() {
         println!("|---|---|---|---|---|---|");
         let mut reference: Option<(Measured, [f64; 2])> = None;
         let mut breakdown = Vec::new();
-        for &(name, mode, force_32bit_locks) in &modes {
+        for &(name, mode, backend) in &modes {
             let settings = SplatSettings {
                 mode,
-                backend: SplatBackend::Compute,
-                force_32bit_locks,
+                backend,
                 two_sided: true,
                 ..SplatSettings::default()
             };
