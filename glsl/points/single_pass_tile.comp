@@ -26,7 +26,7 @@
 #include "../include/splat_resolve.glsl"
 #include "../include/single_pass_sort.glsl"
 
-#define BATCH 16u
+#define BATCH 32u
 
 layout(local_size_x = 16, local_size_y = 16) in;
 
@@ -100,6 +100,8 @@ void main() {
         stored = texelFetch(sampler2D(g_textures[pc.single.z], g_samplers[SAMPLER_NEAREST_CLAMP]), ivec2(pixel), 0).r;
     }
     PixelState p = PixelState(POSITIVE_INFINITY, vec4(0.0), vec4(0.0), uvec2(0u));
+    float cutoff = g_point_frame[pc.handles.y].depth.w;
+    float cutoff2 = cutoff * cutoff;
     for (uint b = 0u; b < n; b += BATCH) {
         if (invocation < BATCH && b + invocation < n) {
             set_up_batch_slot(shared_list, base, b + invocation, invocation);
@@ -107,7 +109,12 @@ void main() {
         barrier();
         uint m = min(BATCH, n - b);
         for (uint k = 0u; inside && k < m; ++k) {
-            if (s_ready[k] != 0u) {
+            // Most of a tile's splats miss most of its pixels: the kernel's
+            // cut-off (splat_sample_at's first test) before the set-up is read.
+            vec4 conic = s_setup[k].conic;
+            vec2 d = centre - s_setup[k].centre.xy;
+            float r2 = conic.x * d.x * d.x + 2.0 * conic.y * d.x * d.y + conic.z * d.y * d.y;
+            if (s_ready[k] != 0u && r2 <= cutoff2) {
                 merge_splat(p, s_setup[k], s_ids[k], centre, stored);
             }
         }

@@ -43,7 +43,7 @@ pub struct PointFrameStats {
     pub tile_entries_dropped: Option<u64>,
     /// Single-pass splatting, compute backend: the longest tile list (the
     /// largest over the views; lists longer than the shared-memory sort's
-    /// 1024 entries are sorted in global memory).
+    /// 896 entries are sorted in global memory).
     pub longest_tile_list: Option<u64>,
     /// CPU time of the selection (prefix search, transforms), milliseconds.
     pub cpu_ms: f64,
