@@ -42,18 +42,25 @@ uvec2 tile_grid() {
     return (size + TILE_SIZE - 1u) / TILE_SIZE;
 }
 
+// The pixels [first, last] whose centres the splat's bounding box (the
+// three-pass mode's quad) holds; false when it holds none (off screen).
+bool splat_pixels(SplatSetup v, out uvec2 first, out uvec2 last) {
+    vec2 size = g_point_frame[pc.handles.y].viewport.xy;
+    vec2 lo = clamp(ceil(v.centre.xy - v.half_extent - 0.5), vec2(0.0), size);
+    vec2 hi = clamp(floor(v.centre.xy + v.half_extent - 0.5), vec2(-1.0), size - 1.0);
+    first = uvec2(lo);
+    last = uvec2(max(hi, vec2(0.0)));
+    return all(greaterThanEqual(hi, lo));
+}
+
 // The tiles [lo, hi) whose pixel centres the splat's bounding box may
 // hold; false when it holds none (off screen).
 bool splat_tiles(SplatSetup v, out uvec2 lo, out uvec2 hi) {
-    vec2 size = g_point_frame[pc.handles.y].viewport.xy;
-    vec2 first = clamp(ceil(v.centre.xy - v.half_extent - 0.5), vec2(0.0), size);
-    vec2 last = clamp(floor(v.centre.xy + v.half_extent - 0.5), vec2(-1.0), size - 1.0);
-    if (any(lessThan(last, first))) {
-        return false;
-    }
-    lo = uvec2(first) / TILE_SIZE;
-    hi = uvec2(last) / TILE_SIZE + 1u;
-    return true;
+    uvec2 first, last;
+    bool any_pixel = splat_pixels(v, first, last);
+    lo = first / TILE_SIZE;
+    hi = last / TILE_SIZE + 1u;
+    return any_pixel;
 }
 
 // The depth key of a splat: its centre's distance from the eye.

@@ -36,9 +36,16 @@ layout(local_size_x = 16, local_size_y = 16) in;
 //   single = (bins, entries, depth buffer (sampled; NO_HANDLE: none),
 //             1: keep W where no splat is (the hybrid triangles wrote it)).
 
+// A tile is 4×4 blocks of 4×4 pixels.
+#define BLOCK_SIZE 4u
+#define BLOCKS (TILE_SIZE / BLOCK_SIZE)
+
 shared SplatSetup s_setup[BATCH];
 shared uvec2 s_ids[BATCH];
-shared uint s_ready[BATCH];
+// Per block, bit k: slot k of the batch is set up and its bounding box
+// touches the block. Two sets, batches alternating: one is cleared while the
+// other is read. Or-ed together, so the order of the writes does not matter.
+shared uint s_touched[2][BLOCKS * BLOCKS];
 
 // A pixel's merged splats: z_d, (A_d·C_d, A_d), (A_d·n, A_d·view depth),
 // the ids of the splat that set z_d.
@@ -72,13 +79,30 @@ void merge_splat(inout PixelState p, SplatSetup v, uvec2 ids, vec2 centre, float
     }
 }
 
-// Sets up entry `k` of the sorted list into slot `slot` of the batch.
-void set_up_batch_slot(bool shared_list, uint base, uint k, uint slot) {
+// Sets up entry `k` of the sorted list into slot `slot_touched.x` of the batch
+// and marks the blocks of the tile its bounding box touches in set
+// `slot_touched.y` of s_touched.
+void set_up_batch_slot(bool shared_list, uint base, uint k, uvec2 slot_touched) {
+    uint slot = slot_touched.x;
     TileEntry e = sorted_entry(shared_list, base, k);
     SplatSetup v;
-    s_ready[slot] = splat_setup_of(e.record, e.index, v) == SPLAT_SETUP_READY ? 1u : 0u;
+    uvec2 first, last;
+    if (splat_setup_of(e.record, e.index, v) != SPLAT_SETUP_READY || !splat_pixels(v, first, last)) {
+        return;
+    }
     s_setup[slot] = v;
     s_ids[slot] = g_point_frame[pc.handles.y].instances[e.record].ids.xy;
+    uvec2 origin = gl_WorkGroupID.xy * TILE_SIZE;
+    if (any(lessThan(last, origin)) || any(greaterThan(first, origin + TILE_SIZE - 1u))) {
+        return;  // misses the tile (never, as binned)
+    }
+    uvec2 lo = (max(first, origin) - origin) / BLOCK_SIZE;
+    uvec2 hi = (min(last, origin + TILE_SIZE - 1u) - origin) / BLOCK_SIZE;
+    for (uint y = lo.y; y <= hi.y; ++y) {
+        for (uint x = lo.x; x <= hi.x; ++x) {
+            atomicOr(s_touched[slot_touched.y][y * BLOCKS + x], 1u << slot);
+        }
+    }
 }
 
 void main() {
@@ -89,6 +113,9 @@ void main() {
     uint bins = pc.single.x;
     uint n = g_tile_bins[bins].w[2u * tiles + tile];
     uint base = g_tile_bins[bins].w[tiles + tile];
+    if (invocation < 2u * BLOCKS * BLOCKS) {
+        s_touched[invocation / (BLOCKS * BLOCKS)][invocation % (BLOCKS * BLOCKS)] = 0u;
+    }
     sort_tile_list(base, n, invocation);
     bool shared_list = n <= SORT_CAPACITY;
 
@@ -102,21 +129,30 @@ void main() {
     PixelState p = PixelState(POSITIVE_INFINITY, vec4(0.0), vec4(0.0), uvec2(0u));
     float cutoff = g_point_frame[pc.handles.y].depth.w;
     float cutoff2 = cutoff * cutoff;
+    uvec2 block = gl_LocalInvocationID.xy / BLOCK_SIZE;
     for (uint b = 0u; b < n; b += BATCH) {
+        uint set = (b / BATCH) & 1u;
         if (invocation < BATCH && b + invocation < n) {
-            set_up_batch_slot(shared_list, base, b + invocation, invocation);
+            set_up_batch_slot(shared_list, base, b + invocation, uvec2(invocation, set));
         }
         barrier();
-        uint m = min(BATCH, n - b);
-        for (uint k = 0u; inside && k < m; ++k) {
-            // Most of a tile's splats miss most of its pixels: the kernel's
-            // cut-off (splat_sample_at's first test) before the set-up is read.
+        // The batch's splats whose boxes touch this pixel's block, in order.
+        uint touched = inside ? s_touched[set][block.y * BLOCKS + block.x] : 0u;
+        while (touched != 0u) {
+            uint k = findLSB(touched);
+            touched &= touched - 1u;
+            // The kernel's cut-off (splat_sample_at's first test) before the
+            // rest of the set-up is read.
             vec4 conic = s_setup[k].conic;
             vec2 d = centre - s_setup[k].centre.xy;
             float r2 = conic.x * d.x * d.x + 2.0 * conic.y * d.x * d.y + conic.z * d.y * d.y;
-            if (s_ready[k] != 0u && r2 <= cutoff2) {
+            if (r2 <= cutoff2) {
                 merge_splat(p, s_setup[k], s_ids[k], centre, stored);
             }
+        }
+        // The other set, read by the previous batch, for the next one.
+        if (invocation < BLOCKS * BLOCKS) {
+            s_touched[set ^ 1u][invocation] = 0u;
         }
         barrier();
     }
