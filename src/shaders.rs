@@ -56,15 +56,19 @@ pub const SPLAT_VISIBILITY_FRAG: SpirV = spirv!("points/visibility.frag");
 pub const SPLAT_ACCUMULATE_FRAG: SpirV = spirv!("points/accumulate.frag");
 /// points.opaque: opaque shaded discs.
 pub const SPLAT_OPAQUE_FRAG: SpirV = spirv!("points/opaque.frag");
-/// points.single_pass (§10.4): the compute backend with 64-bit pixel locks.
-pub const SPLAT_SINGLE_PASS: SpirV = spirv!("points/single_pass.comp");
-/// points.single_pass (§10.4): the compute backend with 32-bit pixel locks.
-pub const SPLAT_SINGLE_PASS_LOCK32: SpirV = spirv!("points/single_pass_lock32.comp");
+/// points.single_pass.clear (§10.4), compute backend: every tile's entry count 0.
+pub const SPLAT_SINGLE_PASS_BINS_CLEAR: SpirV = spirv!("points/single_pass_bins_clear.comp");
+/// points.single_pass.count and .scatter (§10.4), compute backend: the splats binned into tiles.
+pub const SPLAT_SINGLE_PASS_BIN: SpirV = spirv!("points/single_pass_bin.comp");
+/// points.single_pass.prefix (§10.4), compute backend: the tiles' list offsets.
+pub const SPLAT_SINGLE_PASS_PREFIX: SpirV = spirv!("points/single_pass_prefix.comp");
+/// points.single_pass.merge (§10.4), compute backend: per tile, sort, merge front to back, shade.
+pub const SPLAT_SINGLE_PASS_TILE: SpirV = spirv!("points/single_pass_tile.comp");
 /// points.single_pass (§10.4): the interlock backend's fragment stage.
 pub const SPLAT_SINGLE_PASS_INTERLOCK_FRAG: SpirV = spirv!("points/single_pass_interlock.frag");
-/// points.single_pass.clear: every pixel's state reset.
+/// points.single_pass.clear (§10.4), interlock backend: every pixel's state reset.
 pub const SPLAT_SINGLE_PASS_CLEAR: SpirV = spirv!("points/single_pass_clear.comp");
-/// points.single_pass.resolve: normalisation and shading of the pixel sums.
+/// points.single_pass.resolve (§10.4), interlock backend: normalisation and shading of the pixel sums.
 pub const SPLAT_SINGLE_PASS_RESOLVE: SpirV = spirv!("points/single_pass_resolve.comp");
 /// points.normalize: divide by the weight and shade (compute, per pixel).
 pub const SPLAT_NORMALIZE: SpirV = spirv!("points/normalize.comp");

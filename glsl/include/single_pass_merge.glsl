@@ -1,8 +1,8 @@
-// The fuzzy-depth merge of single-pass splatting (dissertation §10.4;
-// glsl/include/single_pass.glsl explains the operator and the locks),
-// shared by the compute backend and the interlock backend
-// (glsl/points/single_pass_interlock.frag): the pixel state buffers, the
-// fragment of a splat at a pixel, and the merge done inside the critical section.
+// The fuzzy-depth merge of single-pass splatting (dissertation §10.4),
+// interlock backend (glsl/points/single_pass_interlock.frag): the pixel state
+// buffers, the fragment of a splat at a pixel, and the text's operator done
+// inside the pixel-ordered critical section. (The compute backend merges
+// per tile in registers: glsl/points/single_pass_tile.comp.)
 #ifndef ALPENGLOW_SINGLE_PASS_MERGE_GLSL
 #define ALPENGLOW_SINGLE_PASS_MERGE_GLSL
 
@@ -12,7 +12,7 @@
 #include "splat_setup.glsl"
 #include "single_pass_state.glsl"
 
-// Per pixel: the lock (0: free) and z_d's bits, the 64-bit word z_d << 32 | lock.
+// Per pixel: a word unused by the interlock (0) and z_d's bits.
 layout(set = 0, binding = 2, std430) coherent buffer PixelWords32 { uint w[]; } g_pixel_words32[];
 layout(set = 0, binding = 2, std430) coherent buffer PixelSumsBuffer { PixelSums p[]; } g_pixel_sums[];
 

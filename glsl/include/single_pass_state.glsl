@@ -1,6 +1,7 @@
-// The per-pixel state of single-pass splatting (dissertation §10.4): the
-// sums of glsl/include/single_pass.glsl, as its clear and resolve passes
-// read them. Layout: src/points/render/single_pass.rs (PIXEL_SUM_BYTES).
+// The per-pixel state of single-pass splatting's interlock backend
+// (dissertation §10.4): the sums of glsl/include/single_pass_merge.glsl, as
+// its clear and resolve passes read them. Layout:
+// src/points/render/single_pass/interlock.rs (PIXEL_SUM_BYTES).
 #ifndef ALPENGLOW_SINGLE_PASS_STATE_GLSL
 #define ALPENGLOW_SINGLE_PASS_STATE_GLSL
 

@@ -33,7 +33,7 @@ layout(set = 0, binding = 2, std430) readonly buffer PointFrame {
     vec4 eye;                 // world eye position, w: 1 = two-sided splats, 0 = back faces culled
     Instance instances[];
 } g_point_frame[];
-layout(set = 0, binding = 2, std430) buffer SplatCounter { uint interval_passed; uint drawn; uint triangles; } g_splat_counters[];
+#include "splat_counter.glsl"
 layout(set = 0, binding = 2, std430) readonly buffer GaussianTable { float g[]; } g_gaussian[];
 
 #define SPLAT_PASS_VISIBILITY 0u
@@ -63,7 +63,8 @@ layout(push_constant) uniform Push {
     uvec4 draws;    // the draw table (storage: first splat, instance record per draw), draws, 0, 0
 #endif
 #ifdef SPLAT_SINGLE_PASS
-    uvec4 single;   // single-pass (§10.4): pixel words, pixel sums, depth buffer (sampled; NO_HANDLE: cleared), splats of the draw
+    uvec4 single;   // single-pass (§10.4): interlock: pixel words, pixel sums, depth buffer (sampled; NO_HANDLE: cleared), splats of the draw;
+                    // tiles: see glsl/include/single_pass_tiles.glsl
 #endif
 } pc;
 

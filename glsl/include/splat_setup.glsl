@@ -2,7 +2,9 @@
 // (dissertation §10.1.6, §10.2.2–10.2.4; ALGORITHMS.md §8), shared by the
 // vertex/fragment stages of the three-pass mode (glsl/points/splat.vert,
 // glsl/include/splat_fragment.glsl) and by single-pass splatting (§10.4,
-// glsl/include/single_pass.glsl), so every mode draws the same kernels.
+// glsl/include/single_pass_tiles.glsl, glsl/points/single_pass_tile.comp;
+// and the compute path's three passes, glsl/include/splat_compute.glsl),
+// so every mode draws the same kernels.
 //
 // splat_setup: the exact interval test r_min ≤ r < r_max with r the splat's
 // eye distance (§10.1.6), culling (near plane, near edge-on, back faces unless

@@ -1,6 +1,7 @@
 #version 460
-// points.single_pass.clear (dissertation §10.4): every pixel's state before
-// the splats: unlocked, z_d = +inf, no sums (glsl/include/single_pass.glsl).
+// points.single_pass.clear (dissertation §10.4), interlock backend: every
+// pixel's state before the splats: z_d = +inf, no sums
+// (glsl/include/single_pass_merge.glsl).
 #include "../include/heap.glsl"
 #include "../include/single_pass_state.glsl"
 
@@ -18,7 +19,7 @@ void main() {
     if (p >= pc.handles.z) {
         return;
     }
-    // Low half: the lock (0: free); high half: z_d (the 64-bit word z_d << 32 | lock).
+    // Low half unused (0); high half: z_d.
     g_pixel_words[pc.handles.x].w[p] = uvec2(0u, floatBitsToUint(POSITIVE_INFINITY));
     g_pixel_sums[pc.handles.y].p[p] = PixelSums(vec4(0.0), vec4(0.0), uvec4(0u));
 }

@@ -147,7 +147,7 @@ pub enum SplatArg {
 /// How single-pass splatting merges each pixel (§10.4).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SplatBackendArg {
-    /// Compute pass with per-pixel locks (64-bit atomics where offered).
+    /// Compute passes: splats binned into 16x16-pixel tiles, each tile sorted front to back and merged (deterministic).
     Compute,
     /// Fragment shader interlock (needs VK_EXT_fragment_shader_interlock).
     Interlock,

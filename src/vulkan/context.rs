@@ -65,8 +65,8 @@ pub struct OptionalFeatures {
     pub large_points: bool,
     /// `vertexPipelineStoresAndAtomics`: the vertex stage counts the splats it draws.
     pub vertex_pipeline_stores_and_atomics: bool,
-    /// `shaderInt64` and `shaderBufferInt64Atomics`: single-pass splatting
-    /// (§10.4) packs depth and lock in one 64-bit word (without: a 32-bit fallback).
+    /// `shaderInt64` and `shaderBufferInt64Atomics`: the compute path's
+    /// visibility buffer (`terrain::visibility`) packs depth and id in one 64-bit word.
     pub shader_buffer_int64_atomics: bool,
     /// `fragmentShaderPixelInterlock` (VK_EXT_fragment_shader_interlock):
     /// the interlock backend of single-pass splatting (§10.4).
@@ -251,9 +251,10 @@ fn describe_device(
     }
 }
 
-/// What the device offers for single-pass splatting (§10.4):
-/// `shaderBufferInt64Atomics`, and `fragmentShaderPixelInterlock` with its
-/// extension VK_EXT_fragment_shader_interlock.
+/// What the device offers of `shaderBufferInt64Atomics` (the compute
+/// path's visibility buffer) and of `fragmentShaderPixelInterlock` with its
+/// extension VK_EXT_fragment_shader_interlock (single-pass splatting's
+/// interlock backend, §10.4).
 fn offered_single_pass_features(instance: &ash::Instance, physical: vk::PhysicalDevice) -> (bool, bool) {
     // SAFETY: plain query on a physical device of this instance.
     let extensions = unsafe { instance.enumerate_device_extension_properties(physical) }.unwrap_or_default();

@@ -11,9 +11,13 @@
 //! | `points.clear`, `points.visibility`, `points.accumulate`, `points.normalize` | ewa, compute path | the same three passes in compute ([`compute`]): 64-bit (depth, record) words and fixed-point integer sums, deterministic to the byte |
 //! | `points.opaque` | opaque | opaque discs with ray–plane depth, shaded directly, with normal and ids |
 //! | `points.single_pass.triangles` | single-pass | hybrid triangles as opaque shaded triangles with depth, when the scene has any |
-//! | `points.single_pass.clear` | single-pass | compute: every pixel's state unlocked, z_d = +inf, sums 0 |
-//! | `points.single_pass` | single-pass | compute (or the interlock backend's raster pass): every splat's pixels merged with the fuzzy depth test (§10.4) |
-//! | `points.single_pass.resolve` | single-pass | full screen: as `points.normalize`, from the pixel state |
+//! | `points.single_pass.clear` | single-pass, compute | every tile's entry count 0 (§10.4; interlock: every pixel's state z_d = +inf, sums 0) |
+//! | `points.single_pass.count` | single-pass, compute | per splat: EWA set-up, bounding box → 16×16-pixel tiles, each tile's count + 1 |
+//! | `points.single_pass.prefix` | single-pass, compute | one workgroup: each tile's list offset; lists past the entry buffer's capacity dropped whole and counted |
+//! | `points.single_pass.scatter` | single-pass, compute | per splat again: (depth key, record, index) into each tile's list |
+//! | `points.single_pass.merge` | single-pass, compute | a workgroup per tile: list sorted by (depth key, record, index), the fuzzy depth test (§10.4) front to back per pixel, normalised and shaded, written once |
+//! | `points.single_pass` | single-pass, interlock | raster pass: every splat fragment merged with the fuzzy depth test (§10.4) in a pixel-ordered critical section |
+//! | `points.single_pass.resolve` | single-pass, interlock | compute: as `points.normalize`, from the pixel state |
 //!
 //! The primitives `object-quad` and `object-instanced` ([`object_space`],
 //! §10.3) draw the same passes with object-space quads and the kernel in a
@@ -37,6 +41,8 @@ pub mod stats;
 mod technique;
 mod triangles;
 
+#[cfg(test)]
+pub(crate) use single_pass::with_entry_capacity;
 pub use stats::PointFrameStats;
 pub use technique::{PointRenderer, PointsFrame};
 
@@ -57,14 +63,17 @@ pub enum SplatMode {
     SinglePass,
 }
 
-/// How single-pass splatting (§10.4) makes each pixel's read-modify-write atomic.
+/// How single-pass splatting (§10.4) orders each pixel's merges (the
+/// fuzzy-depth operator is not commutative).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum SplatBackend {
-    /// A compute pass, one invocation per splat, with a per-pixel spin lock:
-    /// one 64-bit word (z_d, lock) with `shaderBufferInt64Atomics`, else a
-    /// 32-bit lock word and a z_d word. Works everywhere (lavapipe too);
-    /// merges at fuzzy boundaries follow the GPU's invocation order, which
-    /// can vary from run to run.
+    /// Compute passes, tile-binned (§10.4 with the tile order of 3D Gaussian
+    /// splatting): the splats' boxes binned into 16×16-pixel tiles, each
+    /// tile's list sorted by (centre distance, instance record, index) and
+    /// merged front to back per pixel in registers, then shaded. No locks,
+    /// deterministic (two renders are byte-identical), the same on every
+    /// device. Tile entries beyond the entry buffer's capacity drop whole
+    /// tiles' lists, counted in [`PointFrameStats::tile_entries_dropped`].
     #[default]
     Compute,
     /// A raster pass whose fragments merge inside a pixel-ordered critical
@@ -172,9 +181,6 @@ pub struct SplatSettings {
     pub epsilon: Option<f32>,
     /// The single-pass mode's backend (§10.4); ignored by the other modes.
     pub backend: SplatBackend,
-    /// Single-pass compute backend: use the 32-bit lock even where 64-bit
-    /// buffer atomics exist (tests of the fallback).
-    pub force_32bit_locks: bool,
 }
 
 impl Default for SplatSettings {
@@ -189,7 +195,6 @@ impl Default for SplatSettings {
             normal_clusters: false,
             epsilon: None,
             backend: SplatBackend::Compute,
-            force_32bit_locks: false,
         }
     }
 }

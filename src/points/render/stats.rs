@@ -12,7 +12,7 @@ use crate::error::Result;
 use crate::vulkan::{Buffer, FRAMES_IN_FLIGHT};
 
 /// Bytes of the GPU counters (`SplatCounter` in glsl/include/splat.glsl).
-pub(crate) const COUNTER_BYTES: usize = 12;
+pub(crate) const COUNTER_BYTES: usize = 20;
 
 /// Point statistics of one frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -37,6 +37,14 @@ pub struct PointFrameStats {
     /// Of those, triangles drawn: passing `r < s/ε` and not back-facing
     /// (None without `vertexPipelineStoresAndAtomics`).
     pub triangles_drawn: Option<u64>,
+    /// Single-pass splatting, compute backend (§10.4): tile entries dropped
+    /// because the entry buffer was full (whole tiles' lists, which then show
+    /// no splats; 0 in the other modes; None without GPU counters).
+    pub tile_entries_dropped: Option<u64>,
+    /// Single-pass splatting, compute backend: the longest tile list (the
+    /// largest over the views; lists longer than the shared-memory sort's
+    /// 896 entries are sorted in global memory).
+    pub longest_tile_list: Option<u64>,
     /// CPU time of the selection (prefix search, transforms), milliseconds.
     pub cpu_ms: f64,
 }
@@ -64,8 +72,13 @@ impl PointFrameStats {
             (p, Some(d)) => format!("; hybrid: {d} of {p} triangles in prefixes drawn"),
             (p, None) => format!("; hybrid: {p} triangles in prefixes"),
         };
+        let tiles = match (self.longest_tile_list, self.tile_entries_dropped) {
+            (Some(l), Some(0)) if l > 0 => format!("; tiles: longest list {l}"),
+            (Some(l), Some(d)) if l > 0 => format!("; tiles: longest list {l}, {d} entries DROPPED (capacity)"),
+            _ => String::new(),
+        };
         format!(
-            "points: {}/{} instances, {} splats in prefixes of {} listed, {}{triangles}; CPU {:.3} ms",
+            "points: {}/{} instances, {} splats in prefixes of {} listed, {}{triangles}{tiles}; CPU {:.3} ms",
             self.instances_drawn, self.instances, self.prefix_splats, self.list_splats, drawn, self.cpu_ms
         )
     }
@@ -102,10 +115,19 @@ impl StatsLog {
                     .get(4 * k..4 * k + 4)
                     .map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
             };
-            let words = [word(0), word(1), word(2)];
-            stats.interval_passed = Some(u64::from(words[0]));
-            stats.drawn_splats = Some(u64::from(words[1]));
-            stats.triangles_drawn = Some(u64::from(words[2]));
+            let words = [0, 1, 2, 3, 4].map(|k| u64::from(word(k)));
+            stats.interval_passed = Some(words[0]);
+            stats.drawn_splats = Some(words[1]);
+            stats.triangles_drawn = Some(words[2]);
+            stats.tile_entries_dropped = Some(words[3]);
+            stats.longest_tile_list = Some(words[4]);
+            if words[3] > 0 {
+                log::warn!(
+                    "frame {}: single-pass splatting dropped {} tile entries (the entry buffer is full; whole tiles show no splats)",
+                    stats.frame,
+                    words[3]
+                );
+            }
         }
         Ok(())
     }

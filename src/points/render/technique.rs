@@ -11,7 +11,7 @@ use super::gpu_layout::{frame_header, gaussian_table, pack_nodes, FrameHeader, H
 use super::object_space::ObjectSpaceResources;
 use super::passes::{declare_ewa, declare_opaque, PointBuffers, PointView};
 use super::selection::{plan_frame_into, FramePlan, ObjectLayout};
-use super::single_pass::{check_backend, declare_single_pass};
+use super::single_pass::{check_backend, declare_single_pass, entry_capacity};
 use super::stats::{PointFrameStats, StatsLog};
 use super::triangles::TriangleBuffer;
 use super::{SplatMode, SplatPrimitive, SplatSettings};
@@ -149,7 +149,7 @@ impl PointRenderer {
                 ctx,
                 BufferDesc {
                     name: "splat counter".into(),
-                    size: 16,
+                    size: 32,
                     usage: storage,
                     location: MemoryLocation::CpuToGpu,
                 },
@@ -181,6 +181,12 @@ impl PointRenderer {
     /// `points.shadow` draws (`super::shadow`).
     pub(super) fn shadow_sources(&self) -> (&PointScene, &[ObjectLayout], &Arc<Buffer>) {
         (&self.scene, &self.layouts, &self.resources.splats)
+    }
+
+    /// The most splats a frame can plan: every instance's whole list.
+    fn planned_splats(&self) -> u64 {
+        let list = |i: &crate::points::scene::PointInstance| self.scene.objects[i.object].tree.nodes.len() as u64;
+        self.scene.instances.iter().map(list).sum()
     }
 
     /// Statistics of every completed frame not yet taken (call after all
@@ -269,7 +275,10 @@ impl<S: Provides<PointsFrame> + 'static> Declare<S> for PointRenderer {
                 &name,
                 (buffers, point_view),
                 targets,
-                (self.settings.backend, self.settings.force_32bit_locks),
+                (
+                    self.settings.backend,
+                    entry_capacity(self.planned_splats(), ctx.max_storage_buffer_range()),
+                ),
             )?,
         }
         self.views.push(point_view);

@@ -1,0 +1,167 @@
+#version 460
+// points.single_pass.merge (dissertation §10.4; ALGORITHMS.md §8): one
+// workgroup per 16×16-pixel tile, one invocation per pixel. The tile's list
+// (glsl/include/single_pass_tiles.glsl) is sorted front to back by (depth
+// key, record, index) (glsl/include/single_pass_sort.glsl) and walked in
+// batches of BATCH entries: the workgroup sets the batch's splats up into
+// shared memory (one invocation each, the EWA set-up of
+// glsl/include/splat_setup.glsl), then every pixel applies the text's
+// fuzzy-depth operator to each splat of the batch in order, fragment
+// (C_s, A_s, z_s) against its stored (C_d, A_d, z_d):
+//   z_s < z_d − z_f:  C_d = C_s, A_d = A_s, z_d = z_s     (nearer: replaces)
+//   z_s < z_d + z_f:  C_d = (A_d·C_d + A_s·C_s)/(A_d + A_s), A_d += A_s
+//                     (same surface: blends; z_d kept)
+//   otherwise:        dropped (behind),
+// kept as the sums A_d·C_d, A_d (and A·normal, A·view depth) in registers.
+// z is the distance along the view ray (ray–plane depth), z_f = ε·r_k with
+// r_k the incoming splat's radius (camera units) and ε the visibility
+// offset in splat radii (§10.2.3). A fragment the depth buffer (terrain,
+// hybrid triangles) hides is dropped first, as in three-pass accumulation.
+// Finally each pixel is normalised and shaded once, exactly as
+// points.normalize (glsl/include/splat_resolve.glsl): no pixel state in
+// memory. The ids are those of the splat that last set z_d. Every step
+// follows the sorted order, so the image is the same on every run.
+#define SPLAT_SINGLE_PASS
+#define SPLAT_RESOLVE_COMPUTE
+#include "../include/splat_resolve.glsl"
+#include "../include/single_pass_sort.glsl"
+
+#define BATCH 32u
+
+layout(local_size_x = 16, local_size_y = 16) in;
+
+// Push constants (the splat passes' block, splat.glsl):
+//   handles = (splats, point frame, unused, Gaussian table),
+//   outputs, more = the targets written (more.zw: width, height),
+//   single = (bins, entries, depth buffer (sampled; NO_HANDLE: none),
+//             1: keep W where no splat is (the hybrid triangles wrote it)).
+
+// A tile is 4×4 blocks of 4×4 pixels.
+#define BLOCK_SIZE 4u
+#define BLOCKS (TILE_SIZE / BLOCK_SIZE)
+
+shared SplatSetup s_setup[BATCH];
+shared uvec2 s_ids[BATCH];
+// Per block, bit k: slot k of the batch is set up and its bounding box
+// touches the block. Two sets, batches alternating: one is cleared while the
+// other is read. Or-ed together, so the order of the writes does not matter.
+shared uint s_touched[2][BLOCKS * BLOCKS];
+
+// A pixel's merged splats: z_d, (A_d·C_d, A_d), (A_d·n, A_d·view depth),
+// the ids of the splat that set z_d.
+struct PixelState {
+    float zd;
+    vec4 color_weight;
+    vec4 normal_depth;
+    uvec2 ids;
+};
+
+// The operator on pixel state `p` for splat `v` (ids `ids`) at the pixel
+// centred at `centre`, whose depth buffer holds `stored`.
+void merge_splat(inout PixelState p, SplatSetup v, uvec2 ids, vec2 centre, float stored) {
+    SplatSample s;
+    if (!splat_sample_at(centre, v, s) || depth_of(s.position.z) < stored) {
+        return;
+    }
+    float z = length(s.position);
+    float zf = g_point_frame[pc.handles.y].depth.z * v.centre.z;
+    if (!(z < p.zd + zf)) {
+        return;
+    }
+    float w = s.weight;
+    vec4 color_weight = vec4(v.color.rgb * w, w);
+    vec4 normal_depth = vec4(v.normal.xyz * w, -s.position.z * w);
+    if (z < p.zd - zf) {
+        p = PixelState(z, color_weight, normal_depth, ids);
+    } else {
+        p.color_weight += color_weight;
+        p.normal_depth += normal_depth;
+    }
+}
+
+// Sets up entry `k` of the sorted list into slot `slot_touched.x` of the batch
+// and marks the blocks of the tile its bounding box touches in set
+// `slot_touched.y` of s_touched.
+void set_up_batch_slot(bool shared_list, uint base, uint k, uvec2 slot_touched) {
+    uint slot = slot_touched.x;
+    TileEntry e = sorted_entry(shared_list, base, k);
+    SplatSetup v;
+    uvec2 first, last;
+    if (splat_setup_of(e.record, e.index, v) != SPLAT_SETUP_READY || !splat_pixels(v, first, last)) {
+        return;
+    }
+    s_setup[slot] = v;
+    s_ids[slot] = g_point_frame[pc.handles.y].instances[e.record].ids.xy;
+    uvec2 origin = gl_WorkGroupID.xy * TILE_SIZE;
+    if (any(lessThan(last, origin)) || any(greaterThan(first, origin + TILE_SIZE - 1u))) {
+        return;  // misses the tile (never, as binned)
+    }
+    uvec2 lo = (max(first, origin) - origin) / BLOCK_SIZE;
+    uvec2 hi = (min(last, origin + TILE_SIZE - 1u) - origin) / BLOCK_SIZE;
+    for (uint y = lo.y; y <= hi.y; ++y) {
+        for (uint x = lo.x; x <= hi.x; ++x) {
+            atomicOr(s_touched[slot_touched.y][y * BLOCKS + x], 1u << slot);
+        }
+    }
+}
+
+void main() {
+    uvec2 grid = tile_grid();
+    uint tiles = grid.x * grid.y;
+    uint tile = gl_WorkGroupID.y * grid.x + gl_WorkGroupID.x;
+    uint invocation = gl_LocalInvocationIndex;
+    uint bins = pc.single.x;
+    uint n = g_tile_bins[bins].w[2u * tiles + tile];
+    uint base = g_tile_bins[bins].w[tiles + tile];
+    if (invocation < 2u * BLOCKS * BLOCKS) {
+        s_touched[invocation / (BLOCKS * BLOCKS)][invocation % (BLOCKS * BLOCKS)] = 0u;
+    }
+    sort_tile_list(base, n, invocation);
+    bool shared_list = n <= SORT_CAPACITY;
+
+    uvec2 pixel = gl_GlobalInvocationID.xy;
+    bool inside = all(lessThan(pixel, pc.more.zw));
+    vec2 centre = vec2(pixel) + 0.5;
+    float stored = 0.0;  // FAR_DEPTH (reversed depth): hides nothing
+    if (inside && pc.single.z != NO_HANDLE) {
+        stored = texelFetch(sampler2D(g_textures[pc.single.z], g_samplers[SAMPLER_NEAREST_CLAMP]), ivec2(pixel), 0).r;
+    }
+    PixelState p = PixelState(POSITIVE_INFINITY, vec4(0.0), vec4(0.0), uvec2(0u));
+    float cutoff = g_point_frame[pc.handles.y].depth.w;
+    float cutoff2 = cutoff * cutoff;
+    uvec2 block = gl_LocalInvocationID.xy / BLOCK_SIZE;
+    for (uint b = 0u; b < n; b += BATCH) {
+        uint set = (b / BATCH) & 1u;
+        if (invocation < BATCH && b + invocation < n) {
+            set_up_batch_slot(shared_list, base, b + invocation, uvec2(invocation, set));
+        }
+        barrier();
+        // The batch's splats whose boxes touch this pixel's block, in order.
+        uint touched = inside ? s_touched[set][block.y * BLOCKS + block.x] : 0u;
+        while (touched != 0u) {
+            uint k = findLSB(touched);
+            touched &= touched - 1u;
+            // The kernel's cut-off (splat_sample_at's first test) before the
+            // rest of the set-up is read.
+            vec4 conic = s_setup[k].conic;
+            vec2 d = centre - s_setup[k].centre.xy;
+            float r2 = conic.x * d.x * d.x + 2.0 * conic.y * d.x * d.y + conic.z * d.y * d.y;
+            if (r2 <= cutoff2) {
+                merge_splat(p, s_setup[k], s_ids[k], centre, stored);
+            }
+        }
+        // The other set, read by the previous batch, for the next one.
+        if (invocation < BLOCKS * BLOCKS) {
+            s_touched[set ^ 1u][invocation] = 0u;
+        }
+        barrier();
+    }
+    if (!inside) {
+        return;
+    }
+    if (p.color_weight.a > 0.0) {
+        store_resolved(ivec2(pixel), resolve_splats(p.color_weight, p.normal_depth, centre), p.ids);
+    } else if (pc.single.w == 0u) {
+        imageStore(g_images_r32f[pc.outputs.z], ivec2(pixel), vec4(0.0));
+    }
+}

@@ -1,0 +1,317 @@
+//! The compute backend of single-pass splatting (dissertation §10.4;
+//! [`super::SplatBackend::Compute`]): tile-binned, ordered, lock-free and
+//! deterministic. The passes are listed in the module doc of [`super`];
+//! the shaders are `glsl/points/single_pass_{bins_clear,bin,prefix,tile}.comp`
+//! with `glsl/include/single_pass_tiles.glsl` (layouts) and
+//! `glsl/include/single_pass_sort.glsl` (the per-tile sort).
+//!
+//! Capacity: the entry buffer holds [`entry_capacity`] entries, fixed when
+//! the graph is declared (the entry count is only known on the GPU, and
+//! nothing waits for it on the CPU). `points.single_pass.prefix` keeps the
+//! tiles' lists in tile order while they fit and drops every later list
+//! whole: those tiles show no splats, nothing is written out of bounds, the
+//! same tiles are dropped on every run, and the dropped entries are counted
+//! into the frame's splat counters: [`PointFrameStats::tile_entries_dropped`]
+//! (logged as a warning when the frame's statistics are read).
+//!
+//! [`PointFrameStats::tile_entries_dropped`]: super::super::PointFrameStats::tile_entries_dropped
+
+use bytemuck::{Pod, Zeroable};
+
+use super::super::passes::{
+    plan_of, PointBuffers, PointView, ResolvedTargets, ShadingBindings, SplatBindings, SplatPush, NO_HANDLE,
+    PASS_OPAQUE,
+};
+use super::super::PointsFrame;
+use super::{declare_clear, workgroups, ResolvedPush, SinglePassPush, ViewPasses, Written};
+use crate::error::Result;
+use crate::graph::{Binding, BufferAccess, BufferId, BufferInfo, ImageAccess, PassContext, RenderGraph, Stage};
+use crate::shaders;
+use crate::view::{Frame, Provides, SceneTargets};
+use crate::vulkan::{ComputePipeline, Context, MemoryLocation};
+
+/// Pixels per side of a screen tile (`TILE_SIZE` in glsl/include/single_pass_tiles.glsl).
+pub(crate) const TILE_SIZE: u32 = 16;
+/// Bytes of a tile entry (`TileEntry`: depth key, record, index).
+const ENTRY_BYTES: u64 = 12;
+/// Words per tile in the bins buffer: count, offset, kept length, cursor.
+const BIN_WORDS: u64 = 4;
+/// Entries per splat the scene could plan (a splat's box touches about one
+/// to four tiles at the sizes an SPT selects).
+const ENTRIES_PER_SPLAT: u64 = 4;
+/// Fewest entries of a buffer (768 KiB).
+const MIN_ENTRIES: u64 = 1 << 16;
+/// Most entries of a buffer (384 MiB), where the device's storage buffer range allows.
+const MAX_ENTRIES: u64 = 1 << 25;
+/// `pc.single.z` of `points.single_pass.count` and `.scatter`.
+const PHASE_COUNT: u32 = 0;
+const PHASE_SCATTER: u32 = 1;
+
+#[cfg(test)]
+thread_local! {
+    static CAPACITY_OVERRIDE: std::cell::Cell<Option<u32>> = const { std::cell::Cell::new(None) };
+}
+
+/// Runs `f` with every entry buffer this thread declares holding
+/// `capacity` entries (tests of the overflow).
+#[cfg(test)]
+pub(crate) fn with_entry_capacity<R>(capacity: u32, f: impl FnOnce() -> R) -> R {
+    CAPACITY_OVERRIDE.with(|c| c.set(Some(capacity)));
+    let result = f();
+    CAPACITY_OVERRIDE.with(|c| c.set(None));
+    result
+}
+
+/// The tile entries of a view's entry buffer for a scene whose instances'
+/// lists hold `planned_splats` splats together (the most a frame can plan):
+/// [`ENTRIES_PER_SPLAT`] each, at least 2¹⁶ and at most 2²⁵ (384 MiB) or
+/// what `max_range` bytes (the device's `maxStorageBufferRange`) hold.
+pub(crate) fn entry_capacity(planned_splats: u64, max_range: u64) -> u32 {
+    #[cfg(test)]
+    if let Some(capacity) = CAPACITY_OVERRIDE.with(|c| c.get()) {
+        return capacity;
+    }
+    let most = MAX_ENTRIES.min(max_range / ENTRY_BYTES).max(MIN_ENTRIES);
+    let entries = planned_splats
+        .saturating_mul(ENTRIES_PER_SPLAT)
+        .clamp(MIN_ENTRIES, most);
+    u32::try_from(entries).unwrap_or(u32::MAX)
+}
+
+/// A view's tiles and its two buffers.
+#[derive(Clone, Copy, Debug)]
+struct TileBins {
+    /// [`BIN_WORDS`] words per tile (`glsl/include/single_pass_tiles.glsl`).
+    bins: BufferId,
+    /// `capacity` entries.
+    entries: BufferId,
+    /// Tiles per row and per column.
+    grid: [u32; 2],
+    capacity: u32,
+}
+
+impl TileBins {
+    fn tiles(&self) -> u32 {
+        self.grid[0] * self.grid[1]
+    }
+}
+
+/// The compute pipelines of the backend.
+struct Pipelines {
+    clear: ComputePipeline,
+    bin: ComputePipeline,
+    prefix: ComputePipeline,
+    merge: ComputePipeline,
+}
+
+/// The compute backend's passes of one view (see [`super`]); `capacity`:
+/// the entry buffer's entries.
+pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame<S>>,
+    at: ViewPasses<'_>,
+    capacity: u32,
+) -> Result<()> {
+    let (name, targets, written) = (at.name, at.targets, at.written);
+    let (buffers, view) = (at.buffers, at.view);
+    let pipelines = Pipelines {
+        clear: ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS_BINS_CLEAR)?,
+        bin: ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS_BIN)?,
+        prefix: ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS_PREFIX)?,
+        merge: ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS_TILE)?,
+    };
+    let grid = [targets.width, targets.height].map(|n| n.div_ceil(TILE_SIZE).max(1));
+    let capacity = capacity.max(1);
+    let buffer = |graph: &mut RenderGraph<Frame<S>>, what, size: u64| {
+        let location = MemoryLocation::GpuOnly;
+        graph.create_buffer(what, BufferInfo { size, location })
+    };
+    let tiles = TileBins {
+        bins: buffer(graph, "splat tile bins", BIN_WORDS * 4 * u64::from(grid[0] * grid[1])),
+        entries: buffer(graph, "splat tile entries", ENTRY_BYTES * u64::from(capacity)),
+        grid,
+        capacity,
+    };
+    // Every tile's count 0 (the first of its four words).
+    let cleared = (&[tiles.bins][..], tiles.tiles());
+    declare_clear(graph, &name("points.single_pass.clear"), cleared, pipelines.clear);
+    let bin = std::sync::Arc::new(pipelines.bin);
+    let count = (name("points.single_pass.count"), PHASE_COUNT);
+    declare_binning(graph, count, (buffers, view), tiles, bin.clone());
+    declare_prefix(
+        graph,
+        &name("points.single_pass.prefix"),
+        buffers.counter,
+        tiles,
+        pipelines.prefix,
+    );
+    let scatter = (name("points.single_pass.scatter"), PHASE_SCATTER);
+    declare_binning(graph, scatter, (buffers, view), tiles, bin);
+    let merge = (name("points.single_pass.merge"), pipelines.merge);
+    declare_merge(graph, merge, (buffers, view), targets, (tiles, written));
+    Ok(())
+}
+
+/// `points.single_pass.count` (`phase` [`PHASE_COUNT`]: the tiles' counts,
+/// and the splats counted) or `points.single_pass.scatter` ([`PHASE_SCATTER`]:
+/// the entries written): one dispatch per planned draw, one invocation per
+/// splat (`glsl/points/single_pass_bin.comp`).
+fn declare_binning<S: Provides<PointsFrame> + 'static>(
+    graph: &mut RenderGraph<Frame<S>>,
+    (name, phase): (String, u32),
+    (buffers, view): (PointBuffers, PointView),
+    tiles: TileBins,
+    pipeline: std::sync::Arc<ComputePipeline>,
+) {
+    let compute = Stage::Compute;
+    let mut builder = graph.pass(&name);
+    let frame = builder.upload(view.frame, compute);
+    let bins = builder.storage_buffer(tiles.bins, BufferAccess::StorageReadWrite(compute));
+    let entries =
+        (phase == PHASE_SCATTER).then(|| builder.storage_buffer(tiles.entries, BufferAccess::StorageWrite(compute)));
+    let buffers = PointBuffers {
+        counter: buffers.counter.filter(|_| phase == PHASE_COUNT),
+        ..buffers
+    };
+    let (builder, splat) = buffers.read_by_at(builder, frame, (compute, compute));
+    builder.record(move |pass, frame| {
+        let plan = plan_of(frame, view.index)?;
+        let entries = entries.map(|e| pass.handle(e)).transpose()?.unwrap_or(NO_HANDLE);
+        let mut push = SinglePassPush {
+            splat: splat.push(pass, PASS_OPAQUE)?,
+            single: [pass.handle(bins)?, entries, phase, 0],
+        };
+        let cmd = pass.cmd();
+        cmd.bind_compute(&pipeline);
+        for d in &plan.draws {
+            (push.splat.record, push.single[3]) = (d.record, d.count);
+            cmd.push_constants(&push)?;
+            let (x, y) = workgroups(d.count);
+            cmd.dispatch(x, y, 1);
+        }
+        Ok(())
+    });
+}
+
+/// `points.single_pass.prefix`: one workgroup: each tile's offset, kept
+/// length and cursor; dropped entries and the longest list into `counter`
+/// (`glsl/points/single_pass_prefix.comp`).
+fn declare_prefix<S: Provides<PointsFrame> + 'static>(
+    graph: &mut RenderGraph<Frame<S>>,
+    name: &str,
+    counter: Option<BufferId>,
+    tiles: TileBins,
+    pipeline: ComputePipeline,
+) {
+    let compute = Stage::Compute;
+    let mut pass = graph.pass(name);
+    let bins = pass.storage_buffer(tiles.bins, BufferAccess::StorageReadWrite(compute));
+    let counter = counter.map(|c| pass.storage_buffer(c, BufferAccess::StorageReadWrite(compute)));
+    pass.record(move |ctx, _| {
+        let counter = counter.map(|c| ctx.handle(c)).transpose()?.unwrap_or(NO_HANDLE);
+        let push = [ctx.handle(bins)?, tiles.tiles(), tiles.capacity, counter];
+        ctx.dispatch(&pipeline, &push, [1, 1, 1])
+    });
+}
+
+/// Push constants of `points.single_pass.merge` (`Push` in
+/// glsl/include/splat.glsl with `SPLAT_RESOLVE_COMPUTE` and `SPLAT_SINGLE_PASS`).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct MergePush {
+    splat: SplatPush,
+    resolved: ResolvedPush,
+    /// Bins, entries, depth buffer (sampled; [`NO_HANDLE`]: none), 1 to keep W where no splat is.
+    single: [u32; 4],
+}
+
+/// The heap bindings of `points.single_pass.merge`.
+#[derive(Clone, Copy, Debug)]
+struct MergeBindings {
+    shading: ShadingBindings,
+    splat: SplatBindings,
+    bins: Binding,
+    entries: Binding,
+    depth: Option<Binding>,
+    outputs: ResolvedTargets,
+}
+
+impl MergeBindings {
+    /// The pass's push constants (`keep_weight`: the triangles wrote W).
+    fn push(&self, pass: &PassContext<'_>, keep_weight: bool) -> Result<MergePush> {
+        let depth = self.depth.map(|d| pass.handle(d)).transpose()?.unwrap_or(NO_HANDLE);
+        Ok(MergePush {
+            splat: self.splat.push(pass, PASS_OPAQUE)?,
+            resolved: ResolvedPush::of(&self.outputs, pass)?,
+            single: [
+                pass.handle(self.bins)?,
+                pass.handle(self.entries)?,
+                depth,
+                u32::from(keep_weight),
+            ],
+        })
+    }
+}
+
+/// `points.single_pass.merge`: one workgroup per tile sorts its list, merges
+/// the splats front to back per pixel with the fuzzy-depth operator and
+/// writes each pixel once, normalised and shaded (W = 0 where no splat is
+/// unless the triangles wrote it; `glsl/points/single_pass_tile.comp`).
+fn declare_merge<S: Provides<PointsFrame> + 'static>(
+    graph: &mut RenderGraph<Frame<S>>,
+    (name, pipeline): (String, ComputePipeline),
+    (buffers, view): (PointBuffers, PointView),
+    targets: &SceneTargets,
+    (tiles, written): (TileBins, Written),
+) {
+    let compute = Stage::Compute;
+    let weight = match written.weight {
+        true => ImageAccess::StorageReadWrite(compute),
+        false => ImageAccess::StorageWrite(compute),
+    };
+    let mut builder = graph.pass(&name);
+    let shading = ShadingBindings::read_in(&mut builder, (&view, targets), compute);
+    let bins = builder.storage_buffer(tiles.bins, BufferAccess::StorageRead(compute));
+    // Lists longer than the shared-memory sort are sorted in place.
+    let entries = builder.storage_buffer(tiles.entries, BufferAccess::StorageReadWrite(compute));
+    let depth = written.depth.then(|| builder.sample(view.depth, compute));
+    let outputs = ResolvedTargets::declare(&mut builder, (&view, targets), weight);
+    let buffers = PointBuffers {
+        counter: None,
+        ..buffers
+    };
+    let (builder, splat) = buffers.read_by_at(builder, shading.frame, (compute, compute));
+    let bindings = MergeBindings {
+        shading,
+        splat,
+        bins,
+        entries,
+        depth,
+        outputs,
+    };
+    builder.record(move |pass, frame| {
+        bindings.shading.write_header(pass, frame, view.index)?;
+        let push = bindings.push(pass, written.weight)?;
+        pass.dispatch(&pipeline, &push, [tiles.grid[0], tiles.grid[1], 1])
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn push_constants_match_the_shader_block() {
+        // handles, mode, outputs, more, single.
+        assert_eq!(std::mem::size_of::<MergePush>(), 80);
+    }
+
+    #[test]
+    fn entry_capacity_is_clamped() {
+        let range = u64::from(u32::MAX);
+        assert_eq!(entry_capacity(0, range), 1 << 16);
+        assert_eq!(entry_capacity(100_000, range), 400_000);
+        assert_eq!(entry_capacity(u64::MAX, range), 1 << 25);
+        assert_eq!(entry_capacity(u64::MAX, 1 << 27), (1 << 27) / 12);
+    }
+}
