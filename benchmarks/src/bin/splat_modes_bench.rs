@@ -35,6 +35,9 @@ struct Measured {
     /// Median GPU time per points pass, ms, in submission order.
     passes: Vec<(String, f64)>,
     drawn: u64,
+    /// Single pass, compute backend: the longest tile list and the tile
+    /// entries dropped for want of capacity (0 in the other modes).
+    tiles: (u64, u64),
     /// The last frame, tone-mapped sRGB.
     rgba8: Vec<u8>,
 }
@@ -79,6 +82,9 @@ fn measure(ctx: &Context, scene: &Scene, camera: &Camera, points: SplatSettings,
         best_ms: totals.iter().copied().fold(f64::INFINITY, f64::min),
         passes,
         drawn: stats.last().and_then(|s| s.drawn_splats).unwrap_or(0),
+        tiles: stats.last().map_or((0, 0), |s| {
+            (s.longest_tile_list.unwrap_or(0), s.tile_entries_dropped.unwrap_or(0))
+        }),
         rgba8,
     }
 }
@@ -162,7 +168,11 @@ fn main() {
                 m.drawn, m.gpu_ms, m.best_ms, rates[0], rates[1], speedup[0], speedup[1]
             );
             let passes: Vec<String> = m.passes.iter().map(|(n, ms)| format!("{n} {ms:.1}")).collect();
-            breakdown.push(format!("  {name}: {}", passes.join(", ")));
+            let tiles = match m.tiles {
+                (0, _) => String::new(),
+                (longest, dropped) => format!(" (longest tile list {longest}, {dropped} entries dropped)"),
+            };
+            breakdown.push(format!("  {name}: {}{tiles}", passes.join(", ")));
             if reference.is_none() {
                 reference = Some((m, rates));
             }
