@@ -40,6 +40,9 @@ struct Measured {
     /// Median GPU time per points pass, ms, in submission order.
     passes: Vec<(String, f64)>,
     drawn: u64,
+    /// Single pass, compute backend: the longest tile list and the tile
+    /// entries dropped for want of capacity (0 in the other modes).
+    tiles: (u64, u64),
     /// The last frame, tone-mapped sRGB.
     rgba8: Vec<u8>,
 }
@@ -90,6 +93,9 @@ fn measure(
         best_ms: totals.iter().copied().fold(f64::INFINITY, f64::min),
         passes,
         drawn: stats.last().and_then(|s| s.drawn_splats).unwrap_or(0),
+        tiles: stats.last().map_or((0, 0), |s| {
+            (s.longest_tile_list.unwrap_or(0), s.tile_entries_dropped.unwrap_or(0))
+        }),
         rgba8,
     }
 }
@@ -252,7 +258,11 @@ fn main() {
                 m.name, measured.drawn, measured.gpu_ms, measured.best_ms, rates[0], rates[1], speedup[0], speedup[1]
             );
             let passes: Vec<String> = measured.passes.iter().map(|(n, ms)| format!("{n} {ms:.1}")).collect();
-            breakdown.push(format!("  {}: {}", m.name, passes.join(", ")));
+            let tiles = match measured.tiles {
+                (0, _) => String::new(),
+                (longest, dropped) => format!(" (longest tile list {longest}, {dropped} entries dropped)"),
+            };
+            breakdown.push(format!("  {}: {}{tiles}", m.name, passes.join(", ")));
             if reference.is_none() {
                 reference = Some((measured, rates));
             }
