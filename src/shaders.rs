@@ -34,6 +34,8 @@ pub const TERRAIN_SHADOW_RASTER: SpirV = spirv!("terrain/shadow_raster.comp");
 pub const TERRAIN_SHADOW_RASTER_BIG: SpirV = spirv!("terrain/shadow_raster_big.comp");
 /// terrain.shade: the visibility buffer shaded per pixel.
 pub const TERRAIN_SHADE: SpirV = spirv!("terrain/shade.comp");
+/// terrain.shade with the points' sums: splats normalized where they cover a pixel (issue 29).
+pub const TERRAIN_SHADE_SPLATS: SpirV = spirv!("terrain/shade_splats.comp");
 /// terrain.depth: the depth buffer from the compute path's NDC depth.
 pub const TERRAIN_DEPTH_FRAG: SpirV = spirv!("terrain/depth.frag");
 /// Every full-screen pass (sky, points.normalize): one triangle covering the screen.

@@ -23,6 +23,13 @@
 //! 5. `points.normalize`: per pixel, divide and shade as the hardware
 //!    path's normalization (`glsl/include/splat_resolve.glsl`).
 //!
+//! With the terrain on the compute path too, `points.clear` takes the
+//! nearest words from the terrain's visibility keys ([`GroundKeys`]), and
+//! there is no `points.normalize`: the sums go back ([`SplatSums`]) to the
+//! frame's shading pass, `terrain.shade`, which normalizes and shades them
+//! in its one pass over the pixels (issue 29). `points.accumulate` then
+//! writes the point frame's header.
+//!
 //! The primitive setting (§10.3) belongs to the hardware path: compute
 //! rasterises the screen-space ellipse itself.
 
@@ -42,6 +49,7 @@ use crate::graph::{
     stride_groups, Binding, BufferAccess, BufferId, BufferInfo, ImageAccess, PassContext, RenderGraph, Stage,
 };
 use crate::shaders;
+use crate::view::deferred::{GroundKeys, SplatSums};
 use crate::view::depth::FAR_DEPTH;
 use crate::view::{Frame, Provides, SceneTargets};
 use crate::vulkan::{Blend, CompareOp, ComputePipeline, Context, GraphicsPipeline, MemoryLocation};
@@ -66,12 +74,15 @@ struct ComputeSplatPush {
 }
 
 /// Push constants of `points.clear`: nearest, sums, last, depth buffer
-/// (sampled, [`NO_HANDLE`]: far); width, height.
+/// (sampled, [`NO_HANDLE`]: far); width, height, the ground's visibility
+/// keys ([`NO_HANDLE`]: none) and the point frame's depth row (P22, P32)
+/// that turns their view depths into the depth buffer's.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct ClearPush {
     handles: [u32; 4],
     size: [u32; 4],
+    row: [f32; 4],
 }
 
 /// Push constants of `points.normalize` (`Push` with `SPLAT_RESOLVE_COMPUTE`).
@@ -122,23 +133,29 @@ struct Pipelines {
     clear: ComputePipeline,
     visibility: ComputePipeline,
     accumulate: ComputePipeline,
-    normalize: ComputePipeline,
+    /// None: the ground's shading pass resolves the sums.
+    normalize: Option<ComputePipeline>,
 }
 
 /// Declares the compute path's EWA passes of one view (see the module's
-/// list); `name` gives a pass's name for the view.
+/// list); `name` gives a pass's name for the view. With the `ground`'s
+/// visibility keys the splats are tested against them and the sums are
+/// returned for the ground's shading pass (no `points.normalize`).
 pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
     ctx: &Context,
     graph: &mut RenderGraph<Frame<S>>,
     name: &dyn Fn(&str) -> String,
-    (buffers, view): (PointBuffers, PointView),
+    (buffers, view, ground): (PointBuffers, PointView, Option<GroundKeys>),
     targets: &SceneTargets,
-) -> Result<()> {
+) -> Result<Option<SplatSums>> {
     let pipelines = Pipelines {
         clear: ComputePipeline::new(ctx, shaders::SPLAT_COMPUTE_CLEAR)?,
         visibility: ComputePipeline::new(ctx, shaders::SPLAT_COMPUTE_VISIBILITY)?,
         accumulate: ComputePipeline::new(ctx, shaders::SPLAT_COMPUTE_ACCUMULATE)?,
-        normalize: ComputePipeline::new(ctx, shaders::SPLAT_COMPUTE_NORMALIZE)?,
+        normalize: match ground {
+            Some(_) => None,
+            None => Some(ComputePipeline::new(ctx, shaders::SPLAT_COMPUTE_NORMALIZE)?),
+        },
     };
     let pixels = u64::from(targets.width * targets.height).max(1);
     let mut buffer = |what, bytes: u64| {
@@ -163,6 +180,11 @@ pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
         false => None,
     };
     let opaque = hybrid && blended.is_none();
+    if opaque && ground.is_some() {
+        return Err(Error::Graph(format!(
+            "points: opaque hybrid triangles (no {TRIANGLE_FEATURE}) cannot be shaded by the ground's pass"
+        )));
+    }
     if opaque {
         let triangles_only = PointBuffers {
             primitive: SplatPrimitive::Quad,
@@ -177,11 +199,11 @@ pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
             false,
         )?;
     }
-    let depth_written = opaque || !view.clear_depth;
+    let depth_written = (opaque || !view.clear_depth) && ground.is_none();
     declare_clear(
         graph,
         &name("points.clear"),
-        (view, state, depth_written),
+        (view, state, depth_written, ground),
         pipelines.clear,
     );
     let splats = (buffers, view, state);
@@ -189,7 +211,7 @@ pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
         let pass = (true, t.visibility.clone());
         declare_triangles(graph, &name("points.visibility.triangles"), splats, pass);
     }
-    declare_splats(graph, &name("points.visibility"), splats, true, pipelines.visibility)?;
+    declare_splats(graph, &name("points.visibility"), (splats, None), true, pipelines.visibility)?;
     if let Some(t) = blended {
         declare_triangles(
             graph,
@@ -198,21 +220,30 @@ pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
             (false, t.accumulate),
         );
     }
-    declare_splats(graph, &name("points.accumulate"), splats, false, pipelines.accumulate)?;
+    let header = ground.is_some().then_some(targets);
+    declare_splats(graph, &name("points.accumulate"), (splats, header), false, pipelines.accumulate)?;
+    let Some(normalize_pipeline) = pipelines.normalize else {
+        return Ok(Some(SplatSums {
+            nearest: state.nearest,
+            sums: state.sums,
+            last: state.last,
+            frame: view.frame,
+        }));
+    };
     let normalize = name("points.normalize");
     declare_normalize(
         graph,
-        (normalize.as_str(), pipelines.normalize),
+        (normalize.as_str(), normalize_pipeline),
         (view, targets),
         state,
         opaque,
     );
-    Ok(())
+    Ok(None)
 }
 
 /// The device feature the hybrid triangles' passes need on the compute
 /// path (their fragments write the splats' state).
-const TRIANGLE_FEATURE: &str = "fragmentStoresAndAtomics";
+pub(super) const TRIANGLE_FEATURE: &str = "fragmentStoresAndAtomics";
 
 /// The hybrid triangles' pipelines (`glsl/points/hybrid.vert` with the
 /// compute path's fragment stages): no attachment written, no depth test
@@ -288,20 +319,24 @@ fn declare_triangles<S: Provides<PointsFrame> + 'static>(
     });
 }
 
-/// `points.clear`: the nearest words from the depth buffer (when something
-/// drew into it), sums and last records 0.
+/// `points.clear`: the nearest words from the ground's visibility keys
+/// (when given) or the depth buffer (when something drew into it), sums
+/// and last records 0.
 fn declare_clear<S: Provides<PointsFrame> + 'static>(
     graph: &mut RenderGraph<Frame<S>>,
     name: &str,
-    (view, state, depth_written): (PointView, SplatState, bool),
+    (view, state, depth_written, ground): (PointView, SplatState, bool, Option<GroundKeys>),
     pipeline: ComputePipeline,
 ) {
     let write = BufferAccess::StorageWrite(Stage::Compute);
     let mut pass = graph.pass(name);
     let buffers = [state.nearest, state.sums, state.last].map(|b| pass.storage_buffer(b, write));
     let depth = depth_written.then(|| pass.sample(view.depth, Stage::Compute));
-    pass.record(move |ctx, _| {
+    let keys = ground.map(|g| pass.storage_buffer(g.0, BufferAccess::StorageRead(Stage::Compute)));
+    pass.record(move |ctx, frame| {
         let depth = depth.map(|d| ctx.handle(d)).transpose()?.unwrap_or(NO_HANDLE);
+        let keys = keys.map(|k| ctx.handle(k)).transpose()?.unwrap_or(NO_HANDLE);
+        let row = frame.prepared::<PointsFrame>()?.view(view.index)?.header.depth;
         let push = ClearPush {
             handles: [
                 ctx.handle(buffers[0])?,
@@ -309,7 +344,8 @@ fn declare_clear<S: Provides<PointsFrame> + 'static>(
                 ctx.handle(buffers[2])?,
                 depth,
             ],
-            size: [state.size[0], state.size[1], 0, 0],
+            size: [state.size[0], state.size[1], keys, 0],
+            row: [row[0], row[1], 0.0, 0.0],
         };
         let groups = [state.size[0].div_ceil(8), state.size[1].div_ceil(8), 1];
         ctx.dispatch(&pipeline, &push, groups)
@@ -318,17 +354,23 @@ fn declare_clear<S: Provides<PointsFrame> + 'static>(
 
 /// `points.visibility` (`visibility`: raises the nearest words, counts the
 /// drawn splats) or `points.accumulate` (reads them, adds to the sums and
-/// raises the last records): one dispatch per planned draw.
+/// raises the last records): one dispatch for all the view's draws. With
+/// `header` (the view's targets) the pass writes the point frame's header,
+/// for the ground's shading pass to read.
 fn declare_splats<S: Provides<PointsFrame> + 'static>(
     graph: &mut RenderGraph<Frame<S>>,
     name: &str,
-    (buffers, view, state): (PointBuffers, PointView, SplatState),
+    ((buffers, view, state), header): ((PointBuffers, PointView, SplatState), Option<&SceneTargets>),
     visibility: bool,
     pipeline: ComputePipeline,
 ) -> Result<()> {
     let compute = Stage::Compute;
     let mut builder = graph.pass(name);
-    let frame = builder.upload(view.frame, compute);
+    let shading = header.map(|targets| ShadingBindings::read_in(&mut builder, (&view, targets), compute));
+    let frame = match &shading {
+        Some(s) => s.frame,
+        None => builder.upload(view.frame, compute),
+    };
     let buffers = PointBuffers {
         counter: buffers.counter.filter(|_| visibility),
         ..buffers
@@ -352,6 +394,9 @@ fn declare_splats<S: Provides<PointsFrame> + 'static>(
         },
     };
     builder.record(move |pass, frame| {
+        if let Some(shading) = &shading {
+            shading.write_header(pass, frame, view.index)?;
+        }
         let plan = plan_of(frame, view.index)?;
         // The draw table was checked not to overflow when it was written.
         let splats = plan.draws.iter().map(|d| d.count).fold(0u32, u32::wrapping_add);
@@ -409,9 +454,9 @@ mod tests {
 
     #[test]
     fn push_constants_match_the_shader_blocks() {
-        // handles, mode (SplatPush), raster, draws: 64 bytes; clear and normalize: 32 and 64.
+        // handles, mode (SplatPush), raster, draws: 64 bytes; clear and normalize: 48 and 64.
         assert_eq!(std::mem::size_of::<ComputeSplatPush>(), 64);
-        assert_eq!(std::mem::size_of::<ClearPush>(), 32);
+        assert_eq!(std::mem::size_of::<ClearPush>(), 48);
         assert_eq!(std::mem::size_of::<NormalizePush>(), 64);
     }
 }
