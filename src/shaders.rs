@@ -82,6 +82,10 @@ pub const SPLAT_COMPUTE_VISIBILITY: SpirV = spirv!("points/compute_visibility.co
 pub const SPLAT_COMPUTE_ACCUMULATE: SpirV = spirv!("points/compute_accumulate.comp");
 /// points.normalize (compute path): the sums divided and shaded (§10.2.3).
 pub const SPLAT_COMPUTE_NORMALIZE: SpirV = spirv!("points/compute_normalize.comp");
+/// points.opaque (compute path): the nearest splat's index raised per pixel.
+pub const SPLAT_COMPUTE_OPAQUE: SpirV = spirv!("points/compute_opaque.comp");
+/// points.opaque.resolve (compute path): the winning splat shaded per pixel.
+pub const SPLAT_COMPUTE_OPAQUE_RESOLVE: SpirV = spirv!("points/compute_opaque_resolve.comp");
 /// points.*, object-space primitives (§10.3): quads in the tangent plane, the interval test.
 pub const OBJECT_SPLAT_VERT: SpirV = spirv!("points/object_splat.vert");
 /// points.visibility, object-space primitives: the pushed-back quad's depth inside the kernel's disk.

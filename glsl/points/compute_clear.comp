@@ -10,7 +10,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(push_constant) uniform Push {
-    uvec4 handles;  // nearest words, sums, last records, depth buffer (sampled; NO_HANDLE: far)
+    uvec4 handles;  // nearest words, sums and last records (NO_HANDLE: opaque splats), depth buffer (sampled; NO_HANDLE: far)
     uvec4 size;     // width, height, the ground's visibility keys (NO_HANDLE: none), -
     vec4 row;       // the point frame's depth row (P22, P32): view depth → depth
 } pc;
@@ -40,6 +40,9 @@ void main() {
         }
     }
     g_splat_nearest[pc.handles.x].w[p] = uint64_t(floatBitsToUint(depth)) << 32;
+    if (pc.handles.y == NO_HANDLE) {
+        return;  // opaque splats: no sums
+    }
     for (uint k = 0u; k < SPLAT_SUMS; ++k) {
         g_splat_sums[pc.handles.y].s[p * SPLAT_SUMS + k] = int64_t(0);
     }

@@ -175,7 +175,8 @@ impl Terrain {
                 "terrain.shade of view {index}: the view's compute passes left no shading for the splats"
             )));
         };
-        path.raster.declare_shade_with_splats(graph, view, &pass, (keys, sums), targets)
+        path.raster
+            .declare_shade_with_splats(graph, view, &pass, (keys, sums), targets)
     }
 
     /// Whether `terrain.shade` shades the sky too (the compute path): then

@@ -97,13 +97,20 @@ struct NormalizePush {
     more: [u32; 4],
 }
 
-/// A view's per-pixel splat state.
+/// A view's per-pixel splat state: the nearest words, and for EWA the
+/// sums and last records (None: opaque splats, [`super::compute_opaque`]).
 #[derive(Clone, Copy, Debug)]
-struct SplatState {
-    nearest: BufferId,
-    sums: BufferId,
-    last: BufferId,
-    size: [u32; 2],
+pub(super) struct SplatState {
+    pub nearest: BufferId,
+    pub accumulation: Option<(BufferId, BufferId)>,
+    pub size: [u32; 2],
+}
+
+impl SplatState {
+    /// The sums and last records (EWA only).
+    fn accumulation(&self) -> Result<(BufferId, BufferId)> {
+        (self.accumulation).ok_or_else(|| Error::Graph("points: opaque splats have no sums".into()))
+    }
 }
 
 /// The bindings of one of the state's buffers in each pass that uses it.
@@ -167,8 +174,10 @@ pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
     };
     let state = SplatState {
         nearest: buffer("splat nearest depth and record", NEAREST_BYTES),
-        sums: buffer("splat fixed-point sums", SUMS_BYTES),
-        last: buffer("splat last record", LAST_BYTES),
+        accumulation: Some((
+            buffer("splat fixed-point sums", SUMS_BYTES),
+            buffer("splat last record", LAST_BYTES),
+        )),
         size: [targets.width, targets.height],
     };
     // Hybrid triangles (§10.1.8): in the splats' state, as the hardware
@@ -186,18 +195,7 @@ pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
         )));
     }
     if opaque {
-        let triangles_only = PointBuffers {
-            primitive: SplatPrimitive::Quad,
-            ..buffers
-        };
-        declare_opaque(
-            ctx,
-            graph,
-            &name("points.triangles"),
-            (triangles_only, view),
-            targets,
-            false,
-        )?;
+        declare_opaque_triangles(ctx, graph, &name("points.triangles"), (buffers, view), targets)?;
     }
     let depth_written = (opaque || !view.clear_depth) && ground.is_none();
     declare_clear(
@@ -209,24 +207,37 @@ pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
     let splats = (buffers, view, state);
     if let Some(t) = &blended {
         let pass = (true, t.visibility.clone());
-        declare_triangles(graph, &name("points.visibility.triangles"), splats, pass);
+        declare_triangles(graph, &name("points.visibility.triangles"), splats, pass)?;
     }
-    declare_splats(graph, &name("points.visibility"), (splats, None), true, pipelines.visibility)?;
+    declare_splats(
+        graph,
+        &name("points.visibility"),
+        (splats, None),
+        true,
+        pipelines.visibility,
+    )?;
     if let Some(t) = blended {
         declare_triangles(
             graph,
             &name("points.accumulate.triangles"),
             splats,
             (false, t.accumulate),
-        );
+        )?;
     }
     let header = ground.is_some().then_some(targets);
-    declare_splats(graph, &name("points.accumulate"), (splats, header), false, pipelines.accumulate)?;
+    declare_splats(
+        graph,
+        &name("points.accumulate"),
+        (splats, header),
+        false,
+        pipelines.accumulate,
+    )?;
     let Some(normalize_pipeline) = pipelines.normalize else {
+        let (sums, last) = state.accumulation()?;
         return Ok(Some(SplatSums {
             nearest: state.nearest,
-            sums: state.sums,
-            last: state.last,
+            sums,
+            last,
             frame: view.frame,
         }));
     };
@@ -237,8 +248,25 @@ pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
         (view, targets),
         state,
         opaque,
-    );
+    )?;
     Ok(None)
+}
+
+/// `points.triangles`: the hybrid triangles (§10.1.8) opaque and shaded
+/// on the hardware path, with depth and W = 1, for the splats' compute
+/// passes to test against.
+pub(super) fn declare_opaque_triangles<S: Provides<PointsFrame> + 'static>(
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame<S>>,
+    name: &str,
+    (buffers, view): (PointBuffers, PointView),
+    targets: &SceneTargets,
+) -> Result<()> {
+    let triangles_only = PointBuffers {
+        primitive: SplatPrimitive::Quad,
+        ..buffers
+    };
+    declare_opaque(ctx, graph, name, (triangles_only, view), targets, false)
 }
 
 /// The device feature the hybrid triangles' passes need on the compute
@@ -282,7 +310,7 @@ fn declare_triangles<S: Provides<PointsFrame> + 'static>(
     name: &str,
     (buffers, view, state): (PointBuffers, PointView, SplatState),
     (visibility, pipeline): (bool, Arc<GraphicsPipeline>),
-) {
+) -> Result<()> {
     let mut builder = graph.pass(name).graphics();
     let frame = builder.upload(view.frame, Stage::Graphics);
     let (mut builder, splat) = buffers.read_by(builder, frame, visibility);
@@ -296,8 +324,8 @@ fn declare_triangles<S: Provides<PointsFrame> + 'static>(
         },
         false => StateBindings {
             nearest: builder.storage_buffer(state.nearest, BufferAccess::StorageRead(fragment)),
-            sums: Some(builder.storage_buffer(state.sums, written)),
-            last: Some(builder.storage_buffer(state.last, written)),
+            sums: Some(builder.storage_buffer(state.accumulation()?.0, written)),
+            last: Some(builder.storage_buffer(state.accumulation()?.1, written)),
         },
     };
     let builder = builder.pipeline(&pipeline);
@@ -317,12 +345,13 @@ fn declare_triangles<S: Provides<PointsFrame> + 'static>(
         };
         draw_triangles_with(pass.cmd(), &pipeline, plan, (push, |p| &mut p.splat), triangles)
     });
+    Ok(())
 }
 
 /// `points.clear`: the nearest words from the ground's visibility keys
 /// (when given) or the depth buffer (when something drew into it), sums
 /// and last records 0.
-fn declare_clear<S: Provides<PointsFrame> + 'static>(
+pub(super) fn declare_clear<S: Provides<PointsFrame> + 'static>(
     graph: &mut RenderGraph<Frame<S>>,
     name: &str,
     (view, state, depth_written, ground): (PointView, SplatState, bool, Option<GroundKeys>),
@@ -330,20 +359,20 @@ fn declare_clear<S: Provides<PointsFrame> + 'static>(
 ) {
     let write = BufferAccess::StorageWrite(Stage::Compute);
     let mut pass = graph.pass(name);
-    let buffers = [state.nearest, state.sums, state.last].map(|b| pass.storage_buffer(b, write));
+    let nearest = pass.storage_buffer(state.nearest, write);
+    let sums = (state.accumulation).map(|(s, l)| [s, l].map(|b| pass.storage_buffer(b, write)));
     let depth = depth_written.then(|| pass.sample(view.depth, Stage::Compute));
     let keys = ground.map(|g| pass.storage_buffer(g.0, BufferAccess::StorageRead(Stage::Compute)));
     pass.record(move |ctx, frame| {
         let depth = depth.map(|d| ctx.handle(d)).transpose()?.unwrap_or(NO_HANDLE);
         let keys = keys.map(|k| ctx.handle(k)).transpose()?.unwrap_or(NO_HANDLE);
         let row = frame.prepared::<PointsFrame>()?.view(view.index)?.header.depth;
+        let [sums, last] = match sums {
+            Some(buffers) => [ctx.handle(buffers[0])?, ctx.handle(buffers[1])?],
+            None => [NO_HANDLE; 2],
+        };
         let push = ClearPush {
-            handles: [
-                ctx.handle(buffers[0])?,
-                ctx.handle(buffers[1])?,
-                ctx.handle(buffers[2])?,
-                depth,
-            ],
+            handles: [ctx.handle(nearest)?, sums, last, depth],
             size: [state.size[0], state.size[1], keys, 0],
             row: [row[0], row[1], 0.0, 0.0],
         };
@@ -357,7 +386,7 @@ fn declare_clear<S: Provides<PointsFrame> + 'static>(
 /// raises the last records): one dispatch for all the view's draws. With
 /// `header` (the view's targets) the pass writes the point frame's header,
 /// for the ground's shading pass to read.
-fn declare_splats<S: Provides<PointsFrame> + 'static>(
+pub(super) fn declare_splats<S: Provides<PointsFrame> + 'static>(
     graph: &mut RenderGraph<Frame<S>>,
     name: &str,
     ((buffers, view, state), header): ((PointBuffers, PointView, SplatState), Option<&SceneTargets>),
@@ -389,8 +418,8 @@ fn declare_splats<S: Provides<PointsFrame> + 'static>(
         },
         false => StateBindings {
             nearest: builder.storage_buffer(state.nearest, BufferAccess::StorageRead(compute)),
-            sums: Some(builder.storage_buffer(state.sums, written)),
-            last: Some(builder.storage_buffer(state.last, written)),
+            sums: Some(builder.storage_buffer(state.accumulation()?.0, written)),
+            last: Some(builder.storage_buffer(state.accumulation()?.1, written)),
         },
     };
     builder.record(move |pass, frame| {
@@ -423,7 +452,7 @@ fn declare_normalize<S: Provides<PointsFrame> + 'static>(
     (view, targets): (PointView, &SceneTargets),
     state: SplatState,
     triangles: bool,
-) {
+) -> Result<()> {
     let pipeline = Arc::new(pipeline);
     let compute = Stage::Compute;
     let weight = match triangles {
@@ -433,7 +462,8 @@ fn declare_normalize<S: Provides<PointsFrame> + 'static>(
     let mut builder = graph.pass(name);
     let shading = ShadingBindings::read_in(&mut builder, (&view, targets), compute);
     let read = BufferAccess::StorageRead(compute);
-    let [nearest, sums, last] = [state.nearest, state.sums, state.last].map(|b| builder.storage_buffer(b, read));
+    let (sums, last) = state.accumulation()?;
+    let [nearest, sums, last] = [state.nearest, sums, last].map(|b| builder.storage_buffer(b, read));
     let outputs = ResolvedTargets::declare(&mut builder, (&view, targets), weight);
     builder.record(move |pass, frame| {
         let frame = shading.write_header(pass, frame, view.index)?;
@@ -446,6 +476,7 @@ fn declare_normalize<S: Provides<PointsFrame> + 'static>(
         };
         pass.dispatch(&pipeline, &push, outputs.groups())
     });
+    Ok(())
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::compute::{declare_ewa_compute, TRIANGLE_FEATURE};
+use super::compute_opaque::declare_opaque_compute;
 use super::gpu_layout::{frame_header, gaussian_table, pack_nodes, FrameHeader, HEADER_BYTES, INSTANCE_BYTES};
 use super::object_space::ObjectSpaceResources;
 use super::passes::{declare_ewa, declare_opaque, PointBuffers, PointView};
@@ -75,15 +76,16 @@ pub struct PointRenderer {
     stats: StatsLog,
     /// The previous frame's plans, reused ([`Technique::recycle`]).
     spare: Vec<PointViewFrame>,
-    /// EWA splats drawn by compute passes ([`super::compute`]), not the
-    /// hardware rasterizer.
+    /// EWA and opaque splats drawn by compute passes ([`super::compute`],
+    /// [`super::compute_opaque`]), not the hardware rasterizer.
     compute: bool,
 }
 
 impl PointRenderer {
-    /// Whether EWA splats are drawn by compute passes.
+    /// Whether the splats are drawn by compute passes (EWA and opaque on
+    /// the compute path; single-pass splatting is compute either way).
     pub fn draws_in_compute(&self) -> bool {
-        self.compute && self.settings.mode == SplatMode::Ewa
+        self.compute && matches!(self.settings.mode, SplatMode::Ewa | SplatMode::Opaque)
     }
 
     /// Uploads the splat lists of `scene` (re-derived for
@@ -281,6 +283,9 @@ impl<S: Provides<PointsFrame> + 'static> Declare<S> for PointRenderer {
         let name = |base: &str| pass_name(base, &view.name);
         let mut sums = None;
         match self.settings.mode {
+            SplatMode::Opaque if self.compute => {
+                declare_opaque_compute(ctx, graph, &name, (buffers, point_view), targets)?
+            }
             SplatMode::Opaque => {
                 declare_opaque(ctx, graph, &name("points.opaque"), (buffers, point_view), targets, true)?
             }
