@@ -527,7 +527,15 @@ fn info(args: DeviceArgs) -> Result<ExitCode> {
     println!("driver:      {} ({})", i.driver_name, i.driver_info);
     println!("vulkan:      {}", i.api_version);
     println!("vendor/id:   {:#06x}/{:#06x}", i.vendor_id, i.device_id);
-    println!("timestamps:  {} ns per tick", i.timestamp_period_ns);
+    println!(
+        "timestamps:  {} ns per tick, {}",
+        i.timestamp_period_ns,
+        if i.calibrated_timestamps {
+            "calibrated against the CPU clock"
+        } else {
+            "not calibrated"
+        }
+    );
     println!("max image:   {} px per side", i.max_image_dimension_2d);
     println!(
         "memory:      {} device heap{}, at most {} in one allocation",

@@ -453,6 +453,9 @@ impl<P> BakedGraph<P> {
             profile.gpu_ms = if first.is_finite() { (last - first) / 1e6 } else { 0.0 };
             profile.cpu_ms = p.cpu_ms;
             profile.cpu_start_ms = p.cpu_start_ms;
+            profile.submit_ms = ms_since(self.epoch, completed.submitted);
+            profile.fence_ms = ms_since(self.epoch, completed.waited);
+            profile.gpu_start_on_cpu_ms = completed.first_gpu.map(|at| ms_since(self.epoch, at));
             self.profiles.push(profile);
             self.spare_cpu_passes.push(p.cpu_passes);
             return;
@@ -475,6 +478,14 @@ impl<P> BakedGraph<P> {
     /// Timings of the frames completed so far (oldest first), removing them.
     pub fn take_profiles(&mut self) -> Vec<FrameProfile> {
         std::mem::take(&mut self.profiles)
+    }
+}
+
+/// Milliseconds from `epoch` to `at` (negative when `at` is earlier).
+fn ms_since(epoch: Instant, at: Instant) -> f64 {
+    match at.checked_duration_since(epoch) {
+        Some(d) => d.as_secs_f64() * 1e3,
+        None => -(epoch - at).as_secs_f64() * 1e3,
     }
 }
 

@@ -2,8 +2,11 @@
 //! a command buffer and a timestamp query pool, reused once the GPU has
 //! finished the frame that last used the slot.
 
+use std::time::Instant;
+
 use ash::vk;
 
+use super::clock::Calibration;
 use super::commands::CommandRecorder;
 use super::context::{vk_err, Context};
 use super::memory::Garbage;
@@ -24,13 +27,37 @@ struct FrameSlot {
     frame: u64,
     /// The previous frame's timestamps, read by `wait_for_next`.
     completed: Option<CompletedFrame>,
+    /// The last submission's CPU times: right before the submit call, and
+    /// when the first wait for its completion returned; the clocks read
+    /// together right before submitting (with calibrated timestamps).
+    submit_at: Option<Instant>,
+    waited_at: Option<Instant>,
+    calibration: Option<Calibration>,
 }
 
-/// GPU timestamps of a completed frame, in nanoseconds from the first query.
+impl FrameSlot {
+    /// Notes that the wait for the last submission returned (the first
+    /// time only).
+    fn waited(&mut self) {
+        if self.submitted > 0 && self.waited_at.is_none() {
+            self.waited_at = Some(Instant::now());
+        }
+    }
+}
+
+/// GPU timestamps of a completed frame, in nanoseconds from the first query,
+/// and where the frame lies on the CPU clock.
 #[derive(Clone, Debug)]
 pub struct CompletedFrame {
     pub frame: u64,
     pub timestamps_ns: Vec<f64>,
+    /// Right before the frame was submitted.
+    pub submitted: Instant,
+    /// When the first wait for the frame's completion returned.
+    pub waited: Instant,
+    /// The CPU instant of the first timestamp, with calibrated timestamps
+    /// ([`super::DeviceInfo::calibrated_timestamps`]); None without.
+    pub first_gpu: Option<Instant>,
 }
 
 /// The ring of frame slots.
@@ -83,6 +110,9 @@ impl FrameRing {
                 written_queries: 0,
                 frame: 0,
                 completed: None,
+                submit_at: None,
+                waited_at: None,
+                calibration: None,
             });
         }
         Ok(FrameRing {
@@ -130,9 +160,14 @@ impl FrameRing {
         let mut timestamps_ns = self.spare_timestamps.pop().unwrap_or_default();
         timestamps_ns.clear();
         timestamps_ns.extend(ticks.iter().map(|&t| (t.wrapping_sub(first)) as f64 * period));
+        let now = Instant::now();
+        let submitted = s.submit_at.unwrap_or(now);
         Ok(Some(CompletedFrame {
             frame: s.frame,
             timestamps_ns,
+            submitted,
+            waited: s.waited_at.unwrap_or(now).max(submitted),
+            first_gpu: s.calibration.map(|c| c.instant_of(first)),
         }))
     }
 
@@ -147,6 +182,7 @@ impl FrameRing {
     pub fn wait_for_next(&mut self) -> Result<u64> {
         let slot = (self.next_frame % FRAMES_IN_FLIGHT as u64) as usize;
         self.ctx.wait(self.slots[slot].submitted)?;
+        self.slots[slot].waited();
         if self.slots[slot].completed.is_none() {
             let completed = self.read_timestamps(slot)?;
             let s = &mut self.slots[slot];
@@ -161,6 +197,7 @@ impl FrameRing {
     pub fn begin(&mut self, queries: u32) -> Result<(RecordingFrame<'_>, Option<CompletedFrame>)> {
         let slot = (self.next_frame % FRAMES_IN_FLIGHT as u64) as usize;
         self.ctx.wait(self.slots[slot].submitted)?;
+        self.slots[slot].waited();
         let completed = match self.slots[slot].completed.take() {
             Some(c) => Some(c),
             None => self.read_timestamps(slot)?,
@@ -209,6 +246,7 @@ impl FrameRing {
         self.ctx.wait_idle()?;
         let mut done = Vec::new();
         for slot in 0..self.slots.len() {
+            self.slots[slot].waited();
             if let Some(c) = self.slots[slot].completed.take() {
                 done.push(c);
             }
@@ -234,6 +272,9 @@ impl RecordingFrame<'_> {
         let s = &mut self.ring.slots[self.slot];
         // SAFETY: the command buffer is recording and every label was closed.
         unsafe { ctx.shared.device.end_command_buffer(s.cmd) }.map_err(vk_err("vkEndCommandBuffer"))?;
+        s.calibration = ctx.shared.clock.as_ref().and_then(|c| c.calibrate());
+        s.waited_at = None;
+        s.submit_at = Some(Instant::now());
         let value = ctx.submit(s.cmd)?;
         s.submitted = value;
         ctx.collect_garbage()?;

@@ -11,6 +11,10 @@ use serde_json::{json, Value};
 use crate::error::{Error, Result};
 use crate::io::atomic::write_bytes_atomically;
 
+mod trace;
+
+pub use trace::{chrome_trace, gpu_spans_outside_frames, write_chrome_trace};
+
 /// Deserialises a number, reading `null` (how JSON stores NaN and
 /// infinities) as NaN, so that every written profile can be read back.
 fn f64_or_nan<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
@@ -68,6 +72,20 @@ pub struct FrameProfile {
     /// CPU start of this frame, relative to the first frame's start.
     #[serde(deserialize_with = "f64_or_nan")]
     pub cpu_start_ms: f64,
+    /// CPU time right before the frame was submitted (same origin as
+    /// `cpu_start_ms`).
+    #[serde(default, deserialize_with = "f64_or_nan")]
+    pub submit_ms: f64,
+    /// CPU time the first wait for the frame's completion returned (same
+    /// origin): the frame's GPU work ended before it.
+    #[serde(default, deserialize_with = "f64_or_nan")]
+    pub fence_ms: f64,
+    /// The frame's first GPU timestamp on the CPU clock (same origin) when
+    /// GPU timestamps are calibrated
+    /// ([`DeviceInfo::calibrated_timestamps`](crate::DeviceInfo)); None
+    /// without calibration.
+    #[serde(default)]
+    pub gpu_start_on_cpu_ms: Option<f64>,
 }
 
 /// Median timings of one pass over all profiled frames.
@@ -149,7 +167,7 @@ pub fn summarize(frames: &[FrameProfile]) -> (Vec<PassSummary>, FrameSummary) {
 }
 
 /// Serialises `value` as pretty JSON with a final newline.
-fn json_text(value: &Value) -> Result<String> {
+pub(crate) fn json_text(value: &Value) -> Result<String> {
     let mut text = serde_json::to_string_pretty(value).map_err(|e| Error::invalid("JSON encoding", e))?;
     text.push('\n');
     Ok(text)
@@ -173,141 +191,11 @@ pub fn write_profile_json(path: &Path, device_name: &str, raster: &str, frames: 
     write_bytes_atomically(path, profile_json(device_name, raster, frames)?.as_bytes())
 }
 
-/// Milliseconds to whole nanoseconds; NaN, negative or infinite become 0.
-fn ns(ms: f64) -> i64 {
-    let v = (ms * 1.0e6).round();
-    if v.is_finite() && v > 0.0 {
-        v.min(i64::MAX as f64 / 4.0) as i64
-    } else {
-        0
-    }
-}
-
-/// Nanoseconds to the trace's microseconds.
-fn us(ns: i64) -> f64 {
-    ns as f64 / 1000.0
-}
-
-const PID: u32 = 1;
-const CPU_TID: u32 = 1;
-const GPU_TID: u32 = 2;
-
-/// One complete ("X") event.
-fn complete(name: &str, cat: &str, tid: u32, start_ns: i64, dur_ns: i64, args: Value) -> Value {
-    json!({
-        "name": name, "cat": cat, "ph": "X", "pid": PID, "tid": tid,
-        "ts": us(start_ns), "dur": us(dur_ns), "args": args,
-    })
-}
-
-/// One event of a track: name, args, start and duration (ns, relative to
-/// the frame's start).
-type Span<'a> = (&'a str, Value, i64, i64);
-
-/// A pass's span on the CPU or GPU track.
-fn pass_span<'a>(frame: &FrameProfile, pass: &'a PassTiming, start: i64, dur: i64) -> Span<'a> {
-    let args = json!({ "frame": frame.frame, "gpu_ms": pass.gpu_ms, "cpu_ms": pass.cpu_ms });
-    (&pass.name, args, start, dur)
-}
-
-/// Appends one frame's events on one track. `spans` are (name, args,
-/// start, dur) in ns relative to `frame_start`. Passes are laid out in start order and
-/// clipped so they never overlap (the trace format nests events on a
-/// thread; partial overlaps would be misdrawn); the frame event is widened
-/// to enclose them. The raw values stay in each event's `args`.
-fn push_track(
-    events: &mut Vec<Value>,
-    tid: u32,
-    frame: &FrameProfile,
-    frame_start: i64,
-    frame_dur: i64,
-    spans: Vec<Span<'_>>,
-) -> i64 {
-    let mut spans = spans;
-    spans.sort_by_key(|s| s.2);
-    let mut cursor = frame_start;
-    let mut pass_events = Vec::with_capacity(spans.len());
-    for (name, args, start, dur) in spans {
-        let begin = (frame_start + start).max(cursor);
-        let end = (frame_start + start + dur).max(begin);
-        let cat = if name.starts_with("prepare.") {
-            "prepare"
-        } else {
-            "pass"
-        };
-        pass_events.push(complete(name, cat, tid, begin, end - begin, args));
-        cursor = end;
-    }
-    let end = (frame_start + frame_dur).max(cursor);
-    let args = json!({ "gpu_ms": frame.gpu_ms, "cpu_ms": frame.cpu_ms });
-    let name = format!("frame {}", frame.frame);
-    events.push(complete(&name, "frame", tid, frame_start, end - frame_start, args));
-    events.extend(pass_events);
-    end
-}
-
-/// Writes a Chrome Trace Event Format file:
-/// `{"traceEvents": [...], "displayTimeUnit": "ms"}` with complete events
-/// (`ph: "X"`, `ts`/`dur` in microseconds) in process 1 "alpenglow", thread
-/// 1 "CPU (prepare, record)" and thread 2 "GPU (`device_name`)", named by `M` metadata
-/// events. Each track has one "frame N" event per frame enclosing one event
-/// per pass.
-///
-/// GPU and CPU clocks are not calibrated against each other: each GPU frame
-/// is placed at its frame's CPU start, or right after the previous GPU frame
-/// if that is later, so the GPU track never overlaps itself.
-pub fn write_chrome_trace(path: &Path, device_name: &str, frames: &[FrameProfile]) -> Result<()> {
-    write_bytes_atomically(path, chrome_trace(device_name, frames)?.as_bytes())
-}
-
-/// The text of [`write_chrome_trace`].
-pub fn chrome_trace(device_name: &str, frames: &[FrameProfile]) -> Result<String> {
-    let meta =
-        |name: &str, tid: u32, args: Value| json!({ "name": name, "ph": "M", "pid": PID, "tid": tid, "args": args });
-    let mut events = vec![
-        meta("process_name", 0, json!({ "name": "alpenglow" })),
-        meta("thread_name", CPU_TID, json!({ "name": "CPU (prepare, record)" })),
-        meta("thread_sort_index", CPU_TID, json!({ "sort_index": 1 })),
-        meta(
-            "thread_name",
-            GPU_TID,
-            json!({ "name": format!("GPU ({device_name})") }),
-        ),
-        meta("thread_sort_index", GPU_TID, json!({ "sort_index": 2 })),
-    ];
-    let mut cpu_end = 0i64;
-    let mut gpu_end = 0i64;
-    for frame in frames {
-        let cpu_start = ns(frame.cpu_start_ms).max(cpu_end);
-        let prepare = frame.prepare.iter().map(|s| {
-            let args = json!({ "frame": frame.frame, "cpu_ms": s.cpu_ms });
-            (s.name.as_str(), args, ns(s.cpu_start_ms), ns(s.cpu_ms))
-        });
-        let cpu_spans = prepare
-            .chain(
-                frame
-                    .passes
-                    .iter()
-                    .map(|p| pass_span(frame, p, ns(p.cpu_start_ms), ns(p.cpu_ms))),
-            )
-            .collect();
-        cpu_end = push_track(&mut events, CPU_TID, frame, cpu_start, ns(frame.cpu_ms), cpu_spans);
-        let gpu_start = cpu_start.max(gpu_end);
-        let gpu_spans = frame
-            .passes
-            .iter()
-            .map(|p| pass_span(frame, p, ns(p.gpu_start_ms), ns(p.gpu_ms)))
-            .collect();
-        gpu_end = push_track(&mut events, GPU_TID, frame, gpu_start, ns(frame.gpu_ms), gpu_spans);
-    }
-    json_text(&json!({ "traceEvents": events, "displayTimeUnit": "ms" }))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn pass(name: &str, gpu_start: f64, gpu: f64, cpu_start: f64, cpu: f64) -> PassTiming {
+    pub(super) fn pass(name: &str, gpu_start: f64, gpu: f64, cpu_start: f64, cpu: f64) -> PassTiming {
         PassTiming {
             name: name.into(),
             gpu_ms: gpu,
@@ -317,7 +205,7 @@ mod tests {
         }
     }
 
-    fn frames() -> Vec<FrameProfile> {
+    pub(super) fn frames() -> Vec<FrameProfile> {
         (0..3)
             .map(|i| FrameProfile {
                 frame: i,
@@ -331,11 +219,12 @@ mod tests {
                 gpu_ms: 3.7 + i as f64,
                 cpu_ms: 0.3,
                 cpu_start_ms: 2.0 * i as f64,
+                ..FrameProfile::default()
             })
             .collect()
     }
 
-    fn temp(name: &str) -> std::path::PathBuf {
+    pub(super) fn temp(name: &str) -> std::path::PathBuf {
         std::env::temp_dir().join(format!("alpenglow-profile-{}-{name}", std::process::id()))
     }
 
@@ -375,48 +264,5 @@ mod tests {
         assert!(back[0].passes[2].cpu_ms.is_nan());
         assert_eq!(v["summary"]["passes"][1]["name"], "terrain");
         assert_eq!(v["summary"]["frame"]["frames"], 3);
-    }
-
-    #[test]
-    fn chrome_trace_is_well_formed() {
-        let path = temp("trace.json");
-        write_chrome_trace(&path, "Test GPU", &frames()).unwrap();
-        let v: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-        std::fs::remove_file(&path).unwrap();
-        assert_eq!(v["displayTimeUnit"], "ms");
-        let events = v["traceEvents"].as_array().unwrap();
-        let thread_names: Vec<&str> = events
-            .iter()
-            .filter(|e| e["ph"] == "M" && e["name"] == "thread_name")
-            .map(|e| e["args"]["name"].as_str().unwrap())
-            .collect();
-        assert_eq!(thread_names, ["CPU (prepare, record)", "GPU (Test GPU)"]);
-        let complete: Vec<&Value> = events.iter().filter(|e| e["ph"] == "X").collect();
-        // Per frame and track: one frame event plus three passes.
-        assert_eq!(complete.len(), 3 * 2 * 4);
-        for e in &complete {
-            for key in ["name", "ph", "pid", "tid", "ts", "dur"] {
-                assert!(!e[key].is_null(), "{key} missing in {e}");
-            }
-            assert!(e["dur"].as_f64().unwrap() >= 0.0, "{e}");
-            assert!(e["ts"].as_f64().unwrap() >= 0.0, "{e}");
-        }
-        // Passes lie inside their frame and do not overlap on a track.
-        for tid in [1, 2] {
-            let mut frame_span = (0.0, 0.0);
-            let mut last_end = 0.0;
-            for e in complete.iter().filter(|e| e["tid"] == tid) {
-                let (ts, dur) = (e["ts"].as_f64().unwrap(), e["dur"].as_f64().unwrap());
-                if e["cat"] == "frame" {
-                    assert!(ts >= frame_span.1, "frames overlap on track {tid}");
-                    frame_span = (ts, ts + dur);
-                    last_end = ts;
-                } else {
-                    assert!(ts >= frame_span.0 && ts + dur <= frame_span.1 + 1e-9, "{e}");
-                    assert!(ts >= last_end - 1e-9, "passes overlap: {e}");
-                    last_end = ts + dur;
-                }
-            }
-        }
     }
 }
