@@ -436,6 +436,7 @@ impl<P> BakedGraph<P> {
                     cpu_ms,
                     gpu_start_ms: begin / 1e6,
                     cpu_start_ms,
+                    pipeline_stats: None,
                 };
                 match profile.passes.get_mut(i) {
                     Some(t) => {

@@ -38,6 +38,98 @@ pub struct PassTiming {
     /// CPU begin, relative to the frame's CPU start.
     #[serde(deserialize_with = "f64_or_nan")]
     pub cpu_start_ms: f64,
+    /// What the device counted in the pass, when pipeline statistics were
+    /// asked for (`--pipeline-stats`); None otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pipeline_stats: Option<PipelineStats>,
+}
+
+/// Pipeline-statistics counters of one pass (a Vulkan pipeline-statistics
+/// query around it; needs the device feature `pipelineStatisticsQuery`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct PipelineStats {
+    pub input_assembly_vertices: u64,
+    pub input_assembly_primitives: u64,
+    pub vertex_shader_invocations: u64,
+    pub clipping_invocations: u64,
+    pub clipping_primitives: u64,
+    pub fragment_shader_invocations: u64,
+    pub compute_shader_invocations: u64,
+}
+
+impl PipelineStats {
+    /// The counters in the order of their query flags (the order a query
+    /// writes them).
+    pub const COUNT: usize = 7;
+
+    /// The counters from a query's results, in flag order.
+    pub fn from_counters(c: [u64; Self::COUNT]) -> PipelineStats {
+        PipelineStats {
+            input_assembly_vertices: c[0],
+            input_assembly_primitives: c[1],
+            vertex_shader_invocations: c[2],
+            clipping_invocations: c[3],
+            clipping_primitives: c[4],
+            fragment_shader_invocations: c[5],
+            compute_shader_invocations: c[6],
+        }
+    }
+
+    /// The counters in flag order.
+    pub fn counters(&self) -> [u64; Self::COUNT] {
+        [
+            self.input_assembly_vertices,
+            self.input_assembly_primitives,
+            self.vertex_shader_invocations,
+            self.clipping_invocations,
+            self.clipping_primitives,
+            self.fragment_shader_invocations,
+            self.compute_shader_invocations,
+        ]
+    }
+
+    /// Each counter's median over `stats` (the lower middle for an even
+    /// count); None when empty.
+    pub fn median(stats: &[PipelineStats]) -> Option<PipelineStats> {
+        let mid = stats.len().checked_sub(1)? / 2;
+        let mut out = [0u64; Self::COUNT];
+        let mut column = Vec::with_capacity(stats.len());
+        for (k, o) in out.iter_mut().enumerate() {
+            column.clear();
+            column.extend(stats.iter().map(|s| s.counters()[k]));
+            column.sort_unstable();
+            *o = column[mid];
+        }
+        Some(PipelineStats::from_counters(out))
+    }
+
+    /// One line: `vs 1200 fs 64000 cs 0 …` (only the counters that are not 0;
+    /// "nothing counted" when all are).
+    pub fn line(&self) -> String {
+        const NAMES: [&str; PipelineStats::COUNT] =
+            ["ia.vertices", "ia.primitives", "vs", "clip.in", "clip.out", "fs", "cs"];
+        let parts: Vec<String> = (NAMES.iter().zip(self.counters()))
+            .filter(|(_, v)| *v > 0)
+            .map(|(n, v)| format!("{n} {v}"))
+            .collect();
+        match parts.is_empty() {
+            true => "nothing counted".into(),
+            false => parts.join(", "),
+        }
+    }
+}
+
+/// Device memory in use (the profile JSON's and `bench`'s `device_memory`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct DeviceMemoryUse {
+    /// Bytes the context's allocations hold (what the allocator handed out).
+    pub allocated_bytes: u64,
+    /// Bytes of the device-memory blocks the allocator reserved for them.
+    pub reserved_bytes: u64,
+    /// With `VK_EXT_memory_budget`: what this process uses of the device's
+    /// device-local heaps, and their budget; None without it.
+    pub heap_usage_bytes: Option<u64>,
+    pub heap_budget_bytes: Option<u64>,
 }
 
 /// A CPU stage of a frame before its passes are recorded: a technique's
@@ -97,12 +189,26 @@ pub struct PassSummary {
     pub samples: usize,
     /// Median GPU time.
     pub median_gpu_ms: f64,
+    /// 95th and 99th percentile GPU times ([`quantile`]).
+    #[serde(default)]
+    pub p95_gpu_ms: f64,
+    #[serde(default)]
+    pub p99_gpu_ms: f64,
     /// Median CPU recording time.
     pub median_cpu_ms: f64,
+    /// 95th and 99th percentile CPU recording times.
+    #[serde(default)]
+    pub p95_cpu_ms: f64,
+    #[serde(default)]
+    pub p99_cpu_ms: f64,
     /// Smallest GPU time.
     pub min_gpu_ms: f64,
     /// Largest GPU time.
     pub max_gpu_ms: f64,
+    /// Each pipeline statistic's median over the samples that have them
+    /// (`--pipeline-stats`); None without.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pipeline_stats: Option<PipelineStats>,
 }
 
 /// Median timings of whole frames.
@@ -112,8 +218,18 @@ pub struct FrameSummary {
     pub frames: usize,
     /// Median GPU frame time.
     pub median_gpu_ms: f64,
+    /// 95th and 99th percentile GPU frame times ([`quantile`]).
+    #[serde(default)]
+    pub p95_gpu_ms: f64,
+    #[serde(default)]
+    pub p99_gpu_ms: f64,
     /// Median CPU frame time.
     pub median_cpu_ms: f64,
+    /// 95th and 99th percentile CPU frame times.
+    #[serde(default)]
+    pub p95_cpu_ms: f64,
+    #[serde(default)]
+    pub p99_cpu_ms: f64,
 }
 
 /// Median of `values`, ignoring NaN: the middle value for an odd count,
@@ -132,38 +248,69 @@ pub fn median(values: impl IntoIterator<Item = f64>) -> f64 {
     }
 }
 
+/// `q`-quantile (0..=1) of `values` (nearest rank), ignoring non-finite
+/// values; NaN when empty.
+pub fn quantile(values: &[f64], q: f64) -> f64 {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    v[((v.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize]
+}
+
 /// Per-pass medians (passes in order of first appearance; a name that
 /// occurs several times in a frame contributes several samples) and
 /// whole-frame medians.
 pub fn summarize(frames: &[FrameProfile]) -> (Vec<PassSummary>, FrameSummary) {
     let mut order: Vec<&str> = Vec::new();
-    let mut by_name: BTreeMap<&str, (Vec<f64>, Vec<f64>)> = BTreeMap::new();
+    let mut by_name: BTreeMap<&str, PassSamples> = BTreeMap::new();
     for pass in frames.iter().flat_map(|f| &f.passes) {
         let entry = by_name.entry(&pass.name).or_insert_with(|| {
             order.push(&pass.name);
-            (Vec::new(), Vec::new())
+            PassSamples::default()
         });
-        entry.0.push(pass.gpu_ms);
-        entry.1.push(pass.cpu_ms);
+        entry.gpu.push(pass.gpu_ms);
+        entry.cpu.push(pass.cpu_ms);
+        entry.stats.extend(pass.pipeline_stats);
     }
     let passes = order
         .iter()
         .filter_map(|name| by_name.get(name).map(|e| (name, e)))
-        .map(|(name, (gpu, cpu))| PassSummary {
+        .map(|(name, s)| PassSummary {
             name: name.to_string(),
-            samples: gpu.len(),
-            median_gpu_ms: median(gpu.iter().copied()),
-            median_cpu_ms: median(cpu.iter().copied()),
-            min_gpu_ms: gpu.iter().copied().fold(f64::INFINITY, f64::min),
-            max_gpu_ms: gpu.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            samples: s.gpu.len(),
+            median_gpu_ms: median(s.gpu.iter().copied()),
+            p95_gpu_ms: quantile(&s.gpu, 0.95),
+            p99_gpu_ms: quantile(&s.gpu, 0.99),
+            median_cpu_ms: median(s.cpu.iter().copied()),
+            p95_cpu_ms: quantile(&s.cpu, 0.95),
+            p99_cpu_ms: quantile(&s.cpu, 0.99),
+            min_gpu_ms: s.gpu.iter().copied().fold(f64::INFINITY, f64::min),
+            max_gpu_ms: s.gpu.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            pipeline_stats: PipelineStats::median(&s.stats),
         })
         .collect();
+    let gpu: Vec<f64> = frames.iter().map(|f| f.gpu_ms).collect();
+    let cpu: Vec<f64> = frames.iter().map(|f| f.cpu_ms).collect();
     let frame = FrameSummary {
         frames: frames.len(),
-        median_gpu_ms: median(frames.iter().map(|f| f.gpu_ms)),
-        median_cpu_ms: median(frames.iter().map(|f| f.cpu_ms)),
+        median_gpu_ms: median(gpu.iter().copied()),
+        p95_gpu_ms: quantile(&gpu, 0.95),
+        p99_gpu_ms: quantile(&gpu, 0.99),
+        median_cpu_ms: median(cpu.iter().copied()),
+        p95_cpu_ms: quantile(&cpu, 0.95),
+        p99_cpu_ms: quantile(&cpu, 0.99),
     };
     (passes, frame)
+}
+
+/// One pass's timings over the frames of [`summarize`].
+#[derive(Default)]
+struct PassSamples {
+    gpu: Vec<f64>,
+    cpu: Vec<f64>,
+    stats: Vec<PipelineStats>,
 }
 
 /// Serialises `value` as pretty JSON with a final newline.
@@ -174,21 +321,34 @@ pub(crate) fn json_text(value: &Value) -> Result<String> {
 }
 
 /// The text of [`write_profile_json`].
-pub fn profile_json(device_name: &str, raster: &str, frames: &[FrameProfile]) -> Result<String> {
+pub fn profile_json(
+    device_name: &str,
+    raster: &str,
+    frames: &[FrameProfile],
+    memory: Option<DeviceMemoryUse>,
+) -> Result<String> {
     let (passes, frame) = summarize(frames);
     json_text(&json!({
         "device": device_name,
         "raster": raster,
+        "device_memory": memory,
         "frames": frames,
         "summary": { "passes": passes, "frame": frame },
     }))
 }
 
-/// Writes `{"device", "raster", "frames": [...], "summary": {"passes": [...],
-/// "frame": {...}}}` (see [`summarize`]; `raster`: the terrain's path,
-/// [`crate::RasterPath::name`]). Non-finite numbers become `null`.
-pub fn write_profile_json(path: &Path, device_name: &str, raster: &str, frames: &[FrameProfile]) -> Result<()> {
-    write_bytes_atomically(path, profile_json(device_name, raster, frames)?.as_bytes())
+/// Writes `{"device", "raster", "device_memory", "frames": [...],
+/// "summary": {"passes": [...], "frame": {...}}}` (see [`summarize`];
+/// `raster`: the terrain's path, [`crate::RasterPath::name`];
+/// `device_memory`: `memory` or null). Non-finite numbers become `null`.
+pub fn write_profile_json(
+    path: &Path,
+    device_name: &str,
+    raster: &str,
+    frames: &[FrameProfile],
+    memory: Option<DeviceMemoryUse>,
+) -> Result<()> {
+    write_bytes_atomically(path, profile_json(device_name, raster, frames, memory)?.as_bytes())
 }
 
 #[cfg(test)]
@@ -202,6 +362,7 @@ mod tests {
             cpu_ms: cpu,
             gpu_start_ms: gpu_start,
             cpu_start_ms: cpu_start,
+            pipeline_stats: None,
         }
     }
 
@@ -251,7 +412,13 @@ mod tests {
     #[test]
     fn profile_json_parses_back() {
         let path = temp("profile.json");
-        write_profile_json(&path, "Test GPU", "compute", &frames()).unwrap();
+        let memory = DeviceMemoryUse {
+            allocated_bytes: 1 << 20,
+            reserved_bytes: 2 << 20,
+            heap_usage_bytes: None,
+            heap_budget_bytes: None,
+        };
+        write_profile_json(&path, "Test GPU", "compute", &frames(), Some(memory)).unwrap();
         let v: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
         std::fs::remove_file(&path).unwrap();
         assert_eq!(
@@ -264,5 +431,48 @@ mod tests {
         assert!(back[0].passes[2].cpu_ms.is_nan());
         assert_eq!(v["summary"]["passes"][1]["name"], "terrain");
         assert_eq!(v["summary"]["frame"]["frames"], 3);
+        assert_eq!(v["device_memory"]["allocated_bytes"], 1 << 20);
+        assert!(v["device_memory"]["heap_budget_bytes"].is_null());
+        assert!(v["summary"]["passes"][0]["p99_gpu_ms"].is_number());
+    }
+
+    #[test]
+    fn quantiles_beside_the_median() {
+        let values: Vec<f64> = (1..=100).map(f64::from).collect();
+        assert_eq!((quantile(&values, 0.95), quantile(&values, 0.99)), (95.0, 99.0));
+        assert!(quantile(&[f64::NAN], 0.5).is_nan());
+        let mut frames = frames();
+        frames.extend((3..100).map(|i| FrameProfile {
+            frame: i,
+            passes: vec![pass("shadow", 0.0, 1.0, 0.0, 0.1)],
+            gpu_ms: 1.0,
+            ..FrameProfile::default()
+        }));
+        frames[50].gpu_ms = 50.0;
+        let (passes, frame) = summarize(&frames);
+        assert_eq!(
+            (passes[0].median_gpu_ms, passes[0].p95_gpu_ms, passes[0].p99_gpu_ms),
+            (1.0, 1.0, 2.0)
+        );
+        assert_eq!((frame.median_gpu_ms, frame.p99_gpu_ms), (1.0, 5.7));
+    }
+
+    #[test]
+    fn pipeline_stats_medians_and_line() {
+        let s = |vs: u64, fs: u64| PipelineStats {
+            vertex_shader_invocations: vs,
+            fragment_shader_invocations: fs,
+            ..PipelineStats::default()
+        };
+        let median = PipelineStats::median(&[s(3, 10), s(1, 30), s(2, 20)]).unwrap();
+        assert_eq!(median, s(2, 20));
+        assert_eq!(median.line(), "vs 2, fs 20");
+        assert_eq!(PipelineStats::default().line(), "nothing counted");
+        assert_eq!(PipelineStats::median(&[]), None);
+        let mut frames = frames();
+        frames[0].passes[0].pipeline_stats = Some(s(6, 0));
+        let (passes, _) = summarize(&frames);
+        assert_eq!(passes[0].pipeline_stats, Some(s(6, 0)));
+        assert_eq!(passes[1].pipeline_stats, None);
     }
 }
