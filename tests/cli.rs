@@ -435,6 +435,7 @@ fn bench_writes_json_summary() {
         json.as_os_str(),
         "--trace".as_ref(),
         trace.as_os_str(),
+        "--pipeline-stats".as_ref(),
     ]);
     assert_success("bench", &out);
     let stdout = text(&out.stdout);
@@ -461,6 +462,14 @@ fn bench_writes_json_summary() {
         assert_eq!(pass["samples"], 3, "pass {name}");
     }
     finite_ms(&b, "p99_frame_gpu_ms", "bench");
+    // --pipeline-stats: every pass has its counters; the compute passes count invocations.
+    assert!(passes.iter().all(|p| p["pipeline_stats"].is_object()), "{b}");
+    let warp = passes.iter().find(|p| p["name"] == "terrain.warp").unwrap();
+    assert!(
+        warp["pipeline_stats"]["compute_shader_invocations"].as_u64() > Some(0),
+        "{warp}"
+    );
+    assert!(stdout.contains("pipeline statistics (median)"), "{stdout}");
     assert!(b["device_memory"]["allocated_bytes"].as_u64() > Some(0), "{b}");
     // One timeline: with calibrated timestamps every GPU span of the trace
     // lies between its frame's submit and fence wait on the CPU clock.

@@ -80,6 +80,7 @@ fn run_frames(
     args: &BenchArgs,
 ) -> Result<Run> {
     let raster = renderer.raster_path();
+    renderer.set_pipeline_stats(args.pipeline_stats)?;
     // Every frame's profile is reported (the history is bounded by default).
     renderer.set_profile_history((args.warmup + args.frames + MAX_SETTLE_FRAMES) as usize);
     // A still view: first every texture tile (untimed), then warm-up and timed frames.
@@ -167,7 +168,7 @@ fn print_summary(device: &DeviceInfo, sizes: &str, run: &Run, passes: &[PassSumm
             p.p99_cpu_ms
         );
         if let Some(stats) = &p.pipeline_stats {
-            println!("  {:<16} pipeline statistics (median): {}", "", stats.line());
+            println!("  {:<16} pipeline statistics (median): {}", p.name, stats.line());
         }
     }
     if let Some(stats) = run.point_stats.last() {

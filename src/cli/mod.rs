@@ -366,6 +366,7 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
     let (views, profiles, raster, memory) = {
         let settings = render_settings(&args.scene, &scene, &specs, true)?;
         let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
+        renderer.set_pipeline_stats(args.pipeline_stats)?;
         let raster = renderer.raster_path();
         let frame = renderer.render_views_settled(&cameras, MAX_SETTLE_FRAMES)?;
         let views = renderer.read_views(&frame)?;

@@ -10,7 +10,7 @@ use super::binding::{Binding, BindingTarget};
 use super::uploads::UploadArena;
 use super::{Access, Attachments, BufferId, ImageId, PassKind, ResourceId};
 use crate::error::{Error, Result};
-use crate::profile::{FrameProfile, PassTiming, StageTiming};
+use crate::profile::{FrameProfile, PassTiming, PipelineStats, StageTiming};
 use crate::vulkan::{
     AccessFlags2, AccessState, BarrierBatch, Buffer, CommandRecorder, CompletedFrame, ComputePipeline, FrameRing,
     GraphicsPipeline, Image, PipelineStageFlags2,
@@ -322,7 +322,12 @@ impl<P> BakedGraph<P> {
         let query_count = 2 * self.passes.len() as u32;
         // Waits for the frame slot (the GPU) first; CPU times start after it,
         // or with the first prepare stage.
-        let (mut recording, completed) = frames.begin(query_count)?;
+        let stats = if self.pipeline_stats {
+            self.passes.len() as u32
+        } else {
+            0
+        };
+        let (mut recording, completed) = frames.begin(query_count, stats)?;
         if let Some(c) = &completed {
             self.complete(c);
         }
@@ -334,7 +339,7 @@ impl<P> BakedGraph<P> {
             .unwrap_or(record_start)
             .min(record_start);
         let frame = recording.frame;
-        let pool = recording.query_pool();
+        let (pool, stats_pool) = (recording.query_pool(), recording.stats_pool());
         self.touched.clear();
         self.touched.resize(self.physical.len(), false);
         let mut cpu_passes = self.spare_cpu_passes.pop().unwrap_or_default();
@@ -346,6 +351,9 @@ impl<P> BakedGraph<P> {
             let cmd = &mut recording.recorder;
             cmd.begin_label_c(&pass.label, label_color(pass.kind));
             cmd.write_timestamp(pool, 2 * i as u32, PipelineStageFlags2::TOP_OF_PIPE);
+            if stats > 0 {
+                cmd.begin_query(stats_pool, i as u32);
+            }
             self.emit_barriers(cmd, &pass.uses, frame);
             let recorded = begin_attachments(cmd, &self.physical, &pass.attachments, frame).and_then(|rendering| {
                 let mut ctx = PassContext {
@@ -368,6 +376,9 @@ impl<P> BakedGraph<P> {
                 result = Err(Error::Graph(format!("pass '{}': {e}", pass.name)));
             }
             let cmd = &mut recording.recorder;
+            if stats > 0 {
+                cmd.end_query(stats_pool, i as u32);
+            }
             cmd.write_timestamp(pool, 2 * i as u32 + 1, PipelineStageFlags2::ALL_COMMANDS);
             cmd.end_label();
             cpu_passes.push((
@@ -436,7 +447,7 @@ impl<P> BakedGraph<P> {
                     cpu_ms,
                     gpu_start_ms: begin / 1e6,
                     cpu_start_ms,
-                    pipeline_stats: None,
+                    pipeline_stats: (completed.pipeline_stats.get(i)).map(|c| PipelineStats::from_counters(*c)),
                 };
                 match profile.passes.get_mut(i) {
                     Some(t) => {

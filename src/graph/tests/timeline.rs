@@ -46,6 +46,9 @@ fn calibrated_gpu_passes_lie_between_submit_and_fence_wait() {
         copy(&mut graph, "copy c-result", c, result);
         graph.read_back(result);
         let mut baked = graph.bake(&ctx).expect("bake");
+        // Pipeline statistics around every pass (copies count nothing).
+        let stats = ctx.has_feature("pipelineStatisticsQuery");
+        baked.set_pipeline_stats(&ctx, stats).unwrap();
         let mut frames = FrameRing::new(&ctx).unwrap();
         for _ in 0..6 {
             frames.wait_for_next().unwrap();
@@ -57,6 +60,8 @@ fn calibrated_gpu_passes_lie_between_submit_and_fence_wait() {
         for p in &profiles {
             assert!(p.submit_ms >= p.cpu_start_ms && p.fence_ms >= p.submit_ms, "{p:?}");
             assert_eq!(p.gpu_start_on_cpu_ms.is_some(), calibrated, "{p:?}");
+            let counted = p.passes.iter().filter(|pass| pass.pipeline_stats.is_some()).count();
+            assert_eq!(counted, if stats { 3 } else { 0 }, "{p:?}");
         }
         chrome_trace(&ctx.info().name, &profiles).unwrap()
     };
