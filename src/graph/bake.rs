@@ -89,6 +89,8 @@ pub struct BakedGraph<P> {
     /// Whether each pass is wrapped in a pipeline-statistics query:
     /// [`BakedGraph::set_pipeline_stats`].
     pub(crate) pipeline_stats: bool,
+    /// GPU zones for Tracy (feature `tracy`; nothing without it).
+    pub(crate) tracy: crate::profile::tracy::GpuZones,
     /// Per-frame scratch reused by every frame (no allocation per frame):
     /// which resources the frame touched, and the CPU times of the passes
     /// of completed frames.
@@ -520,6 +522,7 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
         profiles: Vec::new(),
         profile_history: DEFAULT_PROFILE_HISTORY,
         pipeline_stats: false,
+        tracy: Default::default(),
         touched: Vec::new(),
         spare_cpu_passes: Vec::new(),
         epoch: Instant::now(),

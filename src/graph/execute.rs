@@ -10,7 +10,7 @@ use super::binding::{Binding, BindingTarget};
 use super::uploads::UploadArena;
 use super::{Access, Attachments, BufferId, ImageId, PassKind, ResourceId};
 use crate::error::{Error, Result};
-use crate::profile::{FrameProfile, PassTiming, PipelineStats, StageTiming};
+use crate::profile::{tracy, FrameProfile, PassTiming, PipelineStats, StageTiming};
 use crate::vulkan::{
     AccessFlags2, AccessState, BarrierBatch, Buffer, CommandRecorder, CompletedFrame, ComputePipeline, FrameRing,
     GraphicsPipeline, Image, PipelineStageFlags2,
@@ -46,7 +46,10 @@ impl CpuStage {
     /// Runs `f` as the stage `name`, appending its timing to `stages`.
     pub fn time<T>(stages: &mut Vec<CpuStage>, name: &std::sync::Arc<str>, f: impl FnOnce() -> T) -> T {
         let start = Instant::now();
-        let value = f();
+        let value = {
+            let _zone = tracy::cpu_zone(name);
+            f()
+        };
         stages.push(CpuStage {
             name: name.clone(),
             start,
@@ -327,6 +330,7 @@ impl<P> BakedGraph<P> {
         } else {
             0
         };
+        let ctx = frames.context().clone();
         let (mut recording, completed) = frames.begin(query_count, stats)?;
         if let Some(c) = &completed {
             self.complete(c);
@@ -350,6 +354,7 @@ impl<P> BakedGraph<P> {
             let pass_start = Instant::now();
             let cmd = &mut recording.recorder;
             cmd.begin_label_c(&pass.label, label_color(pass.kind));
+            self.tracy.begin_pass(&pass.name, || ctx.gpu_time_ns());
             cmd.write_timestamp(pool, 2 * i as u32, PipelineStageFlags2::TOP_OF_PIPE);
             if stats > 0 {
                 cmd.begin_query(stats_pool, i as u32);
@@ -381,6 +386,7 @@ impl<P> BakedGraph<P> {
             }
             cmd.write_timestamp(pool, 2 * i as u32 + 1, PipelineStageFlags2::ALL_COMMANDS);
             cmd.end_label();
+            self.tracy.end_pass();
             cpu_passes.push((
                 (pass_start - frame_start).as_secs_f64() * 1e3,
                 pass_start.elapsed().as_secs_f64() * 1e3,
@@ -395,6 +401,8 @@ impl<P> BakedGraph<P> {
         self.final_accesses = finals;
         // Submit even after a failed pass so the frame slot stays consistent.
         let timeline = recording.submit()?;
+        self.tracy.submitted(frame, || ctx.gpu_time_ns());
+        tracy::frame_mark();
         if let Some(c) = completed {
             frames.recycle(c);
         }
@@ -434,6 +442,8 @@ impl<P> BakedGraph<P> {
                 false => FrameProfile::default(),
             };
             let ts = &completed.timestamps_ns;
+            let at = |i: usize| completed.first_ns + ts.get(i).copied().unwrap_or(0.0);
+            (self.tracy).completed(p.frame, (0..self.passes.len()).map(|i| (at(2 * i), at(2 * i + 1))));
             profile.passes.truncate(self.passes.len());
             for (i, pass) in self.passes.iter().enumerate() {
                 let (begin, end) = (

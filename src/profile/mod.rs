@@ -12,6 +12,7 @@ use crate::error::{Error, Result};
 use crate::io::atomic::write_bytes_atomically;
 
 mod trace;
+pub(crate) mod tracy;
 
 pub use trace::{chrome_trace, gpu_spans_outside_frames, write_chrome_trace};
 

@@ -160,6 +160,15 @@ impl GpuClock {
     }
 }
 
+impl super::Context {
+    /// The device's timestamp clock now, in nanoseconds (ticks times the
+    /// period), where timestamps are calibrated; None otherwise.
+    pub(crate) fn gpu_time_ns(&self) -> Option<i64> {
+        let c = self.shared.clock.as_ref()?.calibrate()?;
+        Some((c.gpu_ticks as f64 * c.period_ns) as i64)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -114,6 +114,8 @@ pub struct CompletedFrame {
     /// The CPU instant of the first timestamp, with calibrated timestamps
     /// ([`super::DeviceInfo::calibrated_timestamps`]); None without.
     pub first_gpu: Option<Instant>,
+    /// The first timestamp on the device's clock, in nanoseconds.
+    pub first_ns: f64,
     /// Each pass's pipeline statistics, in pass order (empty unless asked for).
     pub pipeline_stats: Vec<[u64; PIPELINE_STATISTICS_COUNT]>,
 }
@@ -227,6 +229,7 @@ impl FrameRing {
             submitted,
             waited: s.waited_at.unwrap_or(now).max(submitted),
             first_gpu: s.calibration.map(|c| c.instant_of(first)),
+            first_ns: first as f64 * period,
             pipeline_stats,
         }))
     }
