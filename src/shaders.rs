@@ -34,6 +34,8 @@ pub const TERRAIN_SHADOW_RASTER: SpirV = spirv!("terrain/shadow_raster.comp");
 pub const TERRAIN_SHADOW_RASTER_BIG: SpirV = spirv!("terrain/shadow_raster_big.comp");
 /// terrain.shade: the visibility buffer shaded per pixel.
 pub const TERRAIN_SHADE: SpirV = spirv!("terrain/shade.comp");
+/// terrain.shade with the points' sums: splats normalized where they cover a pixel (issue 29).
+pub const TERRAIN_SHADE_SPLATS: SpirV = spirv!("terrain/shade_splats.comp");
 /// terrain.depth: the depth buffer from the compute path's NDC depth.
 pub const TERRAIN_DEPTH_FRAG: SpirV = spirv!("terrain/depth.frag");
 /// Every full-screen pass (sky, points.normalize): one triangle covering the screen.
@@ -80,6 +82,10 @@ pub const SPLAT_COMPUTE_VISIBILITY: SpirV = spirv!("points/compute_visibility.co
 pub const SPLAT_COMPUTE_ACCUMULATE: SpirV = spirv!("points/compute_accumulate.comp");
 /// points.normalize (compute path): the sums divided and shaded (§10.2.3).
 pub const SPLAT_COMPUTE_NORMALIZE: SpirV = spirv!("points/compute_normalize.comp");
+/// points.opaque (compute path): the nearest splat's index raised per pixel.
+pub const SPLAT_COMPUTE_OPAQUE: SpirV = spirv!("points/compute_opaque.comp");
+/// points.opaque.resolve (compute path): the winning splat shaded per pixel.
+pub const SPLAT_COMPUTE_OPAQUE_RESOLVE: SpirV = spirv!("points/compute_opaque_resolve.comp");
 /// points.*, object-space primitives (§10.3): quads in the tangent plane, the interval test.
 pub const OBJECT_SPLAT_VERT: SpirV = spirv!("points/object_splat.vert");
 /// points.visibility, object-space primitives: the pushed-back quad's depth inside the kernel's disk.

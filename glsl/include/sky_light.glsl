@@ -36,8 +36,9 @@ vec3 unoccluded_sky_light(uint lighting, vec3 n) {
 
 // rgb: outgoing radiance per unit albedo from sky light at world point
 // `world` (bilinear between the texels around world.xy); a: sky visibility
-// (1 = open sky).
-vec4 sky_light(uint lighting, vec3 world, vec3 normal) {
+// (1 = open sky). `point_object`: a point object's surface, lit by the open
+// sky for its own normal and occluded as the terrain under it is.
+vec4 sky_light(uint lighting, vec3 world, vec3 normal, bool point_object) {
     vec4 field = g_lighting[lighting].f.field;
     uint map = g_lighting[lighting].f.maps.x;
     if (map == 0u) {
@@ -46,13 +47,10 @@ vec4 sky_light(uint lighting, vec3 world, vec3 normal) {
     vec2 texels = max(field.zw, vec2(1.0));
     vec2 uv = (world.xy / max(field.xy, vec2(1e-6)) * field.zw + 0.5) / (texels + 1.0);
     vec4 terrain = textureLod(sampler2D(g_textures[nonuniformEXT(map)], g_samplers[SAMPLER_LINEAR_CLAMP]), uv, 0.0);
-#ifdef ALPENGLOW_POINTS
-    // Point objects: the open sky for their own normal, occluded as the
-    // terrain under them is.
-    return vec4(unoccluded_sky_light(lighting, normal) * terrain.a, terrain.a);
-#else
+    if (point_object) {
+        return vec4(unoccluded_sky_light(lighting, normal) * terrain.a, terrain.a);
+    }
     return terrain;
-#endif
 }
 
 #endif

@@ -58,6 +58,10 @@ layout(push_constant) uniform Push {
     uvec4 outputs;  // storage: radiance (rgba32f), view depth (r32f), W (r32f), lighting AOVs (rg32f)
     uvec4 more;     // storage: normal (rgba16f), ids (rg32ui); width, height
 #endif
+#ifdef SPLAT_GROUND_SHADE
+    uvec4 ground;   // terrain.shade with the points' sums: compute view constants, grid vertices, visibility keys, -
+    uvec4 surface;  // lighting constants, noise tile, texturing constants, -
+#endif
 #ifdef SPLAT_COMPUTE
     uvec4 raster;   // compute three-pass (glsl/include/splat_compute.glsl): nearest words, sums, last records, splats of the frame
     uvec4 draws;    // the draw table (storage: first splat, instance record per draw), draws, 0, 0
@@ -69,9 +73,7 @@ layout(push_constant) uniform Push {
 } pc;
 
 
-vec3 srgb_to_linear(vec3 c) {
-    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
-}
+#include "srgb.glsl"
 
 // Linear colour of an sRGB8 triple packed as uint bits r | g << 8 | b << 16 in a float.
 vec3 unpack_srgb(float bits) {

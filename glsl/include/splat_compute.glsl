@@ -16,36 +16,15 @@
 #define SPLAT_COMPUTE
 #include "splat_compute_state.glsl"
 #include "splat_setup.glsl"
+#include "splat_draw_table.glsl"
 
 #define WORKGROUP_SIZE 64u
 #define LARGE_SPLAT_PIXELS 256u
 
 layout(local_size_x = 64) in;
 
-layout(set = 0, binding = 2, std430) readonly buffer SplatDraws { uvec2 d[]; } g_splat_draws[];
-
 shared uint s_large[WORKGROUP_SIZE];
 shared uint s_large_count;
-
-// The instance record of the splat being rasterised.
-uint splat_record;
-
-// The set-up of splat `index` of the frame (counted over the draw table).
-uint frame_splat_setup(uint index, out SplatSetup v) {
-    uint table = pc.draws.x;
-    uint lo = 0u, hi = pc.draws.y;  // the draw is the last whose first splat ≤ index
-    while (hi - lo > 1u) {
-        uint mid = (lo + hi) / 2u;
-        if (g_splat_draws[table].d[mid].x <= index) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    uvec2 draw = g_splat_draws[table].d[lo];
-    splat_record = draw.y;
-    return splat_setup_of(draw.y, index - draw.x, v);
-}
 
 // The pixel's index in the per-pixel buffers.
 uint splat_pixel_index(uvec2 pixel) {

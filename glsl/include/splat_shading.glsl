@@ -6,7 +6,6 @@
 #define ALPENGLOW_SPLAT_SHADING_GLSL
 
 #include "splat.glsl"
-#define ALPENGLOW_POINTS
 #include "surface_lighting.glsl"
 
 vec3 camera_to_world(vec3 v) {
@@ -39,7 +38,7 @@ vec3 shade_splat(vec3 albedo, vec3 normal, vec3 position, out vec2 visibility) {
     }
     vec3 eye = g_point_frame[f].eye.xyz;
     vec3 world = eye + camera_to_world(position);
-    return shade_diffuse(lighting.x, albedo, world, camera_to_world(n), -position.z, eye, visibility);
+    return shade_diffuse(lighting.x, albedo, world, camera_to_world(n), -position.z, eye, true, visibility);
 }
 
 #endif

@@ -22,14 +22,15 @@ vec3 lit_albedo(uint lighting, vec3 albedo) {
 // Radiance leaving a Lambertian point of albedo `albedo` at `world` (normal
 // `normal`, `view_depth` metres ahead of the camera at `eye`) towards the
 // eye, aerial perspective included. `visibility`: (sun visibility, sky
-// visibility), the AOVs.
+// visibility), the AOVs. `point_object`: a point object's surface
+// (sky_light.glsl).
 vec3 shade_diffuse(uint lighting, vec3 albedo, vec3 world, vec3 normal, float view_depth, vec3 eye,
-                   out vec2 visibility) {
+                   bool point_object, out vec2 visibility) {
     vec3 a = lit_albedo(lighting, albedo);
     vec3 sun = g_lighting[lighting].f.sun.xyz;
     uint flags = g_lighting[lighting].f.models.w;
     float sun_vis = sun_visibility(lighting, world, normal, view_depth);
-    vec4 sky = sky_light(lighting, world, normal);
+    vec4 sky = sky_light(lighting, world, normal, point_object);
     vec3 radiance = a * sky.rgb;
     if ((flags & LIGHTING_NO_SUN_DIRECT) == 0u) {
         radiance += a / PI * g_lighting[lighting].f.sun_irradiance.rgb * max(dot(normal, sun), 0.0) * sun_vis;

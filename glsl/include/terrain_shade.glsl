@@ -167,7 +167,7 @@ TerrainShaded shade_terrain(TerrainParams p, TerrainSample s) {
         } else {
             a = albedo(n, s.world, tile, sun, g_lighting[lighting].f.exposure.z, layer);
         }
-        radiance = shade_diffuse(lighting, a, s.world, n, depth, p.eye.xyz, o.visibility);
+        radiance = shade_diffuse(lighting, a, s.world, n, depth, p.eye.xyz, false, o.visibility);
     } else {
         o.visibility = vec2(1.0);
         vec3 c;

@@ -32,9 +32,7 @@ layout(set = 0, binding = 2, std430) readonly buffer TerrainTexturing {
 
 layout(set = 0, binding = 2, std430) readonly buffer PageTable { uvec4 w[]; } g_page_tables[];
 
-vec3 srgb_to_linear(vec3 c) {
-    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
-}
+#include "srgb.glsl"
 
 // Colour (linear), displacement gradient and dominant layer (the nearest
 // texel's normal alpha, texturing.finish) of the atlas at world xy; false

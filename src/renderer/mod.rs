@@ -58,7 +58,7 @@ use crate::post::tonemap::Tonemap;
 use crate::profile::FrameProfile;
 use crate::surface::gpu_layout::TexturingMode;
 use crate::terrain::geometry_image::TerrainSettings;
-use crate::terrain::visibility::RasterPath;
+use crate::terrain::visibility::{ComputeShading, RasterPath};
 use crate::terrain::{Terrain, TerrainFrame, TerrainTexturing};
 use crate::texturing::generation::{TextureAtlas, TextureFrame, TextureFrameStats, TextureStreaming};
 use crate::texturing::page_table::PageTable;
@@ -635,14 +635,6 @@ impl Wiring<'_> {
         // pass writes the view's lighting constants, which name the atlas.
         let casters = scene.draw_terrain || points_present;
         let atlases = lighting::shadow_atlases(ctx, graph, (views, &mut targets), casters, &settings.shadows)?;
-        let mut terrain = match scene.draw_terrain {
-            true => Some(warped_terrain(ctx, graph, scene, settings, views)?),
-            false => None,
-        };
-        // The compute path's `terrain.shade` shades the sky where no terrain is.
-        if !terrain.as_ref().is_some_and(Terrain::shades_sky) {
-            declare_views(&mut Sky::new(ctx)?, ctx, graph, views, &targets)?;
-        }
         let mut points = match points_present {
             true => Some(PointRenderer::new(
                 ctx,
@@ -652,6 +644,14 @@ impl Wiring<'_> {
             )?),
             false => None,
         };
+        let mut terrain = match scene.draw_terrain {
+            true => Some(warped_terrain(ctx, graph, (scene, points.as_ref()), settings, views)?),
+            false => None,
+        };
+        // The compute path's `terrain.shade` shades the sky where no terrain is.
+        if !terrain.as_ref().is_some_and(Terrain::shades_sky) {
+            declare_views(&mut Sky::new(ctx)?, ctx, graph, views, &targets)?;
+        }
         // Edge (validation_layer_edges): the atlas's generation passes before the shadow casters.
         let atlas = match (&terrain, settings.texturing) {
             (Some(terrain), TexturingMode::Atlas) => Some(TextureAtlas::declare(
@@ -665,13 +665,26 @@ impl Wiring<'_> {
         let casters = (terrain.as_ref(), points.as_ref());
         let shadows = lighting::declare_shadows(ctx, graph, (views, atlases), casters, settings.shadows)?;
         // Edge (validation_layer_edges): every view's draws before any post-processing.
+        let mut ground_keys = vec![None; views.len()];
         if let Some(terrain) = &mut terrain {
             let atlas = atlas.as_ref().map(|a| a.bindings());
-            declare_views(terrain, ctx, graph, views, targets.iter().map(|t| (t, atlas)))?;
+            ground_keys = declare_views(terrain, ctx, graph, views, targets.iter().map(|t| (t, atlas)))?;
         }
         if let Some(points) = &mut points {
             let clear_depth = !scene.draw_terrain;
-            declare_views(points, ctx, graph, views, targets.iter().map(|t| (t, clear_depth)))?;
+            // On the compute path the splats test against the terrain's
+            // visibility keys and `terrain.shade` resolves their sums.
+            let shaded_by_terrain = terrain_shades_splats(terrain.as_ref(), points, ctx);
+            let ground = |keys: Option<_>| keys.filter(|_| shaded_by_terrain);
+            let inputs = (targets.iter().zip(&ground_keys)).map(|(t, &keys)| (t, clear_depth, ground(keys)));
+            let sums = declare_views(points, ctx, graph, views, inputs)?;
+            if let Some(terrain) = &mut terrain {
+                for (k, (view, sums)) in views.iter().zip(sums).enumerate() {
+                    if let Some(sums) = sums {
+                        terrain.declare_shade(ViewGraph::new(ctx, graph, (k, view)), (&targets[k], sums))?;
+                    }
+                }
+            }
         }
         let mut aovs = Aovs::new(ctx)?;
         declare_views(&mut aovs, ctx, graph, views, &targets)?;
@@ -770,11 +783,19 @@ fn streaming_for(settings: &RenderSettings, chains: &[ViewChain]) -> TextureStre
     }
 }
 
-/// The terrain of `scene` with every view's `terrain.warp` declared.
+/// Whether the terrain's compute path shades the points' splats in its
+/// `terrain.shade` (issue 29: their normalization fused into it).
+fn terrain_shades_splats(terrain: Option<&Terrain>, points: &PointRenderer, ctx: &Context) -> bool {
+    terrain.is_some_and(Terrain::shades_sky) && points.sums_shaded_by_ground(ctx)
+}
+
+/// The terrain of `scene` with every view's `terrain.warp` declared (and
+/// `points`, when the scene has them, shaded by its compute path when
+/// they can be).
 fn warped_terrain(
     ctx: &Context,
     graph: &mut RenderGraph<RenderFrame>,
-    scene: &Scene,
+    (scene, points): (&Scene, Option<&PointRenderer>),
     settings: &RenderSettings,
     views: &[View],
 ) -> Result<Terrain> {
@@ -786,8 +807,13 @@ fn warped_terrain(
     let field = Arc::new(scene.heights.clone());
     let mut terrain = Terrain::new(ctx, graph, field, settings.terrain, &texturing)?;
     if settings.raster.uses_compute(ctx)? {
-        // The points depth-test against the terrain's depth buffer.
-        terrain.use_compute_raster(ctx, !scene.points.is_empty())?;
+        let shading = match points {
+            Some(p) if p.sums_shaded_by_ground(ctx) => ComputeShading::WithSplats,
+            // The points depth-test against the terrain's depth buffer.
+            Some(_) => ComputeShading::Immediate { write_depth: true },
+            None => ComputeShading::Immediate { write_depth: false },
+        };
+        terrain.use_compute_raster(ctx, shading)?;
     }
     for (k, view) in views.iter().enumerate() {
         terrain.declare_warp(ctx, graph, (k, view))?;

@@ -20,8 +20,9 @@ use crate::terrain::geometry_image::{declare_warp_pass, GeometryImage, TerrainSe
 use crate::terrain::lod::LodFrame;
 use crate::terrain::shading::{declare_draw_pass, DrawPass, SurfaceInputs, TerrainDrawPush};
 use crate::terrain::shadow::ComputeCasters;
-use crate::terrain::visibility::{ComputePass, ComputeRaster, ComputeView, RasterPath};
+use crate::terrain::visibility::{ComputePass, ComputeRaster, ComputeShading, ComputeView, RasterPath};
 use crate::texturing::generation::{AtlasBindings, GenerationInputs};
+use crate::view::deferred::{GroundKeys, SplatSums};
 use crate::view::{
     pass_name, per_view, Declare, Frame, FrameContext, Provides, SceneTargets, Technique, View, ViewGraph, ViewIndex,
 };
@@ -48,14 +49,17 @@ struct TerrainViewState {
     compute: Option<UploadRegion>,
     /// Whether `terrain.draw` of the view was declared.
     drawn: bool,
+    /// The compute path's `terrain.shade` still to declare
+    /// ([`ComputeShading::WithSplats`]) and the view's visibility keys.
+    unshaded: Option<(ComputePass, GroundKeys)>,
 }
 
-/// The compute path's pipelines and whether it writes the depth buffer.
+/// The compute path's pipelines and when it shades.
 struct ComputePath {
     raster: ComputeRaster,
     /// The shadow casters in compute (None: `terrain.shadow` draws them).
     casters: Option<ComputeCasters>,
-    write_depth: bool,
+    shading: ComputeShading,
 }
 
 #[cfg(test)]
@@ -136,10 +140,9 @@ impl Terrain {
     }
 
     /// Rasterizes and shades the terrain in compute shaders (the visibility
-    /// buffer, [`crate::terrain::visibility`]) instead of `terrain.draw`;
-    /// `write_depth`: later passes depth-test against it. Before any
-    /// [`Terrain::declare_warp`].
-    pub fn use_compute_raster(&mut self, ctx: &Context, write_depth: bool) -> Result<()> {
+    /// buffer, [`crate::terrain::visibility`]) instead of `terrain.draw`,
+    /// shaded as `shading` says. Before any [`Terrain::declare_warp`].
+    pub fn use_compute_raster(&mut self, ctx: &Context, shading: ComputeShading) -> Result<()> {
         if !self.views.is_empty() {
             return Err(Error::Graph(
                 "terrain: the raster path is chosen before the views are declared".into(),
@@ -150,11 +153,30 @@ impl Terrain {
         #[cfg(not(test))]
         let hardware_casters = false;
         self.compute = Some(ComputePath {
-            raster: ComputeRaster::new(ctx)?,
+            raster: ComputeRaster::new(ctx, shading)?,
             casters: (!hardware_casters).then(|| ComputeCasters::new(ctx)).transpose()?,
-            write_depth,
+            shading,
         });
         Ok(())
+    }
+
+    /// The compute path's `terrain.shade` of the view with the points'
+    /// `sums` ([`ComputeShading::WithSplats`]): declared after the view's
+    /// points passes, which wrote them.
+    pub fn declare_shade<S: Provides<TerrainFrame> + Provides<PreparedLighting> + 'static>(
+        &mut self,
+        at: ViewGraph<'_, S>,
+        (targets, sums): (&SceneTargets, SplatSums),
+    ) -> Result<()> {
+        let (graph, index, view) = (at.graph, at.index, at.view);
+        let unshaded = (self.views.iter_mut().find(|v| v.index == index)).and_then(|v| v.unshaded.take());
+        let (Some(path), Some((pass, keys))) = (&self.compute, unshaded) else {
+            return Err(Error::Graph(format!(
+                "terrain.shade of view {index}: the view's compute passes left no shading for the splats"
+            )));
+        };
+        path.raster
+            .declare_shade_with_splats(graph, view, &pass, (keys, sums), targets)
     }
 
     /// Whether `terrain.shade` shades the sky too (the compute path): then
@@ -231,6 +253,7 @@ impl Terrain {
             vertices,
             compute,
             drawn: false,
+            unshaded: None,
         });
         Ok(())
     }
@@ -303,14 +326,17 @@ impl Terrain {
 }
 
 /// `terrain.draw` of a view (after its `terrain.warp`): its targets and the
-/// texture atlas's bindings (None: texturing in the draw) in, nothing out.
+/// texture atlas's bindings (None: texturing in the draw) in; out, on the
+/// compute path, the view's visibility keys.
 impl<S: Provides<TerrainFrame> + Provides<PreparedLighting> + 'static> Declare<S> for Terrain {
     type Inputs<'a> = (&'a SceneTargets, Option<&'a AtlasBindings>);
-    type Outputs = ();
+    type Outputs = Option<GroundKeys>;
 
     /// Declares `terrain.draw` of view `index` into `targets`, textured from
-    /// `atlas` when given (after [`Terrain::declare_warp`] of that view).
-    fn declare(&mut self, at: ViewGraph<'_, S>, (targets, atlas): Self::Inputs<'_>) -> Result<()> {
+    /// `atlas` when given (after [`Terrain::declare_warp`] of that view), or
+    /// the compute path's passes (`terrain.shade` left for
+    /// [`Terrain::declare_shade`] with [`ComputeShading::WithSplats`]).
+    fn declare(&mut self, at: ViewGraph<'_, S>, (targets, atlas): Self::Inputs<'_>) -> Result<Option<GroundKeys>> {
         let (ctx, graph, index, view) = (at.ctx, at.graph, at.index, at.view);
         let texturing = self.texturing_constants(atlas);
         let state = (self.views.iter_mut().find(|v| v.index == index))
@@ -332,10 +358,14 @@ impl<S: Provides<TerrainFrame> + Provides<PreparedLighting> + 'static> Declare<S
                 grid_side: side,
                 constants,
                 surface,
-                write_depth: path.write_depth,
+                shading: path.shading,
                 view: index,
             };
-            return path.raster.declare(ctx, graph, view, pass, targets);
+            let keys = path.raster.declare(ctx, graph, view, &pass, targets)?;
+            if path.shading == ComputeShading::WithSplats {
+                state.unshaded = Some((pass, keys));
+            }
+            return Ok(Some(keys));
         }
         let pass = DrawPass {
             view: index,
@@ -344,7 +374,8 @@ impl<S: Provides<TerrainFrame> + Provides<PreparedLighting> + 'static> Declare<S
             index_count: (side - 1) * (side - 1) * 6,
             surface,
         };
-        declare_draw_pass(ctx, graph, &pass_name("terrain.draw", &view.name), pass, targets)
+        declare_draw_pass(ctx, graph, &pass_name("terrain.draw", &view.name), pass, targets)?;
+        Ok(None)
     }
 }
 

@@ -14,9 +14,17 @@
 //! | `terrain.shade` | per pixel: the kept triangle, the exact surface sample on the pixel's ray, the shading; the sky where no triangle was kept (no separate `sky` pass on this path); writes every pixel of the view's targets and the view's lighting constants |
 //! | `terrain.depth` | the depth buffer for passes that depth-test with the hardware (points), when there are such |
 //!
+//! With the points' splats on the compute path too ([`ComputeShading::WithSplats`],
+//! issue 29), `terrain.shade` is declared after the points' passes, which
+//! test their splats against the visibility keys ([`GroundKeys`]), and
+//! shades their sums where they cover a pixel (§10.2.3 pass 3: the
+//! points' normalization fused into the frame's one shading pass); no
+//! `terrain.depth`.
+//!
 //! Shaders: `glsl/terrain/raster_clear.comp`, `raster.comp`,
-//! `raster_big.comp`, `shade.comp`, `depth.frag`;
-//! `glsl/include/terrain_visibility.glsl`.
+//! `raster_big.comp`, `shade.comp` (`shade_splats.comp` with the splats),
+//! `depth.frag`; `glsl/include/terrain_visibility.glsl`,
+//! `glsl/include/terrain_shade_pixel.glsl`.
 
 use std::sync::Arc;
 
@@ -32,6 +40,7 @@ use crate::lighting::technique::PreparedLighting;
 use crate::shaders;
 use crate::terrain::shading::SurfaceInputs;
 use crate::terrain::TerrainFrame;
+use crate::view::deferred::{GroundKeys, SplatSums};
 use crate::view::{Frame, Provides, SceneTargets, View, ViewIndex};
 use crate::vulkan::{
     CompareOp, ComputePipeline, Context, Format, GraphicsPipeline, GraphicsPipelineDesc, MemoryLocation,
@@ -156,8 +165,39 @@ struct ShadePush {
     surface: [u32; 4],
 }
 
+/// Push constants of `terrain.shade` with the points' sums (the splat
+/// passes' block of `glsl/include/splat.glsl` with `SPLAT_GROUND_SHADE`).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ShadeSplatsPush {
+    /// Sums, point frame, 0, nearest words.
+    handles: [u32; 4],
+    /// Last records, 0, 0, 0.
+    mode: [u32; 4],
+    /// Radiance, view depth, W, lighting AOVs (storage).
+    outputs: [u32; 4],
+    /// Normal, ids (storage); width, height.
+    more: [u32; 4],
+    /// View constants, grid vertices, visibility buffer, 0.
+    ground: [u32; 4],
+    /// Lighting constants, noise tile, texturing constants, 0.
+    surface: [u32; 4],
+}
+
 /// `terrain.shade` writes no NDC depth.
 const NO_DEPTH: u32 = u32::MAX;
+
+/// When and with what the compute path's `terrain.shade` runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ComputeShading {
+    /// Right after the raster passes; `write_depth`: `terrain.depth` then
+    /// writes the depth buffer for passes that depth-test with the hardware.
+    Immediate { write_depth: bool },
+    /// After the points' compute passes (declared by
+    /// [`crate::terrain::Terrain::declare_shade`]), shading their sums with
+    /// the ground: the points read the visibility keys, not a depth buffer.
+    WithSplats,
+}
 
 /// Workgroups of `terrain.raster_big` (each loops over the list).
 const BIG_WORKGROUPS: u32 = 256;
@@ -171,8 +211,8 @@ pub struct ComputePass {
     /// The view's [`ComputeView`] (written in prepare).
     pub constants: UploadRegion,
     pub surface: SurfaceInputs,
-    /// Whether later passes depth-test against the terrain (`terrain.depth`).
-    pub write_depth: bool,
+    /// When `terrain.shade` runs, and whether `terrain.depth` follows it.
+    pub shading: ComputeShading,
     /// The view (`terrain.shade` writes its lighting constants).
     pub view: ViewIndex,
 }
@@ -183,30 +223,40 @@ pub struct ComputeRaster {
     raster: Arc<ComputePipeline>,
     big: Arc<ComputePipeline>,
     shade: Arc<ComputePipeline>,
+    /// `terrain.shade` with the points' sums ([`ComputeShading::WithSplats`] only).
+    shade_splats: Option<Arc<ComputePipeline>>,
 }
 
 impl ComputeRaster {
-    /// Builds the pipelines.
-    pub fn new(ctx: &Context) -> Result<ComputeRaster> {
+    /// Builds the pipelines (`terrain.shade`'s with the points' sums when
+    /// `shading` asks for it).
+    pub fn new(ctx: &Context, shading: ComputeShading) -> Result<ComputeRaster> {
         let pipeline = |spirv| ComputePipeline::new(ctx, spirv).map(Arc::new);
         Ok(ComputeRaster {
             clear: pipeline(shaders::TERRAIN_RASTER_CLEAR)?,
             raster: pipeline(shaders::TERRAIN_RASTER)?,
             big: pipeline(shaders::TERRAIN_RASTER_BIG)?,
             shade: pipeline(shaders::TERRAIN_SHADE)?,
+            shade_splats: match shading {
+                ComputeShading::WithSplats => Some(pipeline(shaders::TERRAIN_SHADE_SPLATS)?),
+                ComputeShading::Immediate { .. } => None,
+            },
         })
     }
 
     /// Declares the compute passes of one view (`name`: the view's name)
-    /// into `targets`, after the view's `terrain.warp`.
+    /// into `targets`, after the view's `terrain.warp`: the raster passes,
+    /// then `terrain.shade` (and `terrain.depth`) unless the pass shades
+    /// with the splats ([`ComputeRaster::declare_shade_with_splats`] later).
+    /// Returns the view's visibility keys.
     pub fn declare<S: Provides<TerrainFrame> + Provides<PreparedLighting> + 'static>(
         &self,
         ctx: &Context,
         graph: &mut RenderGraph<Frame<S>>,
         view: &View,
-        pass: ComputePass,
+        pass: &ComputePass,
         targets: &SceneTargets,
-    ) -> Result<()> {
+    ) -> Result<GroundKeys> {
         let pixels = u64::from(targets.width) * u64::from(targets.height);
         let visibility = graph.create_buffer(
             &crate::view::pass_name("terrain visibility", &view.name),
@@ -222,16 +272,20 @@ impl ComputeRaster {
                 location: MemoryLocation::GpuOnly,
             },
         );
-        self.declare_raster(graph, view, &pass, (visibility, list), pixels)?;
-        let ndc_depth = pass.write_depth.then(|| {
+        self.declare_raster(graph, view, pass, (visibility, list), pixels)?;
+        let write_depth = match pass.shading {
+            ComputeShading::Immediate { write_depth } => write_depth,
+            ComputeShading::WithSplats => return Ok(GroundKeys(visibility)),
+        };
+        let ndc_depth = write_depth.then(|| {
             let name = crate::view::pass_name("terrain ndc depth", &view.name);
             graph.create_image(&name, ImageInfo::new(targets.width, targets.height, Format::R32_SFLOAT))
         });
-        self.declare_shade(graph, view, &pass, visibility, (targets, ndc_depth));
+        self.declare_shade(graph, view, pass, visibility, (targets, ndc_depth));
         if let Some(ndc_depth) = ndc_depth {
             declare_depth(ctx, graph, view, ndc_depth, targets)?;
         }
-        Ok(())
+        Ok(GroundKeys(visibility))
     }
 
     /// `terrain.raster_clear`, `terrain.raster`, `terrain.raster_big`.
@@ -324,6 +378,59 @@ impl ComputeRaster {
             };
             ctx.dispatch(&pipeline, &push, [width.div_ceil(8), height.div_ceil(8), 1])
         });
+    }
+}
+
+impl ComputeRaster {
+    /// `terrain.shade` with the points' sums ([`ComputeShading::WithSplats`]):
+    /// every pixel of the view shaded once, the splats normalized and
+    /// shaded where their sums hold weight (§10.2.3 pass 3, W written
+    /// there and 0 elsewhere), the ground or the sky elsewhere. After the
+    /// view's raster passes and the points' `points.accumulate`.
+    pub fn declare_shade_with_splats<S: Provides<TerrainFrame> + Provides<PreparedLighting> + 'static>(
+        &self,
+        graph: &mut RenderGraph<Frame<S>>,
+        view: &View,
+        pass: &ComputePass,
+        (keys, sums): (GroundKeys, SplatSums),
+        targets: &SceneTargets,
+    ) -> Result<()> {
+        let pipeline = (self.shade_splats.clone())
+            .ok_or_else(|| Error::Graph("terrain.shade: the splats' pipeline was not built".into()))?;
+        let weight = (targets.weight)
+            .ok_or_else(|| Error::Graph("terrain.shade: the view's targets have no splat weight".into()))?;
+        let compute = Stage::Compute;
+        let mut shade = graph.pass(&crate::view::pass_name("terrain.shade", &view.name));
+        let constants = shade.upload(pass.constants, compute);
+        let read = BufferAccess::StorageRead(compute);
+        let vertices = shade.storage_buffer(pass.vertices, read);
+        let keys = shade.storage_buffer(keys.0, read);
+        let [nearest, sum, last] = [sums.nearest, sums.sums, sums.last].map(|b| shade.storage_buffer(b, read));
+        let frame = shade.upload(sums.frame, compute);
+        let surface = pass.surface.read_in(&mut shade, targets, compute);
+        let write = ImageAccess::StorageWrite(compute);
+        let [radiance, view_depth, visibility, normal, ids] = targets.shaded().map(|i| shade.storage_image(i, write));
+        let weight = shade.storage_image(weight, write);
+        let (inputs, (width, height), index) = (pass.surface.clone(), (targets.width, targets.height), pass.view);
+        shade.record(move |ctx, frame_data| {
+            let handles = inputs.write(ctx, &surface)?;
+            write_view_lighting(ctx, frame_data, index, surface.lighting())?;
+            let push = ShadeSplatsPush {
+                handles: [ctx.handle(sum)?, ctx.handle(frame)?, 0, ctx.handle(nearest)?],
+                mode: [ctx.handle(last)?, 0, 0, 0],
+                outputs: [
+                    ctx.handle(radiance)?,
+                    ctx.handle(view_depth)?,
+                    ctx.handle(weight)?,
+                    ctx.handle(visibility)?,
+                ],
+                more: [ctx.handle(normal)?, ctx.handle(ids)?, width, height],
+                ground: [ctx.handle(constants)?, ctx.handle(vertices)?, ctx.handle(keys)?, 0],
+                surface: [handles.lighting, handles.noise_tile, handles.texturing_frame, 0],
+            };
+            ctx.dispatch(&pipeline, &push, [width.div_ceil(8), height.div_ceil(8), 1])
+        });
+        Ok(())
     }
 }
 

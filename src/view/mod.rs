@@ -21,6 +21,7 @@
 pub mod aov;
 pub mod camera;
 pub mod camera_path;
+pub mod deferred;
 pub mod depth;
 mod frame;
 pub mod lens;

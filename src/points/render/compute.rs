@@ -23,6 +23,13 @@
 //! 5. `points.normalize`: per pixel, divide and shade as the hardware
 //!    path's normalization (`glsl/include/splat_resolve.glsl`).
 //!
+//! With the terrain on the compute path too, `points.clear` takes the
+//! nearest words from the terrain's visibility keys ([`GroundKeys`]), and
+//! there is no `points.normalize`: the sums go back ([`SplatSums`]) to the
+//! frame's shading pass, `terrain.shade`, which normalizes and shades them
+//! in its one pass over the pixels (issue 29). `points.accumulate` then
+//! writes the point frame's header.
+//!
 //! The primitive setting (§10.3) belongs to the hardware path: compute
 //! rasterises the screen-space ellipse itself.
 
@@ -42,6 +49,7 @@ use crate::graph::{
     stride_groups, Binding, BufferAccess, BufferId, BufferInfo, ImageAccess, PassContext, RenderGraph, Stage,
 };
 use crate::shaders;
+use crate::view::deferred::{GroundKeys, SplatSums};
 use crate::view::depth::FAR_DEPTH;
 use crate::view::{Frame, Provides, SceneTargets};
 use crate::vulkan::{Blend, CompareOp, ComputePipeline, Context, GraphicsPipeline, MemoryLocation};
@@ -66,12 +74,15 @@ struct ComputeSplatPush {
 }
 
 /// Push constants of `points.clear`: nearest, sums, last, depth buffer
-/// (sampled, [`NO_HANDLE`]: far); width, height.
+/// (sampled, [`NO_HANDLE`]: far); width, height, the ground's visibility
+/// keys ([`NO_HANDLE`]: none) and the point frame's depth row (P22, P32)
+/// that turns their view depths into the depth buffer's.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct ClearPush {
     handles: [u32; 4],
     size: [u32; 4],
+    row: [f32; 4],
 }
 
 /// Push constants of `points.normalize` (`Push` with `SPLAT_RESOLVE_COMPUTE`).
@@ -86,13 +97,20 @@ struct NormalizePush {
     more: [u32; 4],
 }
 
-/// A view's per-pixel splat state.
+/// A view's per-pixel splat state: the nearest words, and for EWA the
+/// sums and last records (None: opaque splats, [`super::compute_opaque`]).
 #[derive(Clone, Copy, Debug)]
-struct SplatState {
-    nearest: BufferId,
-    sums: BufferId,
-    last: BufferId,
-    size: [u32; 2],
+pub(super) struct SplatState {
+    pub nearest: BufferId,
+    pub accumulation: Option<(BufferId, BufferId)>,
+    pub size: [u32; 2],
+}
+
+impl SplatState {
+    /// The sums and last records (EWA only).
+    fn accumulation(&self) -> Result<(BufferId, BufferId)> {
+        (self.accumulation).ok_or_else(|| Error::Graph("points: opaque splats have no sums".into()))
+    }
 }
 
 /// The bindings of one of the state's buffers in each pass that uses it.
@@ -122,23 +140,29 @@ struct Pipelines {
     clear: ComputePipeline,
     visibility: ComputePipeline,
     accumulate: ComputePipeline,
-    normalize: ComputePipeline,
+    /// None: the ground's shading pass resolves the sums.
+    normalize: Option<ComputePipeline>,
 }
 
 /// Declares the compute path's EWA passes of one view (see the module's
-/// list); `name` gives a pass's name for the view.
+/// list); `name` gives a pass's name for the view. With the `ground`'s
+/// visibility keys the splats are tested against them and the sums are
+/// returned for the ground's shading pass (no `points.normalize`).
 pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
     ctx: &Context,
     graph: &mut RenderGraph<Frame<S>>,
     name: &dyn Fn(&str) -> String,
-    (buffers, view): (PointBuffers, PointView),
+    (buffers, view, ground): (PointBuffers, PointView, Option<GroundKeys>),
     targets: &SceneTargets,
-) -> Result<()> {
+) -> Result<Option<SplatSums>> {
     let pipelines = Pipelines {
         clear: ComputePipeline::new(ctx, shaders::SPLAT_COMPUTE_CLEAR)?,
         visibility: ComputePipeline::new(ctx, shaders::SPLAT_COMPUTE_VISIBILITY)?,
         accumulate: ComputePipeline::new(ctx, shaders::SPLAT_COMPUTE_ACCUMULATE)?,
-        normalize: ComputePipeline::new(ctx, shaders::SPLAT_COMPUTE_NORMALIZE)?,
+        normalize: match ground {
+            Some(_) => None,
+            None => Some(ComputePipeline::new(ctx, shaders::SPLAT_COMPUTE_NORMALIZE)?),
+        },
     };
     let pixels = u64::from(targets.width * targets.height).max(1);
     let mut buffer = |what, bytes: u64| {
@@ -150,8 +174,10 @@ pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
     };
     let state = SplatState {
         nearest: buffer("splat nearest depth and record", NEAREST_BYTES),
-        sums: buffer("splat fixed-point sums", SUMS_BYTES),
-        last: buffer("splat last record", LAST_BYTES),
+        accumulation: Some((
+            buffer("splat fixed-point sums", SUMS_BYTES),
+            buffer("splat last record", LAST_BYTES),
+        )),
         size: [targets.width, targets.height],
     };
     // Hybrid triangles (§10.1.8): in the splats' state, as the hardware
@@ -163,56 +189,89 @@ pub(super) fn declare_ewa_compute<S: Provides<PointsFrame> + 'static>(
         false => None,
     };
     let opaque = hybrid && blended.is_none();
-    if opaque {
-        let triangles_only = PointBuffers {
-            primitive: SplatPrimitive::Quad,
-            ..buffers
-        };
-        declare_opaque(
-            ctx,
-            graph,
-            &name("points.triangles"),
-            (triangles_only, view),
-            targets,
-            false,
-        )?;
+    if opaque && ground.is_some() {
+        return Err(Error::Graph(format!(
+            "points: opaque hybrid triangles (no {TRIANGLE_FEATURE}) cannot be shaded by the ground's pass"
+        )));
     }
-    let depth_written = opaque || !view.clear_depth;
+    if opaque {
+        declare_opaque_triangles(ctx, graph, &name("points.triangles"), (buffers, view), targets)?;
+    }
+    let depth_written = (opaque || !view.clear_depth) && ground.is_none();
     declare_clear(
         graph,
         &name("points.clear"),
-        (view, state, depth_written),
+        (view, state, depth_written, ground),
         pipelines.clear,
     );
     let splats = (buffers, view, state);
     if let Some(t) = &blended {
         let pass = (true, t.visibility.clone());
-        declare_triangles(graph, &name("points.visibility.triangles"), splats, pass);
+        declare_triangles(graph, &name("points.visibility.triangles"), splats, pass)?;
     }
-    declare_splats(graph, &name("points.visibility"), splats, true, pipelines.visibility)?;
+    declare_splats(
+        graph,
+        &name("points.visibility"),
+        (splats, None),
+        true,
+        pipelines.visibility,
+    )?;
     if let Some(t) = blended {
         declare_triangles(
             graph,
             &name("points.accumulate.triangles"),
             splats,
             (false, t.accumulate),
-        );
+        )?;
     }
-    declare_splats(graph, &name("points.accumulate"), splats, false, pipelines.accumulate)?;
+    let header = ground.is_some().then_some(targets);
+    declare_splats(
+        graph,
+        &name("points.accumulate"),
+        (splats, header),
+        false,
+        pipelines.accumulate,
+    )?;
+    let Some(normalize_pipeline) = pipelines.normalize else {
+        let (sums, last) = state.accumulation()?;
+        return Ok(Some(SplatSums {
+            nearest: state.nearest,
+            sums,
+            last,
+            frame: view.frame,
+        }));
+    };
     let normalize = name("points.normalize");
     declare_normalize(
         graph,
-        (normalize.as_str(), pipelines.normalize),
+        (normalize.as_str(), normalize_pipeline),
         (view, targets),
         state,
         opaque,
-    );
-    Ok(())
+    )?;
+    Ok(None)
+}
+
+/// `points.triangles`: the hybrid triangles (§10.1.8) opaque and shaded
+/// on the hardware path, with depth and W = 1, for the splats' compute
+/// passes to test against.
+pub(super) fn declare_opaque_triangles<S: Provides<PointsFrame> + 'static>(
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame<S>>,
+    name: &str,
+    (buffers, view): (PointBuffers, PointView),
+    targets: &SceneTargets,
+) -> Result<()> {
+    let triangles_only = PointBuffers {
+        primitive: SplatPrimitive::Quad,
+        ..buffers
+    };
+    declare_opaque(ctx, graph, name, (triangles_only, view), targets, false)
 }
 
 /// The device feature the hybrid triangles' passes need on the compute
 /// path (their fragments write the splats' state).
-const TRIANGLE_FEATURE: &str = "fragmentStoresAndAtomics";
+pub(super) const TRIANGLE_FEATURE: &str = "fragmentStoresAndAtomics";
 
 /// The hybrid triangles' pipelines (`glsl/points/hybrid.vert` with the
 /// compute path's fragment stages): no attachment written, no depth test
@@ -251,7 +310,7 @@ fn declare_triangles<S: Provides<PointsFrame> + 'static>(
     name: &str,
     (buffers, view, state): (PointBuffers, PointView, SplatState),
     (visibility, pipeline): (bool, Arc<GraphicsPipeline>),
-) {
+) -> Result<()> {
     let mut builder = graph.pass(name).graphics();
     let frame = builder.upload(view.frame, Stage::Graphics);
     let (mut builder, splat) = buffers.read_by(builder, frame, visibility);
@@ -265,8 +324,8 @@ fn declare_triangles<S: Provides<PointsFrame> + 'static>(
         },
         false => StateBindings {
             nearest: builder.storage_buffer(state.nearest, BufferAccess::StorageRead(fragment)),
-            sums: Some(builder.storage_buffer(state.sums, written)),
-            last: Some(builder.storage_buffer(state.last, written)),
+            sums: Some(builder.storage_buffer(state.accumulation()?.0, written)),
+            last: Some(builder.storage_buffer(state.accumulation()?.1, written)),
         },
     };
     let builder = builder.pipeline(&pipeline);
@@ -286,30 +345,36 @@ fn declare_triangles<S: Provides<PointsFrame> + 'static>(
         };
         draw_triangles_with(pass.cmd(), &pipeline, plan, (push, |p| &mut p.splat), triangles)
     });
+    Ok(())
 }
 
-/// `points.clear`: the nearest words from the depth buffer (when something
-/// drew into it), sums and last records 0.
-fn declare_clear<S: Provides<PointsFrame> + 'static>(
+/// `points.clear`: the nearest words from the ground's visibility keys
+/// (when given) or the depth buffer (when something drew into it), sums
+/// and last records 0.
+pub(super) fn declare_clear<S: Provides<PointsFrame> + 'static>(
     graph: &mut RenderGraph<Frame<S>>,
     name: &str,
-    (view, state, depth_written): (PointView, SplatState, bool),
+    (view, state, depth_written, ground): (PointView, SplatState, bool, Option<GroundKeys>),
     pipeline: ComputePipeline,
 ) {
     let write = BufferAccess::StorageWrite(Stage::Compute);
     let mut pass = graph.pass(name);
-    let buffers = [state.nearest, state.sums, state.last].map(|b| pass.storage_buffer(b, write));
+    let nearest = pass.storage_buffer(state.nearest, write);
+    let sums = (state.accumulation).map(|(s, l)| [s, l].map(|b| pass.storage_buffer(b, write)));
     let depth = depth_written.then(|| pass.sample(view.depth, Stage::Compute));
-    pass.record(move |ctx, _| {
+    let keys = ground.map(|g| pass.storage_buffer(g.0, BufferAccess::StorageRead(Stage::Compute)));
+    pass.record(move |ctx, frame| {
         let depth = depth.map(|d| ctx.handle(d)).transpose()?.unwrap_or(NO_HANDLE);
+        let keys = keys.map(|k| ctx.handle(k)).transpose()?.unwrap_or(NO_HANDLE);
+        let row = frame.prepared::<PointsFrame>()?.view(view.index)?.header.depth;
+        let [sums, last] = match sums {
+            Some(buffers) => [ctx.handle(buffers[0])?, ctx.handle(buffers[1])?],
+            None => [NO_HANDLE; 2],
+        };
         let push = ClearPush {
-            handles: [
-                ctx.handle(buffers[0])?,
-                ctx.handle(buffers[1])?,
-                ctx.handle(buffers[2])?,
-                depth,
-            ],
-            size: [state.size[0], state.size[1], 0, 0],
+            handles: [ctx.handle(nearest)?, sums, last, depth],
+            size: [state.size[0], state.size[1], keys, 0],
+            row: [row[0], row[1], 0.0, 0.0],
         };
         let groups = [state.size[0].div_ceil(8), state.size[1].div_ceil(8), 1];
         ctx.dispatch(&pipeline, &push, groups)
@@ -318,17 +383,23 @@ fn declare_clear<S: Provides<PointsFrame> + 'static>(
 
 /// `points.visibility` (`visibility`: raises the nearest words, counts the
 /// drawn splats) or `points.accumulate` (reads them, adds to the sums and
-/// raises the last records): one dispatch per planned draw.
-fn declare_splats<S: Provides<PointsFrame> + 'static>(
+/// raises the last records): one dispatch for all the view's draws. With
+/// `header` (the view's targets) the pass writes the point frame's header,
+/// for the ground's shading pass to read.
+pub(super) fn declare_splats<S: Provides<PointsFrame> + 'static>(
     graph: &mut RenderGraph<Frame<S>>,
     name: &str,
-    (buffers, view, state): (PointBuffers, PointView, SplatState),
+    ((buffers, view, state), header): ((PointBuffers, PointView, SplatState), Option<&SceneTargets>),
     visibility: bool,
     pipeline: ComputePipeline,
 ) -> Result<()> {
     let compute = Stage::Compute;
     let mut builder = graph.pass(name);
-    let frame = builder.upload(view.frame, compute);
+    let shading = header.map(|targets| ShadingBindings::read_in(&mut builder, (&view, targets), compute));
+    let frame = match &shading {
+        Some(s) => s.frame,
+        None => builder.upload(view.frame, compute),
+    };
     let buffers = PointBuffers {
         counter: buffers.counter.filter(|_| visibility),
         ..buffers
@@ -347,11 +418,14 @@ fn declare_splats<S: Provides<PointsFrame> + 'static>(
         },
         false => StateBindings {
             nearest: builder.storage_buffer(state.nearest, BufferAccess::StorageRead(compute)),
-            sums: Some(builder.storage_buffer(state.sums, written)),
-            last: Some(builder.storage_buffer(state.last, written)),
+            sums: Some(builder.storage_buffer(state.accumulation()?.0, written)),
+            last: Some(builder.storage_buffer(state.accumulation()?.1, written)),
         },
     };
     builder.record(move |pass, frame| {
+        if let Some(shading) = &shading {
+            shading.write_header(pass, frame, view.index)?;
+        }
         let plan = plan_of(frame, view.index)?;
         // The draw table was checked not to overflow when it was written.
         let splats = plan.draws.iter().map(|d| d.count).fold(0u32, u32::wrapping_add);
@@ -378,7 +452,7 @@ fn declare_normalize<S: Provides<PointsFrame> + 'static>(
     (view, targets): (PointView, &SceneTargets),
     state: SplatState,
     triangles: bool,
-) {
+) -> Result<()> {
     let pipeline = Arc::new(pipeline);
     let compute = Stage::Compute;
     let weight = match triangles {
@@ -388,7 +462,8 @@ fn declare_normalize<S: Provides<PointsFrame> + 'static>(
     let mut builder = graph.pass(name);
     let shading = ShadingBindings::read_in(&mut builder, (&view, targets), compute);
     let read = BufferAccess::StorageRead(compute);
-    let [nearest, sums, last] = [state.nearest, state.sums, state.last].map(|b| builder.storage_buffer(b, read));
+    let (sums, last) = state.accumulation()?;
+    let [nearest, sums, last] = [state.nearest, sums, last].map(|b| builder.storage_buffer(b, read));
     let outputs = ResolvedTargets::declare(&mut builder, (&view, targets), weight);
     builder.record(move |pass, frame| {
         let frame = shading.write_header(pass, frame, view.index)?;
@@ -401,6 +476,7 @@ fn declare_normalize<S: Provides<PointsFrame> + 'static>(
         };
         pass.dispatch(&pipeline, &push, outputs.groups())
     });
+    Ok(())
 }
 
 #[cfg(test)]
@@ -409,9 +485,9 @@ mod tests {
 
     #[test]
     fn push_constants_match_the_shader_blocks() {
-        // handles, mode (SplatPush), raster, draws: 64 bytes; clear and normalize: 32 and 64.
+        // handles, mode (SplatPush), raster, draws: 64 bytes; clear and normalize: 48 and 64.
         assert_eq!(std::mem::size_of::<ComputeSplatPush>(), 64);
-        assert_eq!(std::mem::size_of::<ClearPush>(), 32);
+        assert_eq!(std::mem::size_of::<ClearPush>(), 48);
         assert_eq!(std::mem::size_of::<NormalizePush>(), 64);
     }
 }

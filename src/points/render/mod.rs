@@ -8,8 +8,9 @@
 //! | `points.visibility` | ewa | depth: ray–plane depth pushed back by ε; the ids of the winning surfel |
 //! | `points.accumulate` | ewa | depth test ≤ without writes, additive (w·colour, w), (w·normal, w·depth) into float targets; the ids of the last surfel |
 //! | `points.normalize` | ewa | compute, per pixel: divide by w, shade, write radiance, view depth, W, world normal and ids (the winner's, else the last surfel's) |
-//! | `points.clear`, `points.visibility`, `points.accumulate`, `points.normalize` | ewa, compute path | the same three passes in compute ([`compute`]): 64-bit (depth, record) words and fixed-point integer sums, deterministic to the byte |
+//! | `points.clear`, `points.visibility`, `points.accumulate`, `points.normalize` | ewa, compute path | the same three passes in compute ([`compute`]): 64-bit (depth, record) words and fixed-point integer sums, deterministic to the byte; with the terrain on the compute path too, tested against its visibility keys and normalized by `terrain.shade` (no `points.normalize`) |
 //! | `points.opaque` | opaque | opaque discs with ray–plane depth, shaded directly, with normal and ids |
+//! | `points.clear`, `points.opaque`, `points.opaque.resolve` | opaque, compute path | the nearest (depth, splat index) word per pixel by 64-bit `atomicMax`, the winner shaded per pixel ([`compute_opaque`]) |
 //! | `points.single_pass.triangles` | single-pass | hybrid triangles as opaque shaded triangles with depth, when the scene has any |
 //! | `points.single_pass.clear` | single-pass, compute | every tile's entry count 0 (§10.4; interlock: every pixel's state z_d = +inf, sums 0) |
 //! | `points.single_pass.count` | single-pass, compute | per splat: EWA set-up, bounding box → 16×16-pixel tiles, each tile's count + 1 |
@@ -24,12 +25,14 @@
 //! texture instead of the screen-space EWA set-up.
 //!
 //! On the compute raster path (`--raster compute`, the default where the
-//! device has 64-bit buffer atomics) EWA splats are drawn by compute passes
-//! ([`compute`], issue 29); the primitives are the hardware path's.
+//! device has 64-bit buffer atomics) EWA and opaque splats are drawn by
+//! compute passes ([`compute`], [`compute_opaque`], issue 29); the
+//! primitives are the hardware path's.
 //!
 //! The graph derives every barrier between them. Shaders: `glsl/points/`.
 
 mod compute;
+mod compute_opaque;
 pub mod gpu_layout;
 pub mod object_space;
 mod passes;

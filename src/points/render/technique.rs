@@ -6,7 +6,8 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::compute::declare_ewa_compute;
+use super::compute::{declare_ewa_compute, TRIANGLE_FEATURE};
+use super::compute_opaque::declare_opaque_compute;
 use super::gpu_layout::{frame_header, gaussian_table, pack_nodes, FrameHeader, HEADER_BYTES, INSTANCE_BYTES};
 use super::object_space::ObjectSpaceResources;
 use super::passes::{declare_ewa, declare_opaque, PointBuffers, PointView};
@@ -19,6 +20,7 @@ use crate::error::{Error, Result};
 use crate::graph::UploadRegion;
 use crate::points::build::clusters::{cluster_normals, CLUSTER_COUNT};
 use crate::points::scene::PointScene;
+use crate::view::deferred::{GroundKeys, SplatSums};
 use crate::view::{
     pass_name, per_view, Declare, FrameContext, Provides, SceneTargets, Technique, ViewGraph, ViewIndex,
 };
@@ -74,15 +76,16 @@ pub struct PointRenderer {
     stats: StatsLog,
     /// The previous frame's plans, reused ([`Technique::recycle`]).
     spare: Vec<PointViewFrame>,
-    /// EWA splats drawn by compute passes ([`super::compute`]), not the
-    /// hardware rasterizer.
+    /// EWA and opaque splats drawn by compute passes ([`super::compute`],
+    /// [`super::compute_opaque`]), not the hardware rasterizer.
     compute: bool,
 }
 
 impl PointRenderer {
-    /// Whether EWA splats are drawn by compute passes.
+    /// Whether the splats are drawn by compute passes (EWA and opaque on
+    /// the compute path; single-pass splatting is compute either way).
     pub fn draws_in_compute(&self) -> bool {
-        self.compute && self.settings.mode == SplatMode::Ewa
+        self.compute && matches!(self.settings.mode, SplatMode::Ewa | SplatMode::Opaque)
     }
 
     /// Uploads the splat lists of `scene` (re-derived for
@@ -183,6 +186,15 @@ impl PointRenderer {
         (&self.scene, &self.layouts, &self.resources.splats)
     }
 
+    /// Whether the splats' sums can be left to the ground's shading pass
+    /// (`terrain.shade` on the compute path, issue 29): EWA splats on the
+    /// compute path, with hybrid triangles only where they blend into the
+    /// sums (their opaque fallback depth-tests with the hardware).
+    pub fn sums_shaded_by_ground(&self, ctx: &Context) -> bool {
+        let triangles_blend = self.resources.triangles.is_none() || ctx.has_feature(TRIANGLE_FEATURE);
+        self.compute && self.settings.mode == SplatMode::Ewa && triangles_blend
+    }
+
     /// The most splats a frame can plan: every instance's whole list.
     fn planned_splats(&self) -> u64 {
         let list = |i: &crate::points::scene::PointInstance| self.scene.objects[i.object].tree.nodes.len() as u64;
@@ -196,19 +208,32 @@ impl PointRenderer {
     }
 }
 
-/// The points passes of a view: its targets (W required) and whether
-/// they clear the depth buffer (no terrain drew into it) in, nothing out.
+/// The points passes of a view: its targets (W required), whether they
+/// clear the depth buffer (no terrain drew into it) and the ground's
+/// visibility keys (the compute path's, when its shading pass resolves the
+/// splats: [`PointRenderer::sums_shaded_by_ground`]) in; out, in that
+/// case, the splat sums for it.
 impl<S: Provides<PointsFrame> + 'static> Declare<S> for PointRenderer {
-    type Inputs<'a> = (&'a SceneTargets, bool);
-    type Outputs = ();
+    type Inputs<'a> = (&'a SceneTargets, bool, Option<GroundKeys>);
+    type Outputs = Option<SplatSums>;
 
     /// Declares the points passes of view `index` into `targets` (W
     /// required): `points.visibility`, `points.accumulate`,
-    /// `points.normalize` for EWA splats, `points.single_pass*` for
+    /// `points.normalize` for EWA splats (no `points.normalize` when the
+    /// ground's shading pass resolves them), `points.single_pass*` for
     /// single-pass splats (§10.4), or `points.opaque`.
     /// `clear_depth`: no terrain drew into the depth buffer.
-    fn declare(&mut self, at: ViewGraph<'_, S>, (targets, clear_depth): Self::Inputs<'_>) -> Result<()> {
+    fn declare(
+        &mut self,
+        at: ViewGraph<'_, S>,
+        (targets, clear_depth, ground): Self::Inputs<'_>,
+    ) -> Result<Option<SplatSums>> {
         let (ctx, graph, index, view) = (at.ctx, at.graph, at.index, at.view);
+        if ground.is_some() && !self.sums_shaded_by_ground(ctx) {
+            return Err(Error::Graph(
+                "points: handed the ground's visibility keys, but their splats are not resolved by the ground".into(),
+            ));
+        }
         if targets.width > 0xffff || targets.height > 0xffff {
             return Err(Error::invalid(
                 "image size",
@@ -250,16 +275,23 @@ impl<S: Provides<PointsFrame> + 'static> Declare<S> for PointRenderer {
             visibility: targets.visibility,
             normal: targets.normal,
             ids: targets.ids,
-            clear_depth,
+            // With the ground's keys nothing drew into the depth buffer.
+            clear_depth: clear_depth || ground.is_some(),
             draws: (self.draws_in_compute())
                 .then(|| graph.upload_region(&pass_name("point draws", &view.name), 8 * records)),
         };
         let name = |base: &str| pass_name(base, &view.name);
+        let mut sums = None;
         match self.settings.mode {
+            SplatMode::Opaque if self.compute => {
+                declare_opaque_compute(ctx, graph, &name, (buffers, point_view), targets)?
+            }
             SplatMode::Opaque => {
                 declare_opaque(ctx, graph, &name("points.opaque"), (buffers, point_view), targets, true)?
             }
-            SplatMode::Ewa if self.compute => declare_ewa_compute(ctx, graph, &name, (buffers, point_view), targets)?,
+            SplatMode::Ewa if self.compute => {
+                sums = declare_ewa_compute(ctx, graph, &name, (buffers, point_view, ground), targets)?
+            }
             SplatMode::Ewa => {
                 let names = [
                     name("points.visibility"),
@@ -282,7 +314,7 @@ impl<S: Provides<PointsFrame> + 'static> Declare<S> for PointRenderer {
             )?,
         }
         self.views.push(point_view);
-        Ok(())
+        Ok(sums)
     }
 }
 

@@ -150,9 +150,7 @@ fn gpu_interval_test_matches_the_cpu_reference() {
 
 #[test]
 fn the_three_screen_space_primitives_draw_the_same_splats() {
-    let mut points = PointScene::default();
-    points.add(bunny(), PointTransform::parse("r=90,0,0").unwrap());
-    let scene = Scene::points_only(points);
+    let scene = bunny_scene();
     let camera = bunny_camera(0.5);
     let images: Vec<(SplatPrimitive, FrameImages)> = SplatPrimitive::SCREEN_SPACE
         .iter()
@@ -184,9 +182,7 @@ fn the_three_screen_space_primitives_draw_the_same_splats() {
 /// order the GPU runs the fragments in; and they match the hardware path's.
 #[test]
 fn compute_ewa_frames_are_the_same_to_the_byte() {
-    let mut points = PointScene::default();
-    points.add(bunny(), PointTransform::parse("r=90,0,0").unwrap());
-    let scene = Scene::points_only(points);
+    let scene = bunny_scene();
     let camera = bunny_camera(0.4);
     let on = |raster| render_points_on(&scene, &camera, (SplatSettings::default(), raster), (WIDTH, HEIGHT)).0;
     let [first, second] = [(); 2].map(|_| on(RasterPath::Compute));
@@ -207,14 +203,47 @@ fn compute_ewa_frames_are_the_same_to_the_byte() {
     );
 }
 
+/// The compute path's opaque splats (issue 29): the nearest splat per
+/// pixel by a 64-bit `atomicMax` of (depth, splat index), shaded by a
+/// resolve pass: the same to the byte on every run, and the hardware
+/// path's depth-tested discs.
+#[test]
+fn compute_opaque_frames_are_the_same_to_the_byte() {
+    let scene = bunny_scene();
+    let camera = bunny_camera(0.4);
+    let settings = SplatSettings {
+        mode: SplatMode::Opaque,
+        ..SplatSettings::default()
+    };
+    let on = |raster| render_points_on(&scene, &camera, (settings, raster), (WIDTH, HEIGHT)).0;
+    let [first, second] = [(); 2].map(|_| on(RasterPath::Compute));
+    let covered = first.weight.as_ref().unwrap().iter().filter(|w| **w > 0.0).count();
+    assert!(covered > 1000, "the bunny covers {covered} pixels");
+    assert!(first.rgba8 == second.rgba8, "two compute frames differ in colour");
+    let depth_bits = |frame: &FrameImages| frame.depth.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert!(
+        depth_bits(&first) == depth_bits(&second),
+        "two compute frames differ in depth"
+    );
+    let hardware = on(RasterPath::Hardware);
+    let hardware_covered = hardware.weight.as_ref().unwrap().iter().filter(|w| **w > 0.0).count();
+    let differing = pixels_differing(&first, &hardware, 2);
+    eprintln!(
+        "opaque compute against hardware: {differing} of {covered} covered pixels differ by more than 2/255 \
+         (hardware covers {hardware_covered})"
+    );
+    assert!(
+        differing * 100 <= covered,
+        "{differing} pixels differ from the hardware path"
+    );
+}
+
 /// Normal clusters (§10.1.10) send fewer splats and draw the same image: the
 /// clusters they skip hold only back-facing splats, which the vertex stage
 /// would cull anyway.
 #[test]
 fn normal_clusters_skip_back_faces_without_changing_the_image() {
-    let mut points = PointScene::default();
-    points.add(bunny(), PointTransform::parse("r=90,0,0").unwrap());
-    let scene = Scene::points_only(points);
+    let scene = bunny_scene();
     let camera = bunny_camera(0.6);
     let (plain, plain_stats) = render(&scene, &camera, SplatSettings::default());
     let clustered_settings = SplatSettings {
@@ -242,4 +271,11 @@ fn normal_clusters_skip_back_faces_without_changing_the_image() {
         differing * 1000 <= (WIDTH * HEIGHT) as usize,
         "{differing} pixels differ"
     );
+}
+
+/// The bunny upright, alone.
+fn bunny_scene() -> Scene {
+    let mut points = PointScene::default();
+    points.add(bunny(), PointTransform::parse("r=90,0,0").unwrap());
+    Scene::points_only(points)
 }

@@ -246,6 +246,41 @@ fn points_and_rig_views_occlude_alike_in_both_paths() {
     assert!(rocks(&compute[0]) > 20, "{} rock pixels", rocks(&compute[0]));
 }
 
+/// With the splats on the compute path too, the frame shades once: the
+/// points test against the terrain's visibility keys and `terrain.shade`
+/// comes after their `points.accumulate` and resolves their sums (issue
+/// 29): no `terrain.depth`, no `points.normalize`. The hardware path
+/// keeps both of its passes.
+#[test]
+fn terrain_shade_resolves_the_splats_on_the_compute_path() {
+    let mut scene = Scene::new(jacksboro_field());
+    let spt = SptOptions {
+        epsilon: epsilon_from_pixels(1.0, 50f32.to_radians(), HEIGHT).expect("epsilon"),
+        ..SptOptions::default()
+    };
+    scene.points = scatter_rocks(&scene.heights, 2, 200, 400, (30.0, 80.0), 7, &spt).expect("rocks");
+    let (ctx, report) = validated_context();
+    for raster in [RasterPath::Compute, RasterPath::Hardware] {
+        let settings = RenderSettings {
+            raster,
+            ..RenderSettings::new(WIDTH, HEIGHT)
+        };
+        let renderer = Renderer::new(&ctx, &scene, settings).expect("renderer");
+        let names = renderer.pass_names();
+        let at = |pass: &str| names.iter().position(|n| n == pass);
+        let compute = raster == RasterPath::Compute;
+        assert!(at("terrain.depth").is_none(), "{raster:?}: {names:?}");
+        assert_eq!(at("points.normalize").is_some(), !compute, "{raster:?}: {names:?}");
+        if compute {
+            let (accumulate, shade) = (at("points.accumulate"), at("terrain.shade"));
+            assert!(accumulate.is_some() && shade > accumulate, "{names:?}");
+            assert!(at("points.clear") > at("terrain.raster_big"), "{names:?}");
+        }
+    }
+    drop(ctx);
+    assert_validation_clean(&report);
+}
+
 /// Asserts the bounds of the module docs on each view's pair of frames.
 fn compare(cameras: &[(&str, Camera)], hardware: &[FrameImages], compute: &[FrameImages]) {
     for (((name, _), h), c) in cameras.iter().zip(hardware).zip(compute) {
