@@ -26,7 +26,8 @@
 //! * in which light: [`Lighting`], [`SunPosition`], [`SkyModel`],
 //!   [`Exposure`], [`ShadowMode`], [`SkyLightMode`];
 //! * what comes back: [`FrameImages`] (colour, HDR and every AOV of a
-//!   view) and [`FrameProfile`] (GPU and CPU time per pass);
+//!   view) and [`FrameProfile`] (GPU and CPU time per pass;
+//!   [`PipelineStats`], [`DeviceMemoryUse`]);
 //! * when it goes wrong: [`Error`] (one line naming the parameter, file or
 //!   feature at fault) and [`Result`]. The library never panics on input.
 //!
@@ -284,7 +285,7 @@ pub use view::{Exposure, ShadowMode, SkyLightMode, SkyModel, SunPosition};
 // --- What comes back ---
 
 pub use points::render::PointFrameStats;
-pub use profile::FrameProfile;
+pub use profile::{DeviceMemoryUse, FrameProfile, PipelineStats};
 /// One rendered view in host memory: tone-mapped sRGB, HDR radiance,
 /// view-space depth and the simulator AOVs (normal, class, instance,
 /// motion, visibility, splat weight). Row 0 is the top of the image.

@@ -68,8 +68,7 @@ pub mod budget {
 /// median and quantiles of timings.
 pub mod profile {
     pub use crate::profile::{
-        chrome_trace, median, profile_json, summarize, write_chrome_trace, write_profile_json, FrameSummary,
-        PassSummary, PassTiming, StageTiming,
+        chrome_trace, gpu_spans_outside_frames, median, profile_json, quantile, summarize, write_chrome_trace,
+        write_profile_json, DeviceMemoryUse, FrameSummary, PassSummary, PassTiming, PipelineStats, StageTiming,
     };
-    pub use crate::terrain::zoom::quantile;
 }

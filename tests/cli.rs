@@ -419,7 +419,7 @@ fn info_names_device_and_driver() {
 #[test]
 fn bench_writes_json_summary() {
     let dir = fresh_dir("bench_writes_json_summary");
-    let json = dir.join("b.json");
+    let (json, trace) = (dir.join("b.json"), dir.join("t.json"));
     let out = run(&[
         "bench".as_ref(),
         "--validation".as_ref(),
@@ -433,8 +433,14 @@ fn bench_writes_json_summary() {
         "64".as_ref(),
         "--profile".as_ref(),
         json.as_os_str(),
+        "--trace".as_ref(),
+        trace.as_os_str(),
+        "--pipeline-stats".as_ref(),
     ]);
     assert_success("bench", &out);
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("p95") && stdout.contains("p99"), "{stdout}");
+    assert!(stdout.contains("device memory"), "{stdout}");
     let b: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     assert_eq!(b["frames"], 3, "bench JSON: {b}");
     assert_eq!((b["width"].as_u64(), b["height"].as_u64()), (Some(64), Some(64)));
@@ -450,8 +456,28 @@ fn bench_writes_json_summary() {
             .iter()
             .find(|p| p["name"] == name)
             .unwrap_or_else(|| panic!("bench JSON lacks pass {name}: {b}"));
-        finite_ms(pass, "median_gpu_ms", name);
+        for key in ["median_gpu_ms", "p95_gpu_ms", "p99_gpu_ms"] {
+            finite_ms(pass, key, name);
+        }
         assert_eq!(pass["samples"], 3, "pass {name}");
+    }
+    finite_ms(&b, "p99_frame_gpu_ms", "bench");
+    // --pipeline-stats: every pass has its counters; the compute passes count invocations.
+    assert!(passes.iter().all(|p| p["pipeline_stats"].is_object()), "{b}");
+    let warp = passes.iter().find(|p| p["name"] == "terrain.warp").unwrap();
+    assert!(
+        warp["pipeline_stats"]["compute_shader_invocations"].as_u64() > Some(0),
+        "{warp}"
+    );
+    assert!(stdout.contains("pipeline statistics (median)"), "{stdout}");
+    assert!(b["device_memory"]["allocated_bytes"].as_u64() > Some(0), "{b}");
+    // One timeline: with calibrated timestamps every GPU span of the trace
+    // lies between its frame's submit and fence wait on the CPU clock.
+    let trace = std::fs::read_to_string(&trace).unwrap();
+    let calibrated = b["device"]["calibrated_timestamps"] == true;
+    match alpenglow::tools::profile::gpu_spans_outside_frames(&trace) {
+        Ok(outside) => assert!(calibrated && outside.is_empty(), "{outside:#?}"),
+        Err(e) => assert!(!calibrated && e.to_string().contains("not calibrated"), "{e}"),
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

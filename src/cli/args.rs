@@ -449,6 +449,10 @@ pub struct RenderArgs {
     /// Chrome trace (opens in Perfetto).
     #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub trace: Option<PathBuf>,
+    /// Count each pass's pipeline statistics (vertex, fragment, compute
+    /// invocations…) into the profile; needs the device feature pipelineStatisticsQuery.
+    #[arg(long, help_heading = "Output")]
+    pub pipeline_stats: bool,
     #[command(flatten)]
     pub scene: SceneArgs,
 }
@@ -467,6 +471,10 @@ pub struct BenchArgs {
     /// Chrome trace of the timed frames (opens in Perfetto).
     #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub trace: Option<PathBuf>,
+    /// Count each pass's pipeline statistics (vertex, fragment, compute
+    /// invocations…) and report their medians; needs the device feature pipelineStatisticsQuery.
+    #[arg(long, help_heading = "Output")]
+    pub pipeline_stats: bool,
     #[command(flatten)]
     pub scene: SceneArgs,
 }

@@ -1,6 +1,7 @@
 //! Subcommands of the `alpenglow` binary.
 
 mod args;
+mod bench;
 mod errors;
 mod exr;
 mod fly;
@@ -20,23 +21,24 @@ mod tests;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{bail, Result};
 use glam::DVec2;
 
 use alpenglow::files::load_heightmap;
-use alpenglow::tools::profile::{chrome_trace, profile_json, summarize};
+use alpenglow::tools::profile::{chrome_trace, profile_json};
 use alpenglow::{
     validate_size, Camera, Context, ContextOptions, DeviceSelector, FrameProfile, HeightmapOptions, ImportanceFactors,
-    LodMode, LodSettings, Scene, Settings, SketchAlignment, TerrainSettings, TerrainView, TextureSummary,
-    TexturingMode, ValidationReport, ViewSpec,
+    LodMode, LodSettings, Scene, Settings, SketchAlignment, TerrainSettings, TerrainView, TexturingMode,
+    ValidationReport, ViewSpec,
 };
+use bench::report_textures;
 pub use errors::error_line;
 
 use outputs::Outputs;
 
 use args::{
-    AlignArg, BenchArgs, Cli, Command, DeviceArgs, FactorArg, LodArg, RenderArgs, SceneArgs, TerrainArgs,
-    TerrainDebugArgs, ViewArg,
+    AlignArg, Cli, Command, DeviceArgs, FactorArg, LodArg, RenderArgs, SceneArgs, TerrainArgs, TerrainDebugArgs,
+    ViewArg,
 };
 
 /// Lets every option that takes a value accept a value that starts with a
@@ -88,7 +90,7 @@ pub fn run() -> Result<ExitCode> {
     };
     match cli.command {
         Command::Render(args) => render(args),
-        Command::Bench(args) => bench(args),
+        Command::Bench(args) => bench::bench(args),
         Command::Fly(args) => fly::fly(args),
         Command::Spt(args::SptCommand::Build(args)) => spt::build(args),
         Command::Info(args) => info(args),
@@ -361,9 +363,10 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
     let ctx = context(&args.scene.device)?;
     let report = ctx.validation_report();
     let device = ctx.info().name.clone();
-    let (views, profiles, raster) = {
+    let (views, profiles, raster, memory) = {
         let settings = render_settings(&args.scene, &scene, &specs, true)?;
         let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
+        renderer.set_pipeline_stats(args.pipeline_stats)?;
         let raster = renderer.raster_path();
         let frame = renderer.render_views_settled(&cameras, MAX_SETTLE_FRAMES)?;
         let views = renderer.read_views(&frame)?;
@@ -381,7 +384,7 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
                 last.tiles.resident
             );
         }
-        (views, profiles, raster)
+        (views, profiles, raster, ctx.memory_use())
     };
     drop(ctx);
     check_validation(report)?;
@@ -392,7 +395,7 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
         outputs.stage(path(&args.exr).as_deref(), || exr::encode_frame_exr(images))?;
     }
     outputs.stage(args.profile.as_deref(), || {
-        Ok(profile_json(&device, raster.name(), &profiles)?.into_bytes())
+        Ok(profile_json(&device, raster.name(), &profiles, Some(memory))?.into_bytes())
     })?;
     outputs.stage(args.trace.as_deref(), || {
         Ok(chrome_trace(&device, &profiles)?.into_bytes())
@@ -402,119 +405,6 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
         print_profile(&device, frame);
     }
     Ok(ExitCode::SUCCESS)
-}
-
-fn bench(args: BenchArgs) -> Result<ExitCode> {
-    let mut outputs = Outputs::default();
-    outputs.add(args.profile.as_deref(), "--profile")?;
-    outputs.add(args.trace.as_deref(), "--trace")?;
-    check_frames(args.frames, args.warmup)?;
-    let (rig, specs) = views(&args.scene)?;
-    let scene = load_scene(&args.scene)?;
-    let cameras = rig::frame_cameras(rig.as_ref(), &camera(&args.scene, &scene)?)?;
-    let ctx = context(&args.scene.device)?;
-    let report = ctx.validation_report();
-    let device = ctx.info().clone();
-    let mut intervals = Vec::new();
-    let point_stats;
-    let texture_stats;
-    let settle_frames;
-    let raster;
-    let profiles = {
-        let settings = render_settings(&args.scene, &scene, &specs, false)?;
-        let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
-        raster = renderer.raster_path();
-        // Every frame's profile is reported (the history is bounded by default).
-        renderer.set_profile_history((args.warmup + args.frames + MAX_SETTLE_FRAMES) as usize);
-        // A still view: first every texture tile (untimed), then warm-up and timed frames.
-        settle_frames = renderer.render_views_settled(&cameras, MAX_SETTLE_FRAMES)?.frame + 1;
-        let mut last = std::time::Instant::now();
-        for i in 0..args.warmup + args.frames {
-            renderer.render_views(&cameras)?;
-            if i >= args.warmup {
-                intervals.push(last.elapsed().as_secs_f64() * 1e3);
-            }
-            last = std::time::Instant::now();
-        }
-        let profiles = renderer.finish()?;
-        point_stats = renderer.take_point_stats()?;
-        texture_stats = renderer.take_texture_stats()?;
-        profiles
-    };
-    drop(ctx);
-    check_validation(report)?;
-    let untimed = (settle_frames + u64::from(args.warmup)) as usize;
-    let point_stats: Vec<_> = point_stats.into_iter().skip(untimed).collect();
-    let timed: Vec<FrameProfile> = profiles.into_iter().skip(untimed).collect();
-    if timed.is_empty() {
-        return Err(anyhow!("no frame timings were collected"));
-    }
-    let (passes, frame) = summarize(&timed);
-    let sizes: Vec<String> = specs.iter().map(|v| format!("{}x{}", v.width, v.height)).collect();
-    println!(
-        "{} ({}, {}), {}, {} frames: median frame {:.3} ms GPU, {:.3} ms CPU",
-        device.name,
-        device.device_type,
-        device.driver_info,
-        sizes.join("+"),
-        frame.frames,
-        frame.median_gpu_ms,
-        frame.median_cpu_ms
-    );
-    let interval_median = alpenglow::tools::profile::median(intervals.iter().copied());
-    let interval_max = intervals.iter().copied().fold(0.0, f64::max);
-    println!("  frame interval   median {interval_median:>8.3} ms wall (max {interval_max:.3}), 2 frames in flight");
-    for p in &passes {
-        println!(
-            "  {:<16} median {:>8.3} ms GPU (min {:.3}, max {:.3}), {:.3} ms CPU",
-            p.name, p.median_gpu_ms, p.min_gpu_ms, p.max_gpu_ms, p.median_cpu_ms
-        );
-    }
-    if let Some(stats) = point_stats.last() {
-        println!("  {}", stats.summary());
-        let cpu = alpenglow::tools::profile::median(point_stats.iter().map(|s| s.cpu_ms));
-        println!(
-            "  points CPU selection median {cpu:.3} ms per frame ({:.4} ms per instance)",
-            cpu / stats.instances.max(1) as f64
-        );
-    }
-    let texture_stats: Vec<_> = texture_stats.into_iter().skip(untimed).collect();
-    let textures = report_textures(&texture_stats, &timed);
-    if args.profile.is_some() {
-        let value = serde_json::json!({
-            "textures": textures,
-            "device": device,
-            "raster": raster.name(),
-            "width": args.scene.width,
-            "height": args.scene.height,
-            "views": specs.iter().map(|v| serde_json::json!({"name": v.name, "width": v.width, "height": v.height})).collect::<Vec<_>>(),
-            "frames": frame.frames,
-            "median_frame_gpu_ms": frame.median_gpu_ms,
-            "median_frame_cpu_ms": frame.median_cpu_ms,
-            "median_frame_interval_ms": interval_median,
-            "max_frame_interval_ms": interval_max,
-            "passes": passes,
-            "points": point_stats,
-        });
-        let text = serde_json::to_string_pretty(&value)?;
-        outputs.stage(args.profile.as_deref(), || Ok(text.into_bytes()))?;
-    }
-    outputs.stage(args.trace.as_deref(), || {
-        Ok(chrome_trace(&device.name, &timed)?.into_bytes())
-    })?;
-    outputs.commit()?;
-    Ok(ExitCode::SUCCESS)
-}
-
-/// Prints the texture streaming summary of `stats` with the GPU times of
-/// `profiles`; None (and nothing printed) without the atlas.
-fn report_textures(stats: &[alpenglow::TextureFrameStats], profiles: &[FrameProfile]) -> Option<TextureSummary> {
-    let summary = (!stats.is_empty()).then(|| TextureSummary::new(stats, profiles))?;
-    println!("  {}", summary.line());
-    if let Some(line) = summary.per_pass_line() {
-        println!("  {line}");
-    }
-    Some(summary)
 }
 
 fn info(args: DeviceArgs) -> Result<ExitCode> {
@@ -527,7 +417,15 @@ fn info(args: DeviceArgs) -> Result<ExitCode> {
     println!("driver:      {} ({})", i.driver_name, i.driver_info);
     println!("vulkan:      {}", i.api_version);
     println!("vendor/id:   {:#06x}/{:#06x}", i.vendor_id, i.device_id);
-    println!("timestamps:  {} ns per tick", i.timestamp_period_ns);
+    println!(
+        "timestamps:  {} ns per tick, {}",
+        i.timestamp_period_ns,
+        if i.calibrated_timestamps {
+            "calibrated against the CPU clock"
+        } else {
+            "not calibrated"
+        }
+    );
     println!("max image:   {} px per side", i.max_image_dimension_2d);
     println!(
         "memory:      {} device heap{}, at most {} in one allocation",

@@ -86,6 +86,11 @@ pub struct BakedGraph<P> {
     /// The most profiles kept (the oldest are dropped and their memory
     /// reused): [`BakedGraph::set_profile_history`].
     pub(crate) profile_history: usize,
+    /// Whether each pass is wrapped in a pipeline-statistics query:
+    /// [`BakedGraph::set_pipeline_stats`].
+    pub(crate) pipeline_stats: bool,
+    /// GPU zones for Tracy (feature `tracy`; nothing without it).
+    pub(crate) tracy: crate::profile::tracy::GpuZones,
     /// Per-frame scratch reused by every frame (no allocation per frame):
     /// which resources the frame touched, and the CPU times of the passes
     /// of completed frames.
@@ -111,6 +116,20 @@ impl<P> BakedGraph<P> {
         self.profile_history = frames.max(1);
         let excess = self.profiles.len().saturating_sub(self.profile_history);
         self.profiles.drain(..excess);
+    }
+
+    /// Wraps every pass in a pipeline-statistics query (from the next
+    /// frame on; [`crate::profile::PassTiming::pipeline_stats`]); an error
+    /// naming the feature when the device lacks `pipelineStatisticsQuery`.
+    pub fn set_pipeline_stats(&mut self, ctx: &Context, on: bool) -> Result<()> {
+        if on && !ctx.has_feature("pipelineStatisticsQuery") {
+            return Err(Error::Device(format!(
+                "pipeline statistics need the device feature pipelineStatisticsQuery, which '{}' lacks",
+                ctx.info().name
+            )));
+        }
+        self.pipeline_stats = on;
+        Ok(())
     }
 
     /// Names of the passes that were culled because nothing used their output.
@@ -502,6 +521,8 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
         pending: VecDeque::new(),
         profiles: Vec::new(),
         profile_history: DEFAULT_PROFILE_HISTORY,
+        pipeline_stats: false,
+        tracy: Default::default(),
         touched: Vec::new(),
         spare_cpu_passes: Vec::new(),
         epoch: Instant::now(),

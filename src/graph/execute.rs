@@ -10,7 +10,7 @@ use super::binding::{Binding, BindingTarget};
 use super::uploads::UploadArena;
 use super::{Access, Attachments, BufferId, ImageId, PassKind, ResourceId};
 use crate::error::{Error, Result};
-use crate::profile::{FrameProfile, PassTiming, StageTiming};
+use crate::profile::{tracy, FrameProfile, PassTiming, PipelineStats, StageTiming};
 use crate::vulkan::{
     AccessFlags2, AccessState, BarrierBatch, Buffer, CommandRecorder, CompletedFrame, ComputePipeline, FrameRing,
     GraphicsPipeline, Image, PipelineStageFlags2,
@@ -46,7 +46,10 @@ impl CpuStage {
     /// Runs `f` as the stage `name`, appending its timing to `stages`.
     pub fn time<T>(stages: &mut Vec<CpuStage>, name: &std::sync::Arc<str>, f: impl FnOnce() -> T) -> T {
         let start = Instant::now();
-        let value = f();
+        let value = {
+            let _zone = tracy::cpu_zone(name);
+            f()
+        };
         stages.push(CpuStage {
             name: name.clone(),
             start,
@@ -322,7 +325,13 @@ impl<P> BakedGraph<P> {
         let query_count = 2 * self.passes.len() as u32;
         // Waits for the frame slot (the GPU) first; CPU times start after it,
         // or with the first prepare stage.
-        let (mut recording, completed) = frames.begin(query_count)?;
+        let stats = if self.pipeline_stats {
+            self.passes.len() as u32
+        } else {
+            0
+        };
+        let ctx = frames.context().clone();
+        let (mut recording, completed) = frames.begin(query_count, stats)?;
         if let Some(c) = &completed {
             self.complete(c);
         }
@@ -334,7 +343,7 @@ impl<P> BakedGraph<P> {
             .unwrap_or(record_start)
             .min(record_start);
         let frame = recording.frame;
-        let pool = recording.query_pool();
+        let (pool, stats_pool) = (recording.query_pool(), recording.stats_pool());
         self.touched.clear();
         self.touched.resize(self.physical.len(), false);
         let mut cpu_passes = self.spare_cpu_passes.pop().unwrap_or_default();
@@ -345,7 +354,11 @@ impl<P> BakedGraph<P> {
             let pass_start = Instant::now();
             let cmd = &mut recording.recorder;
             cmd.begin_label_c(&pass.label, label_color(pass.kind));
+            self.tracy.begin_pass(&pass.name, || ctx.gpu_time_ns());
             cmd.write_timestamp(pool, 2 * i as u32, PipelineStageFlags2::TOP_OF_PIPE);
+            if stats > 0 {
+                cmd.begin_query(stats_pool, i as u32);
+            }
             self.emit_barriers(cmd, &pass.uses, frame);
             let recorded = begin_attachments(cmd, &self.physical, &pass.attachments, frame).and_then(|rendering| {
                 let mut ctx = PassContext {
@@ -368,8 +381,12 @@ impl<P> BakedGraph<P> {
                 result = Err(Error::Graph(format!("pass '{}': {e}", pass.name)));
             }
             let cmd = &mut recording.recorder;
+            if stats > 0 {
+                cmd.end_query(stats_pool, i as u32);
+            }
             cmd.write_timestamp(pool, 2 * i as u32 + 1, PipelineStageFlags2::ALL_COMMANDS);
             cmd.end_label();
+            self.tracy.end_pass();
             cpu_passes.push((
                 (pass_start - frame_start).as_secs_f64() * 1e3,
                 pass_start.elapsed().as_secs_f64() * 1e3,
@@ -384,6 +401,8 @@ impl<P> BakedGraph<P> {
         self.final_accesses = finals;
         // Submit even after a failed pass so the frame slot stays consistent.
         let timeline = recording.submit()?;
+        self.tracy.submitted(frame, || ctx.gpu_time_ns());
+        tracy::frame_mark();
         if let Some(c) = completed {
             frames.recycle(c);
         }
@@ -423,6 +442,8 @@ impl<P> BakedGraph<P> {
                 false => FrameProfile::default(),
             };
             let ts = &completed.timestamps_ns;
+            let at = |i: usize| completed.first_ns + ts.get(i).copied().unwrap_or(0.0);
+            (self.tracy).completed(p.frame, (0..self.passes.len()).map(|i| (at(2 * i), at(2 * i + 1))));
             profile.passes.truncate(self.passes.len());
             for (i, pass) in self.passes.iter().enumerate() {
                 let (begin, end) = (
@@ -436,6 +457,7 @@ impl<P> BakedGraph<P> {
                     cpu_ms,
                     gpu_start_ms: begin / 1e6,
                     cpu_start_ms,
+                    pipeline_stats: (completed.pipeline_stats.get(i)).map(|c| PipelineStats::from_counters(*c)),
                 };
                 match profile.passes.get_mut(i) {
                     Some(t) => {
@@ -453,6 +475,9 @@ impl<P> BakedGraph<P> {
             profile.gpu_ms = if first.is_finite() { (last - first) / 1e6 } else { 0.0 };
             profile.cpu_ms = p.cpu_ms;
             profile.cpu_start_ms = p.cpu_start_ms;
+            profile.submit_ms = ms_since(self.epoch, completed.submitted);
+            profile.fence_ms = ms_since(self.epoch, completed.waited);
+            profile.gpu_start_on_cpu_ms = completed.first_gpu.map(|at| ms_since(self.epoch, at));
             self.profiles.push(profile);
             self.spare_cpu_passes.push(p.cpu_passes);
             return;
@@ -475,6 +500,14 @@ impl<P> BakedGraph<P> {
     /// Timings of the frames completed so far (oldest first), removing them.
     pub fn take_profiles(&mut self) -> Vec<FrameProfile> {
         std::mem::take(&mut self.profiles)
+    }
+}
+
+/// Milliseconds from `epoch` to `at` (negative when `at` is earlier).
+fn ms_since(epoch: Instant, at: Instant) -> f64 {
+    match at.checked_duration_since(epoch) {
+        Some(d) => d.as_secs_f64() * 1e3,
+        None => -(epoch - at).as_secs_f64() * 1e3,
     }
 }
 

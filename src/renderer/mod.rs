@@ -342,6 +342,15 @@ impl Renderer {
         self.graph.set_profile_history(frames);
     }
 
+    /// Wraps every pass in a pipeline-statistics query from the next frame
+    /// on (vertex, fragment and compute invocations…: each profile pass's
+    /// [`PassTiming::pipeline_stats`](crate::tools::profile::PassTiming));
+    /// an error naming the feature when the device lacks
+    /// `pipelineStatisticsQuery`.
+    pub fn set_pipeline_stats(&mut self, on: bool) -> Result<()> {
+        self.graph.set_pipeline_stats(&self.ctx, on)
+    }
+
     /// Pass names in execution order.
     pub fn pass_names(&self) -> Vec<String> {
         self.graph.pass_names()

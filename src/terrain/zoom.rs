@@ -78,19 +78,10 @@ pub fn projected_quad_areas(positions: &[DVec3], side: usize, view: &View) -> Ve
     areas
 }
 
-/// `q`-quantile (0..=1) of `values` (nearest rank); NaN when empty.
-pub fn quantile(values: &[f64], q: f64) -> f64 {
-    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    v[((v.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::profile::quantile;
     use crate::terrain::procedural::ProceduralTerrain;
     use crate::view::Camera;
 

@@ -14,6 +14,23 @@ use crate::vulkan::{Context, ContextOptions, DeviceSelector, ValidationReport};
 /// tests that check a rendered frame against a reference run in each.
 pub const RASTER_PATHS: [crate::RasterPath; 2] = [crate::RasterPath::Hardware, crate::RasterPath::Compute];
 
+/// A buffer copies read from and write to, shared (to import into a graph).
+pub fn transfer_buffer(
+    ctx: &Context,
+    name: &str,
+    size: u64,
+    location: crate::vulkan::MemoryLocation,
+) -> Arc<crate::vulkan::Buffer> {
+    let usage = crate::vulkan::BufferUsageFlags::TRANSFER_DST | crate::vulkan::BufferUsageFlags::TRANSFER_SRC;
+    let desc = crate::vulkan::BufferDesc {
+        name: name.into(),
+        size,
+        usage,
+        location,
+    };
+    Arc::new(crate::vulkan::Buffer::new(ctx, desc).expect("a transfer buffer"))
+}
+
 /// A context with validation and synchronization validation on.
 pub fn validated_context() -> (Context, Arc<ValidationReport>) {
     let ctx = Context::new(&ContextOptions {

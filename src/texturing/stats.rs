@@ -181,6 +181,7 @@ pub(crate) fn test_profile(frame: u64, passes: &[(&str, f64)]) -> FrameProfile {
             cpu_ms: 0.0,
             gpu_start_ms: 0.0,
             cpu_start_ms: 0.0,
+            pipeline_stats: None,
         })
         .collect();
     FrameProfile {

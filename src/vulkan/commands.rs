@@ -95,6 +95,20 @@ impl CommandRecorder {
         unsafe { self.device().cmd_write_timestamp2(self.cmd, stage, pool, index) };
     }
 
+    /// Begins query `index` of `pool` (a pipeline-statistics pool).
+    pub(crate) fn begin_query(&mut self, pool: vk::QueryPool, index: u32) {
+        // SAFETY: the query was reset in this command buffer before use and
+        // is not active; the caller ends it outside any render pass instance,
+        // as it began.
+        unsafe { (self.device()).cmd_begin_query(self.cmd, pool, index, vk::QueryControlFlags::empty()) };
+    }
+
+    /// Ends query `index` of `pool`, begun by [`CommandRecorder::begin_query`].
+    pub(crate) fn end_query(&mut self, pool: vk::QueryPool, index: u32) {
+        // SAFETY: the query is active in this command buffer.
+        unsafe { self.device().cmd_end_query(self.cmd, pool, index) };
+    }
+
     pub(crate) fn reset_queries(&mut self, pool: vk::QueryPool, count: u32) {
         // SAFETY: recording outside a render pass instance.
         unsafe { self.device().cmd_reset_query_pool(self.cmd, pool, 0, count) };

@@ -13,7 +13,9 @@ use std::sync::{Arc, Mutex};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
+use super::clock::GpuClock;
 use super::device_select::{self, DeviceSelector, REQUIRED_FEATURES};
+use super::features::OptionalFeatures;
 use super::heap::DescriptorHeap;
 use super::memory::Garbage;
 use super::validation::{messenger_info, ValidationReport};
@@ -50,49 +52,15 @@ pub struct DeviceInfo {
     pub max_allocation_bytes: u64,
     /// Whether `VK_EXT_memory_budget` is enabled.
     pub memory_budget: bool,
+    /// Whether GPU timestamps are calibrated against the CPU clock
+    /// (`VK_EXT_calibrated_timestamps` or `VK_KHR_calibrated_timestamps`).
+    pub calibrated_timestamps: bool,
     pub features: Vec<String>,
     /// Optional features the device offers and alpenglow enabled.
     pub optional_features: Vec<String>,
     /// Largest point primitive side in pixels (1 without `largePoints`).
     pub max_point_size: f32,
     pub validation: bool,
-}
-
-/// Features alpenglow uses when the device has them.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct OptionalFeatures {
-    /// `largePoints`: point primitives wider than one pixel (splat point primitives, §10.3).
-    pub large_points: bool,
-    /// `vertexPipelineStoresAndAtomics`: the vertex stage counts the splats it draws.
-    pub vertex_pipeline_stores_and_atomics: bool,
-    /// `shaderInt64` and `shaderBufferInt64Atomics`: the compute path's
-    /// visibility buffer (`terrain::visibility`) packs depth and id in one 64-bit word.
-    pub shader_buffer_int64_atomics: bool,
-    /// `fragmentShaderPixelInterlock` (VK_EXT_fragment_shader_interlock):
-    /// the interlock backend of single-pass splatting (§10.4).
-    pub fragment_shader_pixel_interlock: bool,
-    /// `fragmentStoresAndAtomics`: fragment shaders write storage buffers
-    /// (the interlock backend's pixel state).
-    pub fragment_stores_and_atomics: bool,
-}
-
-impl OptionalFeatures {
-    fn names(self) -> Vec<String> {
-        [
-            ("largePoints", self.large_points),
-            (
-                "vertexPipelineStoresAndAtomics",
-                self.vertex_pipeline_stores_and_atomics,
-            ),
-            ("shaderBufferInt64Atomics", self.shader_buffer_int64_atomics),
-            ("fragmentShaderPixelInterlock", self.fragment_shader_pixel_interlock),
-            ("fragmentStoresAndAtomics", self.fragment_stores_and_atomics),
-        ]
-        .iter()
-        .filter(|(_, on)| *on)
-        .map(|(n, _)| n.to_string())
-        .collect()
-    }
 }
 
 pub(crate) struct Shared {
@@ -113,6 +81,8 @@ pub(crate) struct Shared {
     pub limits: vk::PhysicalDeviceLimits,
     /// Heap and single-allocation limits ([`Context::memory_limits`]).
     pub(super) memory: super::device_memory::DeviceMemory,
+    /// Reads the GPU and CPU clocks together, where the device can.
+    pub(super) clock: Option<GpuClock>,
     report: Option<Arc<ValidationReport>>,
 }
 
@@ -145,12 +115,9 @@ fn select_device(instance: &ash::Instance, options: &ContextOptions) -> Result<d
 /// Creates the logical device of `candidate` with one graphics+compute
 /// queue, the required features (Vulkan 1.2 descriptor indexing and
 /// timeline semaphores, 1.3 dynamic rendering and synchronization2) and
-/// the optional ones it offers; returns them and whether it reports its
-/// memory budget.
-fn open_device(
-    instance: &ash::Instance,
-    candidate: device_select::Candidate,
-) -> Result<(device_select::Candidate, ash::Device, OptionalFeatures, bool)> {
+/// the optional ones it offers (and the extensions of memory budgets and
+/// calibrated timestamps where offered).
+fn open_device(entry: &ash::Entry, instance: &ash::Instance, candidate: device_select::Candidate) -> Result<Opened> {
     let priorities = [1.0f32];
     let queue_infos = [vk::DeviceQueueCreateInfo::default()
         .queue_family_index(candidate.queue_family.unwrap_or(0))
@@ -170,22 +137,8 @@ fn open_device(
         .dynamic_rendering(true)
         .synchronization2(true)
         .maintenance4(true);
-    // SAFETY: plain query on a physical device of this instance.
-    let offered = unsafe { instance.get_physical_device_features(candidate.physical) };
-    let (int64_atomics, pixel_interlock) = offered_single_pass_features(instance, candidate.physical);
-    let optional = OptionalFeatures {
-        large_points: offered.large_points == vk::TRUE,
-        vertex_pipeline_stores_and_atomics: offered.vertex_pipeline_stores_and_atomics == vk::TRUE,
-        shader_buffer_int64_atomics: offered.shader_int64 == vk::TRUE && int64_atomics,
-        fragment_shader_pixel_interlock: pixel_interlock,
-        fragment_stores_and_atomics: offered.fragment_stores_and_atomics == vk::TRUE,
-    };
-    let base = vk::PhysicalDeviceFeatures::default()
-        .independent_blend(true)
-        .large_points(optional.large_points)
-        .vertex_pipeline_stores_and_atomics(optional.vertex_pipeline_stores_and_atomics)
-        .shader_int64(optional.shader_buffer_int64_atomics)
-        .fragment_stores_and_atomics(optional.fragment_stores_and_atomics);
+    let optional = OptionalFeatures::offered(instance, candidate.physical);
+    let base = optional.base();
     v12 = v12.shader_buffer_int64_atomics(optional.shader_buffer_int64_atomics);
     let mut interlock =
         vk::PhysicalDeviceFragmentShaderInterlockFeaturesEXT::default().fragment_shader_pixel_interlock(true);
@@ -196,6 +149,10 @@ fn open_device(
     }
     if memory_budget {
         extensions.push(ash::ext::memory_budget::NAME.as_ptr());
+    }
+    let calibration = super::clock::offered(entry, instance, candidate.physical);
+    if let Some(name) = calibration {
+        extensions.push(name.as_ptr());
     }
     let mut device_info = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queue_infos)
@@ -209,7 +166,24 @@ fn open_device(
     // SAFETY: the features were checked as supported by `inspect`; pointers are to locals.
     let device =
         unsafe { instance.create_device(candidate.physical, &device_info, None) }.map_err(vk_err("vkCreateDevice"))?;
-    Ok((candidate, device, optional, memory_budget))
+    Ok(Opened {
+        candidate,
+        device,
+        optional,
+        memory_budget,
+        calibration,
+    })
+}
+
+/// What [`open_device`] opened.
+struct Opened {
+    candidate: device_select::Candidate,
+    device: ash::Device,
+    optional: OptionalFeatures,
+    /// Whether `VK_EXT_memory_budget` is enabled.
+    memory_budget: bool,
+    /// The calibrated-timestamps extension enabled, if any.
+    calibration: Option<&'static CStr>,
 }
 
 /// What [`Context::info`] reports of the device opened from `candidate`.
@@ -240,6 +214,7 @@ fn describe_device(
         memory_heap_bytes: memory.heap,
         max_allocation_bytes: memory.allocation,
         memory_budget,
+        calibrated_timestamps: false,
         features: REQUIRED_FEATURES.iter().map(|s| s.to_string()).collect(),
         optional_features: optional.names(),
         max_point_size: if optional.large_points {
@@ -249,31 +224,6 @@ fn describe_device(
         },
         validation,
     }
-}
-
-/// What the device offers of `shaderBufferInt64Atomics` (the compute
-/// path's visibility buffer) and of `fragmentShaderPixelInterlock` with its
-/// extension VK_EXT_fragment_shader_interlock (single-pass splatting's
-/// interlock backend, §10.4).
-fn offered_single_pass_features(instance: &ash::Instance, physical: vk::PhysicalDevice) -> (bool, bool) {
-    // SAFETY: plain query on a physical device of this instance.
-    let extensions = unsafe { instance.enumerate_device_extension_properties(physical) }.unwrap_or_default();
-    let has_interlock = extensions
-        .iter()
-        .any(|e| e.extension_name_as_c_str() == Ok(ash::ext::fragment_shader_interlock::NAME));
-    let mut v12 = vk::PhysicalDeviceVulkan12Features::default();
-    let mut interlock = vk::PhysicalDeviceFragmentShaderInterlockFeaturesEXT::default();
-    let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut v12);
-    if has_interlock {
-        features2 = features2.push_next(&mut interlock);
-    }
-    // SAFETY: the device supports Vulkan 1.3 (checked by `inspect`); the
-    // interlock struct is chained only when its extension is offered.
-    unsafe { instance.get_physical_device_features2(physical, &mut features2) };
-    (
-        v12.shader_buffer_int64_atomics == vk::TRUE,
-        has_interlock && interlock.fragment_shader_pixel_interlock == vk::TRUE,
-    )
 }
 
 pub(crate) fn vk_err(call: &'static str) -> impl Fn(vk::Result) -> Error {
@@ -388,8 +338,14 @@ impl Context {
                 instance.destroy_instance(None);
             }
         };
-        let opened = select_device(&instance, options).and_then(|c| open_device(&instance, c));
-        let (candidate, device, optional, memory_budget) = match opened {
+        let opened = select_device(&instance, options).and_then(|c| open_device(&entry, &instance, c));
+        let Opened {
+            candidate,
+            device,
+            optional,
+            memory_budget,
+            calibration,
+        } = match opened {
             Ok(opened) => opened,
             Err(e) => {
                 destroy_instance(&instance);
@@ -426,7 +382,10 @@ impl Context {
         let heap = DescriptorHeap::new(&device)?;
 
         let memory = super::device_memory::query(&instance, candidate.physical, memory_budget);
-        let info = describe_device(&candidate, &optional, &memory, memory_budget, report.is_some());
+        let clock = calibration
+            .and_then(|name| GpuClock::new(&instance, &device, name, candidate.properties.limits.timestamp_period));
+        let mut info = describe_device(&candidate, &optional, &memory, memory_budget, report.is_some());
+        info.calibrated_timestamps = clock.is_some();
         let shared = Shared {
             _entry: entry,
             instance,
@@ -444,6 +403,7 @@ impl Context {
             info,
             limits: candidate.properties.limits,
             memory,
+            clock,
             report,
         };
         log::info!("device: {} ({})", shared.info.name, shared.info.driver_info);

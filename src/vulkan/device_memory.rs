@@ -6,6 +6,7 @@
 use ash::vk;
 
 use super::Context;
+use crate::profile::DeviceMemoryUse;
 
 /// The device's memory limits as Vulkan reports them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -17,6 +18,10 @@ pub(crate) struct DeviceMemory {
     /// Largest single allocation: the smaller of `maxMemoryAllocationSize`
     /// (Vulkan 1.1), `maxBufferSize` (Vulkan 1.3) and the heap.
     pub allocation: u64,
+    /// The device, and whether `VK_EXT_memory_budget` is enabled (for
+    /// [`Context::memory_use`]).
+    pub physical: vk::PhysicalDevice,
+    pub budget: bool,
 }
 
 /// Whether `physical` offers `VK_EXT_memory_budget` (then enabled with the device).
@@ -66,10 +71,48 @@ pub(crate) fn query(instance: &ash::Instance, physical: vk::PhysicalDevice, budg
         allocation: limit(maintenance3.max_memory_allocation_size)
             .min(limit(maintenance4.max_buffer_size))
             .min(limit(largest_heap)),
+        physical,
+        budget,
     }
 }
 
 impl Context {
+    /// Device memory in use now: what the allocator handed out and
+    /// reserved, and with `VK_EXT_memory_budget` this process's use of the
+    /// device-local heaps and their budget.
+    pub fn memory_use(&self) -> DeviceMemoryUse {
+        let (allocated_bytes, reserved_bytes) = match self.shared.allocator.lock() {
+            Ok(allocator) => {
+                let report = allocator.generate_report();
+                (report.total_allocated_bytes, report.total_reserved_bytes)
+            }
+            Err(_) => (0, 0),
+        };
+        let mut use_ = DeviceMemoryUse {
+            allocated_bytes,
+            reserved_bytes,
+            ..DeviceMemoryUse::default()
+        };
+        if self.shared.memory.budget {
+            let mut budgets = vk::PhysicalDeviceMemoryBudgetPropertiesEXT::default();
+            let mut memory = vk::PhysicalDeviceMemoryProperties2::default().push_next(&mut budgets);
+            // SAFETY: plain query on this context's physical device; the
+            // budget struct is chained only when its extension is enabled.
+            unsafe {
+                (self.shared.instance).get_physical_device_memory_properties2(self.shared.memory.physical, &mut memory)
+            };
+            let props = memory.memory_properties;
+            let heaps = &props.memory_heaps[..(props.memory_heap_count as usize).min(vk::MAX_MEMORY_HEAPS)];
+            let local = (0..heaps.len()).filter(|&i| heaps[i].flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL));
+            let (usage, budget) = local.fold((0, 0), |(u, b), i| {
+                (u + budgets.heap_usage[i], b + budgets.heap_budget[i])
+            });
+            use_.heap_usage_bytes = Some(usage);
+            use_.heap_budget_bytes = Some(budget);
+        }
+        use_
+    }
+
     /// What this machine and device can take (`crate::budget`): the
     /// host's available memory, the largest device-local heap (its
     /// `VK_EXT_memory_budget` budget where offered) and the largest single

@@ -1,10 +1,12 @@
 //! The Vulkan backend: the only layer with `unsafe` code and raw Vulkan
 //! handles. Everything above it (graph, passes, scenes) uses these safe types.
 
+mod clock;
 mod commands;
 mod context;
 mod device_memory;
 mod device_select;
+mod features;
 mod frames;
 mod heap;
 mod image;

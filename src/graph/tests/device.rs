@@ -3,10 +3,8 @@
 //! `tests/vulkan_renderer.rs` in issue 26): pass culling, a storage buffer
 //! written by one pass and copied by the next, heap handle reuse.
 
-use std::sync::Arc;
-
 use crate::graph::{BufferAccess, BufferInfo, ImageAccess, ImageInfo, RenderGraph, Stage};
-use crate::test_support::{assert_validation_clean, validated_context};
+use crate::test_support::{assert_validation_clean, transfer_buffer, validated_context};
 use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, Format, FrameRing, MemoryLocation};
 
 #[test]
@@ -14,18 +12,7 @@ fn graph_culls_unused_passes_and_writes_a_storage_buffer_drawn_by_the_next_pass(
     let (ctx, report) = validated_context();
     {
         let mut graph: RenderGraph<()> = RenderGraph::new();
-        let target = Arc::new(
-            Buffer::new(
-                &ctx,
-                BufferDesc {
-                    name: "result".into(),
-                    size: 256,
-                    usage: BufferUsageFlags::TRANSFER_DST | BufferUsageFlags::TRANSFER_SRC,
-                    location: MemoryLocation::GpuToCpu,
-                },
-            )
-            .unwrap(),
-        );
+        let target = transfer_buffer(&ctx, "result", 256, MemoryLocation::GpuToCpu);
         let scratch = graph.create_buffer(
             "scratch",
             BufferInfo {

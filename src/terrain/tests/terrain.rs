@@ -8,11 +8,12 @@
 //! uniform in screen space than a uniform one of the same vertex count.
 //! Validation and synchronization validation are on throughout.
 
+use crate::profile::quantile;
 use crate::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
 use crate::terrain::geometry_image::TerrainSettings;
 use crate::terrain::lod::{DebugScalar, LodFrame, LodMode, LodSettings};
 use crate::terrain::raycast::Raycaster;
-use crate::terrain::zoom::{projected_quad_areas, quantile, zoom_positions};
+use crate::terrain::zoom::{projected_quad_areas, zoom_positions};
 use crate::test_support::{assert_validation_clean, jacksboro_field, validated_context};
 use crate::view::View;
 use crate::RasterPath;
