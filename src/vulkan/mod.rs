@@ -12,6 +12,7 @@ mod heap;
 mod image;
 mod memory;
 mod pipeline;
+pub(crate) mod renderdoc;
 mod validation;
 
 pub use ash::vk::{
