@@ -78,6 +78,12 @@ fn frame_beyond_the_run_is_an_error_before_rendering() {
     expect_error("rdoc_range_fly", &fly, &["--renderdoc-capture 3", "0 to 2"]);
     let bench = ["bench", "--frames", "2", "--warmup", "1", "--renderdoc-capture", "3"];
     expect_error("rdoc_range_bench", &bench, &["--renderdoc-capture 3", "0 to 2"]);
+    let render = ["render", "--renderdoc-capture", "100000"];
+    expect_error(
+        "rdoc_range_render",
+        &render,
+        &["--renderdoc-capture 100000", "0 to 99999"],
+    );
 }
 
 #[test]

@@ -38,7 +38,7 @@ pub(super) fn bench(args: BenchArgs) -> Result<ExitCode> {
     let scene = load_scene(&args.scene)?;
     let cameras = rig::frame_cameras(rig.as_ref(), &camera(&args.scene, &scene)?)?;
     // The frames after the settling ones: warm-up, then timed.
-    let mut capture = FrameCapture::new(&args.renderdoc, Some(u64::from(args.warmup) + u64::from(args.frames)))?;
+    let mut capture = FrameCapture::new(&args.renderdoc, u64::from(args.warmup) + u64::from(args.frames))?;
     let ctx = context(&args.scene.device)?;
     let report = ctx.validation_report();
     let device = ctx.info().clone();

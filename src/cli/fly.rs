@@ -110,7 +110,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
     }
 
     // Before the Vulkan instance (a loaded RenderDoc hooks it) and any output.
-    let mut capture = FrameCapture::new(&args.renderdoc, Some(args.frames.into()))?;
+    let mut capture = FrameCapture::new(&args.renderdoc, args.frames.into())?;
 
     let staging = match &args.out_dir {
         Some(dir) => Some(outputs.stage_dir(dir)?),

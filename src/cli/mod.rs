@@ -362,7 +362,8 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
     outputs.add(args.trace.as_deref(), "--trace")?;
     let scene = load_scene(&args.scene)?;
     let cameras = rig::frame_cameras(rig.as_ref(), &camera(&args.scene, &scene)?)?;
-    let mut capture = renderdoc::FrameCapture::new(&args.renderdoc, None)?;
+    // Frames from the first, one by one up to the captured one (at most MAX_FRAMES).
+    let mut capture = renderdoc::FrameCapture::new(&args.renderdoc, MAX_FRAMES.into())?;
     let ctx = context(&args.scene.device)?;
     let report = ctx.validation_report();
     let device = ctx.info().name.clone();

@@ -44,12 +44,12 @@ pub(crate) struct FrameCapture {
 impl FrameCapture {
     /// RenderDoc for `--renderdoc-capture`, attached or loaded (call before
     /// the Vulkan context); None without the option. `frames`: how many
-    /// frames the run renders, when known before it starts.
-    pub(crate) fn new(args: &RenderDocArgs, frames: Option<u64>) -> Result<Option<FrameCapture>> {
+    /// frames the run renders (at most).
+    pub(crate) fn new(args: &RenderDocArgs, frames: u64) -> Result<Option<FrameCapture>> {
         let Some(frame) = args.capture else {
             return Ok(None);
         };
-        if let Some(frames) = frames.filter(|&n| u64::from(frame) >= n) {
+        if u64::from(frame) >= frames {
             bail!(
                 "--renderdoc-capture {frame} is out of range: the run renders frames 0 to {}",
                 frames - 1

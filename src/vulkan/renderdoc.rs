@@ -198,6 +198,17 @@ impl RenderDocCapture {
     /// Captures the next presented frame (windowed programs: a key such as
     /// F11); [`RenderDocCapture::latest_capture`] names the file once the
     /// frame was presented.
+    ///
+    /// ```no_run
+    /// # let mut rdoc = alpenglow::tools::renderdoc::RenderDocCapture::attach().unwrap();
+    /// // On the capture key:
+    /// let before = rdoc.captures();
+    /// rdoc.trigger_capture();
+    /// // … render and present a frame, then:
+    /// if rdoc.captures() > before {
+    ///     println!("RenderDoc capture: {:?}", rdoc.latest_capture());
+    /// }
+    /// ```
     pub fn trigger_capture(&mut self) {
         backend::trigger(&mut self.api);
     }
