@@ -104,6 +104,19 @@ fn renderdoc_without_a_capture_is_a_usage_error() {
     assert_one_line_error("render --renderdoc", &out, &["--renderdoc-capture"]);
 }
 
+/// A small flythrough of three frames capturing frame 1.
+const FLY_CAPTURE: [&str; 9] = [
+    "fly",
+    "--width",
+    "64",
+    "--height",
+    "48",
+    "--frames",
+    "3",
+    "--renderdoc-capture",
+    "1",
+];
+
 /// `renderdoccmd capture … fly --frames 3 --renderdoc-capture 1`: one
 /// capture, of frame 1, where the device runs under RenderDoc.
 #[test]
@@ -114,20 +127,7 @@ fn renderdoccmd_captures_the_asked_frame() {
     };
     let dir = fresh_dir("rdoc_capture");
     let template = dir.join("cap");
-    let args = [
-        "fly",
-        "--width",
-        "64",
-        "--height",
-        "48",
-        "--frames",
-        "3",
-        "--renderdoc-capture",
-        "1",
-        "--vegetation",
-        "off",
-        "--validation",
-    ];
+    let args = [&FLY_CAPTURE[..], &["--vegetation", "off", "--validation"]].concat();
     let out = under_renderdoccmd(&template, Path::new(bin()), &args);
     let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
     if stderr.contains("is Vulkan 1.2 under RenderDoc") {
@@ -148,6 +148,35 @@ fn renderdoccmd_captures_the_asked_frame() {
     let captures: Vec<String> = entries(&dir).into_iter().filter(|n| n.ends_with(".rdc")).collect();
     assert_eq!(captures, ["cap_frame1_capture.rdc"]);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `fly --renderdoc-capture 1 --renderdoc`: the library loaded in-process
+/// (before the Vulkan instance), the capture in RenderDoc's default place.
+#[test]
+fn renderdoc_option_loads_the_library() {
+    if renderdoccmd().is_none() || RenderDocCapture::attach().is_some() {
+        eprintln!("RenderDoc is not installed (or this runs under it): load test skipped");
+        return;
+    }
+    let out = run(&[&FLY_CAPTURE[..], &["--renderdoc"]].concat());
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    if stderr.contains("is Vulkan 1.2 under RenderDoc") {
+        assert_one_line_error("fly --renderdoc", &out, &["bufferDeviceAddressCaptureReplay"]);
+        eprintln!("no capture on this device: {}", stderr.trim());
+        return;
+    }
+    assert_success("fly --renderdoc", &out);
+    let line = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("RenderDoc capture of frame 1: "));
+    let path = Path::new(line.unwrap_or_else(|| panic!("no capture printed:\n{stdout}")));
+    assert!(
+        path.to_string_lossy().ends_with("_frame1_capture.rdc"),
+        "{}",
+        path.display()
+    );
+    assert!(path.is_file(), "{} missing", path.display());
+    let _ = std::fs::remove_file(path);
 }
 
 /// The in-application API against the real library: this test binary runs
