@@ -155,6 +155,10 @@ pub use error::Result;
 /// # Ok::<(), alpenglow::Error>(())
 /// ```
 pub use vulkan::Context;
+/// A window's surface and swapchain (any `raw-window-handle` window):
+/// frames reach it through [`Renderer::present`] of a renderer built with
+/// [`Settings::present_to`]. What `alpenglow view` shows its frames in.
+pub use vulkan::Swapchain;
 pub use vulkan::{ContextOptions, DeviceInfo, DeviceSelector, ValidationReport};
 
 // --- The scene ---

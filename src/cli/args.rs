@@ -35,6 +35,8 @@ pub enum Command {
     Bench(BenchArgs),
     /// Render a camera path (keyframe file or orbit) to a PNG sequence and report per-frame times.
     Fly(FlyArgs),
+    /// Show the scene live in a window with a fly camera (WASD, mouse, wheel; arrows move the sun; F12 captures).
+    View(super::view::ViewArgs),
     /// Sequential point trees: `spt build IN OUT`.
     #[command(subcommand)]
     Spt(SptCommand),

@@ -18,6 +18,7 @@ mod synth;
 mod terrain_spec;
 #[cfg(test)]
 mod tests;
+mod view;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -93,6 +94,7 @@ pub fn run() -> Result<ExitCode> {
         Command::Render(args) => render(args),
         Command::Bench(args) => bench::bench(args),
         Command::Fly(args) => fly::fly(args),
+        Command::View(args) => view::view(args),
         Command::Spt(args::SptCommand::Build(args)) => spt::build(args),
         Command::Info(args) => info(args),
         Command::Layers(command) => layers::run(command),

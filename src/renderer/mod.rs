@@ -24,6 +24,7 @@ pub mod footprint;
 mod frame_data;
 mod lighting;
 mod outputs;
+mod present;
 mod readback;
 mod ring;
 pub mod scene;
@@ -53,6 +54,7 @@ use crate::points::render::{PointFrameStats, PointRenderer, PointsFrame, SplatSe
 use crate::post::aovs::{Aovs, AovsFrame};
 use crate::post::exposure::ExposureMeter;
 use crate::post::motion_blur::{MotionBlur, MotionBlurSettings};
+use crate::post::present::{declare_present, PresentFrame};
 use crate::post::resolve::Resolve;
 use crate::post::tonemap::Tonemap;
 use crate::profile::FrameProfile;
@@ -120,6 +122,9 @@ pub struct RenderSettings {
     /// The lighting of the first frames (None: [`Scene::default_lighting`]);
     /// change it between frames with [`Renderer::set_lighting`].
     pub lighting: Option<Lighting>,
+    /// The format of the swapchain frames are presented to
+    /// ([`RenderSettings::present_to`], [`Renderer::present`]); None: headless.
+    pub(crate) present: Option<crate::vulkan::Format>,
 }
 
 impl RenderSettings {
@@ -145,6 +150,7 @@ impl RenderSettings {
             },
             cache_dir: None,
             lighting: None,
+            present: None,
         }
     }
 
@@ -179,6 +185,7 @@ frame_slots! {
         texturing: TextureFrame,
         points: PointsFrame,
         aovs: AovsFrame,
+        present: PresentFrame,
     }
 }
 
@@ -220,6 +227,10 @@ pub struct Renderer {
     /// Frames rendered so far.
     frames_rendered: u64,
     techniques: Techniques,
+    /// The swapchain image the frame ends in, and the view it shows
+    /// ([`Renderer::present`]); None: headless.
+    presented: Option<crate::graph::ImageId>,
+    shown: usize,
 }
 
 impl Renderer {
@@ -283,13 +294,14 @@ impl Renderer {
             true => settings.outputs,
             false => Outputs::NONE,
         };
-        let readback = declare_outputs(
+        let (readback, displays) = declare_outputs(
             ctx,
             &mut graph,
             (&views, &targets, &chains),
             &settings,
             (outputs, slots),
         )?;
+        let presented = (settings.present).map(|format| declare_present(&mut graph, displays, format));
         let graph = graph.bake(ctx)?;
         Ok(Renderer {
             ctx: ctx.clone(),
@@ -305,6 +317,8 @@ impl Renderer {
             lighting,
             frames_rendered: 0,
             techniques,
+            presented,
+            shown: 0,
         })
     }
 
@@ -379,6 +393,12 @@ impl Renderer {
         for (spec, camera) in self.render_specs.iter().zip(cameras) {
             view_of(spec, camera).validate()?;
         }
+        if self.presented.is_some() && !self.graph.present_bound() {
+            return Err(Error::invalid(
+                "frame",
+                "the renderer presents to a window (Settings::present_to): render with Renderer::present",
+            ));
+        }
         // The slot's previous frame must be done before prepare writes its uploads.
         let index = self.frames.wait_for_next()?;
         // The frame (views, prepared data) and its stages are reused frame
@@ -435,6 +455,9 @@ impl Renderer {
             frame.prepare_into(points, (), &mut uploads, stages)?;
         }
         frame.prepare_into(&mut t.aovs, (), &mut uploads, stages)?;
+        if self.presented.is_some() {
+            frame.insert(PresentFrame { view: self.shown });
+        }
         self.graph.execute(&mut self.frames, frame, stages)
     }
 
@@ -540,6 +563,12 @@ impl Renderer {
             atlas.observe_profiles(self.graph.profiles());
         }
         Ok(self.graph.take_profiles())
+    }
+
+    /// The timings of the frames the GPU has completed and not yet taken,
+    /// without waiting (a live viewer's per-frame profile).
+    pub fn take_profiles(&mut self) -> Vec<FrameProfile> {
+        self.graph.take_profiles()
     }
 
     /// Texture atlas statistics of the frames recorded so far and not yet
@@ -732,7 +761,7 @@ fn declare_outputs(
     (views, targets, chains): (&[View], &[SceneTargets], &[ViewChain]),
     settings: &RenderSettings,
     (outputs, slots): (Outputs, usize),
-) -> Result<Vec<Readback>> {
+) -> Result<(Vec<Readback>, Vec<crate::graph::ImageId>)> {
     let mut exposure = ExposureMeter::new(ctx)?;
     let mut tonemap = Tonemap::new(ctx)?;
     let resolve = Resolve::new(ctx)?;
@@ -740,7 +769,7 @@ fn declare_outputs(
         Some(s) if s.shutter_s > 0.0 => Some((MotionBlur::new(ctx)?, s)),
         _ => None,
     };
-    let mut readback = Vec::new();
+    let (mut readback, mut displays) = (Vec::new(), Vec::new());
     for (index, ((view, rendered), chain)) in views.iter().zip(targets).zip(chains).enumerate() {
         let blur = blur.as_ref().map(|(b, s)| (b, *s));
         let targets = chain.declare(graph, rendered, (&resolve, blur))?;
@@ -750,8 +779,9 @@ fn declare_outputs(
             Some(rb) => readback.push(rb),
             None => graph.keep(targets.display),
         }
+        displays.push(targets.display);
     }
-    Ok(readback)
+    Ok((readback, displays))
 }
 
 /// The view `spec` renders through `camera`, without allocating (the

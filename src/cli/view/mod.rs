@@ -1,0 +1,387 @@
+//! `alpenglow view`: the scene live in a window (winit: X11 and Wayland),
+//! through a fly camera. The frames are the renderer's, presented through
+//! a swapchain the render graph imports ([`alpenglow::Swapchain`]); the
+//! render size is `--width`×`--height` whatever the window's (letterboxed
+//! into it), so a frame on screen is the frame `render` writes.
+//!
+//! Keys: WASD move, E/Space up, Q/C down, Shift 4× faster; mouse look
+//! with a button held; the wheel scales the speed; arrows move the sun
+//! (up/down: elevation, left/right: azimuth); V cycles a rig's views; F12
+//! writes PNG, EXR, profile and trace of the frame on screen; Esc quits.
+//!
+//! Scripted (tests, recordings): `--frames N` renders N frames and exits,
+//! with a fixed 1/30 s step per frame so a run is reproducible; `--input
+//! EVENTS` replays key and mouse events ([`input`]); `--screenshot OUT.png`
+//! writes the last frame (as `render --out` would, no overlay). At exit
+//! the camera is printed as `render` options.
+
+mod captures;
+mod fly_camera;
+mod input;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{anyhow, Result};
+use clap::Args;
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{DeviceEvent, DeviceId, ElementState, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::keyboard::PhysicalKey;
+use winit::window::{Window, WindowId};
+
+use alpenglow::{Context, Lighting, Renderer, Scene, SunPosition, Swapchain};
+
+use super::args::SceneArgs;
+use fly_camera::FlyCamera;
+use input::{Held, Input, Key, Script};
+
+/// The time step of a scripted run (`--frames`), seconds.
+const SCRIPTED_STEP_S: f64 = 1.0 / 30.0;
+/// Degrees the sun moves per arrow-key press.
+const SUN_STEP_DEG: f32 = 2.0;
+
+#[derive(Args, Debug)]
+pub struct ViewArgs {
+    /// Render COUNT frames, then exit (scripted runs; 1–100000). Without
+    /// it the viewer runs until the window is closed or Esc.
+    #[arg(long, value_name = "COUNT", value_parser = clap::value_parser!(u32).range(1..=100_000), help_heading = "Viewer")]
+    pub frames: Option<u32>,
+    /// Replay key and mouse events: one `FRAME key NAME [down|up]`,
+    /// `FRAME mouse DX DY` or `FRAME wheel NOTCHES` per line.
+    #[arg(long, value_name = "EVENTS", help_heading = "Viewer")]
+    pub input: Option<PathBuf>,
+    /// Write the last frame (tone-mapped sRGB, without the overlay) as PNG.
+    #[arg(long, value_name = "OUT.png", help_heading = "Viewer")]
+    pub screenshot: Option<PathBuf>,
+    /// Where F12 writes its captures (capture_FRAME.png, .exr, .json, .trace.json).
+    #[arg(
+        long = "capture-dir",
+        default_value = ".",
+        value_name = "DIR",
+        help_heading = "Viewer"
+    )]
+    pub capture_dir: PathBuf,
+    /// Present as fast as frames come (mailbox or immediate) instead of vsync.
+    #[arg(long = "no-vsync", help_heading = "Viewer")]
+    pub no_vsync: bool,
+    #[command(flatten)]
+    pub scene: SceneArgs,
+}
+
+/// Runs the viewer.
+pub fn view(args: ViewArgs) -> Result<ExitCode> {
+    super::check_frames(args.frames.unwrap_or(1), 0)?;
+    let script = match &args.input {
+        Some(path) => Script::load(path)?,
+        None => Script::default(),
+    };
+    let (rig, specs) = super::views(&args.scene)?;
+    let mut outputs = super::outputs::Outputs::default();
+    outputs.add_image(args.screenshot.as_deref(), "--screenshot")?;
+    let scene = super::load_scene(&args.scene)?;
+    let camera = super::camera(&args.scene, &scene)?;
+    // Every view of a rig renders each frame (one is shown); a rig's
+    // views follow the fly camera as they follow `--eye`.
+    super::rig::frame_cameras(rig.as_ref(), &camera)?;
+    let settings = super::render_settings(&args.scene, &scene, &specs, true)?;
+    let ctx = super::context(&args.scene.device)?;
+    let report = ctx.validation_report();
+    let event_loop = EventLoop::new().map_err(|e| anyhow!("the viewer needs a display (X11 or Wayland): {e}"))?;
+    let mut app = Viewer {
+        state: None,
+        setup: Some(Setup { ctx, scene, settings }),
+        rig,
+        fly: FlyCamera::new(camera),
+        held: Held::default(),
+        looking: false,
+        script,
+        frames: args.frames.map(u64::from),
+        rendered: 0,
+        shown: 0,
+        vsync: !args.no_vsync,
+        last_time: None,
+        error: None,
+        captures: captures::Captures::new(args.capture_dir.clone(), args.screenshot.clone()),
+        size: (args.scene.width, args.scene.height),
+    };
+    let run = event_loop.run_app(&mut app);
+    let sun = app.state.as_ref().map(|s| sun_options(s.renderer.lighting()));
+    let Viewer {
+        state,
+        error,
+        fly,
+        captures,
+        ..
+    } = app;
+    let screenshot = match state {
+        Some(state) => state.finish(captures, outputs),
+        None => Ok(()),
+    };
+    // Everything Vulkan is gone: the validation report is complete.
+    check_frames_ran(error, run)?;
+    screenshot?;
+    super::check_validation(report)?;
+    println!("camera: {}", fly.options());
+    if let Some(sun) = sun {
+        println!("sun: {sun}");
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The first error of the run: the viewer's own, else the event loop's.
+fn check_frames_ran(error: Option<anyhow::Error>, run: Result<(), winit::error::EventLoopError>) -> Result<()> {
+    if let Some(e) = error {
+        return Err(e);
+    }
+    run.map_err(|e| anyhow!("the window's event loop failed: {e}"))
+}
+
+/// What the window needs before its first frame.
+struct Setup {
+    ctx: Context,
+    scene: Scene,
+    settings: alpenglow::Settings,
+}
+
+/// The window and what draws into it (dropped in this order: renderer,
+/// swapchain, window).
+struct Live {
+    renderer: Renderer,
+    swapchain: Swapchain,
+    window: Window,
+}
+
+impl Live {
+    /// Waits for the GPU and writes the screenshot of the last frame.
+    fn finish(mut self, captures: captures::Captures, outputs: super::outputs::Outputs) -> Result<()> {
+        captures.screenshot(&mut self.renderer, outputs)?;
+        drop(self.renderer);
+        drop(self.swapchain);
+        drop(self.window);
+        Ok(())
+    }
+}
+
+struct Viewer {
+    state: Option<Live>,
+    setup: Option<Setup>,
+    rig: Option<alpenglow::Rig>,
+    fly: FlyCamera,
+    held: Held,
+    /// A mouse button is down: motion turns the camera.
+    looking: bool,
+    script: Script,
+    /// Frames to render (scripted), or None: until closed.
+    frames: Option<u64>,
+    rendered: u64,
+    shown: usize,
+    vsync: bool,
+    last_time: Option<Instant>,
+    error: Option<anyhow::Error>,
+    captures: captures::Captures,
+    /// The render size (the window's initial inner size).
+    size: (u32, u32),
+}
+
+impl Viewer {
+    /// Opens the window and its swapchain and builds the renderer.
+    fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        let Some(setup) = self.setup.take() else {
+            return Ok(());
+        };
+        let attributes = Window::default_attributes()
+            .with_title("alpenglow")
+            .with_inner_size(PhysicalSize::new(self.size.0, self.size.1));
+        let window = event_loop.create_window(attributes)?;
+        let size = window.inner_size();
+        let swapchain = Swapchain::new(&setup.ctx, &window, (size.width, size.height), self.vsync)?;
+        let mut settings = setup.settings;
+        settings.present_to(&swapchain);
+        let mut renderer = super::lighting::renderer(&setup.ctx, &setup.scene, settings)?;
+        renderer.set_profile_history(captures::PROFILE_HISTORY);
+        window.request_redraw();
+        self.state = Some(Live {
+            renderer,
+            swapchain,
+            window,
+        });
+        Ok(())
+    }
+
+    fn handle(&mut self, input: Input, event_loop: &ActiveEventLoop) {
+        match input {
+            Input::Key { key, pressed } => {
+                self.held.set(key, pressed);
+                if pressed {
+                    self.pressed(key, event_loop);
+                }
+            }
+            Input::Look { dx, dy } => self.fly.turn(dx, dy),
+            Input::Wheel(notches) => self.fly.scroll(notches),
+        }
+    }
+
+    /// What a key press does at once (held keys move the camera each frame).
+    fn pressed(&mut self, key: Key, event_loop: &ActiveEventLoop) {
+        let Some(state) = &mut self.state else { return };
+        let sun = |d_elevation: f32, d_azimuth: f32| move |l: Lighting| move_sun(l, d_elevation, d_azimuth);
+        let result = match key {
+            Key::Escape => {
+                event_loop.exit();
+                Ok(())
+            }
+            Key::V => {
+                self.shown = (self.shown + 1) % state.renderer.views().len();
+                Ok(())
+            }
+            Key::Up => set_lighting(&mut state.renderer, sun(SUN_STEP_DEG, 0.0)),
+            Key::Down => set_lighting(&mut state.renderer, sun(-SUN_STEP_DEG, 0.0)),
+            Key::Left => set_lighting(&mut state.renderer, sun(0.0, -SUN_STEP_DEG)),
+            Key::Right => set_lighting(&mut state.renderer, sun(0.0, SUN_STEP_DEG)),
+            Key::F12 => {
+                self.captures.request();
+                Ok(())
+            }
+            _ => Ok(()),
+        };
+        if let Err(e) = result {
+            log::warn!("{e}");
+        }
+    }
+
+    /// Renders and presents one frame.
+    fn frame(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        for input in self.script.due(self.rendered) {
+            self.handle(input, event_loop);
+        }
+        let now = Instant::now();
+        let dt = match (self.frames, self.last_time) {
+            (Some(_), _) => SCRIPTED_STEP_S,
+            (None, Some(last)) => now.duration_since(last).as_secs_f64().min(0.25),
+            (None, None) => 0.0,
+        };
+        self.last_time = Some(now);
+        self.fly.advance(self.held.motion(), dt);
+        let Some(state) = &mut self.state else {
+            return Ok(());
+        };
+        let cameras = super::rig::frame_cameras(self.rig.as_ref(), &self.fly.camera())?;
+        let Some(outcome) = state.renderer.present(&cameras, &mut state.swapchain, self.shown)? else {
+            return Ok(()); // minimised
+        };
+        self.rendered += 1;
+        self.captures.frame_done(&mut state.renderer, outcome, self.shown)?;
+        if self.frames.is_some_and(|n| self.rendered >= n) {
+            event_loop.exit();
+        } else {
+            state.window.request_redraw();
+        }
+        Ok(())
+    }
+
+    fn fail(&mut self, error: anyhow::Error, event_loop: &ActiveEventLoop) {
+        self.error.get_or_insert(error);
+        event_loop.exit();
+    }
+}
+
+/// Applies `change` to the renderer's lighting.
+fn set_lighting(renderer: &mut Renderer, change: impl FnOnce(Lighting) -> Lighting) -> Result<()> {
+    let lighting = change(*renderer.lighting());
+    renderer.set_lighting(lighting)?;
+    Ok(())
+}
+
+/// The sun of `lighting` as `render` options.
+fn sun_options(lighting: &Lighting) -> String {
+    match move_sun(*lighting, 0.0, 0.0).sun {
+        SunPosition::Angles {
+            elevation_deg,
+            azimuth_deg,
+        } => format!("--sun-elevation {elevation_deg:.4} --sun-azimuth {azimuth_deg:.4}"),
+        SunPosition::Direction(_) => String::new(),
+    }
+}
+
+/// The sun moved by `d_elevation` and `d_azimuth` degrees (elevation kept
+/// within −10°..90°).
+fn move_sun(mut lighting: Lighting, d_elevation: f32, d_azimuth: f32) -> Lighting {
+    let (elevation, azimuth) = match lighting.sun {
+        SunPosition::Angles {
+            elevation_deg,
+            azimuth_deg,
+        } => (elevation_deg, azimuth_deg),
+        SunPosition::Direction(d) => {
+            let d = d.normalize_or_zero();
+            (d.z.clamp(-1.0, 1.0).asin().to_degrees(), d.x.atan2(d.y).to_degrees())
+        }
+    };
+    lighting.sun = SunPosition::Angles {
+        elevation_deg: (elevation + d_elevation).clamp(-10.0, 90.0),
+        azimuth_deg: (azimuth + d_azimuth).rem_euclid(360.0),
+    };
+    lighting
+}
+
+impl ApplicationHandler for Viewer {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if let Err(e) = self.open(event_loop) {
+            self.fail(e, event_loop);
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => {
+                if let Some(state) = &mut self.state {
+                    state.swapchain.resize(size.width, size.height);
+                    state.window.request_redraw();
+                }
+            }
+            WindowEvent::KeyboardInput { event, .. } if !event.repeat => {
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    if let Some(key) = Key::from_winit(code) {
+                        let pressed = event.state == ElementState::Pressed;
+                        self.handle(Input::Key { key, pressed }, event_loop);
+                    }
+                }
+            }
+            WindowEvent::MouseInput { state, .. } => self.looking = state == ElementState::Pressed,
+            WindowEvent::MouseWheel { delta, .. } => {
+                let notches = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => f64::from(y),
+                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
+                };
+                self.handle(Input::Wheel(notches), event_loop);
+            }
+            WindowEvent::RedrawRequested => {
+                if let Err(e) = self.frame(event_loop) {
+                    self.fail(e, event_loop);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn device_event(&mut self, event_loop: &ActiveEventLoop, _: DeviceId, event: DeviceEvent) {
+        if let DeviceEvent::MouseMotion { delta: (dx, dy) } = event {
+            if self.looking {
+                self.handle(Input::Look { dx, dy }, event_loop);
+            }
+        }
+    }
+
+    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
+        // A live viewer draws continuously (tiles stream in, the profile
+        // moves); a minimised window asks again when it is restored.
+        if let Some(state) = &self.state {
+            if state.swapchain.extent() != (0, 0) {
+                state.window.request_redraw();
+            }
+        }
+    }
+}
