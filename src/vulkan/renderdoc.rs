@@ -213,6 +213,13 @@ impl RenderDocCapture {
         backend::trigger(&mut self.api);
     }
 
+    /// Turns RenderDoc's own capture keys (F12 and Print Screen by
+    /// default) off, for a program whose keys they would shadow; captures
+    /// then come from [`RenderDocCapture::trigger_capture`] only.
+    pub fn disable_capture_keys(&mut self) {
+        backend::disable_keys(&mut self.api);
+    }
+
     /// How many captures RenderDoc wrote in this process.
     pub fn captures(&self) -> u32 {
         backend::captures(&self.api)
@@ -285,6 +292,10 @@ mod backend {
         api.trigger_capture();
     }
 
+    pub fn disable_keys(api: &mut Api) {
+        api.set_capture_keys::<renderdoc::InputButton>(&[]);
+    }
+
     pub fn captures(api: &Api) -> u32 {
         api.get_num_captures()
     }
@@ -333,6 +344,9 @@ mod backend {
         match *api {}
     }
     pub fn trigger(api: &mut Api) {
+        match *api {}
+    }
+    pub fn disable_keys(api: &mut Api) {
         match *api {}
     }
     pub fn captures(api: &Api) -> u32 {
