@@ -47,7 +47,7 @@ fn a_scripted_view_matches_the_headless_render_of_its_camera() {
     // hold still so the texture tiles settle.
     std::fs::write(
         &events,
-        "0 key W down\n6 key W up\n7 mouse 100 30\n8 key Up\n8 key Up\n8 key Right\n9 key F12\n",
+        "0 key W down\n6 key W up\n7 mouse 100 30\n8 key Up\n8 key Up\n8 key Right\n9 key F12\n9 key F11\n",
     )
     .unwrap();
     let (shot, reference) = (dir.join("shot.png"), dir.join("reference.png"));
@@ -105,6 +105,9 @@ fn a_scripted_view_matches_the_headless_render_of_its_camera() {
         (elevation - 34.0).abs() < 1e-3 && (azimuth - 182.0).abs() < 1e-3,
         "sun {elevation} {azimuth}"
     );
+    // F11 without RenderDoc: a warning, the run goes on.
+    let stderr = text(&out.stderr);
+    assert!(stderr.contains("F11: RenderDoc is not loaded"), "{stderr}");
     // F12 wrote the frame on screen: PNG, EXR, profile and trace.
     for ext in ["png", "exr", "json", "trace.json"] {
         let path = dir.join(format!("capture_00009.{ext}"));

@@ -7,7 +7,9 @@
 //! Keys: WASD move, E/Space up, Q/C down, Shift 4× faster; mouse look
 //! with a button held; the wheel scales the speed; arrows move the sun
 //! (up/down: elevation, left/right: azimuth); V cycles a rig's views; F12
-//! writes PNG, EXR, profile and trace of the frame on screen; F1 hides the
+//! writes PNG, EXR, profile and trace of the frame on screen; F11 has
+//! RenderDoc capture the next frame (under RenderDoc or with
+//! `--renderdoc`); F1 hides the
 //! overlay ([`hud`]: per-pass GPU times, frame-time plot, statistics,
 //! switches); Esc quits.
 //!
@@ -35,6 +37,7 @@ use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::keyboard::PhysicalKey;
 use winit::window::{Window, WindowId};
 
+use alpenglow::tools::renderdoc::RenderDocCapture;
 use alpenglow::{Context, Lighting, Renderer, Scene, SunPosition, Swapchain};
 
 use super::args::SceneArgs;
@@ -67,6 +70,11 @@ pub struct ViewArgs {
         help_heading = "Viewer"
     )]
     pub capture_dir: PathBuf,
+    /// Load RenderDoc's library (default: librenderdoc.so from the linker's
+    /// path or the usual install places) so F11 can capture; not needed
+    /// when the viewer runs under RenderDoc.
+    #[arg(long, value_name = "PATH", num_args = 0..=1, help_heading = "Viewer")]
+    pub renderdoc: Option<Option<PathBuf>>,
     /// Present as fast as frames come (mailbox or immediate) instead of vsync.
     #[arg(long = "no-vsync", help_heading = "Viewer")]
     pub no_vsync: bool,
@@ -90,6 +98,16 @@ pub fn view(args: ViewArgs) -> Result<ExitCode> {
     // views follow the fly camera as they follow `--eye`.
     super::rig::frame_cameras(rig.as_ref(), &camera)?;
     let settings = super::render_settings(&args.scene, &scene, &specs, true)?;
+    // RenderDoc hooks Vulkan only when loaded before the instance.
+    let renderdoc = match &args.renderdoc {
+        Some(path) => Some(RenderDocCapture::load(path.as_deref())?),
+        None => RenderDocCapture::attach(),
+    };
+    let renderdoc = renderdoc.map(|mut r| {
+        // Its own capture keys (F12, Print Screen) would clash with the viewer's.
+        r.disable_capture_keys();
+        r
+    });
     let ctx = super::context(&args.scene.device)?;
     let report = ctx.validation_report();
     let event_loop = EventLoop::new().map_err(|e| anyhow!("the viewer needs a display (X11 or Wayland): {e}"))?;
@@ -104,6 +122,8 @@ pub fn view(args: ViewArgs) -> Result<ExitCode> {
         state: None,
         setup: Some(Setup { ctx, scene, settings }),
         switches,
+        renderdoc,
+        renderdoc_pending: None,
         notice: None,
         textures_line: None,
         points_line: None,
@@ -208,6 +228,10 @@ struct Viewer {
     state: Option<Live>,
     setup: Option<Setup>,
     switches: hud::Switches,
+    /// RenderDoc's in-application API, when loaded or attached (F11).
+    renderdoc: Option<RenderDocCapture>,
+    /// The capture count when F11 was pressed, until the capture is written.
+    renderdoc_pending: Option<u32>,
     /// A message the overlay shows (a switch the renderer refused).
     notice: Option<String>,
     /// The last tile-streaming and point statistics.
@@ -291,6 +315,16 @@ impl Viewer {
                 self.captures.request();
                 Ok(())
             }
+            Key::F11 => match &mut self.renderdoc {
+                Some(rdoc) => {
+                    rdoc.trigger_capture();
+                    self.renderdoc_pending = Some(rdoc.captures());
+                    Ok(())
+                }
+                None => Err(anyhow!(
+                    "F11: RenderDoc is not loaded (run under renderdoccmd or qrenderdoc, or pass --renderdoc)"
+                )),
+            },
             Key::F1 => {
                 state.hud.visible = !state.hud.visible;
                 Ok(())
@@ -330,7 +364,22 @@ impl Viewer {
         } else {
             state.window.request_redraw();
         }
+        self.report_renderdoc();
         Ok(())
+    }
+
+    /// Prints the RenderDoc capture F11 asked for once RenderDoc wrote it.
+    fn report_renderdoc(&mut self) {
+        let (Some(rdoc), Some(before)) = (&self.renderdoc, self.renderdoc_pending) else {
+            return;
+        };
+        if rdoc.captures() > before {
+            self.renderdoc_pending = None;
+            let file = rdoc.latest_capture().map(|p| p.display().to_string());
+            let line = format!("F11: RenderDoc capture {}", file.unwrap_or_default());
+            println!("{line}");
+            self.notice = Some(line);
+        }
     }
 
     /// Builds this frame's overlay and applies the switches it changed.
