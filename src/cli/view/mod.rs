@@ -117,6 +117,7 @@ pub fn view(args: ViewArgs) -> Result<ExitCode> {
         sky: settings.lighting.map(|l| l.sky).unwrap_or_default(),
         terrain_view: settings.terrain.view,
         texturing: settings.texturing,
+        image: alpenglow::PresentedImage::Color,
     };
     let mut app = Viewer {
         state: None,
@@ -199,7 +200,9 @@ impl Live {
         change(&mut self.setup.settings);
         self.setup.settings.lighting = Some(lighting);
         let settings = self.setup.settings.clone();
+        let image = self.renderer.presented_image();
         self.renderer = build_renderer(&self.setup.ctx, &self.setup.scene, settings)?;
+        self.renderer.set_presented_image(image);
         Ok(())
     }
 }
@@ -305,6 +308,13 @@ impl Viewer {
             }
             Key::V => {
                 self.shown = (self.shown + 1) % state.renderer.views().len();
+                Ok(())
+            }
+            Key::G => {
+                let all = alpenglow::PresentedImage::ALL;
+                let at = all.iter().position(|i| *i == self.switches.image).unwrap_or(0);
+                self.switches.image = all[(at + 1) % all.len()];
+                state.renderer.set_presented_image(self.switches.image);
                 Ok(())
             }
             Key::Up => set_lighting(&mut state.renderer, sun(SUN_STEP_DEG, 0.0)),
@@ -434,6 +444,7 @@ impl Viewer {
 /// once, the terrain view and texturing by rebuilding the renderer. An
 /// error (a mode the renderer was not built for) leaves the frame as it was.
 fn apply_switches(state: &mut Live, old: hud::Switches, new: hud::Switches) -> Result<()> {
+    state.renderer.set_presented_image(new.image);
     if (old.shadows, old.sky_light, old.sky) != (new.shadows, new.sky_light, new.sky) {
         set_lighting(&mut state.renderer, |mut l| {
             (l.shadows, l.sky_light, l.sky) = (new.shadows, new.sky_light, new.sky);
