@@ -45,10 +45,12 @@ fn a_scripted_view_matches_the_headless_render_of_its_camera() {
     // W held for frames 0–5 (6 steps of 1/30 s), a look to the right and
     // down, the sun up 2 steps and right 1, F12 at frame 9; frames 10–13
     // hold still so the texture tiles settle, and present the depth,
-    // normal and class debug views (the screenshot stays the colour).
+    // normal and class debug views (the screenshot stays the colour); the
+    // window is resized twice (the swapchain is recreated, the render size
+    // stays).
     std::fs::write(
         &events,
-        "0 key W down\n6 key W up\n7 mouse 100 30\n8 key Up\n8 key Up\n8 key Right\n9 key F12\n9 key F11\n10 key G\n11 key G\n12 key G\n",
+        "0 key W down\n6 key W up\n7 mouse 100 30\n8 key Up\n8 key Up\n8 key Right\n9 key F12\n9 key F11\n10 key G\n11 key G\n12 key G\n3 resize 300 240\n5 resize 200 100\n",
     )
     .unwrap();
     let (shot, reference) = (dir.join("shot.png"), dir.join("reference.png"));

@@ -156,6 +156,12 @@ impl Swapchain {
         }
     }
 
+    /// Whether the window is minimised (0 pixels wide or high): nothing
+    /// is presented until it is restored.
+    pub fn is_minimised(&self) -> bool {
+        self.wanted.0 == 0 || self.wanted.1 == 0
+    }
+
     /// The images' size in pixels.
     pub fn extent(&self) -> (u32, u32) {
         self.extent
@@ -311,6 +317,14 @@ impl Swapchain {
         }
         self.extent = (extent.width, extent.height);
         self.stale = false;
+        log::debug!(
+            "swapchain: {}×{} {:?}, {:?}, {} images",
+            extent.width,
+            extent.height,
+            self.format.format,
+            mode,
+            self.images.len()
+        );
         Ok(true)
     }
 

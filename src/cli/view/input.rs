@@ -10,6 +10,7 @@
 //! 7 mouse 40 -10    # mouse look: moved 40 px right, 10 px up (button held)
 //! 8 wheel 2         # two notches up: faster
 //! 9 key F12         # a press and release
+//! 10 resize 640 360 # the window asks for a new size
 //! ```
 
 use std::path::Path;
@@ -120,6 +121,11 @@ pub enum Input {
     },
     /// Wheel notches (up positive).
     Wheel(f64),
+    /// Asks the window for a new inner size in pixels (scripts only).
+    Resize {
+        width: u32,
+        height: u32,
+    },
 }
 
 /// Events of a script, each with the frame it comes before, in order.
@@ -184,7 +190,20 @@ fn parse_line(line: &str) -> Result<Vec<(u64, Input)>> {
             dy: number(3)?,
         }],
         Some("wheel") => vec![Input::Wheel(number(2)?)],
-        Some(other) => bail!("unknown event '{other}' (key, mouse or wheel)"),
+        Some("resize") => {
+            let side = |k: usize| -> Result<u32> {
+                let v = number(k)?;
+                if !(1.0..=16384.0).contains(&v) || v.fract() != 0.0 {
+                    bail!("{v}: a window side is a whole number of pixels, 1 to 16384");
+                }
+                Ok(v as u32)
+            };
+            vec![Input::Resize {
+                width: side(2)?,
+                height: side(3)?,
+            }]
+        }
+        Some(other) => bail!("unknown event '{other}' (key, mouse, wheel or resize)"),
         None => bail!("an event is missing"),
     };
     Ok(inputs.into_iter().map(|i| (frame, i)).collect())

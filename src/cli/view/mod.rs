@@ -294,6 +294,12 @@ impl Viewer {
             }
             Input::Look { dx, dy } => self.fly.turn(dx, dy),
             Input::Wheel(notches) => self.fly.scroll(notches),
+            Input::Resize { width, height } => {
+                if let Some(state) = &self.state {
+                    // The window manager (if any) answers with a Resized event.
+                    let _ = state.window.request_inner_size(PhysicalSize::new(width, height));
+                }
+            }
         }
     }
 
@@ -560,7 +566,7 @@ impl ApplicationHandler for Viewer {
         // A live viewer draws continuously (tiles stream in, the profile
         // moves); a minimised window asks again when it is restored.
         if let Some(state) = &self.state {
-            if state.swapchain.extent() != (0, 0) {
+            if !state.swapchain.is_minimised() {
                 state.window.request_redraw();
             }
         }
