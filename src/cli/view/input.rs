@@ -253,7 +253,7 @@ mod tests {
         let path = dir.join("events.txt");
         std::fs::write(
             &path,
-            "# comment\n5 key w up\n0 key W down\n3 mouse 4 -2 # look\n3 wheel 1\n7 key F12\n",
+            "# comment\n5 key w up\n0 key W down\n3 mouse 4 -2 # look\n3 wheel 1\n7 key F12\n8 resize 64 32\n",
         )
         .unwrap();
         let mut script = Script::load(&path).unwrap();
@@ -266,7 +266,8 @@ mod tests {
         );
         assert_eq!(script.due(6), vec![w(false)]);
         let f12 = |pressed| Input::Key { key: Key::F12, pressed };
-        assert_eq!(script.due(100), vec![f12(true), f12(false)]);
+        assert_eq!(script.due(7), vec![f12(true), f12(false)]);
+        assert_eq!(script.due(100), vec![Input::Resize { width: 64, height: 32 }]);
         for (text, error) in [
             ("x key W", "frame number"),
             ("1 key Z", "unknown key 'Z'"),
@@ -274,6 +275,8 @@ mod tests {
             ("1 mouse 1", "a number is missing"),
             ("1 wheel inf", "out of range"),
             ("1 key W sideways", "'sideways'"),
+            ("1 resize 0 10", "whole number of pixels"),
+            ("1 resize 10.5 10", "whole number of pixels"),
         ] {
             std::fs::write(&path, text).unwrap();
             let message = format!("{:#}", Script::load(&path).unwrap_err());
