@@ -176,3 +176,68 @@ fn a_bad_events_file_is_a_one_line_error_before_any_window() {
     assert_one_line_error("no frames", &out, &["--frames"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_rig_shows_the_view_v_selects() {
+    let dir = fresh_dir("view-rig");
+    let events = dir.join("events.txt");
+    // Two V presses: the third view (rear_left); G presents each of its
+    // AOVs' debug views for a frame, then its colour again.
+    let cycle: String = (2..10).map(|frame| format!("{frame} key G\n")).collect();
+    std::fs::write(&events, format!("0 key V\n1 key V\n{cycle}")).unwrap();
+    let shot = dir.join("shot.png");
+    let scene = [
+        "--terrain",
+        "procedural:ridged,size=65,spacing=40",
+        "--rig-preset",
+        "ring6",
+        "--width",
+        "96",
+    ];
+    let start = ["--eye", "1280,-300,1000", "--target", "1280,1280,500"];
+    let mut args = vec![
+        "view",
+        "--frames",
+        "11",
+        "--validation",
+        "--input",
+        events.to_str().unwrap(),
+    ];
+    args.extend(["--screenshot", shot.to_str().unwrap()]);
+    args.extend(scene);
+    args.extend(start);
+    let Some(out) = run_on_xvfb(&args) else { return };
+    assert_success("view with a rig", &out);
+    let stdout = text(&out.stdout);
+    let (eye, target) = (
+        option(&stdout, "camera: ", "--eye"),
+        option(&stdout, "camera: ", "--target"),
+    );
+    let pattern = dir.join("{view}.png");
+    let mut render = vec![
+        "render",
+        "--out",
+        pattern.to_str().unwrap(),
+        "--eye",
+        eye,
+        "--target",
+        target,
+    ];
+    render.extend(scene);
+    let out = run(&render);
+    assert_success("render with a rig", &out);
+    let (viewed, w, h) = rgba(&shot);
+    assert_eq!((w, h), (96, 72), "the screenshot is one view of the rig");
+    let mut flips = Vec::new();
+    for name in ["front", "front_left", "rear_left", "rear"] {
+        let (headless, _, _) = rgba(&dir.join(format!("{name}.png")));
+        flips.push((mean_flip(&headless, &viewed, w, h).0, name));
+    }
+    flips.sort_by(|a, b| a.0.total_cmp(&b.0));
+    assert_eq!(
+        flips[0].1, "rear_left",
+        "the screenshot is the view V selected: {flips:?}"
+    );
+    assert!(flips[0].0 <= 0.02, "{flips:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

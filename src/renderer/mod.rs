@@ -803,17 +803,24 @@ fn declare_outputs(
         Some(s) if s.shutter_s > 0.0 => Some((MotionBlur::new(ctx)?, s)),
         _ => None,
     };
-    let (mut readback, mut displays) = (Vec::new(), Vec::new());
+    // Every view's images are final before any is read (validation layers
+    // before 1.3.268 count view k's tonemap dispatch as writing view j's
+    // display image: after the barrier of j's readback it would look like
+    // an unsynchronised write before the present pass reads it).
+    let mut displays = Vec::new();
     for (index, ((view, rendered), chain)) in views.iter().zip(targets).zip(chains).enumerate() {
         let blur = blur.as_ref().map(|(b, s)| (b, *s));
         let targets = chain.declare(graph, rendered, (&resolve, blur))?;
         let exposure = exposure.declare(ViewGraph::new(ctx, graph, (index, view)), &targets)?;
         tonemap.declare(ViewGraph::new(ctx, graph, (index, view)), (&targets, exposure))?;
-        match Readback::declare(ctx, graph, view, &targets, (outputs, slots))? {
+        displays.push((view.name.clone(), targets));
+    }
+    let mut readback = Vec::new();
+    for (view, (_, targets)) in views.iter().zip(&displays) {
+        match Readback::declare(ctx, graph, view, targets, (outputs, slots))? {
             Some(rb) => readback.push(rb),
             None => graph.keep(targets.display),
         }
-        displays.push((view.name.clone(), targets));
     }
     Ok((readback, displays))
 }
