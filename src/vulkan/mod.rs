@@ -13,6 +13,7 @@ mod image;
 mod memory;
 mod pipeline;
 mod present;
+mod shader_overrides;
 mod validation;
 
 pub use ash::vk::{
