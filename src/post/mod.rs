@@ -7,6 +7,7 @@ pub mod aovs;
 pub mod distortion;
 pub mod exposure;
 pub mod motion_blur;
+pub mod overlay;
 pub mod present;
 pub mod resample;
 pub mod resolve;

@@ -54,6 +54,7 @@ use crate::points::render::{PointFrameStats, PointRenderer, PointsFrame, SplatSe
 use crate::post::aovs::{Aovs, AovsFrame};
 use crate::post::exposure::ExposureMeter;
 use crate::post::motion_blur::{MotionBlur, MotionBlurSettings};
+use crate::post::overlay::{Overlay, OverlayPrepared};
 use crate::post::present::{declare_present, PresentFrame};
 use crate::post::resolve::Resolve;
 use crate::post::tonemap::Tonemap;
@@ -186,6 +187,7 @@ frame_slots! {
         points: PointsFrame,
         aovs: AovsFrame,
         present: PresentFrame,
+        overlay: OverlayPrepared,
     }
 }
 
@@ -201,6 +203,8 @@ struct Techniques {
     atlas: Option<TextureAtlas>,
     points: Option<PointRenderer>,
     aovs: Aovs,
+    /// Over the presented frame (a renderer that presents).
+    overlay: Option<Overlay>,
 }
 
 /// Renders one scene, frame after frame. `Send`: a simulator may hand it to
@@ -289,7 +293,7 @@ impl Renderer {
             settings: &settings,
             views: &views,
         };
-        let (techniques, targets) = wiring.declare(&mut graph, &chains, lighting.setup(), progress)?;
+        let (mut techniques, targets) = wiring.declare(&mut graph, &chains, lighting.setup(), progress)?;
         let outputs = match settings.readback {
             true => settings.outputs,
             false => Outputs::NONE,
@@ -301,7 +305,16 @@ impl Renderer {
             &settings,
             (outputs, slots),
         )?;
-        let presented = (settings.present).map(|format| declare_present(&mut graph, displays, format));
+        let presented = match settings.present {
+            Some(format) => {
+                let window = declare_present(&mut graph, displays, format);
+                let mut overlay = Overlay::new(ctx, format)?;
+                overlay.declare(&mut graph, window);
+                techniques.overlay = Some(overlay);
+                Some(window)
+            }
+            None => None,
+        };
         let graph = graph.bake(ctx)?;
         Ok(Renderer {
             ctx: ctx.clone(),
@@ -458,6 +471,9 @@ impl Renderer {
         if self.presented.is_some() {
             frame.insert(PresentFrame { view: self.shown });
         }
+        if let Some(overlay) = &mut t.overlay {
+            frame.prepare_into(overlay, (), &mut uploads, stages)?;
+        }
         self.graph.execute(&mut self.frames, frame, stages)
     }
 
@@ -602,6 +618,15 @@ impl Renderer {
         Ok(self.techniques.atlas.as_ref().map(|a| a.page_table().clone()))
     }
 
+    /// Point statistics of the frames the GPU has completed, without
+    /// waiting (a live viewer's); empty without point objects.
+    pub fn take_completed_point_stats(&mut self) -> Result<Vec<PointFrameStats>> {
+        match &mut self.techniques.points {
+            Some(p) => p.take_stats(),
+            None => Ok(Vec::new()),
+        }
+    }
+
     /// Point statistics of the frames completed so far and not yet taken
     /// (complete after [`Renderer::finish`]); empty without point objects.
     pub fn take_point_stats(&mut self) -> Result<Vec<PointFrameStats>> {
@@ -725,6 +750,7 @@ impl Wiring<'_> {
             atlas,
             points,
             aovs,
+            overlay: None,
         };
         Ok((techniques, targets))
     }

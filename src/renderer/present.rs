@@ -7,6 +7,7 @@
 use super::{Camera, RenderSettings, Renderer};
 use crate::error::{Error, Result};
 use crate::graph::FrameOutcome;
+use crate::post::overlay::OverlayFrame;
 use crate::vulkan::Swapchain;
 
 impl RenderSettings {
@@ -18,6 +19,18 @@ impl RenderSettings {
 }
 
 impl Renderer {
+    /// What the overlay draws over the next presented frame (over the
+    /// shown view, after `present.blit`; never in what is read back).
+    pub fn set_overlay(&mut self, overlay: OverlayFrame) -> Result<()> {
+        match &mut self.techniques.overlay {
+            Some(o) => o.set(overlay),
+            None => Err(Error::invalid(
+                "overlay",
+                "the renderer does not present (Settings::present_to)",
+            )),
+        }
+    }
+
     /// Renders a frame of every view (view `k` through `cameras[k]`) and
     /// presents view `shown`, letterboxed, to `swapchain`. None (nothing
     /// rendered) while the window is minimised. The renderer must have

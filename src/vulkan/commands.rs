@@ -309,6 +309,12 @@ impl CommandRecorder {
         unsafe { self.device().cmd_draw(self.cmd, vertices, instances, 0, 0) };
     }
 
+    /// Draws `vertices` vertices from vertex index `first` (one instance).
+    pub fn draw_range(&mut self, vertices: u32, first: u32) {
+        // SAFETY: inside a rendering instance with a graphics pipeline bound.
+        unsafe { self.device().cmd_draw(self.cmd, vertices, 1, first, 0) };
+    }
+
     /// Draws indexed vertices.
     pub fn draw_indexed(&mut self, indices: u32, instances: u32) {
         // SAFETY: as in `draw`, with an index buffer bound.

@@ -5,7 +5,7 @@
 //! frame FRAME (0-based) is rendered; `#` starts a comment:
 //!
 //! ```text
-//! 0 key W down      # hold W (names: W A S D Q E Space C Shift V F11 F12
+//! 0 key W down      # hold W (names: W A S D Q E Space C Shift V F1 F11 F12
 //! 6 key W up        #   Up Down Left Right Escape)
 //! 7 mouse 40 -10    # mouse look: moved 40 px right, 10 px up (button held)
 //! 8 wheel 2         # two notches up: faster
@@ -37,6 +37,8 @@ pub enum Key {
     Down,
     Left,
     Right,
+    /// Hides or shows the overlay.
+    F1,
     /// Capture: RenderDoc's next frame.
     F11,
     /// Capture: PNG, EXR, profile and trace of the frame on screen.
@@ -44,7 +46,7 @@ pub enum Key {
     Escape,
 }
 
-const NAMES: [(&str, Key); 17] = [
+const NAMES: [(&str, Key); 18] = [
     ("W", Key::W),
     ("A", Key::A),
     ("S", Key::S),
@@ -59,6 +61,7 @@ const NAMES: [(&str, Key); 17] = [
     ("Down", Key::Down),
     ("Left", Key::Left),
     ("Right", Key::Right),
+    ("F1", Key::F1),
     ("F11", Key::F11),
     ("F12", Key::F12),
     ("Escape", Key::Escape),
@@ -90,6 +93,7 @@ impl Key {
             K::ArrowDown => Key::Down,
             K::ArrowLeft => Key::Left,
             K::ArrowRight => Key::Right,
+            K::F1 => Key::F1,
             K::F11 => Key::F11,
             K::F12 => Key::F12,
             K::Escape => Key::Escape,

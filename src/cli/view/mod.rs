@@ -7,7 +7,9 @@
 //! Keys: WASD move, E/Space up, Q/C down, Shift 4× faster; mouse look
 //! with a button held; the wheel scales the speed; arrows move the sun
 //! (up/down: elevation, left/right: azimuth); V cycles a rig's views; F12
-//! writes PNG, EXR, profile and trace of the frame on screen; Esc quits.
+//! writes PNG, EXR, profile and trace of the frame on screen; F1 hides the
+//! overlay ([`hud`]: per-pass GPU times, frame-time plot, statistics,
+//! switches); Esc quits.
 //!
 //! Scripted (tests, recordings): `--frames N` renders N frames and exits,
 //! with a fixed 1/30 s step per frame so a run is reproducible; `--input
@@ -17,6 +19,7 @@
 
 mod captures;
 mod fly_camera;
+mod hud;
 mod input;
 
 use std::path::PathBuf;
@@ -90,9 +93,20 @@ pub fn view(args: ViewArgs) -> Result<ExitCode> {
     let ctx = super::context(&args.scene.device)?;
     let report = ctx.validation_report();
     let event_loop = EventLoop::new().map_err(|e| anyhow!("the viewer needs a display (X11 or Wayland): {e}"))?;
+    let switches = hud::Switches {
+        shadows: settings.lighting.map(|l| l.shadows).unwrap_or_default(),
+        sky_light: settings.lighting.map(|l| l.sky_light).unwrap_or_default(),
+        sky: settings.lighting.map(|l| l.sky).unwrap_or_default(),
+        terrain_view: settings.terrain.view,
+        texturing: settings.texturing,
+    };
     let mut app = Viewer {
         state: None,
         setup: Some(Setup { ctx, scene, settings }),
+        switches,
+        notice: None,
+        textures_line: None,
+        points_line: None,
         rig,
         fly: FlyCamera::new(camera),
         held: Held::default(),
@@ -151,7 +165,30 @@ struct Setup {
 struct Live {
     renderer: Renderer,
     swapchain: Swapchain,
+    hud: hud::Hud,
     window: Window,
+    /// What the renderer was built from (rebuilt when a switch needs it).
+    setup: Setup,
+}
+
+impl Live {
+    /// A new renderer from the setup with `change` applied to its settings,
+    /// keeping the lighting.
+    fn rebuild(&mut self, change: impl FnOnce(&mut alpenglow::Settings)) -> Result<()> {
+        let lighting = *self.renderer.lighting();
+        change(&mut self.setup.settings);
+        self.setup.settings.lighting = Some(lighting);
+        let settings = self.setup.settings.clone();
+        self.renderer = build_renderer(&self.setup.ctx, &self.setup.scene, settings)?;
+        Ok(())
+    }
+}
+
+/// A renderer presenting to the swapchain `settings` name.
+fn build_renderer(ctx: &Context, scene: &Scene, settings: alpenglow::Settings) -> Result<Renderer> {
+    let mut renderer = super::lighting::renderer(ctx, scene, settings)?;
+    renderer.set_profile_history(captures::PROFILE_HISTORY);
+    Ok(renderer)
 }
 
 impl Live {
@@ -160,7 +197,9 @@ impl Live {
         captures.screenshot(&mut self.renderer, outputs)?;
         drop(self.renderer);
         drop(self.swapchain);
+        drop(self.hud);
         drop(self.window);
+        drop(self.setup);
         Ok(())
     }
 }
@@ -168,6 +207,12 @@ impl Live {
 struct Viewer {
     state: Option<Live>,
     setup: Option<Setup>,
+    switches: hud::Switches,
+    /// A message the overlay shows (a switch the renderer refused).
+    notice: Option<String>,
+    /// The last tile-streaming and point statistics.
+    textures_line: Option<String>,
+    points_line: Option<String>,
     rig: Option<alpenglow::Rig>,
     fly: FlyCamera,
     held: Held,
@@ -198,15 +243,16 @@ impl Viewer {
         let window = event_loop.create_window(attributes)?;
         let size = window.inner_size();
         let swapchain = Swapchain::new(&setup.ctx, &window, (size.width, size.height), self.vsync)?;
-        let mut settings = setup.settings;
-        settings.present_to(&swapchain);
-        let mut renderer = super::lighting::renderer(&setup.ctx, &setup.scene, settings)?;
-        renderer.set_profile_history(captures::PROFILE_HISTORY);
+        let mut setup = setup;
+        setup.settings.present_to(&swapchain);
+        let renderer = build_renderer(&setup.ctx, &setup.scene, setup.settings.clone())?;
         window.request_redraw();
         self.state = Some(Live {
             renderer,
             swapchain,
+            hud: hud::Hud::new(&window),
             window,
+            setup,
         });
         Ok(())
     }
@@ -245,6 +291,10 @@ impl Viewer {
                 self.captures.request();
                 Ok(())
             }
+            Key::F1 => {
+                state.hud.visible = !state.hud.visible;
+                Ok(())
+            }
             _ => Ok(()),
         };
         if let Err(e) = result {
@@ -265,10 +315,11 @@ impl Viewer {
         };
         self.last_time = Some(now);
         self.fly.advance(self.held.motion(), dt);
+        let cameras = super::rig::frame_cameras(self.rig.as_ref(), &self.fly.camera())?;
+        self.overlay()?;
         let Some(state) = &mut self.state else {
             return Ok(());
         };
-        let cameras = super::rig::frame_cameras(self.rig.as_ref(), &self.fly.camera())?;
         let Some(outcome) = state.renderer.present(&cameras, &mut state.swapchain, self.shown)? else {
             return Ok(()); // minimised
         };
@@ -282,10 +333,71 @@ impl Viewer {
         Ok(())
     }
 
+    /// Builds this frame's overlay and applies the switches it changed.
+    fn overlay(&mut self) -> Result<()> {
+        let Some(state) = &mut self.state else {
+            return Ok(());
+        };
+        let renderer = &mut state.renderer;
+        let textures = renderer.take_texture_stats()?.last().map(|t| {
+            format!(
+                "textures: {} tiles visible, {} generated, {} resident ({:.0} % hits)",
+                t.tiles.visible,
+                t.tiles.generated,
+                t.tiles.resident,
+                t.hit_rate * 100.0
+            )
+        });
+        let points = renderer.take_completed_point_stats()?.last().map(|p| p.summary());
+        self.points_line = points.or(self.points_line.take());
+        self.textures_line = textures.or(self.textures_line.take());
+        let views = renderer.views();
+        let device = renderer.context().info().name.clone();
+        let stats = hud::HudStats {
+            device: &device,
+            raster: renderer.raster_path().name(),
+            profiles: &self.captures.profiles,
+            memory: renderer.context().memory_use(),
+            textures: self.textures_line.clone(),
+            points: self.points_line.clone(),
+            view: (self.shown, views.len(), views[self.shown].name.as_str()),
+            notice: self.notice.as_deref(),
+        };
+        let mut switches = self.switches;
+        let overlay = state.hud.build(&state.window, &stats, &mut switches);
+        state.renderer.set_overlay(overlay)?;
+        if switches != self.switches {
+            self.notice = apply_switches(state, self.switches, switches)
+                .err()
+                .map(|e| format!("{e:#}"));
+            self.switches = switches;
+        }
+        Ok(())
+    }
+
     fn fail(&mut self, error: anyhow::Error, event_loop: &ActiveEventLoop) {
         self.error.get_or_insert(error);
         event_loop.exit();
     }
+}
+
+/// Applies the switches that changed from `old` to `new`: lighting at
+/// once, the terrain view and texturing by rebuilding the renderer. An
+/// error (a mode the renderer was not built for) leaves the frame as it was.
+fn apply_switches(state: &mut Live, old: hud::Switches, new: hud::Switches) -> Result<()> {
+    if (old.shadows, old.sky_light, old.sky) != (new.shadows, new.sky_light, new.sky) {
+        set_lighting(&mut state.renderer, |mut l| {
+            (l.shadows, l.sky_light, l.sky) = (new.shadows, new.sky_light, new.sky);
+            l
+        })?;
+    }
+    if (old.terrain_view, old.texturing) != (new.terrain_view, new.texturing) {
+        state.rebuild(|s| {
+            s.terrain.view = new.terrain_view;
+            s.texturing = new.texturing;
+        })?;
+    }
+    Ok(())
 }
 
 /// Applies `change` to the renderer's lighting.
@@ -334,6 +446,15 @@ impl ApplicationHandler for Viewer {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        if let Some(state) = &mut self.state {
+            let input = matches!(
+                event,
+                WindowEvent::KeyboardInput { .. } | WindowEvent::MouseInput { .. } | WindowEvent::MouseWheel { .. }
+            );
+            if state.hud.on_event(&state.window, &event) && input {
+                return;
+            }
+        }
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => {
