@@ -50,9 +50,8 @@ impl ShaderReload {
     /// Reloads what changed: rebuilds `state`'s renderer, or sets `error`
     /// (cleared by the next successful reload).
     pub(super) fn frame(&mut self, state: Option<&mut Live>, error: &mut Option<String>) {
-        let (Some(state), Some(reload)) = (state, self.watcher.poll()) else {
-            return;
-        };
+        let Some(state) = state else { return };
+        let Some(reload) = self.watcher.poll() else { return };
         let outcome = reload.and_then(|names| {
             state
                 .rebuild(|_| {})
