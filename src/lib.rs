@@ -146,10 +146,11 @@ pub use error::Result;
 
 // --- The GPU ---
 
+pub use post::overlay::{OverlayFrame, OverlayMesh, OverlayTexels, OverlayVertex, OVERLAY_ATLAS_SIDE};
 /// What the viewer's overlay draws over a presented frame
 /// ([`Renderer::set_overlay`]): triangle meshes and font-atlas updates in
 /// egui's layout, without depending on egui.
-pub use post::overlay::{OverlayFrame, OverlayMesh, OverlayTexels, OverlayVertex, OVERLAY_ATLAS_SIDE};
+pub use post::present::PresentedImage;
 /// The Vulkan instance and device every renderer of a program shares.
 ///
 /// ```no_run

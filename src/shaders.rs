@@ -50,6 +50,8 @@ pub const OVERLAY_VERT: SpirV = spirv!("post/overlay.vert");
 pub const OVERLAY_FRAG: SpirV = spirv!("post/overlay.frag");
 /// overlay.font: a rectangle of the overlay's font atlas from an upload region.
 pub const OVERLAY_FONT: SpirV = spirv!("post/overlay_font.comp");
+/// present.aov: one of a view's AOVs in display colours (the viewer's debug views).
+pub const PRESENT_AOV: SpirV = spirv!("post/present_aov.comp");
 /// tonemap: HDR → sRGB8.
 pub const TONEMAP: SpirV = spirv!("post/tonemap.comp");
 /// exposure.meter: sums of log luminance per 128×64-pixel tile.

@@ -44,10 +44,11 @@ fn a_scripted_view_matches_the_headless_render_of_its_camera() {
     let events = dir.join("events.txt");
     // W held for frames 0–5 (6 steps of 1/30 s), a look to the right and
     // down, the sun up 2 steps and right 1, F12 at frame 9; frames 10–13
-    // hold still so the texture tiles settle.
+    // hold still so the texture tiles settle, and present the depth,
+    // normal and class debug views (the screenshot stays the colour).
     std::fs::write(
         &events,
-        "0 key W down\n6 key W up\n7 mouse 100 30\n8 key Up\n8 key Up\n8 key Right\n9 key F12\n",
+        "0 key W down\n6 key W up\n7 mouse 100 30\n8 key Up\n8 key Up\n8 key Right\n9 key F12\n9 key F11\n10 key G\n11 key G\n12 key G\n",
     )
     .unwrap();
     let (shot, reference) = (dir.join("shot.png"), dir.join("reference.png"));
@@ -105,6 +106,9 @@ fn a_scripted_view_matches_the_headless_render_of_its_camera() {
         (elevation - 34.0).abs() < 1e-3 && (azimuth - 182.0).abs() < 1e-3,
         "sun {elevation} {azimuth}"
     );
+    // F11 without RenderDoc: a warning, the run goes on.
+    let stderr = text(&out.stderr);
+    assert!(stderr.contains("F11: RenderDoc is not loaded"), "{stderr}");
     // F12 wrote the frame on screen: PNG, EXR, profile and trace.
     for ext in ["png", "exr", "json", "trace.json"] {
         let path = dir.join(format!("capture_00009.{ext}"));

@@ -456,6 +456,8 @@ pub struct RenderArgs {
     #[arg(long, help_heading = "Output")]
     pub pipeline_stats: bool,
     #[command(flatten)]
+    pub renderdoc: super::renderdoc::RenderDocArgs,
+    #[command(flatten)]
     pub scene: SceneArgs,
 }
 
@@ -477,6 +479,8 @@ pub struct BenchArgs {
     /// invocations…) and report their medians; needs the device feature pipelineStatisticsQuery.
     #[arg(long, help_heading = "Output")]
     pub pipeline_stats: bool,
+    #[command(flatten)]
+    pub renderdoc: super::renderdoc::RenderDocArgs,
     #[command(flatten)]
     pub scene: SceneArgs,
 }
@@ -507,6 +511,8 @@ pub struct FlyArgs {
     /// Chrome trace of all frames (opens in Perfetto).
     #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub trace: Option<PathBuf>,
+    #[command(flatten)]
+    pub renderdoc: super::renderdoc::RenderDocArgs,
     #[command(flatten)]
     pub scene: SceneArgs,
 }

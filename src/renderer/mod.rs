@@ -55,7 +55,7 @@ use crate::post::aovs::{Aovs, AovsFrame};
 use crate::post::exposure::ExposureMeter;
 use crate::post::motion_blur::{MotionBlur, MotionBlurSettings};
 use crate::post::overlay::{Overlay, OverlayPrepared};
-use crate::post::present::{declare_present, PresentFrame};
+use crate::post::present::{declare_present, PresentFrame, PresentedImage};
 use crate::post::resolve::Resolve;
 use crate::post::tonemap::Tonemap;
 use crate::profile::FrameProfile;
@@ -235,6 +235,7 @@ pub struct Renderer {
     /// ([`Renderer::present`]); None: headless.
     presented: Option<crate::graph::ImageId>,
     shown: usize,
+    presented_image: PresentedImage,
 }
 
 impl Renderer {
@@ -307,7 +308,7 @@ impl Renderer {
         )?;
         let presented = match settings.present {
             Some(format) => {
-                let window = declare_present(&mut graph, displays, format);
+                let window = declare_present(ctx, &mut graph, &displays, format)?;
                 let mut overlay = Overlay::new(ctx, format)?;
                 overlay.declare(&mut graph, window);
                 techniques.overlay = Some(overlay);
@@ -332,6 +333,7 @@ impl Renderer {
             techniques,
             presented,
             shown: 0,
+            presented_image: PresentedImage::Color,
         })
     }
 
@@ -469,7 +471,10 @@ impl Renderer {
         }
         frame.prepare_into(&mut t.aovs, (), &mut uploads, stages)?;
         if self.presented.is_some() {
-            frame.insert(PresentFrame { view: self.shown });
+            frame.insert(PresentFrame {
+                view: self.shown,
+                image: self.presented_image,
+            });
         }
         if let Some(overlay) = &mut t.overlay {
             frame.prepare_into(overlay, (), &mut uploads, stages)?;
@@ -778,6 +783,9 @@ fn validation_layer_edges(graph: &mut RenderGraph<RenderFrame>) {
     }
 }
 
+/// A view's name and its post-processed targets (what the present passes show).
+type NamedTargets = (String, SceneTargets);
+
 /// Each view's post chain (resolve, distortion, motion blur), exposure,
 /// tone mapping and readback of `outputs` into `slots` slots (none read
 /// back: the display image is kept).
@@ -787,7 +795,7 @@ fn declare_outputs(
     (views, targets, chains): (&[View], &[SceneTargets], &[ViewChain]),
     settings: &RenderSettings,
     (outputs, slots): (Outputs, usize),
-) -> Result<(Vec<Readback>, Vec<crate::graph::ImageId>)> {
+) -> Result<(Vec<Readback>, Vec<NamedTargets>)> {
     let mut exposure = ExposureMeter::new(ctx)?;
     let mut tonemap = Tonemap::new(ctx)?;
     let resolve = Resolve::new(ctx)?;
@@ -805,7 +813,7 @@ fn declare_outputs(
             Some(rb) => readback.push(rb),
             None => graph.keep(targets.display),
         }
-        displays.push(targets.display);
+        displays.push((view.name.clone(), targets));
     }
     Ok((readback, displays))
 }

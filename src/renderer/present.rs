@@ -8,6 +8,7 @@ use super::{Camera, RenderSettings, Renderer};
 use crate::error::{Error, Result};
 use crate::graph::FrameOutcome;
 use crate::post::overlay::OverlayFrame;
+use crate::post::present::PresentedImage;
 use crate::vulkan::Swapchain;
 
 impl RenderSettings {
@@ -19,6 +20,17 @@ impl RenderSettings {
 }
 
 impl Renderer {
+    /// Which image of the shown view the next presented frames show: the
+    /// colour (default) or an AOV's debug view.
+    pub fn set_presented_image(&mut self, image: PresentedImage) {
+        self.presented_image = image;
+    }
+
+    /// The image [`Renderer::set_presented_image`] chose.
+    pub fn presented_image(&self) -> PresentedImage {
+        self.presented_image
+    }
+
     /// What the overlay draws over the next presented frame (over the
     /// shown view, after `present.blit`; never in what is read back).
     pub fn set_overlay(&mut self, overlay: OverlayFrame) -> Result<()> {

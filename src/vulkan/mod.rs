@@ -13,6 +13,7 @@ mod image;
 mod memory;
 mod pipeline;
 mod present;
+pub(crate) mod renderdoc;
 mod shader_overrides;
 mod validation;
 

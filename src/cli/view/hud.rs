@@ -12,8 +12,8 @@ use winit::event::WindowEvent;
 use winit::window::Window;
 
 use alpenglow::{
-    DeviceMemoryUse, FrameProfile, OverlayFrame, OverlayMesh, OverlayTexels, OverlayVertex, ShadowMode, SkyLightMode,
-    SkyModel, TerrainView, TexturingMode,
+    DeviceMemoryUse, FrameProfile, OverlayFrame, OverlayMesh, OverlayTexels, OverlayVertex, PresentedImage, ShadowMode,
+    SkyLightMode, SkyModel, TerrainView, TexturingMode,
 };
 
 /// Frame times the plot shows.
@@ -40,6 +40,8 @@ pub struct Switches {
     /// Rebuild the renderer when these change.
     pub terrain_view: TerrainView,
     pub texturing: TexturingMode,
+    /// The colour or an AOV's debug view (at once).
+    pub image: PresentedImage,
 }
 
 pub struct Hud {
@@ -235,6 +237,14 @@ fn switch_rows(ui: &mut egui::Ui, s: &mut Switches) {
     use SkyLightMode as Sl;
     use TerrainView as Tv;
     use TexturingMode as Tm;
+    for row in PresentedImage::ALL.chunks(4) {
+        ui.horizontal(|ui| {
+            ui.label(if row[0] == PresentedImage::Color { "image" } else { "" });
+            for &image in row {
+                ui.selectable_value(&mut s.image, image, image.name());
+            }
+        });
+    }
     ui.horizontal(|ui| {
         ui.label("shadows");
         for (v, n) in [(Sm::Cascaded, "cascaded"), (Sm::Horizon, "horizon"), (Sm::Off, "off")] {

@@ -5,7 +5,7 @@
 //! frame FRAME (0-based) is rendered; `#` starts a comment:
 //!
 //! ```text
-//! 0 key W down      # hold W (names: W A S D Q E Space C Shift V F1 F11 F12
+//! 0 key W down      # hold W (names: W A S D Q E Space C Shift V G F1 F11 F12
 //! 6 key W up        #   Up Down Left Right Escape)
 //! 7 mouse 40 -10    # mouse look: moved 40 px right, 10 px up (button held)
 //! 8 wheel 2         # two notches up: faster
@@ -32,6 +32,8 @@ pub enum Key {
     Shift,
     /// Cycles the shown view of a rig.
     V,
+    /// Cycles the presented image: colour, then each AOV's debug view.
+    G,
     /// Sun elevation up/down, azimuth left/right.
     Up,
     Down,
@@ -46,7 +48,7 @@ pub enum Key {
     Escape,
 }
 
-const NAMES: [(&str, Key); 18] = [
+const NAMES: [(&str, Key); 19] = [
     ("W", Key::W),
     ("A", Key::A),
     ("S", Key::S),
@@ -57,6 +59,7 @@ const NAMES: [(&str, Key); 18] = [
     ("C", Key::C),
     ("Shift", Key::Shift),
     ("V", Key::V),
+    ("G", Key::G),
     ("Up", Key::Up),
     ("Down", Key::Down),
     ("Left", Key::Left),
@@ -89,6 +92,7 @@ impl Key {
             K::KeyC | K::ControlLeft => Key::C,
             K::ShiftLeft | K::ShiftRight => Key::Shift,
             K::KeyV => Key::V,
+            K::KeyG => Key::G,
             K::ArrowUp => Key::Up,
             K::ArrowDown => Key::Down,
             K::ArrowLeft => Key::Left,

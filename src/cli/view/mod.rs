@@ -7,7 +7,9 @@
 //! Keys: WASD move, E/Space up, Q/C down, Shift 4× faster; mouse look
 //! with a button held; the wheel scales the speed; arrows move the sun
 //! (up/down: elevation, left/right: azimuth); V cycles a rig's views; F12
-//! writes PNG, EXR, profile and trace of the frame on screen; F1 hides the
+//! writes PNG, EXR, profile and trace of the frame on screen; F11 has
+//! RenderDoc capture the next frame (under RenderDoc or with
+//! `--renderdoc`); F1 hides the
 //! overlay ([`hud`]: per-pass GPU times, frame-time plot, statistics,
 //! switches); Esc quits.
 //!
@@ -37,6 +39,7 @@ use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::keyboard::PhysicalKey;
 use winit::window::{Window, WindowId};
 
+use alpenglow::tools::renderdoc::RenderDocCapture;
 use alpenglow::{Context, Lighting, Renderer, Scene, SunPosition, Swapchain};
 
 use super::args::SceneArgs;
@@ -69,6 +72,11 @@ pub struct ViewArgs {
         help_heading = "Viewer"
     )]
     pub capture_dir: PathBuf,
+    /// Load RenderDoc's library (default: librenderdoc.so from the linker's
+    /// path or the usual install places) so F11 can capture; not needed
+    /// when the viewer runs under RenderDoc.
+    #[arg(long, value_name = "PATH", num_args = 0..=1, help_heading = "Viewer")]
+    pub renderdoc: Option<Option<PathBuf>>,
     /// Present as fast as frames come (mailbox or immediate) instead of vsync.
     #[arg(long = "no-vsync", help_heading = "Viewer")]
     pub no_vsync: bool,
@@ -97,6 +105,16 @@ pub fn view(args: ViewArgs) -> Result<ExitCode> {
     // views follow the fly camera as they follow `--eye`.
     super::rig::frame_cameras(rig.as_ref(), &camera)?;
     let settings = super::render_settings(&args.scene, &scene, &specs, true)?;
+    // RenderDoc hooks Vulkan only when loaded before the instance.
+    let renderdoc = match &args.renderdoc {
+        Some(path) => Some(RenderDocCapture::load(path.as_deref())?),
+        None => RenderDocCapture::attach(),
+    };
+    let renderdoc = renderdoc.map(|mut r| {
+        // Its own capture keys (F12, Print Screen) would clash with the viewer's.
+        r.disable_capture_keys();
+        r
+    });
     let ctx = super::context(&args.scene.device)?;
     let report = ctx.validation_report();
     #[cfg(feature = "hot-reload")]
@@ -108,11 +126,14 @@ pub fn view(args: ViewArgs) -> Result<ExitCode> {
         sky: settings.lighting.map(|l| l.sky).unwrap_or_default(),
         terrain_view: settings.terrain.view,
         texturing: settings.texturing,
+        image: alpenglow::PresentedImage::Color,
     };
     let mut app = Viewer {
         state: None,
         setup: Some(Setup { ctx, scene, settings }),
         switches,
+        renderdoc,
+        renderdoc_pending: None,
         notice: None,
         shader_error: None,
         #[cfg(feature = "hot-reload")]
@@ -191,7 +212,9 @@ impl Live {
         change(&mut self.setup.settings);
         self.setup.settings.lighting = Some(lighting);
         let settings = self.setup.settings.clone();
+        let image = self.renderer.presented_image();
         self.renderer = build_renderer(&self.setup.ctx, &self.setup.scene, settings)?;
+        self.renderer.set_presented_image(image);
         Ok(())
     }
 }
@@ -220,6 +243,10 @@ struct Viewer {
     state: Option<Live>,
     setup: Option<Setup>,
     switches: hud::Switches,
+    /// RenderDoc's in-application API, when loaded or attached (F11).
+    renderdoc: Option<RenderDocCapture>,
+    /// The capture count when F11 was pressed, until the capture is written.
+    renderdoc_pending: Option<u32>,
     /// A message the overlay shows (a switch the renderer refused).
     notice: Option<String>,
     /// The compile errors of the last shader reload (feature `hot-reload`),
@@ -300,6 +327,13 @@ impl Viewer {
                 self.shown = (self.shown + 1) % state.renderer.views().len();
                 Ok(())
             }
+            Key::G => {
+                let all = alpenglow::PresentedImage::ALL;
+                let at = all.iter().position(|i| *i == self.switches.image).unwrap_or(0);
+                self.switches.image = all[(at + 1) % all.len()];
+                state.renderer.set_presented_image(self.switches.image);
+                Ok(())
+            }
             Key::Up => set_lighting(&mut state.renderer, sun(SUN_STEP_DEG, 0.0)),
             Key::Down => set_lighting(&mut state.renderer, sun(-SUN_STEP_DEG, 0.0)),
             Key::Left => set_lighting(&mut state.renderer, sun(0.0, -SUN_STEP_DEG)),
@@ -308,6 +342,16 @@ impl Viewer {
                 self.captures.request();
                 Ok(())
             }
+            Key::F11 => match &mut self.renderdoc {
+                Some(rdoc) => {
+                    rdoc.trigger_capture();
+                    self.renderdoc_pending = Some(rdoc.captures());
+                    Ok(())
+                }
+                None => Err(anyhow!(
+                    "F11: RenderDoc is not loaded (run under renderdoccmd or qrenderdoc, or pass --renderdoc)"
+                )),
+            },
             Key::F1 => {
                 state.hud.visible = !state.hud.visible;
                 Ok(())
@@ -349,7 +393,22 @@ impl Viewer {
         } else {
             state.window.request_redraw();
         }
+        self.report_renderdoc();
         Ok(())
+    }
+
+    /// Prints the RenderDoc capture F11 asked for once RenderDoc wrote it.
+    fn report_renderdoc(&mut self) {
+        let (Some(rdoc), Some(before)) = (&self.renderdoc, self.renderdoc_pending) else {
+            return;
+        };
+        if rdoc.captures() > before {
+            self.renderdoc_pending = None;
+            let file = rdoc.latest_capture().map(|p| p.display().to_string());
+            let line = format!("F11: RenderDoc capture {}", file.unwrap_or_default());
+            println!("{line}");
+            self.notice = Some(line);
+        }
     }
 
     /// Builds this frame's overlay and applies the switches it changed.
@@ -404,6 +463,7 @@ impl Viewer {
 /// once, the terrain view and texturing by rebuilding the renderer. An
 /// error (a mode the renderer was not built for) leaves the frame as it was.
 fn apply_switches(state: &mut Live, old: hud::Switches, new: hud::Switches) -> Result<()> {
+    state.renderer.set_presented_image(new.image);
     if (old.shadows, old.sky_light, old.sky) != (new.shadows, new.sky_light, new.sky) {
         set_lighting(&mut state.renderer, |mut l| {
             (l.shadows, l.sky_light, l.sky) = (new.shadows, new.sky_light, new.sky);
