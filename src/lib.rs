@@ -121,6 +121,9 @@ mod module_graph_tests;
 pub mod bench;
 #[forbid(unsafe_code)]
 pub mod files;
+#[cfg(feature = "hot-reload")]
+#[forbid(unsafe_code)]
+pub mod hot_reload;
 #[forbid(unsafe_code)]
 pub mod tools;
 

@@ -89,6 +89,8 @@ pub(crate) struct Shared {
     /// Reads the GPU and CPU clocks together, where the device can.
     pub(super) clock: Option<GpuClock>,
     report: Option<Arc<ValidationReport>>,
+    /// SPIR-V that replaces embedded modules (feature `hot-reload`).
+    pub(super) shader_overrides: super::shader_overrides::ShaderOverrides,
 }
 
 /// A Vulkan instance and device with everything alpenglow renders through.
@@ -425,6 +427,7 @@ impl Context {
             memory,
             clock,
             report,
+            shader_overrides: Default::default(),
         };
         log::info!("device: {} ({})", shared.info.name, shared.info.driver_info);
         Ok(Context {

@@ -14,6 +14,7 @@ mod memory;
 mod pipeline;
 mod present;
 pub(crate) mod renderdoc;
+mod shader_overrides;
 mod validation;
 
 pub use ash::vk::{

@@ -23,6 +23,8 @@ mod captures;
 mod fly_camera;
 mod hud;
 mod input;
+#[cfg(feature = "hot-reload")]
+mod shader_reload;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -78,6 +80,11 @@ pub struct ViewArgs {
     /// Present as fast as frames come (mailbox or immediate) instead of vsync.
     #[arg(long = "no-vsync", help_heading = "Viewer")]
     pub no_vsync: bool,
+    /// Watch DIR and hot-reload its shaders (default: ./glsl, else the
+    /// source tree's).
+    #[cfg(feature = "hot-reload")]
+    #[arg(long, value_name = "DIR", help_heading = "Viewer")]
+    pub glsl: Option<PathBuf>,
     #[command(flatten)]
     pub scene: SceneArgs,
 }
@@ -110,6 +117,8 @@ pub fn view(args: ViewArgs) -> Result<ExitCode> {
     });
     let ctx = super::context(&args.scene.device)?;
     let report = ctx.validation_report();
+    #[cfg(feature = "hot-reload")]
+    let shaders = shader_reload::ShaderReload::new(&ctx, args.glsl.as_deref())?;
     let event_loop = EventLoop::new().map_err(|e| anyhow!("the viewer needs a display (X11 or Wayland): {e}"))?;
     let switches = hud::Switches {
         shadows: settings.lighting.map(|l| l.shadows).unwrap_or_default(),
@@ -126,6 +135,9 @@ pub fn view(args: ViewArgs) -> Result<ExitCode> {
         renderdoc,
         renderdoc_pending: None,
         notice: None,
+        shader_error: None,
+        #[cfg(feature = "hot-reload")]
+        shaders,
         textures_line: None,
         points_line: None,
         rig,
@@ -237,6 +249,11 @@ struct Viewer {
     renderdoc_pending: Option<u32>,
     /// A message the overlay shows (a switch the renderer refused).
     notice: Option<String>,
+    /// The compile errors of the last shader reload (feature `hot-reload`),
+    /// one line each, while the last good shaders keep running.
+    shader_error: Option<String>,
+    #[cfg(feature = "hot-reload")]
+    shaders: shader_reload::ShaderReload,
     /// The last tile-streaming and point statistics.
     textures_line: Option<String>,
     points_line: Option<String>,
@@ -365,6 +382,8 @@ impl Viewer {
         };
         self.last_time = Some(now);
         self.fly.advance(self.held.motion(), dt);
+        #[cfg(feature = "hot-reload")]
+        self.shaders.frame(self.state.as_mut(), &mut self.shader_error);
         let cameras = super::rig::frame_cameras(self.rig.as_ref(), &self.fly.camera())?;
         self.overlay()?;
         let Some(state) = &mut self.state else {
@@ -426,7 +445,7 @@ impl Viewer {
             textures: self.textures_line.clone(),
             points: self.points_line.clone(),
             view: (self.shown, views.len(), views[self.shown].name.as_str()),
-            notice: self.notice.as_deref(),
+            notice: self.notice.as_deref().or(self.shader_error.as_deref()),
         };
         let mut switches = self.switches;
         let overlay = state.hud.build(&state.window, &stats, &mut switches);
