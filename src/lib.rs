@@ -123,7 +123,7 @@ pub mod bench;
 pub mod files;
 #[cfg(feature = "hot-reload")]
 #[forbid(unsafe_code)]
-pub mod hot_reload;
+pub(crate) mod hot_reload;
 #[forbid(unsafe_code)]
 pub mod tools;
 

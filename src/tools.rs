@@ -79,3 +79,11 @@ pub mod profile {
 pub mod renderdoc {
     pub use crate::vulkan::renderdoc::RenderDocCapture;
 }
+
+/// Hot reload of `glsl/` (feature `hot-reload`): shaders recompiled when
+/// their files change, installed for the pipelines built afterwards
+/// (`alpenglow view` rebuilds its renderer). docs/PROFILING.md.
+#[cfg(feature = "hot-reload")]
+pub mod hot_reload {
+    pub use crate::hot_reload::ShaderWatcher;
+}

@@ -456,9 +456,10 @@ pub struct RenderArgs {
     #[arg(long, help_heading = "Output")]
     pub pipeline_stats: bool,
     #[command(flatten)]
-    pub renderdoc: super::renderdoc::RenderDocArgs,
-    #[command(flatten)]
     pub scene: SceneArgs,
+    // After the scene: its Debug heading stays last in --help.
+    #[command(flatten)]
+    pub renderdoc: super::renderdoc::RenderDocArgs,
 }
 
 #[derive(Args, Debug)]
@@ -480,9 +481,10 @@ pub struct BenchArgs {
     #[arg(long, help_heading = "Output")]
     pub pipeline_stats: bool,
     #[command(flatten)]
-    pub renderdoc: super::renderdoc::RenderDocArgs,
-    #[command(flatten)]
     pub scene: SceneArgs,
+    // After the scene: its Debug heading stays last in --help.
+    #[command(flatten)]
+    pub renderdoc: super::renderdoc::RenderDocArgs,
 }
 
 #[derive(Args, Debug)]
@@ -512,9 +514,10 @@ pub struct FlyArgs {
     #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub trace: Option<PathBuf>,
     #[command(flatten)]
-    pub renderdoc: super::renderdoc::RenderDocArgs,
-    #[command(flatten)]
     pub scene: SceneArgs,
+    // After the scene: its Debug heading stays last in --help.
+    #[command(flatten)]
+    pub renderdoc: super::renderdoc::RenderDocArgs,
 }
 
 #[derive(Subcommand, Debug)]

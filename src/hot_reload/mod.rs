@@ -8,7 +8,7 @@
 //!
 //! ```no_run
 //! # fn frame(ctx: &alpenglow::Context, renderer: &mut alpenglow::Renderer) -> alpenglow::Result<()> {
-//! let mut watcher = alpenglow::hot_reload::ShaderWatcher::new(ctx, "glsl")?;
+//! let mut watcher = alpenglow::tools::hot_reload::ShaderWatcher::new(ctx, "glsl")?;
 //! // once a frame:
 //! match watcher.poll() {
 //!     Some(Ok(names)) => { /* rebuild the renderer: names were recompiled */ }

@@ -500,26 +500,26 @@ impl Context {
             .semaphore(self.shared.timeline)
             .value(value)
             .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS);
-        let mut signal = vec![timeline];
-        let mut wait = Vec::new();
-        if let Some(p) = present {
-            // The swapchain image is first written by a transfer or an attachment.
-            wait.push(
-                vk::SemaphoreSubmitInfo::default().semaphore(p.acquired).stage_mask(
+        // On the stack: a frame's submission allocates nothing.
+        let (mut signal, mut wait) = ([timeline; 2], [vk::SemaphoreSubmitInfo::default()]);
+        let (signals, waits) = match present {
+            Some(p) => {
+                // The swapchain image is first written by a transfer or an attachment.
+                wait[0] = vk::SemaphoreSubmitInfo::default().semaphore(p.acquired).stage_mask(
                     vk::PipelineStageFlags2::ALL_TRANSFER | vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
-                ),
-            );
-            signal.push(
-                vk::SemaphoreSubmitInfo::default()
+                );
+                signal[1] = vk::SemaphoreSubmitInfo::default()
                     .semaphore(p.rendered)
-                    .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS),
-            );
-        }
+                    .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS);
+                (2, 1)
+            }
+            None => (1, 0),
+        };
         let buffers = [vk::CommandBufferSubmitInfo::default().command_buffer(command_buffer)];
         let submit = vk::SubmitInfo2::default()
-            .wait_semaphore_infos(&wait)
+            .wait_semaphore_infos(&wait[..waits])
             .command_buffer_infos(&buffers)
-            .signal_semaphore_infos(&signal);
+            .signal_semaphore_infos(&signal[..signals]);
         // SAFETY: the queue is externally synchronised by the mutex; the command
         // buffer is fully recorded and not in use by another submission; the
         // binary semaphores are unsignalled (acquire signals, present waits).

@@ -278,10 +278,11 @@ pub const SCENE_OTHER: &[&str] = &[
     "--device",
 ];
 
-pub const RENDER_OTHER: &[&str] = &["--out", "--exr", "--profile", "--trace"];
+// `--renderdoc-capture`: needs RenderDoc (tests/cli_renderdoc.rs), not varied here.
+pub const RENDER_OTHER: &[&str] = &["--out", "--exr", "--profile", "--trace", "--renderdoc-capture"];
 
 pub const BENCH: &[Opt] = &[opt("--frames", int(1, 100_000, 2)), opt("--warmup", int(0, 100_000, 1))];
-pub const BENCH_OTHER: &[&str] = &["--profile", "--trace"];
+pub const BENCH_OTHER: &[&str] = &["--profile", "--trace", "--renderdoc-capture"];
 
 pub const FLY: &[Opt] = &[
     opt("--frames", int(1, 100_000, 3)),
@@ -294,7 +295,7 @@ pub const FLY: &[Opt] = &[
         },
     ),
 ];
-pub const FLY_OTHER: &[&str] = &["--path", "--out-dir", "--profile", "--trace"];
+pub const FLY_OTHER: &[&str] = &["--path", "--out-dir", "--profile", "--trace", "--renderdoc-capture"];
 
 pub const SPT: &[Opt] = &[
     opt("--samples", int(1, U64, 5_000)),

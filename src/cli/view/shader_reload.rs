@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, Result};
 
-use alpenglow::hot_reload::ShaderWatcher;
+use alpenglow::tools::hot_reload::ShaderWatcher;
 use alpenglow::Context;
 
 use super::Live;
