@@ -1,9 +1,11 @@
 #version 460
 // points.single_pass.merge (dissertation §10.4; ALGORITHMS.md §8): one
 // workgroup per 16×16-pixel tile, one invocation per pixel. The tile's list
-// (glsl/include/single_pass_tiles.glsl) is sorted front to back by (depth
-// key, record, index) (glsl/include/single_pass_sort.glsl) and walked in
-// batches of BATCH entries: the workgroup sets the batch's splats up into
+// is its slice of the sorted entries (glsl/include/single_pass_tiles.glsl,
+// glsl/include/single_pass_radix.glsl: front to back, ties in draw order),
+// found by two binary searches for the tile's keys; a list the entry
+// buffer's capacity cut short is dropped whole (and counted). It is walked
+// in batches of BATCH entries: the workgroup sets the batch's splats up into
 // shared memory (one invocation each, the EWA set-up of
 // glsl/include/splat_setup.glsl), then every pixel applies the text's
 // fuzzy-depth operator to each splat of the batch in order, fragment
@@ -24,16 +26,16 @@
 #define SPLAT_SINGLE_PASS
 #define SPLAT_RESOLVE_COMPUTE
 #include "../include/splat_resolve.glsl"
-#include "../include/single_pass_sort.glsl"
+#include "../include/single_pass_tiles.glsl"
 
 #define BATCH 32u
 
 layout(local_size_x = 16, local_size_y = 16) in;
 
 // Push constants (the splat passes' block, splat.glsl):
-//   handles = (splats, point frame, unused, Gaussian table),
+//   handles = (splats, point frame, counter (NO_HANDLE: none), Gaussian table),
 //   outputs, more = the targets written (more.zw: width, height),
-//   single = (bins, entries, depth buffer (sampled; NO_HANDLE: none),
+//   single = (bins, entries (sorted), depth buffer (sampled; NO_HANDLE: none),
 //             1: keep W where no splat is (the hybrid triangles wrote it)).
 
 // A tile is 4×4 blocks of 4×4 pixels.
@@ -79,12 +81,12 @@ void merge_splat(inout PixelState p, SplatSetup v, uvec2 ids, vec2 centre, float
     }
 }
 
-// Sets up entry `k` of the sorted list into slot `slot_touched.x` of the batch
+// Sets up sorted entry `k` into slot `slot_touched.x` of the batch
 // and marks the blocks of the tile its bounding box touches in set
 // `slot_touched.y` of s_touched.
-void set_up_batch_slot(bool shared_list, uint base, uint k, uvec2 slot_touched) {
+void set_up_batch_slot(uint k, uvec2 slot_touched) {
     uint slot = slot_touched.x;
-    TileEntry e = sorted_entry(shared_list, base, k);
+    TileEntry e = g_tile_entries[pc.single.y].e[k];
     SplatSetup v;
     uvec2 first, last;
     if (splat_setup_of(e.record, e.index, v) != SPLAT_SETUP_READY || !splat_pixels(v, first, last)) {
@@ -105,19 +107,53 @@ void set_up_batch_slot(bool shared_list, uint base, uint k, uvec2 slot_touched) 
     }
 }
 
+// The first of the `sorted` entries whose key is at least `key`.
+uint lower_bound(uint key, uint sorted) {
+    uint lo = 0u, hi = sorted;
+    while (lo < hi) {
+        uint mid = (lo + hi) / 2u;
+        if (g_tile_entries[pc.single.y].e[mid].key < key) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+shared uvec2 s_list;
+
+// The tile's slice [first, end) of the sorted entries; empty when the
+// capacity cut it short (its entries are then counted as dropped).
+uvec2 tile_list(uint tile, uint tiles) {
+    if (gl_LocalInvocationIndex == 0u) {
+        uint bins = pc.single.x;
+        uint sorted = g_tile_bins[bins].w[tiles + STATE_SORTED];
+        uint depth_bits = g_tile_bins[bins].w[tiles + STATE_DEPTH_BITS];
+        uint first = lower_bound(tile << depth_bits, sorted);
+        // The last tile index may end the key space.
+        uint next = tile + 1u;
+        uint end = (next >> (32u - depth_bits)) != 0u ? sorted : lower_bound(next << depth_bits, sorted);
+        uint count = g_tile_bins[bins].w[tile];
+        bool whole = end - first == count;
+        if (!whole && pc.handles.z != NO_HANDLE) {
+            atomicAdd(g_splat_counters[pc.handles.z].tile_entries_dropped, count);
+        }
+        s_list = whole ? uvec2(first, end) : uvec2(first);
+    }
+    barrier();
+    return s_list;
+}
+
 void main() {
     uvec2 grid = tile_grid();
     uint tiles = grid.x * grid.y;
     uint tile = gl_WorkGroupID.y * grid.x + gl_WorkGroupID.x;
     uint invocation = gl_LocalInvocationIndex;
-    uint bins = pc.single.x;
-    uint n = g_tile_bins[bins].w[2u * tiles + tile];
-    uint base = g_tile_bins[bins].w[tiles + tile];
     if (invocation < 2u * BLOCKS * BLOCKS) {
         s_touched[invocation / (BLOCKS * BLOCKS)][invocation % (BLOCKS * BLOCKS)] = 0u;
     }
-    sort_tile_list(base, n, invocation);
-    bool shared_list = n <= SORT_CAPACITY;
+    uvec2 list = tile_list(tile, tiles);
 
     uvec2 pixel = gl_GlobalInvocationID.xy;
     bool inside = all(lessThan(pixel, pc.more.zw));
@@ -130,10 +166,10 @@ void main() {
     float cutoff = g_point_frame[pc.handles.y].depth.w;
     float cutoff2 = cutoff * cutoff;
     uvec2 block = gl_LocalInvocationID.xy / BLOCK_SIZE;
-    for (uint b = 0u; b < n; b += BATCH) {
-        uint set = (b / BATCH) & 1u;
-        if (invocation < BATCH && b + invocation < n) {
-            set_up_batch_slot(shared_list, base, b + invocation, uvec2(invocation, set));
+    for (uint b = list.x; b < list.y; b += BATCH) {
+        uint set = ((b - list.x) / BATCH) & 1u;
+        if (invocation < BATCH && b + invocation < list.y) {
+            set_up_batch_slot(b + invocation, uvec2(invocation, set));
         }
         barrier();
         // The batch's splats whose boxes touch this pixel's block, in order.
