@@ -44,8 +44,10 @@
 //! 7. `points.single_pass.merge`: one workgroup per tile finds its slice of
 //!    the sorted entries by binary search (a list the capacity cut short is
 //!    dropped whole and counted, [`super::PointFrameStats::tile_entries_dropped`]),
-//!    and every pixel applies the operator to the slice's splats in order,
-//!    in registers, then is normalised, shaded and written once.
+//!    and walks it in batches of 32 splats set up in shared memory: every
+//!    pixel applies the operator to the batch's splats whose boxes touch its
+//!    4×2-pixel block, in order, in registers, then is normalised, shaded
+//!    and written once.
 //!
 //! Interlock backend ([`SplatBackend::Interlock`], [`interlock`]):
 //! `points.single_pass.triangles` as above, `points.single_pass.clear`
