@@ -121,6 +121,9 @@ mod module_graph_tests;
 pub mod bench;
 #[forbid(unsafe_code)]
 pub mod files;
+#[cfg(feature = "hot-reload")]
+#[forbid(unsafe_code)]
+pub mod hot_reload;
 #[forbid(unsafe_code)]
 pub mod tools;
 
@@ -143,6 +146,11 @@ pub use error::Result;
 
 // --- The GPU ---
 
+pub use post::overlay::{OverlayFrame, OverlayMesh, OverlayTexels, OverlayVertex, OVERLAY_ATLAS_SIDE};
+/// What the viewer's overlay draws over a presented frame
+/// ([`Renderer::set_overlay`]): triangle meshes and font-atlas updates in
+/// egui's layout, without depending on egui.
+pub use post::present::PresentedImage;
 /// The Vulkan instance and device every renderer of a program shares.
 ///
 /// ```no_run
@@ -155,6 +163,10 @@ pub use error::Result;
 /// # Ok::<(), alpenglow::Error>(())
 /// ```
 pub use vulkan::Context;
+/// A window's surface and swapchain (any `raw-window-handle` window):
+/// frames reach it through [`Renderer::present`] of a renderer built with
+/// [`Settings::present_to`]. What `alpenglow view` shows its frames in.
+pub use vulkan::Swapchain;
 pub use vulkan::{ContextOptions, DeviceInfo, DeviceSelector, ValidationReport};
 
 // --- The scene ---

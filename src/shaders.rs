@@ -44,6 +44,14 @@ pub const FULL_SCREEN_VERT: SpirV = spirv!("post/full_screen.vert");
 pub const SKY: SpirV = spirv!("lighting/sky.comp");
 /// aovs: distance and motion from view depth and the cameras (compute).
 pub const AOVS: SpirV = spirv!("post/aovs.comp");
+/// overlay.draw: the viewer's overlay (egui meshes pulled from an upload region), vertex stage.
+pub const OVERLAY_VERT: SpirV = spirv!("post/overlay.vert");
+/// overlay.draw: fragment stage (vertex colour × font atlas, premultiplied).
+pub const OVERLAY_FRAG: SpirV = spirv!("post/overlay.frag");
+/// overlay.font: a rectangle of the overlay's font atlas from an upload region.
+pub const OVERLAY_FONT: SpirV = spirv!("post/overlay_font.comp");
+/// present.aov: one of a view's AOVs in display colours (the viewer's debug views).
+pub const PRESENT_AOV: SpirV = spirv!("post/present_aov.comp");
 /// tonemap: HDR → sRGB8.
 pub const TONEMAP: SpirV = spirv!("post/tonemap.comp");
 /// exposure.meter: sums of log luminance per 128×64-pixel tile.

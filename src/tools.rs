@@ -72,3 +72,10 @@ pub mod profile {
         write_profile_json, DeviceMemoryUse, FrameSummary, PassSummary, PassTiming, PipelineStats, StageTiming,
     };
 }
+
+/// RenderDoc frame captures through its in-application API: of a frame of
+/// a headless run (`render`/`bench`/`fly --renderdoc-capture N`) or of the
+/// next presented frame (`trigger_capture`). docs/PROFILING.md.
+pub mod renderdoc {
+    pub use crate::vulkan::renderdoc::RenderDocCapture;
+}

@@ -1,21 +1,13 @@
 //! Links the static glslang and SPIRV-Tools archives that Debian's
-//! `libshaderc_combined.a` leaves out (it only bundles shaderc itself).
+//! `libshaderc_combined.a` leaves out: the arguments come from
+//! `alpenglow-shader-compiler`'s build script (`rustc-link-arg` does not
+//! reach a dependent's binaries and tests by itself).
 fn main() {
-    println!("cargo:rerun-if-changed=build.rs");
-    if std::env::var("CARGO_CFG_TARGET_OS").as_deref() == Ok("linux") {
-        for arg in [
-            "-Wl,--start-group",
-            "-l:libglslang.a",
-            "-l:libMachineIndependent.a",
-            "-l:libOSDependent.a",
-            "-l:libGenericCodeGen.a",
-            "-l:libOGLCompiler.a",
-            "-l:libSPIRV.a",
-            "-l:libSPIRV-Tools-opt.a",
-            "-l:libSPIRV-Tools.a",
-            "-Wl,--end-group",
-        ] {
-            println!("cargo:rustc-link-arg={arg}");
-        }
+    println!("cargo:rerun-if-env-changed=DEP_ALPENGLOW_GLSLANG_LINK_ARGS");
+    for arg in std::env::var("DEP_ALPENGLOW_GLSLANG_LINK_ARGS")
+        .unwrap_or_default()
+        .split_whitespace()
+    {
+        println!("cargo:rustc-link-arg={arg}");
     }
 }

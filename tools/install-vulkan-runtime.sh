@@ -3,7 +3,8 @@
 #   - the Vulkan loader and the Khronos validation layers,
 #   - lavapipe from bookworm-backports (Mesa >= 23: descriptor indexing),
 #   - the static shaderc / glslang / SPIRV-Tools libraries for the tools crate,
-#   - image-diff and build prerequisites.
+#   - image-diff and build prerequisites,
+#   - a virtual X display (xvfb, xauth) for the viewer's tests (`alpenglow view`).
 # Idempotent: does nothing when everything is already there. Run as root (or
 # with sudo available).
 set -euo pipefail
@@ -36,7 +37,7 @@ if ! command -v cargo >/dev/null 2>&1 && [ ! -x "$HOME/.cargo/bin/cargo" ]; then
 fi
 
 need=()
-for p in libvulkan1 vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools pkg-config gcc g++; do
+for p in libvulkan1 vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools pkg-config gcc g++ xvfb xauth; do
   have_pkg "$p" || need+=("$p")
 done
 if ! lavapipe_recent; then need+=("mesa-vulkan-drivers(backports)"); fi
@@ -59,6 +60,6 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends \
-  libvulkan1 vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools pkg-config gcc g++ >/dev/null
+  libvulkan1 vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools pkg-config gcc g++ xvfb xauth >/dev/null
 $SUDO apt-get install -y -qq --no-install-recommends -t bookworm-backports mesa-vulkan-drivers >/dev/null
 lavapipe_recent || { echo "install-vulkan-runtime: mesa-vulkan-drivers from bookworm-backports did not install" >&2; exit 1; }

@@ -35,6 +35,8 @@ pub enum Command {
     Bench(BenchArgs),
     /// Render a camera path (keyframe file or orbit) to a PNG sequence and report per-frame times.
     Fly(FlyArgs),
+    /// Show the scene live in a window with a fly camera (WASD, mouse, wheel; arrows move the sun; F12 captures).
+    View(super::view::ViewArgs),
     /// Sequential point trees: `spt build IN OUT`.
     #[command(subcommand)]
     Spt(SptCommand),
@@ -454,6 +456,8 @@ pub struct RenderArgs {
     #[arg(long, help_heading = "Output")]
     pub pipeline_stats: bool,
     #[command(flatten)]
+    pub renderdoc: super::renderdoc::RenderDocArgs,
+    #[command(flatten)]
     pub scene: SceneArgs,
 }
 
@@ -475,6 +479,8 @@ pub struct BenchArgs {
     /// invocations…) and report their medians; needs the device feature pipelineStatisticsQuery.
     #[arg(long, help_heading = "Output")]
     pub pipeline_stats: bool,
+    #[command(flatten)]
+    pub renderdoc: super::renderdoc::RenderDocArgs,
     #[command(flatten)]
     pub scene: SceneArgs,
 }
@@ -505,6 +511,8 @@ pub struct FlyArgs {
     /// Chrome trace of all frames (opens in Perfetto).
     #[arg(long, value_name = "FILE", help_heading = "Output")]
     pub trace: Option<PathBuf>,
+    #[command(flatten)]
+    pub renderdoc: super::renderdoc::RenderDocArgs,
     #[command(flatten)]
     pub scene: SceneArgs,
 }

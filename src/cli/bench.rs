@@ -13,6 +13,7 @@ use alpenglow::{DeviceInfo, DeviceMemoryUse, FrameProfile, TextureSummary};
 
 use super::args::BenchArgs;
 use super::outputs::Outputs;
+use super::renderdoc::{self, FrameCapture};
 use super::{
     camera, check_frames, check_validation, context, lighting, load_scene, render_settings, rig, views,
     MAX_SETTLE_FRAMES,
@@ -36,13 +37,15 @@ pub(super) fn bench(args: BenchArgs) -> Result<ExitCode> {
     let (rig, specs) = views(&args.scene)?;
     let scene = load_scene(&args.scene)?;
     let cameras = rig::frame_cameras(rig.as_ref(), &camera(&args.scene, &scene)?)?;
+    // The frames after the settling ones: warm-up, then timed.
+    let mut capture = FrameCapture::new(&args.renderdoc, u64::from(args.warmup) + u64::from(args.frames))?;
     let ctx = context(&args.scene.device)?;
     let report = ctx.validation_report();
     let device = ctx.info().clone();
     let run = {
         let settings = render_settings(&args.scene, &scene, &specs, false)?;
         let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
-        run_frames(&ctx, &mut renderer, &cameras, &args)?
+        run_frames(&ctx, &mut renderer, &cameras, &args, &mut capture)?
     };
     drop(ctx);
     check_validation(report)?;
@@ -67,6 +70,7 @@ pub(super) fn bench(args: BenchArgs) -> Result<ExitCode> {
     outputs.stage(args.trace.as_deref(), || {
         Ok(chrome_trace(&device.name, &run.timed)?.into_bytes())
     })?;
+    renderdoc::report(capture)?;
     outputs.commit()?;
     Ok(ExitCode::SUCCESS)
 }
@@ -78,6 +82,7 @@ fn run_frames(
     renderer: &mut alpenglow::Renderer,
     cameras: &[alpenglow::Camera],
     args: &BenchArgs,
+    capture: &mut Option<FrameCapture>,
 ) -> Result<Run> {
     let raster = renderer.raster_path();
     renderer.set_pipeline_stats(args.pipeline_stats)?;
@@ -88,7 +93,7 @@ fn run_frames(
     let mut intervals = Vec::new();
     let mut last = std::time::Instant::now();
     for i in 0..args.warmup + args.frames {
-        renderer.render_views(cameras)?;
+        renderdoc::frame(capture, i.into(), || Ok(renderer.render_views(cameras)?))?;
         if i >= args.warmup {
             intervals.push(last.elapsed().as_secs_f64() * 1e3);
         }

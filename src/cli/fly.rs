@@ -31,6 +31,7 @@ use alpenglow::tools::profile::{chrome_trace, median, summarize};
 use alpenglow::{Camera, CameraPath, FrameImages, FrameProfile, Orbit, Rig, Scene, TextureFrameStats};
 
 use super::args::FlyArgs;
+use super::renderdoc::{self, FrameCapture};
 use super::{
     camera, check_frames, check_validation, context, load_scene, render_settings, report_textures, rig, views, Outputs,
 };
@@ -108,6 +109,9 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
         frame_cameras(&path, &source, rig.as_ref(), &base, i, args.frames)?;
     }
 
+    // Before the Vulkan instance (a loaded RenderDoc hooks it) and any output.
+    let mut capture = FrameCapture::new(&args.renderdoc, args.frames.into())?;
+
     let staging = match &args.out_dir {
         Some(dir) => Some(outputs.stage_dir(dir)?),
         None => None,
@@ -154,7 +158,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
         for i in 0..args.frames {
             let cams = frame_cameras(&path, &source, rig.as_ref(), &base, i, args.frames)?;
             let start = Instant::now();
-            let outcome = renderer.render_views(&cams)?;
+            let outcome = renderdoc::frame(&mut capture, i.into(), || Ok(renderer.render_views(&cams)?))?;
             wall[i as usize] += start.elapsed();
             if let Some((index, frame)) = pending.take() {
                 let start = Instant::now();
@@ -186,6 +190,7 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
         writes: staging.is_some(),
     };
     report_fly(&args, &run, &texture_stats, &mut outputs)?;
+    renderdoc::report(capture)?;
     outputs.commit()?;
     if let Some(dir) = &args.out_dir {
         println!("  {} frames written to {}", args.frames, dir.display());

@@ -11,12 +11,14 @@ mod orbit;
 mod outputs;
 mod points;
 mod progress;
+mod renderdoc;
 mod rig;
 mod spt;
 mod synth;
 mod terrain_spec;
 #[cfg(test)]
 mod tests;
+mod view;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -92,6 +94,7 @@ pub fn run() -> Result<ExitCode> {
         Command::Render(args) => render(args),
         Command::Bench(args) => bench::bench(args),
         Command::Fly(args) => fly::fly(args),
+        Command::View(args) => view::view(args),
         Command::Spt(args::SptCommand::Build(args)) => spt::build(args),
         Command::Info(args) => info(args),
         Command::Layers(command) => layers::run(command),
@@ -104,10 +107,11 @@ fn context(args: &DeviceArgs) -> Result<Context> {
         Some(d) => d.parse::<DeviceSelector>()?,
         None => DeviceSelector::Best,
     };
-    Ok(Context::new(&ContextOptions {
+    Context::new(&ContextOptions {
         validation: args.validation,
         device,
-    })?)
+    })
+    .map_err(renderdoc::explain_device_error)
 }
 
 /// Fails when validation reported anything (call after everything Vulkan was dropped).
@@ -360,6 +364,8 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
     outputs.add(args.trace.as_deref(), "--trace")?;
     let scene = load_scene(&args.scene)?;
     let cameras = rig::frame_cameras(rig.as_ref(), &camera(&args.scene, &scene)?)?;
+    // Frames from the first, one by one up to the captured one (at most MAX_FRAMES).
+    let mut capture = renderdoc::FrameCapture::new(&args.renderdoc, MAX_FRAMES.into())?;
     let ctx = context(&args.scene.device)?;
     let report = ctx.validation_report();
     let device = ctx.info().name.clone();
@@ -368,6 +374,9 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
         let mut renderer = lighting::renderer(&ctx, &scene, settings)?;
         renderer.set_pipeline_stats(args.pipeline_stats)?;
         let raster = renderer.raster_path();
+        if let Some(capture) = &mut capture {
+            capture.render_until(&mut renderer, &cameras)?;
+        }
         let frame = renderer.render_views_settled(&cameras, MAX_SETTLE_FRAMES)?;
         let views = renderer.read_views(&frame)?;
         let profiles = renderer.finish()?;
@@ -400,6 +409,7 @@ fn render(args: RenderArgs) -> Result<ExitCode> {
     outputs.stage(args.trace.as_deref(), || {
         Ok(chrome_trace(&device, &profiles)?.into_bytes())
     })?;
+    renderdoc::report(capture)?;
     outputs.commit()?;
     if let Some(frame) = profiles.last() {
         print_profile(&device, frame);

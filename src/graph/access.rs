@@ -65,6 +65,9 @@ pub enum Access {
     TransferDst,
     /// Read by the host after the frame completes.
     HostRead,
+    /// Presented to a window after the frame (a swapchain image's final
+    /// layout; the submission's semaphore signal orders it).
+    Present,
 }
 
 impl Access {
@@ -109,6 +112,7 @@ impl Access {
             TransferSrc => (S::ALL_TRANSFER, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
             TransferDst => (S::ALL_TRANSFER, A::TRANSFER_WRITE, L::TRANSFER_DST_OPTIMAL),
             HostRead => (S::HOST, A::HOST_READ, L::UNDEFINED),
+            Present => (S::NONE, A::NONE, L::PRESENT_SRC_KHR),
         }
     }
 
@@ -152,6 +156,7 @@ impl Access {
                 | DepthAttachmentRead
                 | TransferSrc
                 | TransferDst
+                | Present
         )
     }
 

@@ -8,11 +8,12 @@ use std::time::Instant;
 
 use super::alias::{assign_slots, AliasSlot};
 use super::uploads::{UploadArena, UploadWriter};
-use super::{Access, Attachments, ImageInfo, PassDecl, PassKind, RenderGraph, ResourceDecl, ResourceId};
+use super::{Access, Attachments, ImageId, ImageInfo, PassDecl, PassKind, RenderGraph, ResourceDecl, ResourceId};
 use crate::error::{Error, Result};
 use crate::profile::FrameProfile;
 use crate::vulkan::{
-    AccessState, Buffer, BufferDesc, BufferUsageFlags, Context, Image, ImageDesc, ImageUsageFlags, MemoryBlock,
+    AccessState, AcquiredImage, Buffer, BufferDesc, BufferUsageFlags, Context, Image, ImageDesc, ImageUsageFlags,
+    MemoryBlock, PresentSync,
 };
 
 /// The physical resource(s) behind a graph resource.
@@ -101,9 +102,45 @@ pub struct BakedGraph<P> {
     pub(crate) uploads: Option<UploadArena>,
     /// The graph's number (what its passes' bindings carry).
     pub(crate) serial: u32,
+    /// The semaphores of the next frame's swapchain image, when one is
+    /// bound ([`BakedGraph::bind_presented`]).
+    pub(crate) present: Option<PresentSync>,
 }
 
 impl<P> BakedGraph<P> {
+    /// Binds the swapchain image `acquired` to `image` (declared with
+    /// [`RenderGraph::import_presented`]) for the next frame: the frame
+    /// waits for its acquisition, overwrites it (its old contents are
+    /// discarded) and signals its presentation.
+    pub fn bind_presented(&mut self, image: ImageId, acquired: &AcquiredImage) -> Result<()> {
+        let is_presented = matches!(self.physical.get(image.0 .0), Some(Physical::Image(v)) if v.len() <= 1)
+            && self.final_accesses.contains(&(image.0, Access::Present));
+        if !is_presented {
+            return Err(Error::Graph(
+                "bind_presented: the image was not imported as presented".into(),
+            ));
+        }
+        acquired.image.set_state(AccessState::UNUSED);
+        self.physical[image.0 .0] = Physical::Image(vec![acquired.image.clone()]);
+        self.present = Some(acquired.sync);
+        Ok(())
+    }
+
+    /// Whether a swapchain image is bound for the next frame.
+    pub fn present_bound(&self) -> bool {
+        self.present.is_some()
+    }
+
+    /// Forgets the swapchain images bound for the frame just submitted.
+    pub(crate) fn unbind_presented(&mut self) {
+        self.present = None;
+        for (r, access) in &self.final_accesses {
+            if *access == Access::Present {
+                self.physical[r.0] = Physical::Image(Vec::new());
+            }
+        }
+    }
+
     /// Names of the passes in execution order.
     pub fn pass_names(&self) -> Vec<String> {
         self.passes.iter().map(|p| p.name.clone()).collect()
@@ -222,7 +259,8 @@ fn validate<P>(graph: &RenderGraph<P>) -> Result<()> {
         if r.0 >= graph.resources.len() {
             return Err(Error::Graph(format!("output #{} is not a resource of this graph", r.0)));
         }
-        if a.is_some() && graph.resources[r.0].is_image() {
+        let presented = matches!(graph.resources[r.0], ResourceDecl::Presented { .. });
+        if a.is_some() && graph.resources[r.0].is_image() && !presented {
             return Err(Error::Graph(format!(
                 "'{}': only buffers can be read back",
                 graph.resources[r.0].name()
@@ -260,6 +298,7 @@ fn image_format(decl: &ResourceDecl) -> Option<crate::vulkan::Format> {
     match decl {
         ResourceDecl::TransientImage { info, .. } => Some(info.format),
         ResourceDecl::ImportedImages(images) => images.first().map(|i| i.desc().format),
+        ResourceDecl::Presented { format, .. } => Some(*format),
         _ => None,
     }
 }
@@ -437,6 +476,7 @@ fn create_physical(
                 }
                 Physical::Image(images)
             }
+            ResourceDecl::Presented { .. } => Physical::Image(Vec::new()),
             ResourceDecl::ImportedBuffers(buffers) => {
                 for buffer in &buffers {
                     if !buffer.desc().usage.contains(buffer_usage[i]) {
@@ -517,6 +557,7 @@ pub(crate) fn bake<P: 'static>(graph: RenderGraph<P>, ctx: &Context) -> Result<B
         physical,
         imported,
         final_accesses,
+        present: None,
         culled,
         pending: VecDeque::new(),
         profiles: Vec::new(),

@@ -400,7 +400,10 @@ impl<P> BakedGraph<P> {
         self.emit_barriers(&mut recording.recorder, &finals, frame);
         self.final_accesses = finals;
         // Submit even after a failed pass so the frame slot stays consistent.
-        let timeline = recording.submit()?;
+        let present = self.present.take();
+        let timeline = recording.submit(present.as_ref());
+        self.unbind_presented();
+        let timeline = timeline?;
         self.tracy.submitted(frame, || ctx.gpu_time_ns());
         tracy::frame_mark();
         if let Some(c) = completed {

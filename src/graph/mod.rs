@@ -95,6 +95,13 @@ pub(crate) enum ResourceDecl {
     /// One physical image per frame slot (or one shared by all).
     ImportedImages(Vec<Arc<Image>>),
     ImportedBuffers(Vec<Arc<Buffer>>),
+    /// A window's swapchain image: a different one each frame, bound
+    /// before the frame is executed ([`BakedGraph::bind_presented`]),
+    /// presented after it.
+    Presented {
+        name: String,
+        format: Format,
+    },
     /// The upload arena: one host-visible buffer per frame slot, created at
     /// bake time from the regions declared.
     Uploads,
@@ -104,20 +111,25 @@ impl ResourceDecl {
     pub(crate) fn is_imported(&self) -> bool {
         matches!(
             self,
-            ResourceDecl::ImportedImages(_) | ResourceDecl::ImportedBuffers(_) | ResourceDecl::Uploads
+            ResourceDecl::ImportedImages(_)
+                | ResourceDecl::ImportedBuffers(_)
+                | ResourceDecl::Uploads
+                | ResourceDecl::Presented { .. }
         )
     }
 
     pub(crate) fn is_image(&self) -> bool {
         matches!(
             self,
-            ResourceDecl::TransientImage { .. } | ResourceDecl::ImportedImages(_)
+            ResourceDecl::TransientImage { .. } | ResourceDecl::ImportedImages(_) | ResourceDecl::Presented { .. }
         )
     }
 
     pub(crate) fn name(&self) -> String {
         match self {
-            ResourceDecl::TransientImage { name, .. } | ResourceDecl::TransientBuffer { name, .. } => name.clone(),
+            ResourceDecl::TransientImage { name, .. }
+            | ResourceDecl::TransientBuffer { name, .. }
+            | ResourceDecl::Presented { name, .. } => name.clone(),
             ResourceDecl::ImportedImages(i) => i.first().map(|i| i.desc().name.clone()).unwrap_or_default(),
             ResourceDecl::ImportedBuffers(b) => b.first().map(|b| b.desc().name.clone()).unwrap_or_default(),
             ResourceDecl::Uploads => "upload arena".into(),
@@ -255,6 +267,18 @@ impl<P: 'static> RenderGraph<P> {
     /// One persistent image per frame in flight, used round-robin.
     pub fn import_images_per_frame(&mut self, images: Vec<Arc<Image>>) -> ImageId {
         ImageId(self.declare(ResourceDecl::ImportedImages(images)))
+    }
+
+    /// A window's swapchain image of `format`, presented after every
+    /// frame: the renderer binds the image it acquired before each frame
+    /// ([`BakedGraph::bind_presented`]); its contents start undefined.
+    pub fn import_presented(&mut self, name: &str, format: Format) -> ImageId {
+        let id = self.declare(ResourceDecl::Presented {
+            name: name.into(),
+            format,
+        });
+        self.outputs.push((id, Some(Access::Present)));
+        ImageId(id)
     }
 
     /// A persistent buffer owned outside the graph (vertex buffers, atlases).

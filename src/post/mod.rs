@@ -7,6 +7,8 @@ pub mod aovs;
 pub mod distortion;
 pub mod exposure;
 pub mod motion_blur;
+pub mod overlay;
+pub mod present;
 pub mod resample;
 pub mod resolve;
 pub mod tonemap;

@@ -24,6 +24,7 @@ pub mod footprint;
 mod frame_data;
 mod lighting;
 mod outputs;
+mod present;
 mod readback;
 mod ring;
 pub mod scene;
@@ -53,6 +54,8 @@ use crate::points::render::{PointFrameStats, PointRenderer, PointsFrame, SplatSe
 use crate::post::aovs::{Aovs, AovsFrame};
 use crate::post::exposure::ExposureMeter;
 use crate::post::motion_blur::{MotionBlur, MotionBlurSettings};
+use crate::post::overlay::{Overlay, OverlayPrepared};
+use crate::post::present::{declare_present, PresentFrame, PresentedImage};
 use crate::post::resolve::Resolve;
 use crate::post::tonemap::Tonemap;
 use crate::profile::FrameProfile;
@@ -120,6 +123,9 @@ pub struct RenderSettings {
     /// The lighting of the first frames (None: [`Scene::default_lighting`]);
     /// change it between frames with [`Renderer::set_lighting`].
     pub lighting: Option<Lighting>,
+    /// The format of the swapchain frames are presented to
+    /// ([`RenderSettings::present_to`], [`Renderer::present`]); None: headless.
+    pub(crate) present: Option<crate::vulkan::Format>,
 }
 
 impl RenderSettings {
@@ -145,6 +151,7 @@ impl RenderSettings {
             },
             cache_dir: None,
             lighting: None,
+            present: None,
         }
     }
 
@@ -179,6 +186,8 @@ frame_slots! {
         texturing: TextureFrame,
         points: PointsFrame,
         aovs: AovsFrame,
+        present: PresentFrame,
+        overlay: OverlayPrepared,
     }
 }
 
@@ -194,6 +203,8 @@ struct Techniques {
     atlas: Option<TextureAtlas>,
     points: Option<PointRenderer>,
     aovs: Aovs,
+    /// Over the presented frame (a renderer that presents).
+    overlay: Option<Overlay>,
 }
 
 /// Renders one scene, frame after frame. `Send`: a simulator may hand it to
@@ -220,6 +231,11 @@ pub struct Renderer {
     /// Frames rendered so far.
     frames_rendered: u64,
     techniques: Techniques,
+    /// The swapchain image the frame ends in, and the view it shows
+    /// ([`Renderer::present`]); None: headless.
+    presented: Option<crate::graph::ImageId>,
+    shown: usize,
+    presented_image: PresentedImage,
 }
 
 impl Renderer {
@@ -278,18 +294,28 @@ impl Renderer {
             settings: &settings,
             views: &views,
         };
-        let (techniques, targets) = wiring.declare(&mut graph, &chains, lighting.setup(), progress)?;
+        let (mut techniques, targets) = wiring.declare(&mut graph, &chains, lighting.setup(), progress)?;
         let outputs = match settings.readback {
             true => settings.outputs,
             false => Outputs::NONE,
         };
-        let readback = declare_outputs(
+        let (readback, displays) = declare_outputs(
             ctx,
             &mut graph,
             (&views, &targets, &chains),
             &settings,
             (outputs, slots),
         )?;
+        let presented = match settings.present {
+            Some(format) => {
+                let window = declare_present(ctx, &mut graph, &displays, format)?;
+                let mut overlay = Overlay::new(ctx, format)?;
+                overlay.declare(&mut graph, window);
+                techniques.overlay = Some(overlay);
+                Some(window)
+            }
+            None => None,
+        };
         let graph = graph.bake(ctx)?;
         Ok(Renderer {
             ctx: ctx.clone(),
@@ -305,6 +331,9 @@ impl Renderer {
             lighting,
             frames_rendered: 0,
             techniques,
+            presented,
+            shown: 0,
+            presented_image: PresentedImage::Color,
         })
     }
 
@@ -379,6 +408,12 @@ impl Renderer {
         for (spec, camera) in self.render_specs.iter().zip(cameras) {
             view_of(spec, camera).validate()?;
         }
+        if self.presented.is_some() && !self.graph.present_bound() {
+            return Err(Error::invalid(
+                "frame",
+                "the renderer presents to a window (Settings::present_to): render with Renderer::present",
+            ));
+        }
         // The slot's previous frame must be done before prepare writes its uploads.
         let index = self.frames.wait_for_next()?;
         // The frame (views, prepared data) and its stages are reused frame
@@ -435,6 +470,15 @@ impl Renderer {
             frame.prepare_into(points, (), &mut uploads, stages)?;
         }
         frame.prepare_into(&mut t.aovs, (), &mut uploads, stages)?;
+        if self.presented.is_some() {
+            frame.insert(PresentFrame {
+                view: self.shown,
+                image: self.presented_image,
+            });
+        }
+        if let Some(overlay) = &mut t.overlay {
+            frame.prepare_into(overlay, (), &mut uploads, stages)?;
+        }
         self.graph.execute(&mut self.frames, frame, stages)
     }
 
@@ -542,6 +586,12 @@ impl Renderer {
         Ok(self.graph.take_profiles())
     }
 
+    /// The timings of the frames the GPU has completed and not yet taken,
+    /// without waiting (a live viewer's per-frame profile).
+    pub fn take_profiles(&mut self) -> Vec<FrameProfile> {
+        self.graph.take_profiles()
+    }
+
     /// Texture atlas statistics of the frames recorded so far and not yet
     /// taken (their GPU times are the `texturing.*` passes of
     /// [`Renderer::finish`]'s profiles); empty unless texturing from the atlas.
@@ -571,6 +621,15 @@ impl Renderer {
     /// colours which part of the terrain); None unless texturing from the atlas.
     pub fn texture_page_table(&self) -> Result<Option<PageTable>> {
         Ok(self.techniques.atlas.as_ref().map(|a| a.page_table().clone()))
+    }
+
+    /// Point statistics of the frames the GPU has completed, without
+    /// waiting (a live viewer's); empty without point objects.
+    pub fn take_completed_point_stats(&mut self) -> Result<Vec<PointFrameStats>> {
+        match &mut self.techniques.points {
+            Some(p) => p.take_stats(),
+            None => Ok(Vec::new()),
+        }
     }
 
     /// Point statistics of the frames completed so far and not yet taken
@@ -696,6 +755,7 @@ impl Wiring<'_> {
             atlas,
             points,
             aovs,
+            overlay: None,
         };
         Ok((techniques, targets))
     }
@@ -723,6 +783,9 @@ fn validation_layer_edges(graph: &mut RenderGraph<RenderFrame>) {
     }
 }
 
+/// A view's name and its post-processed targets (what the present passes show).
+type NamedTargets = (String, SceneTargets);
+
 /// Each view's post chain (resolve, distortion, motion blur), exposure,
 /// tone mapping and readback of `outputs` into `slots` slots (none read
 /// back: the display image is kept).
@@ -732,7 +795,7 @@ fn declare_outputs(
     (views, targets, chains): (&[View], &[SceneTargets], &[ViewChain]),
     settings: &RenderSettings,
     (outputs, slots): (Outputs, usize),
-) -> Result<Vec<Readback>> {
+) -> Result<(Vec<Readback>, Vec<NamedTargets>)> {
     let mut exposure = ExposureMeter::new(ctx)?;
     let mut tonemap = Tonemap::new(ctx)?;
     let resolve = Resolve::new(ctx)?;
@@ -740,18 +803,26 @@ fn declare_outputs(
         Some(s) if s.shutter_s > 0.0 => Some((MotionBlur::new(ctx)?, s)),
         _ => None,
     };
-    let mut readback = Vec::new();
+    // Every view's images are final before any is read (validation layers
+    // before 1.3.268 count view k's tonemap dispatch as writing view j's
+    // display image: after the barrier of j's readback it would look like
+    // an unsynchronised write before the present pass reads it).
+    let mut displays = Vec::new();
     for (index, ((view, rendered), chain)) in views.iter().zip(targets).zip(chains).enumerate() {
         let blur = blur.as_ref().map(|(b, s)| (b, *s));
         let targets = chain.declare(graph, rendered, (&resolve, blur))?;
         let exposure = exposure.declare(ViewGraph::new(ctx, graph, (index, view)), &targets)?;
         tonemap.declare(ViewGraph::new(ctx, graph, (index, view)), (&targets, exposure))?;
-        match Readback::declare(ctx, graph, view, &targets, (outputs, slots))? {
+        displays.push((view.name.clone(), targets));
+    }
+    let mut readback = Vec::new();
+    for (view, (_, targets)) in views.iter().zip(&displays) {
+        match Readback::declare(ctx, graph, view, targets, (outputs, slots))? {
             Some(rb) => readback.push(rb),
             None => graph.keep(targets.display),
         }
     }
-    Ok(readback)
+    Ok((readback, displays))
 }
 
 /// The view `spec` renders through `camera`, without allocating (the

@@ -309,6 +309,12 @@ impl CommandRecorder {
         unsafe { self.device().cmd_draw(self.cmd, vertices, instances, 0, 0) };
     }
 
+    /// Draws `vertices` vertices from vertex index `first` (one instance).
+    pub fn draw_range(&mut self, vertices: u32, first: u32) {
+        // SAFETY: inside a rendering instance with a graphics pipeline bound.
+        unsafe { self.device().cmd_draw(self.cmd, vertices, 1, first, 0) };
+    }
+
     /// Draws indexed vertices.
     pub fn draw_indexed(&mut self, indices: u32, instances: u32) {
         // SAFETY: as in `draw`, with an index buffer bound.
@@ -368,6 +374,64 @@ impl CommandRecorder {
                 vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
                 dst.raw,
                 &[region],
+            )
+        };
+    }
+
+    /// Fills the whole colour image `dst` (TRANSFER_DST layout) with `color`.
+    pub fn clear_color_image(&mut self, dst: &Image, color: [f32; 4]) {
+        let value = vk::ClearColorValue { float32: color };
+        let range = super::memory::subresource_range(vk::ImageAspectFlags::COLOR);
+        // SAFETY: the graph put `dst` in TRANSFER_DST_OPTIMAL; it is a colour image.
+        unsafe {
+            (self.device()).cmd_clear_color_image(
+                self.cmd,
+                dst.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &value,
+                &[range],
+            )
+        };
+    }
+
+    /// Scales the whole colour image `src` (TRANSFER_SRC layout) into the
+    /// rectangle `to` = (x, y, width, height) of `dst` (TRANSFER_DST),
+    /// filtered linearly, converting the format (a swizzle between RGBA
+    /// and BGRA, say). Both formats must support blits (8-bit UNORM do).
+    pub fn blit_image(&mut self, src: &Image, dst: &Image, to: [u32; 4]) {
+        let corner = |x: u32, y: u32| vk::Offset3D {
+            x: x as i32,
+            y: y as i32,
+            z: 0,
+        };
+        let (s, d) = (src.desc(), dst.desc());
+        let layers = vk::ImageSubresourceLayers::default()
+            .aspect_mask(vk::ImageAspectFlags::COLOR)
+            .layer_count(1);
+        let x1 = (to[0] + to[2]).min(d.width);
+        let y1 = (to[1] + to[3]).min(d.height);
+        let region = vk::ImageBlit::default()
+            .src_subresource(layers)
+            .src_offsets([
+                corner(0, 0),
+                vk::Offset3D {
+                    z: 1,
+                    ..corner(s.width, s.height)
+                },
+            ])
+            .dst_subresource(layers)
+            .dst_offsets([corner(to[0], to[1]), vk::Offset3D { z: 1, ..corner(x1, y1) }]);
+        // SAFETY: the graph put `src` in TRANSFER_SRC_OPTIMAL and `dst` in
+        // TRANSFER_DST_OPTIMAL; the regions lie within both images.
+        unsafe {
+            self.device().cmd_blit_image(
+                self.cmd,
+                src.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                dst.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[region],
+                vk::Filter::LINEAR,
             )
         };
     }

@@ -55,6 +55,9 @@ pub struct DeviceInfo {
     /// Whether GPU timestamps are calibrated against the CPU clock
     /// (`VK_EXT_calibrated_timestamps` or `VK_KHR_calibrated_timestamps`).
     pub calibrated_timestamps: bool,
+    /// Whether frames can be presented to a window (`VK_KHR_swapchain`
+    /// and a surface extension of the loader).
+    pub presentation: bool,
     pub features: Vec<String>,
     /// Optional features the device offers and alpenglow enabled.
     pub optional_features: Vec<String>,
@@ -64,8 +67,10 @@ pub struct DeviceInfo {
 }
 
 pub(crate) struct Shared {
-    _entry: ash::Entry,
+    pub entry: ash::Entry,
     pub instance: ash::Instance,
+    /// The device's physical device (surface queries).
+    pub physical: vk::PhysicalDevice,
     debug_instance: Option<ash::ext::debug_utils::Instance>,
     messenger: vk::DebugUtilsMessengerEXT,
     pub debug_device: Option<ash::ext::debug_utils::Device>,
@@ -84,6 +89,8 @@ pub(crate) struct Shared {
     /// Reads the GPU and CPU clocks together, where the device can.
     pub(super) clock: Option<GpuClock>,
     report: Option<Arc<ValidationReport>>,
+    /// SPIR-V that replaces embedded modules (feature `hot-reload`).
+    pub(super) shader_overrides: super::shader_overrides::ShaderOverrides,
 }
 
 /// A Vulkan instance and device with everything alpenglow renders through.
@@ -154,6 +161,10 @@ fn open_device(entry: &ash::Entry, instance: &ash::Instance, candidate: device_s
     if let Some(name) = calibration {
         extensions.push(name.as_ptr());
     }
+    let presentation = super::present::offers_swapchain(instance, candidate.physical);
+    if presentation {
+        extensions.push(ash::khr::swapchain::NAME.as_ptr());
+    }
     let mut device_info = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queue_infos)
         .enabled_features(&base)
@@ -172,6 +183,7 @@ fn open_device(entry: &ash::Entry, instance: &ash::Instance, candidate: device_s
         optional,
         memory_budget,
         calibration,
+        presentation,
     })
 }
 
@@ -184,6 +196,8 @@ struct Opened {
     memory_budget: bool,
     /// The calibrated-timestamps extension enabled, if any.
     calibration: Option<&'static CStr>,
+    /// Whether `VK_KHR_swapchain` is enabled.
+    presentation: bool,
 }
 
 /// What [`Context::info`] reports of the device opened from `candidate`.
@@ -215,6 +229,7 @@ fn describe_device(
         max_allocation_bytes: memory.allocation,
         memory_budget,
         calibrated_timestamps: false,
+        presentation: false,
         features: REQUIRED_FEATURES.iter().map(|s| s.to_string()).collect(),
         optional_features: optional.names(),
         max_point_size: if optional.large_points {
@@ -280,6 +295,10 @@ impl Context {
             layer_names.push(VALIDATION_LAYER.as_ptr());
             extension_names.push(ash::ext::validation_features::NAME.as_ptr());
         }
+        // Windows (the viewer, `alpenglow view`): every surface extension the
+        // loader offers, so a swapchain can be made on any window later
+        // (harmless headless: nothing is created until a window asks).
+        extension_names.extend(super::present::surface_extensions(&extensions));
         let debug_utils = has_debug_utils || options.validation;
         if debug_utils {
             extension_names.push(ash::ext::debug_utils::NAME.as_ptr());
@@ -345,6 +364,7 @@ impl Context {
             optional,
             memory_budget,
             calibration,
+            presentation,
         } = match opened {
             Ok(opened) => opened,
             Err(e) => {
@@ -386,9 +406,11 @@ impl Context {
             .and_then(|name| GpuClock::new(&instance, &device, name, candidate.properties.limits.timestamp_period));
         let mut info = describe_device(&candidate, &optional, &memory, memory_budget, report.is_some());
         info.calibrated_timestamps = clock.is_some();
+        info.presentation = presentation;
         let shared = Shared {
-            _entry: entry,
+            entry,
             instance,
+            physical: candidate.physical,
             debug_instance,
             messenger,
             debug_device,
@@ -405,6 +427,7 @@ impl Context {
             memory,
             clock,
             report,
+            shader_overrides: Default::default(),
         };
         log::info!("device: {} ({})", shared.info.name, shared.info.driver_info);
         Ok(Context {
@@ -456,26 +479,64 @@ impl Context {
     /// Submits `command_buffer`, signalling the timeline; returns the value
     /// that marks its completion.
     pub(crate) fn submit(&self, command_buffer: vk::CommandBuffer) -> Result<u64> {
+        self.submit_presenting(command_buffer, None)
+    }
+
+    /// [`Context::submit`] of a frame that draws into a swapchain image:
+    /// it waits for the image's acquisition and signals that it may be
+    /// presented (`present`).
+    pub(crate) fn submit_presenting(
+        &self,
+        command_buffer: vk::CommandBuffer,
+        present: Option<&super::present::PresentSync>,
+    ) -> Result<u64> {
         let queue = self
             .shared
             .queue
             .lock()
             .map_err(|_| Error::Device("queue lock poisoned".into()))?;
         let value = self.shared.last_submitted.load(Ordering::SeqCst) + 1;
-        let signal = [vk::SemaphoreSubmitInfo::default()
+        let timeline = vk::SemaphoreSubmitInfo::default()
             .semaphore(self.shared.timeline)
             .value(value)
-            .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
+            .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS);
+        let mut signal = vec![timeline];
+        let mut wait = Vec::new();
+        if let Some(p) = present {
+            // The swapchain image is first written by a transfer or an attachment.
+            wait.push(
+                vk::SemaphoreSubmitInfo::default().semaphore(p.acquired).stage_mask(
+                    vk::PipelineStageFlags2::ALL_TRANSFER | vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                ),
+            );
+            signal.push(
+                vk::SemaphoreSubmitInfo::default()
+                    .semaphore(p.rendered)
+                    .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS),
+            );
+        }
         let buffers = [vk::CommandBufferSubmitInfo::default().command_buffer(command_buffer)];
         let submit = vk::SubmitInfo2::default()
+            .wait_semaphore_infos(&wait)
             .command_buffer_infos(&buffers)
             .signal_semaphore_infos(&signal);
         // SAFETY: the queue is externally synchronised by the mutex; the command
-        // buffer is fully recorded and not in use by another submission.
+        // buffer is fully recorded and not in use by another submission; the
+        // binary semaphores are unsignalled (acquire signals, present waits).
         unsafe { self.shared.device.queue_submit2(*queue, &[submit], vk::Fence::null()) }
             .map_err(vk_err("vkQueueSubmit2"))?;
         self.shared.last_submitted.store(value, Ordering::SeqCst);
         Ok(value)
+    }
+
+    /// Runs `f` with the queue, locked (presentation).
+    pub(crate) fn with_queue<T>(&self, f: impl FnOnce(vk::Queue) -> T) -> Result<T> {
+        let queue = self
+            .shared
+            .queue
+            .lock()
+            .map_err(|_| Error::Device("queue lock poisoned".into()))?;
+        Ok(f(*queue))
     }
 
     /// The timeline value of the last submission.

@@ -337,8 +337,10 @@ impl RecordingFrame<'_> {
         self.ring.slots[self.slot].stats.pool
     }
 
-    /// Ends recording and submits; returns the timeline value of completion.
-    pub fn submit(self) -> Result<u64> {
+    /// Ends recording and submits (waiting for a swapchain image's
+    /// acquisition and signalling its presentation with `present`);
+    /// returns the timeline value of completion.
+    pub fn submit(self, present: Option<&super::present::PresentSync>) -> Result<u64> {
         let ctx = self.ring.ctx.clone();
         let s = &mut self.ring.slots[self.slot];
         // SAFETY: the command buffer is recording and every label was closed.
@@ -346,7 +348,7 @@ impl RecordingFrame<'_> {
         s.calibration = ctx.shared.clock.as_ref().and_then(|c| c.calibrate());
         s.waited_at = None;
         s.submit_at = Some(Instant::now());
-        let value = ctx.submit(s.cmd)?;
+        let value = ctx.submit_presenting(s.cmd, present)?;
         s.submitted = value;
         ctx.collect_garbage()?;
         Ok(value)

@@ -145,6 +145,30 @@ impl Image {
         })
     }
 
+    /// Wraps image `raw` of a swapchain (owned and destroyed by it) with a
+    /// view; no heap handles (it is written by transfers and attachments only).
+    pub(crate) fn from_swapchain(ctx: &Context, raw: vk::Image, desc: ImageDesc) -> Result<Image> {
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(raw)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(desc.format)
+            .subresource_range(subresource_range(vk::ImageAspectFlags::COLOR));
+        // SAFETY: `raw` is a live swapchain image of this device; the view matches its format.
+        let view =
+            unsafe { ctx.shared.device.create_image_view(&view_info, None) }.map_err(vk_err("vkCreateImageView"))?;
+        ctx.name_object(view, &desc.name);
+        Ok(Image {
+            ctx: ctx.clone(),
+            raw,
+            view,
+            memory: None,
+            desc,
+            sampled_handle: None,
+            storage_handle: None,
+            state: Mutex::new(AccessState::UNUSED),
+        })
+    }
+
     /// The image's description.
     pub fn desc(&self) -> &ImageDesc {
         &self.desc
@@ -189,9 +213,10 @@ impl Drop for Image {
         if let Some(handle) = self.storage_handle {
             heap.release(HeapKind::StorageImage, handle, last);
         }
-        if let Some(memory) = self.memory.take() {
-            self.ctx
-                .defer_destroy(Garbage::Image(self.raw, self.view, memory.into_owned()));
+        match self.memory.take() {
+            Some(memory) => (self.ctx).defer_destroy(Garbage::Image(self.raw, self.view, memory.into_owned())),
+            // A swapchain's image: its swapchain destroys it.
+            None => self.ctx.defer_destroy(Garbage::ImageView(self.view)),
         }
     }
 }

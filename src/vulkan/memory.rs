@@ -69,6 +69,8 @@ pub struct Barrier {
 pub(crate) enum Garbage {
     Buffer(vk::Buffer, Allocation),
     Image(vk::Image, vk::ImageView, Option<Allocation>),
+    /// The view of an image owned elsewhere (a swapchain's).
+    ImageView(vk::ImageView),
     Memory(Allocation),
     Pipeline(vk::Pipeline),
     CommandPool(vk::CommandPool),
@@ -86,6 +88,7 @@ impl Garbage {
                     device.destroy_buffer(buffer, None);
                     free(shared, allocation);
                 }
+                Garbage::ImageView(view) => device.destroy_image_view(view, None),
                 Garbage::Image(image, view, allocation) => {
                     device.destroy_image_view(view, None);
                     device.destroy_image(image, None);

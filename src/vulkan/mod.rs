@@ -12,6 +12,9 @@ mod heap;
 mod image;
 mod memory;
 mod pipeline;
+mod present;
+pub(crate) mod renderdoc;
+mod shader_overrides;
 mod validation;
 
 pub use ash::vk::{
@@ -26,4 +29,5 @@ pub use frames::{CompletedFrame, FrameRing, FRAMES_IN_FLIGHT};
 pub use image::{Image, ImageDesc, MemoryBlock};
 pub use memory::{AccessState, Barrier, Buffer, BufferDesc, MemoryLocation};
 pub use pipeline::{Blend, ComputePipeline, GraphicsPipeline, GraphicsPipelineDesc, SpirV, VertexAttribute};
+pub use present::{AcquiredImage, PresentSync, Swapchain};
 pub use validation::ValidationReport;

@@ -16,7 +16,8 @@ pub struct SpirV {
 }
 
 fn create_module(ctx: &Context, spirv: &SpirV) -> Result<vk::ShaderModule> {
-    let words = ash::util::read_spv(&mut std::io::Cursor::new(spirv.bytes)).map_err(|e| Error::Shader {
+    let bytes = ctx.shader_bytes(spirv);
+    let words = ash::util::read_spv(&mut std::io::Cursor::new(&bytes[..])).map_err(|e| Error::Shader {
         path: spirv.name.into(),
         message: e.to_string(),
     })?;
@@ -27,7 +28,8 @@ fn create_module(ctx: &Context, spirv: &SpirV) -> Result<vk::ShaderModule> {
         });
     }
     let info = vk::ShaderModuleCreateInfo::default().code(&words);
-    // SAFETY: `words` is a SPIR-V module produced by the tools crate.
+    // SAFETY: `words` is a SPIR-V module produced by shaderc (the tools
+    // crate's, or hot reload's: the same compile function).
     unsafe { ctx.shared.device.create_shader_module(&info, None) }.map_err(vk_err("vkCreateShaderModule"))
 }
 

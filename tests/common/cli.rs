@@ -32,7 +32,7 @@ pub fn run<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
     let args: Vec<&std::ffi::OsStr> = args.iter().map(AsRef::as_ref).collect();
     let scene_command = args
         .first()
-        .is_some_and(|a| ["render", "bench", "fly"].iter().any(|c| a == c));
+        .is_some_and(|a| ["render", "bench", "fly", "view"].iter().any(|c| a == c));
     let says_vegetation = args.iter().any(|a| *a == "--vegetation");
     let mut args = args;
     if scene_command && !says_vegetation {
@@ -46,12 +46,36 @@ pub fn run<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
 /// validation layers and synchronization validation, and exits non-zero on
 /// any message (issue 27: no test renders unvalidated).
 pub fn run_as_is<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
+    run_with(Command::new(bin()), args)
+}
+
+/// Runs `alpenglow ARGS` as [`run`] does, on a virtual X display
+/// (`xvfb-run`): the viewer's tests. None when `xvfb-run` is missing
+/// (tools/test installs it; `ALPENGLOW_REQUIRE_XVFB=1` makes that a failure).
+pub fn run_on_xvfb<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Option<Output> {
+    let found = Command::new("xvfb-run").arg("--help").output().is_ok();
+    if !found {
+        let required = std::env::var("ALPENGLOW_REQUIRE_XVFB").is_ok_and(|v| v == "1");
+        assert!(!required, "xvfb-run is missing (apt install xvfb xauth)");
+        eprintln!("xvfb-run is missing: the viewer test is skipped (apt install xvfb xauth)");
+        return None;
+    }
+    let mut command = Command::new("xvfb-run");
+    command.args(["-a", "-s", "-screen 0 800x600x24", bin()]);
     let mut args: Vec<&std::ffi::OsStr> = args.iter().map(AsRef::as_ref).collect();
-    let renders = (args.first()).is_some_and(|a| ["render", "bench", "fly"].iter().any(|c| a == c));
+    if !args.iter().any(|a| *a == "--vegetation") {
+        args.extend([std::ffi::OsStr::new("--vegetation"), std::ffi::OsStr::new("off")]);
+    }
+    Some(run_with(command, &args))
+}
+
+fn run_with<S: AsRef<std::ffi::OsStr>>(mut command: Command, args: &[S]) -> Output {
+    let mut args: Vec<&std::ffi::OsStr> = args.iter().map(AsRef::as_ref).collect();
+    let renders = (args.first()).is_some_and(|a| ["render", "bench", "fly", "view"].iter().any(|c| a == c));
     if renders && !args.iter().any(|a| *a == "--validation") {
         args.push(std::ffi::OsStr::new("--validation"));
     }
-    Command::new(bin())
+    command
         .args(&args)
         .env(
             "XDG_CACHE_HOME",
