@@ -70,9 +70,15 @@ pub const SPLAT_OPAQUE_FRAG: SpirV = spirv!("points/opaque.frag");
 pub const SPLAT_SINGLE_PASS_BINS_CLEAR: SpirV = spirv!("points/single_pass_bins_clear.comp");
 /// points.single_pass.count and .scatter (§10.4), compute backend: the splats binned into tiles.
 pub const SPLAT_SINGLE_PASS_BIN: SpirV = spirv!("points/single_pass_bin.comp");
-/// points.single_pass.prefix (§10.4), compute backend: the tiles' list offsets.
+/// points.single_pass.prefix (§10.4), compute backend: the binning workgroups' entry offsets, the sort's state.
 pub const SPLAT_SINGLE_PASS_PREFIX: SpirV = spirv!("points/single_pass_prefix.comp");
-/// points.single_pass.merge (§10.4), compute backend: per tile, sort, merge front to back, shade.
+/// points.single_pass.radix<k>.count (§10.4), compute backend: each radix block's digit counts.
+pub const SPLAT_SINGLE_PASS_RADIX_COUNT: SpirV = spirv!("points/single_pass_radix_count.comp");
+/// points.single_pass.radix<k>.scan (§10.4), compute backend: each (digit, block)'s output position.
+pub const SPLAT_SINGLE_PASS_RADIX_SCAN: SpirV = spirv!("points/single_pass_radix_scan.comp");
+/// points.single_pass.radix<k>.scatter (§10.4), compute backend: each block's entries, stably, to their positions.
+pub const SPLAT_SINGLE_PASS_RADIX_SCATTER: SpirV = spirv!("points/single_pass_radix_scatter.comp");
+/// points.single_pass.merge (§10.4), compute backend: per tile, its sorted slice merged front to back, shaded.
 pub const SPLAT_SINGLE_PASS_TILE: SpirV = spirv!("points/single_pass_tile.comp");
 /// points.single_pass (§10.4): the interlock backend's fragment stage.
 pub const SPLAT_SINGLE_PASS_INTERLOCK_FRAG: SpirV = spirv!("points/single_pass_interlock.frag");

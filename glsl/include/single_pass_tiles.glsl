@@ -1,18 +1,19 @@
 // Tile binning of single-pass splatting (dissertation §10.4; ALGORITHMS.md
 // §8), shared by its compute passes (src/points/render/single_pass/tiles.rs):
 // the screen is cut into TILE_SIZE² pixel tiles; every drawn splat is
-// entered into the list of each tile its bounding box touches, as a depth
-// key (the distance of the splat's centre from the eye) and a reference to
-// the splat (instance record, index in the draw). The lists are sorted by
-// (key, record, index), a total order, and merged front to back per pixel
-// (glsl/points/single_pass_tile.comp), so the result does not depend on the
-// order in which the GPU's invocations entered them.
+// entered into the list of each tile its bounding box touches, as a sort
+// key (the tile's index in the high bits, the splat centre's distance from
+// the eye below) and a reference to the splat (instance record, index in
+// the draw). The entries are written at positions that depend only on the
+// splats' order in the draws (an exclusive prefix of the entry counts per
+// workgroup of splats), then sorted by key with a stable LSD radix sort
+// (glsl/include/single_pass_radix.glsl), so each tile's list is a slice of
+// the sorted entries, front to back, ties in draw order: the result does
+// not depend on the order of the GPU's invocations.
 //
-// The bins buffer holds four arrays of one word per tile (T tiles):
-//   [0, T)    count:  entries the splats add (points.single_pass.count)
-//   [T, 2T)   offset: where the tile's list starts in the entry buffer
-//   [2T, 3T)  kept:   the list's length, its count if it fits the capacity, else 0
-//   [3T, 4T)  cursor: entries written so far (points.single_pass.scatter)
+// The bins buffer holds one word per tile (its count of entries, from
+// points.single_pass.count), then the sort's state
+// (glsl/include/single_pass_radix.glsl).
 // Layouts: src/points/render/single_pass/tiles.rs.
 #ifndef ALPENGLOW_SINGLE_PASS_TILES_GLSL
 #define ALPENGLOW_SINGLE_PASS_TILES_GLSL
@@ -21,20 +22,9 @@
 #define SPLAT_SINGLE_PASS
 #endif
 #include "splat_setup.glsl"
+#include "single_pass_radix.glsl"
 
 #define TILE_SIZE 16u
-
-layout(set = 0, binding = 2, std430) coherent buffer TileBins { uint w[]; } g_tile_bins[];
-
-// One entry of a tile's list: the depth key (a positive float's bits, so
-// that unsigned order is numeric order), the instance record and the
-// splat's index in the draw.
-struct TileEntry {
-    uint key;
-    uint record;
-    uint index;
-};
-layout(set = 0, binding = 2, std430) coherent buffer TileEntries { TileEntry e[]; } g_tile_entries[];
 
 // Tiles per row and per column of the view.
 uvec2 tile_grid() {
@@ -63,9 +53,15 @@ bool splat_tiles(SplatSetup v, out uvec2 lo, out uvec2 hi) {
     return any_pixel;
 }
 
-// The depth key of a splat: its centre's distance from the eye.
-uint splat_depth_key(SplatSetup v) {
+// The depth of a splat: its centre's distance from the eye, as the bits of
+// a positive float (unsigned order is numeric order).
+uint splat_depth_bits(SplatSetup v) {
     return floatBitsToUint(length(v.position.xyz));
+}
+
+// The bits of a tile index among `tiles` (at least 1).
+uint tile_bits(uint tiles) {
+    return tiles > 1u ? uint(findMSB(tiles - 1u)) + 1u : 1u;
 }
 
 #endif

@@ -70,6 +70,9 @@ layout(push_constant) uniform Push {
     uvec4 single;   // single-pass (§10.4): interlock: pixel words, pixel sums, depth buffer (sampled; NO_HANDLE: cleared), splats of the draw;
                     // tiles: see glsl/include/single_pass_tiles.glsl
 #endif
+#ifdef SPLAT_SINGLE_PASS_BIN
+    uvec4 bin;      // single-pass tiles' binning (glsl/points/single_pass_bin.comp): group buffer, the draw's first group, -, -
+#endif
 } pc;
 
 

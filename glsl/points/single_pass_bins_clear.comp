@@ -1,6 +1,7 @@
 #version 460
-// points.single_pass.clear (dissertation §10.4): every tile's count 0
-// before points.single_pass.count (glsl/include/single_pass_tiles.glsl).
+// points.single_pass.clear (dissertation §10.4): every tile's count and the
+// sort state 0 before points.single_pass.count
+// (glsl/include/single_pass_tiles.glsl, glsl/include/single_pass_radix.glsl).
 #include "../include/heap.glsl"
 
 layout(local_size_x = 64) in;
@@ -8,7 +9,7 @@ layout(local_size_x = 64) in;
 layout(set = 0, binding = 2, std430) writeonly buffer TileBins { uint w[]; } g_tile_bins[];
 
 layout(push_constant) uniform Push {
-    uvec4 p;  // bins, tiles, unused, unused
+    uvec4 p;  // bins, words (tiles + sort state), unused, unused
 } pc;
 
 void main() {

@@ -1,68 +1,85 @@
 #version 460
-// points.single_pass.prefix (dissertation §10.4): one workgroup scans the
-// tiles' counts in tile order (256 tiles a step, carried over), giving each
-// tile its list's offset in the entry buffer, its kept length and a cursor
-// of 0 (glsl/include/single_pass_tiles.glsl). A list that would end beyond
-// the buffer's capacity is dropped whole (kept = 0), and so is every later
-// one: which entries are lost depends only on the counts, never on the
-// order of the GPU's invocations. The dropped entries and the longest list
-// are added to the frame's splat counters (PointFrameStats).
-#include "../include/heap.glsl"
+// points.single_pass.prefix (dissertation §10.4): one workgroup turns the
+// binning's counts into the sort's state (glsl/include/single_pass_tiles.glsl):
+//   - the workgroups' entry counts into their exclusive prefix (each
+//     invocation sums a run of consecutive groups, one invocation scans the
+//     runs' sums): where points.single_pass.scatter writes each workgroup's
+//     entries, and the frame's entries N;
+//   - the entries sorted, M = min(N, capacity), and the radix sort's blocks;
+//   - the key's depth bits (32 − the tile index's bits) and the shift that
+//     fits the frame's depth range (greatest − least depth bits) into them;
+//   - the longest tile list, added to the frame's splat counters
+//     (PointFrameStats); the dropped entries are counted by
+//     points.single_pass.merge, which drops the lists the capacity cut.
+// Only the counts decide all of it, never the order of the GPU's invocations.
+#include "../include/single_pass_radix.glsl"
 #include "../include/splat_counter.glsl"
+
+#define INVOCATIONS 256u
 
 layout(local_size_x = 256) in;
 
-layout(set = 0, binding = 2, std430) buffer TileBins { uint w[]; } g_tile_bins[];
-
 layout(push_constant) uniform Push {
     uvec4 p;  // bins, tiles, capacity (entries), counter (0xffffffff: none)
+    uvec4 q;  // group buffer, groups of the frame's draws, -, -
 } pc;
 
-shared uint s_scan[256];
-shared uint s_carry;
+shared uint s_sum[INVOCATIONS];
+shared uint s_longest[INVOCATIONS];
+
+// a + b, saturated at 2³² − 1 (a sum past it cannot fit any capacity).
+uint add_saturated(uint a, uint b) {
+    uint sum = a + b;
+    return sum < a ? 0xffffffffu : sum;
+}
 
 void main() {
     uint t = gl_LocalInvocationIndex;
     uint bins = pc.p.x, tiles = pc.p.y, capacity = pc.p.z;
-    if (t == 0u) {
-        s_carry = 0u;
+    uint groups = pc.q.x, group_count = pc.q.y;
+    uint run = (group_count + INVOCATIONS - 1u) / INVOCATIONS;
+    uint first = min(t * run, group_count), end = min(first + run, group_count);
+    uint sum = 0u;
+    for (uint g = first; g < end; ++g) {
+        sum = add_saturated(sum, g_tile_bins[groups].w[g]);
     }
-    uint dropped = 0u;
+    s_sum[t] = sum;
     uint longest = 0u;
-    for (uint base = 0u; base < tiles; base += 256u) {
-        uint tile = base + t;
-        uint count = tile < tiles ? g_tile_bins[bins].w[tile] : 0u;
-        s_scan[t] = count;
-        barrier();
-        for (uint d = 1u; d < 256u; d <<= 1u) {
-            uint add = t >= d ? s_scan[t - d] : 0u;
-            barrier();
-            s_scan[t] += add;
-            barrier();
-        }
-        // Saturating: a sum past 2³² − 1 cannot fit any capacity anyway.
-        uint carry = s_carry;
-        uint inclusive = carry + s_scan[t];
-        inclusive = inclusive < carry ? 0xffffffffu : inclusive;
-        if (tile < tiles) {
-            bool fits = inclusive <= capacity;
-            g_tile_bins[bins].w[tiles + tile] = inclusive - count;
-            g_tile_bins[bins].w[2u * tiles + tile] = fits ? count : 0u;
-            g_tile_bins[bins].w[3u * tiles + tile] = 0u;
-            dropped += fits ? 0u : count;
-            longest = max(longest, count);
-        }
-        barrier();
-        if (t == 255u) {
-            s_carry = inclusive;
-        }
-        barrier();
+    for (uint tile = t; tile < tiles; tile += INVOCATIONS) {
+        longest = max(longest, g_tile_bins[bins].w[tile]);
     }
-    uint counter = pc.p.w;
-    if (counter != 0xffffffffu) {
-        if (dropped > 0u) {
-            atomicAdd(g_splat_counters[counter].tile_entries_dropped, dropped);
+    s_longest[t] = longest;
+    barrier();
+    if (t == 0u) {
+        uint total = 0u;
+        for (uint i = 0u; i < INVOCATIONS; ++i) {
+            uint s = s_sum[i];
+            s_sum[i] = total;
+            total = add_saturated(total, s);
+            longest = max(longest, s_longest[i]);
         }
-        atomicMax(g_splat_counters[counter].longest_tile_list, longest);
+        uint sorted = min(total, capacity);
+        uint least = ~g_tile_bins[bins].w[tiles + STATE_LEAST_COMPLEMENT];
+        uint greatest = g_tile_bins[bins].w[tiles + STATE_GREATEST];
+        uint span = greatest >= least ? greatest - least : 0u;
+        uint span_bits = span == 0u ? 0u : uint(findMSB(span)) + 1u;
+        uint depth_bits = 32u - (tiles > 1u ? uint(findMSB(tiles - 1u)) + 1u : 1u);
+        g_tile_bins[bins].w[tiles + STATE_ENTRIES] = total;
+        g_tile_bins[bins].w[tiles + STATE_SORTED] = sorted;
+        g_tile_bins[bins].w[tiles + STATE_SHIFT] = span_bits > depth_bits ? span_bits - depth_bits : 0u;
+        g_tile_bins[bins].w[tiles + STATE_LEAST] = greatest >= least ? least : 0u;
+        g_tile_bins[bins].w[tiles + STATE_DEPTH_BITS] = depth_bits;
+        g_tile_bins[bins].w[tiles + STATE_BLOCKS] = (sorted + RADIX_BLOCK - 1u) / RADIX_BLOCK;
+        uint counter = pc.p.w;
+        if (counter != 0xffffffffu) {
+            atomicMax(g_splat_counters[counter].longest_tile_list, longest);
+        }
+    }
+    barrier();
+    uint offset = s_sum[t];
+    for (uint g = first; g < end; ++g) {
+        uint count = g_tile_bins[groups].w[g];
+        g_tile_bins[groups].w[g] = offset;
+        offset = add_saturated(offset, count);
     }
 }

@@ -12,11 +12,12 @@
 //! | `points.opaque` | opaque | opaque discs with ray–plane depth, shaded directly, with normal and ids |
 //! | `points.clear`, `points.opaque`, `points.opaque.resolve` | opaque, compute path | the nearest (depth, splat index) word per pixel by 64-bit `atomicMax`, the winner shaded per pixel ([`compute_opaque`]) |
 //! | `points.single_pass.triangles` | single-pass | hybrid triangles as opaque shaded triangles with depth, when the scene has any |
-//! | `points.single_pass.clear` | single-pass, compute | every tile's entry count 0 (§10.4; interlock: every pixel's state z_d = +inf, sums 0) |
-//! | `points.single_pass.count` | single-pass, compute | per splat: EWA set-up, bounding box → 16×16-pixel tiles, each tile's count + 1 |
-//! | `points.single_pass.prefix` | single-pass, compute | one workgroup: each tile's list offset; lists past the entry buffer's capacity dropped whole and counted |
-//! | `points.single_pass.scatter` | single-pass, compute | per splat again: (depth key, record, index) into each tile's list |
-//! | `points.single_pass.merge` | single-pass, compute | a workgroup per tile: list sorted by (depth key, record, index), the fuzzy depth test (§10.4) front to back per pixel, normalised and shaded, written once |
+//! | `points.single_pass.clear` | single-pass, compute | every tile's entry count and the sort state 0 (§10.4; interlock: every pixel's state z_d = +inf, sums 0) |
+//! | `points.single_pass.count` | single-pass, compute | per splat: EWA set-up, bounding box → 16×16-pixel tiles, each tile's count + 1, the depth range, each workgroup's entries |
+//! | `points.single_pass.prefix` | single-pass, compute | one workgroup: each binning workgroup's first entry, the frame's entries, the sort key's layout |
+//! | `points.single_pass.scatter` | single-pass, compute | per splat again: (key = tile, depth; record, index) at positions fixed by draw order |
+//! | `points.single_pass.radix{0..3}.{count,scan,scatter}` | single-pass, compute | a stable LSD radix sort of the entries' keys, 8 bits a pass: each tile's list a slice, front to back |
+//! | `points.single_pass.merge` | single-pass, compute | a workgroup per tile: its sorted slice (dropped whole and counted if the capacity cut it), the fuzzy depth test (§10.4) front to back per pixel, normalised and shaded, written once |
 //! | `points.single_pass` | single-pass, interlock | raster pass: every splat fragment merged with the fuzzy depth test (§10.4) in a pixel-ordered critical section |
 //! | `points.single_pass.resolve` | single-pass, interlock | compute: as `points.normalize`, from the pixel state |
 //!
@@ -71,9 +72,10 @@ pub enum SplatMode {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum SplatBackend {
     /// Compute passes, tile-binned (§10.4 with the tile order of 3D Gaussian
-    /// splatting): the splats' boxes binned into 16×16-pixel tiles, each
-    /// tile's list sorted by (centre distance, instance record, index) and
-    /// merged front to back per pixel in registers, then shaded. No locks,
+    /// splatting): the splats' boxes binned into 16×16-pixel tiles, the
+    /// entries radix-sorted by (tile, centre distance; ties in draw order)
+    /// and each tile's list merged front to back per pixel in registers,
+    /// then shaded. No locks,
     /// deterministic (two renders are byte-identical), the same on every
     /// device. Tile entries beyond the entry buffer's capacity drop whole
     /// tiles' lists, counted in [`PointFrameStats::tile_entries_dropped`].

@@ -42,8 +42,7 @@ pub struct PointFrameStats {
     /// no splats; 0 in the other modes; None without GPU counters).
     pub tile_entries_dropped: Option<u64>,
     /// Single-pass splatting, compute backend: the longest tile list (the
-    /// largest over the views; lists longer than the shared-memory sort's
-    /// 896 entries are sorted in global memory).
+    /// largest over the views; the merge walks it in one workgroup).
     pub longest_tile_list: Option<u64>,
     /// CPU time of the selection (prefix search, transforms), milliseconds.
     pub cpu_ms: f64,

@@ -12,7 +12,7 @@ use super::gpu_layout::{frame_header, gaussian_table, pack_nodes, FrameHeader, H
 use super::object_space::ObjectSpaceResources;
 use super::passes::{declare_ewa, declare_opaque, PointBuffers, PointView};
 use super::selection::{plan_frame_into, FramePlan, ObjectLayout};
-use super::single_pass::{check_backend, declare_single_pass, entry_capacity};
+use super::single_pass::{check_backend, declare_single_pass, entry_capacity, TileCapacity};
 use super::stats::{PointFrameStats, StatsLog};
 use super::triangles::TriangleBuffer;
 use super::{SplatMode, SplatPrimitive, SplatSettings};
@@ -309,7 +309,11 @@ impl<S: Provides<PointsFrame> + 'static> Declare<S> for PointRenderer {
                 targets,
                 (
                     self.settings.backend,
-                    entry_capacity(self.planned_splats(), ctx.max_storage_buffer_range()),
+                    TileCapacity {
+                        entries: entry_capacity(self.planned_splats(), ctx.max_storage_buffer_range()),
+                        splats: self.planned_splats(),
+                        draws: records,
+                    },
                 ),
             )?,
         }

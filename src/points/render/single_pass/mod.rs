@@ -19,23 +19,34 @@
 //! which a pixel's fragments arrive. Both backends fix that order:
 //!
 //! Passes of a view, compute backend ([`SplatBackend::Compute`], [`tiles`]):
-//! the splats binned into 16×16-pixel screen tiles and each tile's list
-//! merged front to back (the depth order of 3D Gaussian splatting's tile
-//! renderer, with §10.4's operator), deterministic and lock-free:
+//! the splats binned into 16×16-pixel screen tiles, the tile entries sorted
+//! by (tile, depth) with a GPU radix sort, and each tile's slice merged
+//! front to back (the depth order of 3D Gaussian splatting's tile renderer,
+//! with §10.4's operator), deterministic and lock-free, one dispatch chain
+//! with no CPU round trip:
 //! 1. `points.single_pass.triangles` (only with hybrid triangles, §10.1.8):
 //!    the triangles opaque and shaded, with depth, so splats test against them;
-//! 2. `points.single_pass.clear`: every tile's entry count 0;
+//! 2. `points.single_pass.clear`: every tile's entry count and the sort state 0;
 //! 3. `points.single_pass.count`: a dispatch per planned draw, one
 //!    invocation per splat: the EWA set-up, its bounding box's tiles, each
-//!    tile's count + 1 (and the interval-passed and drawn splats counted);
-//! 4. `points.single_pass.prefix`: one workgroup scans the counts into each
-//!    tile's list offset; lists past the entry buffer's capacity are dropped
-//!    whole and counted ([`super::PointFrameStats::tile_entries_dropped`]);
-//! 5. `points.single_pass.scatter`: the same dispatches again, each tile
-//!    entry (depth key, record, index) written at its list's offset + a cursor;
-//! 6. `points.single_pass.merge`: one workgroup per tile sorts its list by
-//!    (depth key, record, index), a total order, and every pixel applies the
-//!    operator to the sorted splats in registers, then is normalised, shaded
+//!    tile's count + 1, the frame's depth range, each workgroup's entries
+//!    (and the interval-passed and drawn splats counted);
+//! 4. `points.single_pass.prefix`: one workgroup: each binning workgroup's
+//!    first entry (an exclusive prefix in draw order), the frame's entries
+//!    and the key's layout: the tile index in the high bits, the centre
+//!    distance's float bits less the frame's least below, shifted to fit;
+//! 5. `points.single_pass.scatter`: the same dispatches again, each splat's
+//!    entries (key, record, index) written at positions fixed by the draws'
+//!    order, none past the entry buffer's capacity;
+//! 6. `points.single_pass.radix{0..3}.{count,scan,scatter}` ([`radix`]): a
+//!    stable LSD radix sort of the 32-bit keys, 8 bits a pass: equal keys
+//!    keep draw order, so the sorted entries are the same on every run;
+//! 7. `points.single_pass.merge`: one workgroup per tile finds its slice of
+//!    the sorted entries by binary search (a list the capacity cut short is
+//!    dropped whole and counted, [`super::PointFrameStats::tile_entries_dropped`]),
+//!    and walks it in batches of 32 splats set up in shared memory: every
+//!    pixel applies the operator to the batch's splats whose boxes touch its
+//!    4×2-pixel block, in order, in registers, then is normalised, shaded
 //!    and written once.
 //!
 //! Interlock backend ([`SplatBackend::Interlock`], [`interlock`]):
@@ -46,13 +57,14 @@
 //! pixel: divide and shade).
 
 mod interlock;
+mod radix;
 mod tiles;
 
 use bytemuck::{Pod, Zeroable};
 
-pub(super) use tiles::entry_capacity;
 #[cfg(test)]
 pub(crate) use tiles::with_entry_capacity;
+pub(super) use tiles::{entry_capacity, TileCapacity};
 
 use super::passes::{declare_opaque, PointBuffers, PointView, ResolvedTargets, SplatPush};
 use super::{PointsFrame, SplatBackend, SplatPrimitive};
@@ -175,15 +187,15 @@ struct ViewPasses<'a> {
 }
 
 /// The passes of single-pass splatting of one view (see the module's
-/// list); `name` gives a pass's name for the view; `capacity`: the tile
-/// entries the compute backend's entry buffer holds ([`entry_capacity`]).
+/// list); `name` gives a pass's name for the view; `capacity`: what the
+/// compute backend's buffers are sized for ([`entry_capacity`] entries).
 pub(super) fn declare_single_pass<S: Provides<PointsFrame> + 'static>(
     ctx: &Context,
     graph: &mut RenderGraph<Frame<S>>,
     name: &dyn Fn(&str) -> String,
     (buffers, view): (PointBuffers, PointView),
     targets: &SceneTargets,
-    (backend, capacity): (SplatBackend, u32),
+    (backend, capacity): (SplatBackend, TileCapacity),
 ) -> Result<()> {
     check_backend(ctx, backend)?;
     // Hybrid triangles (§10.1.8) as opaque shaded triangles with depth, W = 1,

@@ -2,17 +2,21 @@
 //! [`super::SplatBackend::Compute`]): tile-binned, ordered, lock-free and
 //! deterministic. The passes are listed in the module doc of [`super`];
 //! the shaders are `glsl/points/single_pass_{bins_clear,bin,prefix,tile}.comp`
-//! with `glsl/include/single_pass_tiles.glsl` (layouts) and
-//! `glsl/include/single_pass_sort.glsl` (the per-tile sort).
+//! with `glsl/include/single_pass_tiles.glsl` (layouts), and the radix sort's
+//! ([`radix`]) `glsl/points/single_pass_radix_{count,scan,scatter}.comp` with
+//! `glsl/include/single_pass_radix.glsl`.
 //!
-//! Capacity: the entry buffer holds [`entry_capacity`] entries, fixed when
+//! Capacity: the entry buffers hold [`entry_capacity`] entries, fixed when
 //! the graph is declared (the entry count is only known on the GPU, and
-//! nothing waits for it on the CPU). `points.single_pass.prefix` keeps the
-//! tiles' lists in tile order while they fit and drops every later list
-//! whole: those tiles show no splats, nothing is written out of bounds, the
-//! same tiles are dropped on every run, and the dropped entries are counted
-//! into the frame's splat counters: [`PointFrameStats::tile_entries_dropped`]
-//! (logged as a warning when the frame's statistics are read).
+//! nothing waits for it on the CPU; every sort pass is dispatched for the
+//! capacity and its workgroups past the entries return at once).
+//! `points.single_pass.scatter` writes the entries whose positions fall
+//! below the capacity, and `points.single_pass.merge` drops every tile
+//! whose list was cut short whole: those tiles show no splats, nothing is
+//! written out of bounds, the same tiles are dropped on every run, and
+//! their entries are counted into the frame's splat counters:
+//! [`PointFrameStats::tile_entries_dropped`] (logged as a warning when the
+//! frame's statistics are read).
 //!
 //! [`PointFrameStats::tile_entries_dropped`]: super::super::PointFrameStats::tile_entries_dropped
 
@@ -23,7 +27,8 @@ use super::super::passes::{
     PASS_OPAQUE,
 };
 use super::super::PointsFrame;
-use super::{declare_clear, workgroups, ResolvedPush, SinglePassPush, ViewPasses, Written};
+use super::radix::{self, RADIX_BLOCK};
+use super::{declare_clear, workgroups, ResolvedPush, SinglePassPush, ViewPasses, Written, WORKGROUP_SIZE};
 use crate::error::Result;
 use crate::graph::{Binding, BufferAccess, BufferId, BufferInfo, ImageAccess, PassContext, RenderGraph, Stage};
 use crate::shaders;
@@ -32,17 +37,18 @@ use crate::vulkan::{ComputePipeline, Context, MemoryLocation};
 
 /// Pixels per side of a screen tile (`TILE_SIZE` in glsl/include/single_pass_tiles.glsl).
 pub(crate) const TILE_SIZE: u32 = 16;
-/// Bytes of a tile entry (`TileEntry`: depth key, record, index).
+/// Bytes of a tile entry (`TileEntry`: sort key, record, index).
 const ENTRY_BYTES: u64 = 12;
-/// Words per tile in the bins buffer: count, offset, kept length, cursor.
-const BIN_WORDS: u64 = 4;
+/// Words of the sort state after the tiles' counts in the bins buffer
+/// (glsl/include/single_pass_radix.glsl).
+const STATE_WORDS: u32 = 8;
 /// Entries per splat the scene could plan (a splat's box touches about one
 /// to four tiles at the sizes an SPT selects).
 const ENTRIES_PER_SPLAT: u64 = 4;
 /// Fewest entries of a buffer (768 KiB).
 const MIN_ENTRIES: u64 = 1 << 16;
-/// Most entries of a buffer (384 MiB), where the device's storage buffer range allows.
-const MAX_ENTRIES: u64 = 1 << 25;
+/// Most entries of a buffer (192 MiB; two of them), where the device's storage buffer range allows.
+const MAX_ENTRIES: u64 = 1 << 24;
 /// `pc.single.z` of `points.single_pass.count` and `.scatter`.
 const PHASE_COUNT: u32 = 0;
 const PHASE_SCATTER: u32 = 1;
@@ -62,10 +68,10 @@ pub(crate) fn with_entry_capacity<R>(capacity: u32, f: impl FnOnce() -> R) -> R 
     result
 }
 
-/// The tile entries of a view's entry buffer for a scene whose instances'
+/// The tile entries of a view's entry buffers for a scene whose instances'
 /// lists hold `planned_splats` splats together (the most a frame can plan):
-/// [`ENTRIES_PER_SPLAT`] each, at least 2¹⁶ and at most 2²⁵ (384 MiB) or
-/// what `max_range` bytes (the device's `maxStorageBufferRange`) hold.
+/// [`ENTRIES_PER_SPLAT`] each, at least 2¹⁶ and at most 2²⁴ (192 MiB a
+/// buffer) or what `max_range` bytes (the device's `maxStorageBufferRange`) hold.
 pub(crate) fn entry_capacity(planned_splats: u64, max_range: u64) -> u32 {
     #[cfg(test)]
     if let Some(capacity) = CAPACITY_OVERRIDE.with(|c| c.get()) {
@@ -78,21 +84,53 @@ pub(crate) fn entry_capacity(planned_splats: u64, max_range: u64) -> u32 {
     u32::try_from(entries).unwrap_or(u32::MAX)
 }
 
-/// A view's tiles and its two buffers.
+/// What the compute backend's buffers of a view are sized for.
 #[derive(Clone, Copy, Debug)]
-struct TileBins {
-    /// [`BIN_WORDS`] words per tile (`glsl/include/single_pass_tiles.glsl`).
-    bins: BufferId,
-    /// `capacity` entries.
-    entries: BufferId,
+pub(crate) struct TileCapacity {
+    /// Tile entries ([`entry_capacity`]).
+    pub entries: u32,
+    /// The most splats a frame can plan.
+    pub splats: u64,
+    /// The most draws a frame can plan.
+    pub draws: u64,
+}
+
+impl TileCapacity {
+    /// Workgroups of the binning passes a frame can dispatch: one word
+    /// each in the group buffer.
+    fn groups(&self) -> u32 {
+        let groups = self.splats.div_ceil(u64::from(WORKGROUP_SIZE)) + self.draws;
+        u32::try_from(groups.max(1)).unwrap_or(u32::MAX)
+    }
+}
+
+/// A view's tiles and its buffers.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct TileBins {
+    /// One word per tile, then [`STATE_WORDS`] (`glsl/include/single_pass_radix.glsl`).
+    pub bins: BufferId,
+    /// `capacity` entries: the binning's output and the sorted entries.
+    pub entries: BufferId,
+    /// `capacity` entries: the radix sort's other buffer.
+    pub scratch: BufferId,
+    /// One word per workgroup of the binning passes.
+    groups: BufferId,
+    /// Per (digit, radix block) of the capacity: a count, then a position.
+    pub digits: BufferId,
     /// Tiles per row and per column.
     grid: [u32; 2],
-    capacity: u32,
+    pub capacity: u32,
+    group_capacity: u32,
 }
 
 impl TileBins {
-    fn tiles(&self) -> u32 {
+    pub fn tiles(&self) -> u32 {
         self.grid[0] * self.grid[1]
+    }
+
+    /// Radix blocks of the capacity: the stride of the digit rows.
+    pub fn blocks(&self) -> u32 {
+        self.capacity.div_ceil(RADIX_BLOCK)
     }
 }
 
@@ -105,12 +143,12 @@ struct Pipelines {
 }
 
 /// The compute backend's passes of one view (see [`super`]); `capacity`:
-/// the entry buffer's entries.
+/// what its buffers are sized for.
 pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
     ctx: &Context,
     graph: &mut RenderGraph<Frame<S>>,
     at: ViewPasses<'_>,
-    capacity: u32,
+    capacity: TileCapacity,
 ) -> Result<()> {
     let (name, targets, written) = (at.name, at.targets, at.written);
     let (buffers, view) = (at.buffers, at.view);
@@ -121,19 +159,25 @@ pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
         merge: ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS_TILE)?,
     };
     let grid = [targets.width, targets.height].map(|n| n.div_ceil(TILE_SIZE).max(1));
-    let capacity = capacity.max(1);
+    let entries = capacity.entries.max(1);
+    let group_capacity = capacity.groups();
     let buffer = |graph: &mut RenderGraph<Frame<S>>, what, size: u64| {
         let location = MemoryLocation::GpuOnly;
         graph.create_buffer(what, BufferInfo { size, location })
     };
+    let blocks = u64::from(entries.div_ceil(RADIX_BLOCK));
     let tiles = TileBins {
-        bins: buffer(graph, "splat tile bins", BIN_WORDS * 4 * u64::from(grid[0] * grid[1])),
-        entries: buffer(graph, "splat tile entries", ENTRY_BYTES * u64::from(capacity)),
+        bins: buffer(graph, "splat tile bins", 4 * u64::from(grid[0] * grid[1] + STATE_WORDS)),
+        entries: buffer(graph, "splat tile entries", ENTRY_BYTES * u64::from(entries)),
+        scratch: buffer(graph, "splat tile entries (sort)", ENTRY_BYTES * u64::from(entries)),
+        groups: buffer(graph, "splat tile groups", 4 * u64::from(group_capacity)),
+        digits: buffer(graph, "splat tile digits", 4 * radix::DIGITS * blocks),
         grid,
-        capacity,
+        capacity: entries,
+        group_capacity,
     };
-    // Every tile's count 0 (the first of its four words).
-    let cleared = (&[tiles.bins][..], tiles.tiles());
+    // Every tile's count and the sort state 0.
+    let cleared = (&[tiles.bins][..], tiles.tiles() + STATE_WORDS);
     declare_clear(graph, &name("points.single_pass.clear"), cleared, pipelines.clear);
     let bin = std::sync::Arc::new(pipelines.bin);
     let count = (name("points.single_pass.count"), PHASE_COUNT);
@@ -141,21 +185,51 @@ pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
     declare_prefix(
         graph,
         &name("points.single_pass.prefix"),
-        buffers.counter,
+        (buffers.counter, view),
         tiles,
         pipelines.prefix,
     );
     let scatter = (name("points.single_pass.scatter"), PHASE_SCATTER);
     declare_binning(graph, scatter, (buffers, view), tiles, bin);
+    radix::declare(ctx, graph, name, tiles)?;
     let merge = (name("points.single_pass.merge"), pipelines.merge);
     declare_merge(graph, merge, (buffers, view), targets, (tiles, written));
     Ok(())
 }
 
+/// Push constants of the binning passes (`Push` in glsl/include/splat.glsl
+/// with `SPLAT_SINGLE_PASS_BIN`).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct BinPush {
+    single: SinglePassPush,
+    /// The group buffer, the draw's first workgroup in it.
+    bin: [u32; 4],
+}
+
+/// The first workgroup in the group buffer of each of the frame's draws
+/// (splat counts `counts`) that fit `group_capacity` workgroups (later
+/// draws are not binned; the capacity holds every draw a frame can plan),
+/// and the workgroups of those draws.
+fn draw_groups(counts: impl Iterator<Item = u32>, group_capacity: u32) -> (Vec<u32>, u32) {
+    let mut first = 0u32;
+    let mut firsts = Vec::new();
+    for count in counts {
+        let groups = count.div_ceil(WORKGROUP_SIZE);
+        if first.saturating_add(groups) > group_capacity {
+            break;
+        }
+        firsts.push(first);
+        first += groups;
+    }
+    (firsts, first)
+}
+
 /// `points.single_pass.count` (`phase` [`PHASE_COUNT`]: the tiles' counts,
-/// and the splats counted) or `points.single_pass.scatter` ([`PHASE_SCATTER`]:
-/// the entries written): one dispatch per planned draw, one invocation per
-/// splat (`glsl/points/single_pass_bin.comp`).
+/// the depth range, each workgroup's entries, and the splats counted) or
+/// `points.single_pass.scatter` ([`PHASE_SCATTER`]: the entries written):
+/// one dispatch per planned draw, one invocation per splat
+/// (`glsl/points/single_pass_bin.comp`).
 fn declare_binning<S: Provides<PointsFrame> + 'static>(
     graph: &mut RenderGraph<Frame<S>>,
     (name, phase): (String, u32),
@@ -164,27 +238,41 @@ fn declare_binning<S: Provides<PointsFrame> + 'static>(
     pipeline: std::sync::Arc<ComputePipeline>,
 ) {
     let compute = Stage::Compute;
+    let counting = phase == PHASE_COUNT;
     let mut builder = graph.pass(&name);
     let frame = builder.upload(view.frame, compute);
-    let bins = builder.storage_buffer(tiles.bins, BufferAccess::StorageReadWrite(compute));
-    let entries =
-        (phase == PHASE_SCATTER).then(|| builder.storage_buffer(tiles.entries, BufferAccess::StorageWrite(compute)));
+    let (bins, groups) = match counting {
+        true => (
+            builder.storage_buffer(tiles.bins, BufferAccess::StorageReadWrite(compute)),
+            builder.storage_buffer(tiles.groups, BufferAccess::StorageWrite(compute)),
+        ),
+        false => (
+            builder.storage_buffer(tiles.bins, BufferAccess::StorageRead(compute)),
+            builder.storage_buffer(tiles.groups, BufferAccess::StorageRead(compute)),
+        ),
+    };
+    let entries = (!counting).then(|| builder.storage_buffer(tiles.entries, BufferAccess::StorageWrite(compute)));
     let buffers = PointBuffers {
-        counter: buffers.counter.filter(|_| phase == PHASE_COUNT),
+        counter: buffers.counter.filter(|_| counting),
         ..buffers
     };
     let (builder, splat) = buffers.read_by_at(builder, frame, (compute, compute));
     builder.record(move |pass, frame| {
         let plan = plan_of(frame, view.index)?;
         let entries = entries.map(|e| pass.handle(e)).transpose()?.unwrap_or(NO_HANDLE);
-        let mut push = SinglePassPush {
-            splat: splat.push(pass, PASS_OPAQUE)?,
-            single: [pass.handle(bins)?, entries, phase, 0],
+        let mut push = BinPush {
+            single: SinglePassPush {
+                splat: splat.push(pass, PASS_OPAQUE)?,
+                single: [pass.handle(bins)?, entries, phase, 0],
+            },
+            bin: [pass.handle(groups)?, 0, 0, 0],
         };
+        let (firsts, _) = draw_groups(plan.draws.iter().map(|d| d.count), tiles.group_capacity);
         let cmd = pass.cmd();
         cmd.bind_compute(&pipeline);
-        for d in &plan.draws {
-            (push.splat.record, push.single[3]) = (d.record, d.count);
+        for (d, first) in plan.draws.iter().zip(firsts) {
+            (push.single.splat.record, push.single.single[3]) = (d.record, d.count);
+            push.bin[1] = first;
             cmd.push_constants(&push)?;
             let (x, y) = workgroups(d.count);
             cmd.dispatch(x, y, 1);
@@ -193,23 +281,29 @@ fn declare_binning<S: Provides<PointsFrame> + 'static>(
     });
 }
 
-/// `points.single_pass.prefix`: one workgroup: each tile's offset, kept
-/// length and cursor; dropped entries and the longest list into `counter`
-/// (`glsl/points/single_pass_prefix.comp`).
+/// `points.single_pass.prefix`: one workgroup: each binning workgroup's
+/// first entry, the frame's entries, the sort's state; the longest list
+/// into `counter` (`glsl/points/single_pass_prefix.comp`).
 fn declare_prefix<S: Provides<PointsFrame> + 'static>(
     graph: &mut RenderGraph<Frame<S>>,
     name: &str,
-    counter: Option<BufferId>,
+    (counter, view): (Option<BufferId>, PointView),
     tiles: TileBins,
     pipeline: ComputePipeline,
 ) {
     let compute = Stage::Compute;
     let mut pass = graph.pass(name);
     let bins = pass.storage_buffer(tiles.bins, BufferAccess::StorageReadWrite(compute));
+    let groups = pass.storage_buffer(tiles.groups, BufferAccess::StorageReadWrite(compute));
     let counter = counter.map(|c| pass.storage_buffer(c, BufferAccess::StorageReadWrite(compute)));
-    pass.record(move |ctx, _| {
+    pass.record(move |ctx, frame| {
+        let plan = plan_of(frame, view.index)?;
+        let (_, group_count) = draw_groups(plan.draws.iter().map(|d| d.count), tiles.group_capacity);
         let counter = counter.map(|c| ctx.handle(c)).transpose()?.unwrap_or(NO_HANDLE);
-        let push = [ctx.handle(bins)?, tiles.tiles(), tiles.capacity, counter];
+        let push = [
+            [ctx.handle(bins)?, tiles.tiles(), tiles.capacity, counter],
+            [ctx.handle(groups)?, group_count, 0, 0],
+        ];
         ctx.dispatch(&pipeline, &push, [1, 1, 1])
     });
 }
@@ -253,8 +347,9 @@ impl MergeBindings {
     }
 }
 
-/// `points.single_pass.merge`: one workgroup per tile sorts its list, merges
-/// the splats front to back per pixel with the fuzzy-depth operator and
+/// `points.single_pass.merge`: one workgroup per tile finds its slice of
+/// the sorted entries (dropping it whole, and counting it, when the
+/// capacity cut it short), merges the splats front to back per pixel with the fuzzy-depth operator and
 /// writes each pixel once, normalised and shaded (W = 0 where no splat is
 /// unless the triangles wrote it; `glsl/points/single_pass_tile.comp`).
 fn declare_merge<S: Provides<PointsFrame> + 'static>(
@@ -272,14 +367,10 @@ fn declare_merge<S: Provides<PointsFrame> + 'static>(
     let mut builder = graph.pass(&name);
     let shading = ShadingBindings::read_in(&mut builder, (&view, targets), compute);
     let bins = builder.storage_buffer(tiles.bins, BufferAccess::StorageRead(compute));
-    // Lists longer than the shared-memory sort are sorted in place.
-    let entries = builder.storage_buffer(tiles.entries, BufferAccess::StorageReadWrite(compute));
+    let entries = builder.storage_buffer(tiles.entries, BufferAccess::StorageRead(compute));
     let depth = written.depth.then(|| builder.sample(view.depth, compute));
     let outputs = ResolvedTargets::declare(&mut builder, (&view, targets), weight);
-    let buffers = PointBuffers {
-        counter: None,
-        ..buffers
-    };
+    // The counter takes the entries of lists dropped for want of capacity.
     let (builder, splat) = buffers.read_by_at(builder, shading.frame, (compute, compute));
     let bindings = MergeBindings {
         shading,
@@ -311,7 +402,14 @@ mod tests {
         let range = u64::from(u32::MAX);
         assert_eq!(entry_capacity(0, range), 1 << 16);
         assert_eq!(entry_capacity(100_000, range), 400_000);
-        assert_eq!(entry_capacity(u64::MAX, range), 1 << 25);
+        assert_eq!(entry_capacity(u64::MAX, range), 1 << 24);
         assert_eq!(entry_capacity(u64::MAX, 1 << 27), (1 << 27) / 12);
+    }
+
+    #[test]
+    fn draws_get_consecutive_workgroups_within_the_capacity() {
+        assert_eq!(draw_groups([64, 1, 65, 0].into_iter(), 100), (vec![0, 1, 2, 4], 4));
+        assert_eq!(draw_groups([640, 64, 1].into_iter(), 10), (vec![0], 10));
+        assert_eq!(draw_groups(std::iter::empty(), 1), (vec![], 0));
     }
 }
