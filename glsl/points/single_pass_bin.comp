@@ -4,7 +4,7 @@
 // draw), the EWA set-up of glsl/include/splat_setup.glsl, then its bounding
 // box's tiles (glsl/include/single_pass_tiles.glsl):
 //   phase 0 (count):   each tile's count += 1, the least and greatest depth
-//                      kept, the workgroup's entries (the sum of its splats'
+//                      kept (reduced per workgroup), the workgroup's entries (the sum of its splats'
 //                      tiles) written to its word of the group buffer; the
 //                      splats passing the interval test and drawn are
 //                      counted as in every mode;
@@ -32,6 +32,11 @@ layout(local_size_x = 64) in;
 //          draw's first workgroup in it, -, -).
 
 shared uint s_entries[WORKGROUP_SIZE];
+// Each invocation's ~(depth bits) and depth bits (0: not binned, a no-op
+// for the atomicMax below), reduced once per workgroup: two atomics a
+// workgroup on the frame's depth range, not two a splat.
+shared uint s_least_complement[WORKGROUP_SIZE];
+shared uint s_greatest[WORKGROUP_SIZE];
 
 void main() {
     // Dispatches wider than the 65535-workgroup limit use rows of workgroups.
@@ -58,6 +63,9 @@ void main() {
     }
     uvec2 box = binned ? hi - lo : uvec2(0u);
     s_entries[gl_LocalInvocationIndex] = box.x * box.y;
+    uint bits = binned ? splat_depth_bits(v) : 0u;
+    s_least_complement[gl_LocalInvocationIndex] = binned ? ~bits : 0u;
+    s_greatest[gl_LocalInvocationIndex] = bits;
     barrier();
     uint first_group = pc.bin.y;
     bool in_draw = group * WORKGROUP_SIZE < pc.single.w;
@@ -68,13 +76,19 @@ void main() {
                 sum += s_entries[i];
             }
             g_tile_bins[groups].w[first_group + group] = sum;
+            uint least_complement = 0u, greatest = 0u;
+            for (uint i = 0u; i < WORKGROUP_SIZE; ++i) {
+                least_complement = max(least_complement, s_least_complement[i]);
+                greatest = max(greatest, s_greatest[i]);
+            }
+            if (least_complement != 0u || greatest != 0u) {
+                atomicMax(g_tile_bins[bins].w[tiles + STATE_LEAST_COMPLEMENT], least_complement);
+                atomicMax(g_tile_bins[bins].w[tiles + STATE_GREATEST], greatest);
+            }
         }
         if (!binned) {
             return;
         }
-        uint bits = splat_depth_bits(v);
-        atomicMax(g_tile_bins[bins].w[tiles + STATE_LEAST_COMPLEMENT], ~bits);
-        atomicMax(g_tile_bins[bins].w[tiles + STATE_GREATEST], bits);
         for (uint y = lo.y; y < hi.y; ++y) {
             for (uint x = lo.x; x < hi.x; ++x) {
                 atomicAdd(g_tile_bins[bins].w[y * grid.x + x], 1u);
