@@ -27,6 +27,10 @@ pub use crate::io::image_out::{
 /// Reading back the EXR files alpenglow writes, and an RGBA8 PNG encoder (the tests' fixtures).
 pub use crate::io::image_out::{encode_png_rgba8, read_exr_channels};
 pub use crate::io::limits::InputLimits;
+pub use crate::io::pyramid::{
+    write_pyramid, FieldRows, FnRows, HeightPyramid, HeightRows, HgtMosaic, PyramidOptions, PyramidSummary,
+    PyramidTile, TileKey, DEFAULT_HEIGHT_STEP, DEFAULT_RESIDENT_SIDE, DEFAULT_TILE_SIDE,
+};
 pub use crate::points::build::input::{load_points_file, PointInput};
 pub use crate::points::build::spt_file::{read_spt, write_spt};
 pub use crate::points::scene::load_point_object;

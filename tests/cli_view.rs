@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::cli::{assert_one_line_error, assert_success, fresh_dir, run, run_on_xvfb, text};
+use common::cli::{assert_one_line_error, assert_success, fresh_dir, read_rgba, run, run_on_xvfb, text};
 use common::mean_flip;
 
 const SMALL_TERRAIN: &str = "procedural:ridged,size=129,spacing=40";
@@ -28,14 +28,6 @@ fn option<'a>(stdout: &'a str, prefix: &str, name: &str) -> &'a str {
 fn vec3(text: &str) -> [f64; 3] {
     let v: Vec<f64> = text.split(',').map(|x| x.parse().unwrap()).collect();
     [v[0], v[1], v[2]]
-}
-
-fn rgba(path: &std::path::Path) -> (Vec<u8>, u32, u32) {
-    let image = image::open(path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .to_rgba8();
-    let (w, h) = image.dimensions();
-    (image.into_raw(), w, h)
 }
 
 #[test]
@@ -139,8 +131,8 @@ fn a_scripted_view_matches_the_headless_render_of_its_camera() {
     render.extend(["--sun-elevation", &e, "--sun-azimuth", &a]);
     let out = run(&render);
     assert_success("render", &out);
-    let (viewed, w, h) = rgba(&shot);
-    let (headless, rw, rh) = rgba(&reference);
+    let (viewed, w, h) = read_rgba(&shot);
+    let (headless, rw, rh) = read_rgba(&reference);
     assert_eq!((w, h), (rw, rh));
     let (flip, _) = mean_flip(&headless, &viewed, w, h);
     assert!(
@@ -226,11 +218,11 @@ fn a_rig_shows_the_view_v_selects() {
     render.extend(scene);
     let out = run(&render);
     assert_success("render with a rig", &out);
-    let (viewed, w, h) = rgba(&shot);
+    let (viewed, w, h) = read_rgba(&shot);
     assert_eq!((w, h), (96, 72), "the screenshot is one view of the rig");
     let mut flips = Vec::new();
     for name in ["front", "front_left", "rear_left", "rear"] {
-        let (headless, _, _) = rgba(&dir.join(format!("{name}.png")));
+        let (headless, _, _) = read_rgba(&dir.join(format!("{name}.png")));
         flips.push((mean_flip(&headless, &viewed, w, h).0, name));
     }
     flips.sort_by(|a, b| a.0.total_cmp(&b.0));

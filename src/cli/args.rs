@@ -48,6 +48,9 @@ pub enum Command {
     /// Height-field synthesis (§7.3): `synth fill`, `synth transition`.
     #[command(subcommand)]
     Synth(super::synth::SynthCommand),
+    /// Height pyramids for fields of any size: `dem import`, `dem info`.
+    #[command(subcommand)]
+    Dem(super::dem::DemCommand),
 }
 
 #[derive(Args, Debug, Clone)]
@@ -95,7 +98,9 @@ pub struct SceneArgs {
     /// 100 km away.
     #[arg(long, value_name = "METRES", help_heading = "Camera")]
     pub far: Option<f64>,
-    /// Height field: 16-bit PNG (value·scale + offset) or EXR (first channel, metres·scale + offset).
+    /// Height field: 16-bit PNG (value·scale + offset), EXR (first channel,
+    /// metres·scale + offset), GeoTIFF, SRTM .hgt, or a height pyramid
+    /// (.hpyr, `alpenglow dem import`; see --resident-side).
     #[arg(long, value_name = "FILE", help_heading = "Terrain")]
     pub heightmap: Option<PathBuf>,
     /// Metres between height samples: DX, or DX,DY for columns and rows,
@@ -344,6 +349,11 @@ pub struct TerrainArgs {
     /// height-sample spacing (0.15: 15 cm for 1 m samples).
     #[arg(long = "detail-amplitude", default_value_t = 0.15, value_name = "FRACTION")]
     pub detail_amplitude: f32,
+    /// Height pyramids (.hpyr): the finest level with at most this many
+    /// samples a side is held in memory as the sketch atlas (§7.4.4);
+    /// memory then does not grow with the field.
+    #[arg(long = "resident-side", default_value_t = alpenglow::files::DEFAULT_RESIDENT_SIDE, value_name = "SAMPLES", value_parser = clap::value_parser!(u32).range(2..=16384))]
+    pub resident_side: u32,
     /// Which rasterizer draws the terrain and the EWA splats: compute
     /// shaders (the terrain into a visibility buffer, then one shading pass
     /// per pixel; the splats and their shadows with 64-bit atomics; needs

@@ -2,6 +2,7 @@
 
 mod args;
 mod bench;
+mod dem;
 mod errors;
 mod exr;
 mod fly;
@@ -99,6 +100,7 @@ pub fn run() -> Result<ExitCode> {
         Command::Info(args) => info(args),
         Command::Layers(command) => layers::run(command),
         Command::Synth(command) => synth::synth(command),
+        Command::Dem(command) => dem::run(command),
     }
 }
 
@@ -233,6 +235,10 @@ fn load_terrain(args: &SceneArgs) -> Result<Scene> {
         return Ok(Scene::new(spec.generate()?));
     }
     match &args.heightmap {
+        Some(path) if is_pyramid(path) => {
+            let pyramid = alpenglow::files::HeightPyramid::open(path)?;
+            Ok(Scene::from_pyramid(&pyramid, args.terrain.resident_side)?)
+        }
         Some(path) => {
             let field = load_heightmap(
                 path,
@@ -251,6 +257,11 @@ fn load_terrain(args: &SceneArgs) -> Result<Scene> {
         }
         None => Ok(Scene::default_terrain()?),
     }
+}
+
+/// Whether `path` names a height pyramid (`.hpyr`).
+fn is_pyramid(path: &std::path::Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("hpyr"))
 }
 
 /// The input limits of `--max-input-mb`.

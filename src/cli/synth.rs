@@ -172,7 +172,7 @@ pub fn synth(command: SynthCommand) -> Result<ExitCode> {
     }
 }
 
-fn heightmap_options(args: &HeightArgs) -> HeightmapOptions {
+pub(crate) fn heightmap_options(args: &HeightArgs) -> HeightmapOptions {
     HeightmapOptions {
         scale: args.height_scale,
         offset: args.height_offset,

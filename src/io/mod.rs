@@ -12,6 +12,7 @@ pub mod hgt;
 pub mod image_out;
 pub mod limits;
 mod png_height;
+pub mod pyramid;
 
 use std::io::Read;
 use std::path::Path;

@@ -8,6 +8,7 @@ use glam::{DVec2, DVec3, Vec3};
 use crate::budget::{Footprint, MemoryLimits};
 use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
+use crate::io::pyramid::HeightPyramid;
 use crate::points::build::plants::scatter::{scatter, ScatterRule};
 use crate::points::build::spt::{epsilon_from_pixels, SptOptions};
 #[cfg(test)]
@@ -185,6 +186,34 @@ impl Scene {
             snow_line: lo + (hi - lo) * 0.8,
             ..Lighting::default()
         }
+    }
+
+    /// A scene of the height pyramid `pyramid`: its finest level with at
+    /// most `max_side` samples a side ([`HeightPyramid::level_within`])
+    /// becomes the terrain's sketch atlas in memory (§7.4.4: "a large
+    /// sketch atlas in main memory"), so memory is bounded by `max_side`,
+    /// not by the field (a 65536² field at `max_side` 4096 holds level 4,
+    /// 4097², over the field's whole extent).
+    pub fn from_pyramid(pyramid: &HeightPyramid, max_side: u32) -> Result<Scene> {
+        if !(2..=16384).contains(&max_side) {
+            return Err(Error::invalid(
+                "resident side",
+                format!("{max_side} samples (must be within 2..=16384)"),
+            ));
+        }
+        let level = pyramid.level_within(max_side);
+        let field = pyramid.level_field(level)?;
+        log::info!(
+            "{}: level {level} of {} ({}×{} samples, {:.2}×{:.2} m) resident",
+            pyramid.path().display(),
+            pyramid.levels(),
+            field.columns,
+            field.rows,
+            field.spacing.x,
+            field.spacing.y
+        );
+        field.validate(pyramid.path())?;
+        Ok(Scene::new(field))
     }
 
     /// A scene of `heights` with the default sun and no point objects.

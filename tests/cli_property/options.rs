@@ -179,6 +179,11 @@ pub const SCENE: &[Opt] = &[
     },
     opt("--terrain", Kind::Special(Special::Terrain)),
     opt("--detail-amplitude", float(0.0, 10.0)),
+    // Only read for height pyramids (.hpyr); any value is valid for others.
+    Opt {
+        scene: Scene::Heightmap,
+        ..opt("--resident-side", int(2, 16384, 16384))
+    },
     // A 2048² grid (4 M vertices warped per frame) is legal but ran past
     // 60 s on lavapipe in a debug build under load; 2049 and more are
     // generated.

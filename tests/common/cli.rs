@@ -130,6 +130,15 @@ pub fn assert_one_line_error(what: &str, out: &Output, needles: &[&str]) {
     }
 }
 
+/// The RGBA8 pixels of an image file and its size.
+pub fn read_rgba(path: &Path) -> (Vec<u8>, u32, u32) {
+    let image = image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgba8();
+    let (w, h) = image.dimensions();
+    (image.into_raw(), w, h)
+}
+
 /// The entries of `dir` (file names), sorted.
 pub fn entries(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
