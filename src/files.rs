@@ -27,6 +27,9 @@ pub use crate::io::image_out::{
 /// Reading back the EXR files alpenglow writes, and an RGBA8 PNG encoder (the tests' fixtures).
 pub use crate::io::image_out::{encode_png_rgba8, read_exr_channels};
 pub use crate::io::limits::InputLimits;
+/// GDAL rasters as height rows (feature `gdal`).
+#[cfg(feature = "gdal")]
+pub use crate::io::pyramid::GdalRows;
 pub use crate::io::pyramid::{
     write_pyramid, FieldRows, FnRows, HeightPyramid, HeightRows, HgtMosaic, PyramidOptions, PyramidSummary,
     PyramidTile, TileKey, DEFAULT_HEIGHT_STEP, DEFAULT_RESIDENT_SIDE, DEFAULT_TILE_SIDE,

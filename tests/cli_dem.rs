@@ -149,10 +149,10 @@ fn procedural_pyramid(dir: &Path, side: u32) -> PathBuf {
         (0..side)
             .map(|i| {
                 let x = i as f32;
-                let h = 400.0 * (x / 9000.0 + phase).sin()
-                    + 150.0 * (x / 2100.0 + 2.0 * phase).sin()
-                    + 40.0 * (x / 430.0 - phase).sin()
-                    + 8.0 * (x / 77.0).sin();
+                let h = 500.0 * (x / 2900.0 + phase).sin()
+                    + 220.0 * (x / 1100.0 + 2.0 * phase).sin()
+                    + 60.0 * (x / 330.0 - phase).sin()
+                    + 12.0 * (x / 77.0).sin();
                 (h / quantum).round() * quantum
             })
             .collect()
@@ -189,6 +189,8 @@ fn render_peak_memory(pyramid: &Path, png: &Path) -> u64 {
             "--height",
             "100",
         ])
+        // Over the field's south-west, looking north-east along it from 2 km up.
+        .args(["--eye", "8000,3000,2600", "--target", "9000,9000,600"])
         .arg("--heightmap")
         .arg(pyramid)
         .arg("--out")
@@ -248,4 +250,91 @@ fn a_65536_field_renders_in_bounded_memory() {
     // The pyramids go; the two PNGs stay to be looked at.
     std::fs::remove_file(&small).ok();
     std::fs::remove_file(&big).ok();
+}
+
+/// GDAL (feature `gdal`): a GeoTIFF written by GDAL itself, and a VRT
+/// mosaic of its two halves, import to the same heights as alpenglow's own
+/// GeoTIFF reader gives (two independent readers), north-up rows flipped to
+/// the field's south-up order, spacing from the geotransform.
+#[cfg(feature = "gdal")]
+#[test]
+fn gdal_rasters_and_vrt_mosaics_import_like_the_builtin_reader() {
+    use alpenglow::files::{load_heightmap, HeightPyramid};
+    use gdal::raster::Buffer;
+    use gdal::{spatial_ref::SpatialRef, DriverManager};
+
+    let dir = fresh_dir("dem-gdal");
+    let field = common::jacksboro_field();
+    let (w, h) = (field.columns as usize, field.rows as usize);
+    let driver = DriverManager::get_driver_by_name("GTiff").unwrap();
+    // Columns c0..c1 of the field as a north-up GeoTIFF in UTM 16N.
+    let write_tif = |name: &str, c0: usize, c1: usize| {
+        let path = dir.join(name);
+        let mut ds = driver.create_with_band_type::<f32, _>(&path, c1 - c0, h, 1).unwrap();
+        ds.set_geo_transform(&[500_000.0 + c0 as f64 * 74.4, 74.4, 0.0, 4_000_000.0, 0.0, -92.6])
+            .unwrap();
+        ds.set_spatial_ref(&SpatialRef::from_epsg(32616).unwrap()).unwrap();
+        let data: Vec<f32> = (0..h)
+            .flat_map(|r| (c0..c1).map(move |c| (c, h - 1 - r)))
+            .map(|(c, r)| field.height(c as u32, r as u32))
+            .collect();
+        let mut buffer = Buffer::new((c1 - c0, h), data);
+        ds.rasterband(1)
+            .unwrap()
+            .write((0, 0), (c1 - c0, h), &mut buffer)
+            .unwrap();
+        path
+    };
+    let whole = write_tif("whole.tif", 0, w);
+    let west = write_tif("west.tif", 0, 200);
+    let east = write_tif("east.tif", 200, w);
+    let vrt = dir.join("mosaic.vrt");
+    let source = |file: &Path, x0: usize, width: usize| {
+        format!(
+            "<SimpleSource><SourceFilename relativeToVRT=\"0\">{}</SourceFilename><SourceBand>1</SourceBand>\
+             <SrcRect xOff=\"0\" yOff=\"0\" xSize=\"{width}\" ySize=\"{h}\"/>\
+             <DstRect xOff=\"{x0}\" yOff=\"0\" xSize=\"{width}\" ySize=\"{h}\"/></SimpleSource>",
+            file.display()
+        )
+    };
+    std::fs::write(
+        &vrt,
+        format!(
+            "<VRTDataset rasterXSize=\"{w}\" rasterYSize=\"{h}\">\
+             <GeoTransform>500000, 74.4, 0, 4000000, 0, -92.6</GeoTransform>\
+             <VRTRasterBand dataType=\"Float32\" band=\"1\">{}{}</VRTRasterBand></VRTDataset>",
+            source(&west, 0, 200),
+            source(&east, 200, w - 200)
+        ),
+    )
+    .unwrap();
+    let builtin = load_heightmap(&whole, &alpenglow::HeightmapOptions::default()).unwrap();
+    assert_eq!(
+        builtin.heights, field.heights,
+        "the GeoTIFF's rows are the field's, flipped"
+    );
+    for (name, input) in [("tif", &whole), ("vrt", &vrt)] {
+        let out = dir.join(format!("{name}.hpyr"));
+        let import = run(&[
+            "dem".as_ref(),
+            "import".as_ref(),
+            input.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+        ]);
+        assert_success(name, &import);
+        let pyramid = HeightPyramid::open(&out).unwrap();
+        let spacing = pyramid.spacing();
+        assert!(
+            (spacing.x - 74.4).abs() < 1e-9 && (spacing.y - 92.6).abs() < 1e-9,
+            "{name}: {spacing}"
+        );
+        let level0 = pyramid.level_field(0).unwrap();
+        for (i, (a, b)) in level0.heights.iter().zip(&builtin.heights).enumerate() {
+            assert!(
+                (a - b).abs() <= 0.5 / 256.0,
+                "{name}: sample {i}: GDAL {a} vs built-in {b}"
+            );
+        }
+    }
 }

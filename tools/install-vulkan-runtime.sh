@@ -4,7 +4,9 @@
 #   - lavapipe from bookworm-backports (Mesa >= 23: descriptor indexing),
 #   - the static shaderc / glslang / SPIRV-Tools libraries for the tools crate,
 #   - image-diff and build prerequisites,
-#   - a virtual X display (xvfb, xauth) for the viewer's tests (`alpenglow view`).
+#   - a virtual X display (xvfb, xauth) for the viewer's tests (`alpenglow view`),
+#   - GDAL's headers and library (libgdal-dev) for the feature `gdal`
+#     (`alpenglow dem import` of any GDAL raster; the test suite enables it).
 # Idempotent: does nothing when everything is already there. Run as root (or
 # with sudo available).
 set -euo pipefail
@@ -37,7 +39,7 @@ if ! command -v cargo >/dev/null 2>&1 && [ ! -x "$HOME/.cargo/bin/cargo" ]; then
 fi
 
 need=()
-for p in libvulkan1 vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools pkg-config gcc g++ xvfb xauth; do
+for p in libvulkan1 vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools pkg-config gcc g++ xvfb xauth libgdal-dev; do
   have_pkg "$p" || need+=("$p")
 done
 if ! lavapipe_recent; then need+=("mesa-vulkan-drivers(backports)"); fi

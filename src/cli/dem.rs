@@ -7,7 +7,8 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use alpenglow::files::{
-    load_heightmap, write_pyramid, FieldRows, HeightPyramid, HeightRows, HgtMosaic, PyramidOptions, DEFAULT_TILE_SIDE,
+    load_heightmap, write_pyramid, FieldRows, HeightPyramid, HeightRows, HgtMosaic, PyramidOptions, PyramidSummary,
+    DEFAULT_TILE_SIDE,
 };
 use anyhow::{bail, Result};
 use clap::{Args, Subcommand};
@@ -17,8 +18,9 @@ use crate::cli::synth::{heightmap_options, HeightArgs};
 
 #[derive(Subcommand, Debug)]
 pub enum DemCommand {
-    /// Write a height pyramid (.hpyr) from a height map (PNG, EXR, GeoTIFF)
-    /// or from SRTM .hgt cells (several cells: one mosaic, streamed).
+    /// Write a height pyramid (.hpyr) from a height map (PNG, EXR, GeoTIFF;
+    /// with the gdal feature any GDAL raster, streamed: COG, VRT, ...) or
+    /// from SRTM .hgt cells (several cells: one mosaic, streamed).
     Import(ImportArgs),
     /// Describe a height pyramid; --verify reads and checks every tile.
     Info(InfoArgs),
@@ -82,11 +84,9 @@ fn import(args: ImportArgs) -> Result<ExitCode> {
         write_pyramid(&args.out, &mut mosaic, &options)?
     } else {
         let [input] = args.inputs.as_slice() else {
-            bail!("several inputs make a mosaic only of SRTM .hgt cells; import other height maps one at a time");
+            bail!("several inputs make a mosaic only of SRTM .hgt cells; import other height maps one at a time (or a GDAL VRT of them)");
         };
-        let field = load_heightmap(input, &heightmap_options(&args.heights))?;
-        let mut rows = FieldRows::new(&field, input);
-        write_pyramid(&args.out, &mut rows as &mut dyn HeightRows, &options)?
+        import_one(input, &args, &options)?
     };
     let samples = f64::from(summary.columns) * f64::from(summary.rows);
     println!(
@@ -103,6 +103,37 @@ fn import(args: ImportArgs) -> Result<ExitCode> {
         started.elapsed().as_secs_f64()
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// Whether `path` is read by GDAL (feature `gdal`): everything but the
+/// PNG and EXR height maps, whose row order and value mapping are
+/// alpenglow's own (`--rows`, `--height-scale`).
+fn read_by_gdal(path: &Path) -> bool {
+    let own = ["png", "exr"];
+    cfg!(feature = "gdal")
+        && !path
+            .extension()
+            .is_some_and(|e| own.iter().any(|o| e.eq_ignore_ascii_case(o)))
+}
+
+/// The pyramid of one height map (streamed by GDAL where it reads it).
+fn import_one(input: &Path, args: &ImportArgs, options: &PyramidOptions) -> Result<PyramidSummary> {
+    if read_by_gdal(input) {
+        #[cfg(feature = "gdal")]
+        {
+            let spacing = args.heights.spacing.map(|(dx, dy)| DVec2::new(dx, dy));
+            let mut rows = alpenglow::files::GdalRows::open(
+                input,
+                spacing,
+                f64::from(args.heights.height_scale),
+                f64::from(args.heights.height_offset),
+            )?;
+            return Ok(write_pyramid(&args.out, &mut rows, options)?);
+        }
+    }
+    let field = load_heightmap(input, &heightmap_options(&args.heights))?;
+    let mut rows = FieldRows::new(&field, input);
+    Ok(write_pyramid(&args.out, &mut rows as &mut dyn HeightRows, options)?)
 }
 
 fn info(args: InfoArgs) -> Result<ExitCode> {

@@ -34,6 +34,8 @@
 //! and the tiles asked for ([`cache::TileCache`] bounds them).
 
 pub(crate) mod format;
+#[cfg(feature = "gdal")]
+mod gdal_rows;
 pub mod mosaic;
 mod reader;
 #[cfg(test)]
@@ -45,6 +47,8 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec2;
 
+#[cfg(feature = "gdal")]
+pub use gdal_rows::GdalRows;
 pub use mosaic::HgtMosaic;
 pub use reader::HeightPyramid;
 pub use writer::write_pyramid;
