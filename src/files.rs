@@ -31,7 +31,7 @@ pub use crate::io::limits::InputLimits;
 #[cfg(feature = "gdal")]
 pub use crate::io::pyramid::GdalRows;
 pub use crate::io::pyramid::{
-    write_pyramid, FieldRows, FnRows, HeightPyramid, HeightRows, HgtMosaic, PyramidOptions, PyramidSummary,
+    write_pyramid, FieldRows, FieldShape, FnRows, HeightPyramid, HeightRows, HgtMosaic, PyramidOptions, PyramidSummary,
     PyramidTile, TileKey, DEFAULT_HEIGHT_STEP, DEFAULT_RESIDENT_SIDE, DEFAULT_TILE_SIDE,
 };
 pub use crate::points::build::input::{load_points_file, PointInput};

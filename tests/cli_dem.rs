@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use alpenglow::files::{write_pyramid, FnRows, PyramidOptions};
+use alpenglow::files::{write_pyramid, FieldShape, FnRows, PyramidOptions};
 use alpenglow::glam::DVec2;
 use common::cli::*;
 
@@ -160,9 +160,12 @@ fn procedural_pyramid(dir: &Path, side: u32) -> PathBuf {
     let (across, along) = (profile(0.3), profile(1.7));
     let path = dir.join(format!("procedural-{side}.hpyr"));
     let mut source = FnRows {
-        columns: side,
-        rows: side,
-        spacing: DVec2::ONE,
+        shape: FieldShape {
+            columns: side,
+            rows: side,
+            spacing: DVec2::ONE,
+            origin: path.clone(),
+        },
         fill: |r: u32, row: &mut [f32]| {
             row.copy_from_slice(&across);
             let offset = along[r as usize] + 600.0;
@@ -170,7 +173,6 @@ fn procedural_pyramid(dir: &Path, side: u32) -> PathBuf {
                 *h += offset;
             }
         },
-        origin: path.clone(),
     };
     write_pyramid(&path, &mut source, &PyramidOptions::default()).unwrap();
     path

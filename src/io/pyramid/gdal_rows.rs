@@ -13,12 +13,12 @@
 //! the caller's, make the values metres. No-data samples are an error
 //! naming the first one (fill them first, e.g. `gdal_fillnodata.py`).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use gdal::Dataset;
 use glam::DVec2;
 
-use super::HeightRows;
+use super::{FieldShape, HeightRows};
 use crate::error::{Error, Result};
 use crate::io::heightmap::check_spacing;
 use crate::io::hgt::metres_per_degree;
@@ -26,15 +26,12 @@ use crate::io::hgt::metres_per_degree;
 /// A GDAL raster's first band, read by rows.
 pub struct GdalRows {
     dataset: Dataset,
-    columns: u32,
-    rows: u32,
-    spacing: DVec2,
+    shape: FieldShape,
     /// The raster's row 0 is the northern edge.
     north_up: bool,
     no_data: Option<f64>,
     scale: f64,
     offset: f64,
-    origin: PathBuf,
 }
 
 impl GdalRows {
@@ -89,48 +86,45 @@ impl GdalRows {
         check_spacing(spacing).map_err(bad)?;
         Ok(GdalRows {
             dataset,
-            columns,
-            rows,
-            spacing,
+            shape: FieldShape {
+                columns,
+                rows,
+                spacing,
+                origin: path.to_path_buf(),
+            },
             north_up,
             no_data,
             scale: band_scale * scale,
             offset: band_offset * scale + offset,
-            origin: path.to_path_buf(),
         })
     }
 }
 
 impl HeightRows for GdalRows {
-    fn columns(&self) -> u32 {
-        self.columns
-    }
-    fn rows(&self) -> u32 {
-        self.rows
-    }
-    fn spacing(&self) -> DVec2 {
-        self.spacing
-    }
-    fn origin(&self) -> &Path {
-        &self.origin
+    fn shape(&self) -> &FieldShape {
+        &self.shape
     }
     fn read_rows(&mut self, first: u32, out: &mut [f32]) -> Result<()> {
-        let columns = self.columns as usize;
+        let (columns, rows, origin) = (
+            self.shape.columns as usize,
+            self.shape.rows as usize,
+            &self.shape.origin,
+        );
         let count = out.len() / columns.max(1);
         // Field rows first..first+count are raster rows counted from the
         // north when the raster is north-up.
         let raster_first = if self.north_up {
-            self.rows as usize - first as usize - count
+            rows - first as usize - count
         } else {
             first as usize
         };
         let band = self
             .dataset
             .rasterband(1)
-            .map_err(|e| Error::input(&self.origin, crate::io::one_line(e)))?;
+            .map_err(|e| Error::input(origin, crate::io::one_line(e)))?;
         let buffer = band
             .read_as::<f64>((0, raster_first as isize), (columns, count), (columns, count), None)
-            .map_err(|e| Error::input(&self.origin, crate::io::one_line(e)))?;
+            .map_err(|e| Error::input(origin, crate::io::one_line(e)))?;
         let data = buffer.data();
         for k in 0..count {
             let raster_row = if self.north_up { count - 1 - k } else { k };
@@ -138,7 +132,7 @@ impl HeightRows for GdalRows {
             for (c, (h, &v)) in out[k * columns..(k + 1) * columns].iter_mut().zip(source).enumerate() {
                 if self.no_data.is_some_and(|nd| v == nd || (nd.is_nan() && v.is_nan())) {
                     return Err(Error::input(
-                        &self.origin,
+                        origin,
                         format!(
                             "no-data sample at column {c}, row {} (from the north); fill the voids first (e.g. gdal_fillnodata.py)",
                             raster_first + raster_row

@@ -150,17 +150,24 @@ pub struct PyramidTile {
     pub heights: Vec<f32>,
 }
 
+/// The size, spacing and name of a [`HeightRows`] source.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FieldShape {
+    /// Samples per row.
+    pub columns: u32,
+    /// Rows.
+    pub rows: u32,
+    /// Metres between samples in x and y.
+    pub spacing: DVec2,
+    /// What errors name (a file, or a description).
+    pub origin: PathBuf,
+}
+
 /// A height field read top to bottom (field row 0 first) in bands: what
 /// [`write_pyramid`] consumes, so that no source need be in memory whole.
 pub trait HeightRows {
-    /// Samples per row.
-    fn columns(&self) -> u32;
-    /// Rows.
-    fn rows(&self) -> u32;
-    /// Metres between samples in x and y.
-    fn spacing(&self) -> DVec2;
-    /// What errors name (a file, or a description).
-    fn origin(&self) -> &Path;
+    /// Its size, spacing and name.
+    fn shape(&self) -> &FieldShape;
     /// Fills `out` (`out.len() / columns` rows) with rows `first..`.
     fn read_rows(&mut self, first: u32, out: &mut [f32]) -> Result<()>;
 }
@@ -168,30 +175,24 @@ pub trait HeightRows {
 /// A height field in memory as [`HeightRows`].
 pub struct FieldRows<'a> {
     field: &'a HeightField,
-    origin: PathBuf,
+    shape: FieldShape,
 }
 
 impl<'a> FieldRows<'a> {
     pub fn new(field: &'a HeightField, origin: &Path) -> Self {
-        FieldRows {
-            field,
+        let shape = FieldShape {
+            columns: field.columns,
+            rows: field.rows,
+            spacing: field.spacing,
             origin: origin.to_path_buf(),
-        }
+        };
+        FieldRows { field, shape }
     }
 }
 
 impl HeightRows for FieldRows<'_> {
-    fn columns(&self) -> u32 {
-        self.field.columns
-    }
-    fn rows(&self) -> u32 {
-        self.field.rows
-    }
-    fn spacing(&self) -> DVec2 {
-        self.field.spacing
-    }
-    fn origin(&self) -> &Path {
-        &self.origin
+    fn shape(&self) -> &FieldShape {
+        &self.shape
     }
     fn read_rows(&mut self, first: u32, out: &mut [f32]) -> Result<()> {
         let start = first as usize * self.field.columns as usize;
@@ -199,7 +200,7 @@ impl HeightRows for FieldRows<'_> {
             .field
             .heights
             .get(start..start + out.len())
-            .ok_or_else(|| Error::input(&self.origin, "the field has fewer samples than its size"))?;
+            .ok_or_else(|| Error::input(&self.shape.origin, "the field has fewer samples than its size"))?;
         out.copy_from_slice(source);
         Ok(())
     }
@@ -208,28 +209,16 @@ impl HeightRows for FieldRows<'_> {
 /// A procedural field as [`HeightRows`]: `fill(row, heights)` writes one
 /// row's heights; rows are made on every core as they are read.
 pub struct FnRows<F: Fn(u32, &mut [f32]) + Sync> {
-    pub columns: u32,
-    pub rows: u32,
-    pub spacing: DVec2,
+    pub shape: FieldShape,
     pub fill: F,
-    pub origin: PathBuf,
 }
 
 impl<F: Fn(u32, &mut [f32]) + Sync> HeightRows for FnRows<F> {
-    fn columns(&self) -> u32 {
-        self.columns
-    }
-    fn rows(&self) -> u32 {
-        self.rows
-    }
-    fn spacing(&self) -> DVec2 {
-        self.spacing
-    }
-    fn origin(&self) -> &Path {
-        &self.origin
+    fn shape(&self) -> &FieldShape {
+        &self.shape
     }
     fn read_rows(&mut self, first: u32, out: &mut [f32]) -> Result<()> {
-        let columns = self.columns as usize;
+        let columns = self.shape.columns as usize;
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
         let rows_per_thread = (out.len() / columns.max(1)).div_ceil(threads).max(1);
         let fill = &self.fill;

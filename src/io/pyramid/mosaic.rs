@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec2;
 
-use super::HeightRows;
+use super::{FieldShape, HeightRows};
 use crate::error::{Error, Result};
 use crate::io::hgt::{decode_hgt, metres_per_degree};
 
@@ -26,8 +26,7 @@ pub struct HgtMosaic {
     lon_cells: u32,
     /// Samples per cell side (1201 or 3601).
     side: u32,
-    spacing: DVec2,
-    origin: PathBuf,
+    shape: FieldShape,
     /// Decoded cells (north-up rows) of the rows of degrees read last.
     loaded: Vec<(i32, Vec<Vec<f32>>)>,
 }
@@ -141,8 +140,12 @@ impl HgtMosaic {
             lat_cells,
             lon_cells,
             side,
-            spacing: metres_per_degree(centre) * arc,
-            origin: first.clone(),
+            shape: FieldShape {
+                columns: lon_cells * (side - 1) + 1,
+                rows: lat_cells * (side - 1) + 1,
+                spacing: metres_per_degree(centre) * arc,
+                origin: first.clone(),
+            },
             loaded: Vec::new(),
         })
     }
@@ -151,7 +154,7 @@ impl HgtMosaic {
     /// centre latitude.
     pub fn with_spacing(mut self, spacing: DVec2) -> Result<HgtMosaic> {
         crate::io::heightmap::check_spacing(spacing).map_err(|m| Error::invalid("spacing", m))?;
-        self.spacing = spacing;
+        self.shape.spacing = spacing;
         Ok(self)
     }
 
@@ -176,20 +179,11 @@ impl HgtMosaic {
 }
 
 impl HeightRows for HgtMosaic {
-    fn columns(&self) -> u32 {
-        self.lon_cells * (self.side - 1) + 1
-    }
-    fn rows(&self) -> u32 {
-        self.lat_cells * (self.side - 1) + 1
-    }
-    fn spacing(&self) -> DVec2 {
-        self.spacing
-    }
-    fn origin(&self) -> &Path {
-        &self.origin
+    fn shape(&self) -> &FieldShape {
+        &self.shape
     }
     fn read_rows(&mut self, first: u32, out: &mut [f32]) -> Result<()> {
-        let columns = self.columns() as usize;
+        let columns = self.shape.columns as usize;
         let step = self.side - 1;
         for (k, row) in out.chunks_exact_mut(columns).enumerate() {
             let r = first + k as u32;

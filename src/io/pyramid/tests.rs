@@ -194,15 +194,17 @@ fn bad_sources_and_options_write_nothing() {
 #[test]
 fn procedural_rows_are_made_in_bands() {
     let mut source = FnRows {
-        columns: 300,
-        rows: 70,
-        spacing: DVec2::ONE,
+        shape: FieldShape {
+            columns: 300,
+            rows: 70,
+            spacing: DVec2::ONE,
+            origin: PathBuf::from("procedural"),
+        },
         fill: |r, row: &mut [f32]| {
             for (c, h) in row.iter_mut().enumerate() {
                 *h = (c as u32 * 3 + r * 7) as f32;
             }
         },
-        origin: PathBuf::from("procedural"),
     };
     let path = temp("fn.hpyr");
     write_pyramid(
@@ -247,9 +249,9 @@ fn hgt_cells_stitch_into_one_field() {
         .map(|&(lat, lon)| write_cell(&dir, lat, lon, f))
         .collect();
     let mut mosaic = HgtMosaic::open(&paths).unwrap();
-    assert_eq!((mosaic.columns(), mosaic.rows()), (2401, 2401));
+    assert_eq!((mosaic.shape().columns, mosaic.shape().rows), (2401, 2401));
     // 3″ at 47° N: ≈ 63 m east, 93 m north.
-    let s = mosaic.spacing();
+    let s = mosaic.shape().spacing;
     assert!((s.x - 63.3).abs() < 0.5 && (s.y - 92.6).abs() < 0.5, "{s}");
     let mut rows = vec![0f32; 2401 * 3];
     mosaic.read_rows(1199, &mut rows).unwrap();

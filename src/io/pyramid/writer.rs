@@ -26,14 +26,15 @@ use crate::io::heightmap::{check_spacing, MAX_ABS_HEIGHT};
 /// Writes the pyramid of `source` to `path` (all or nothing).
 pub fn write_pyramid(path: &Path, source: &mut dyn HeightRows, options: &PyramidOptions) -> Result<PyramidSummary> {
     options.validate()?;
-    let (columns, rows) = (source.columns(), source.rows());
+    let shape = source.shape().clone();
+    let (columns, rows) = (shape.columns, shape.rows);
     if columns < 2 || rows < 2 {
         return Err(Error::input(
-            source.origin(),
+            &shape.origin,
             format!("height field is {columns}×{rows}; at least 2×2 samples are needed"),
         ));
     }
-    check_spacing(source.spacing()).map_err(|m| Error::input(source.origin(), m))?;
+    check_spacing(shape.spacing).map_err(|m| Error::input(&shape.origin, m))?;
     let mut summary = None;
     write_atomically(path, |tmp| {
         let file = File::create(tmp).map_err(|e| write_error(path, e))?;
@@ -50,13 +51,13 @@ pub fn write_pyramid(path: &Path, source: &mut dyn HeightRows, options: &Pyramid
             let count = band.min(rows - first);
             let slice = &mut buffer[..count as usize * columns as usize];
             source.read_rows(first, slice)?;
-            check_heights(source.origin(), slice, columns, first)?;
+            check_heights(&shape.origin, slice, columns, first)?;
             for row in slice.chunks_exact(columns as usize) {
                 writer.accept(0, row.to_vec())?;
             }
             first += count;
         }
-        summary = Some(writer.finish(source.spacing())?);
+        summary = Some(writer.finish(shape.spacing)?);
         Ok(())
     })?;
     summary.ok_or_else(|| Error::output(path, "the pyramid was not written"))
