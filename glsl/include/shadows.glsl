@@ -61,10 +61,22 @@ float shadow_cascade(uint lighting, uint i, vec3 world, vec3 normal, vec3 sun) {
     return shadow_cascade_pcf(lighting, i, world + normal * offset + sun * texel);
 }
 
+// Sun visibility beyond the shadow cascades (§9.5: horizon maps against
+// shadow maps): the terrain's horizon map at `world` (horizon.glsl; baked
+// once per terrain with the sky light, independent of the sun), or 1 where
+// the frame has no horizon map (no terrain).
+float distant_sun_visibility(uint lighting, vec3 world) {
+    if (g_lighting[lighting].f.maps.y == 0u) {
+        return 1.0;
+    }
+    return horizon_sun_visibility(lighting, world);
+}
+
 // 0 = in shadow, 1 = lit, filtered, at world point `world` with geometric
 // normal `normal`, `view_depth` metres from the camera along its axis.
 // Shadows off: 1. A sun below the horizon: 0 (softened over its disc).
-// Beyond the last cascade: lit (by the terrain; the horizon is still applied).
+// Beyond the last cascade: the horizon map (distant_sun_visibility), blended
+// in over the last cascade's blend band, so shadows reach any distance.
 float sun_visibility(uint lighting, vec3 world, vec3 normal, float view_depth) {
     uint mode = g_lighting[lighting].f.models.y;
     if (mode == SHADOWS_OFF) {
@@ -85,7 +97,7 @@ float sun_visibility(uint lighting, vec3 world, vec3 normal, float view_depth) {
         ++i;
     }
     if (i >= count) {
-        return above;
+        return distant_sun_visibility(lighting, world) * above;
     }
     vec3 n = normalize(normal);
     float v = shadow_cascade(lighting, i, world, n, sun.xyz);
@@ -93,7 +105,8 @@ float sun_visibility(uint lighting, vec3 world, vec3 normal, float view_depth) {
     float band = SHADOW_BLEND_BAND * (far[i] - start);
     float t = band > 0.0 ? (view_depth - (far[i] - band)) / band : 0.0;
     if (t > 0.0) {
-        float next = i + 1u < count ? shadow_cascade(lighting, i + 1u, world, n, sun.xyz) : 1.0;
+        float next = i + 1u < count ? shadow_cascade(lighting, i + 1u, world, n, sun.xyz)
+                                    : distant_sun_visibility(lighting, world);
         v = mix(v, next, clamp(t, 0.0, 1.0));
     }
     return v * above;

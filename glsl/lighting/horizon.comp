@@ -1,8 +1,10 @@
 #version 460
 // sky_light.horizon (§9.5, Hoffman's horizon mapping; ALGORITHMS.md §6): per
 // height-field texel and for K azimuths φ_k = 2πk/K (+X towards +Y), march
-// the field outwards with exponentially growing steps and keep the highest
-// elevation of the terrain. Writes per (texel, azimuth) packHalf2x16(z_h,
+// the field outwards with exponentially growing steps (3 % of the distance,
+// at least one texel: 10 % skipped narrow far ridges, +0.008 sky visibility
+// against the Monte Carlo reference at 5× relief, +0.003 now) and keep the
+// highest elevation of the terrain. Writes per (texel, azimuth) packHalf2x16(z_h,
 // d): z_h = sin of the horizon elevation (−1: nothing above the nadir),
 // d = distance to the horizon point in units of the smaller spacing; and the
 // sun horizon map (every K/16-th azimuth, the angle in radians) in 2×2
@@ -52,7 +54,7 @@ void main() {
                 best = slope;
                 best_t = t;
             }
-            t += max(step0, 0.1 * t);
+            t += max(step0, 0.03 * t);
         }
         float z_h = best < -1e29 ? -1.0 : best * inversesqrt(1.0 + best * best);
         g_bake_uints[pc.handles.y].v[base + k] = packHalf2x16(vec2(z_h, best_t / step0));

@@ -151,7 +151,10 @@ pub(super) fn declare_sky_light(
             bounce_albedo: lighting.bounce_albedo,
             ..ReferenceSettings::default()
         };
-        let reference = MonteCarloReference::new(ctx, &scene.heights, settings)?;
+        // The surface the bake traces (the B-spline at the samples), so
+        // that the cheap methods and the reference see the same terrain.
+        let drawn = crate::surface::bspline::knot_field(&scene.heights);
+        let reference = MonteCarloReference::new(ctx, &drawn, settings)?;
         let images = reference.declare(graph, region, &sky_inputs);
         targets.lighting.images.extend([
             (LightingMap::ReferenceSkyLight, images.sky_light),

@@ -163,6 +163,20 @@ pub fn sample_bspline_gradient(field: &HeightField, x: f64, y: f64) -> DVec2 {
     DVec2::new(dx, dy)
 }
 
+/// The drawn surface at the samples: `field` with each sample replaced by
+/// [`sample_bspline`] at its own position, over the same grid (§7.4; at a
+/// knot the B-spline is the `[1, 4, 1] / 6` average along each axis,
+/// clamp-to-edge). What is traced on the samples' bilinear patches (the
+/// sky-light bake and its horizon maps, the Monte Carlo reference, §9.2–9.5)
+/// sees, through this field, the surface the renderer draws rather than
+/// the raw samples, whose peaks stand higher and valleys lie deeper.
+pub fn knot_field(field: &HeightField) -> HeightField {
+    let s = field.spacing;
+    HeightField::from_fn(field.columns, field.rows, s, |c, r| {
+        sample_bspline(field, f64::from(c) * s.x, f64::from(r) * s.y) as f32
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -300,5 +314,35 @@ mod tests {
         };
         assert!(sample_bspline(&empty, 1.0, 1.0).is_nan());
         let _ = sample_bspline_gradient(&empty, 1.0, 1.0);
+    }
+
+    /// At the knots the surface is the [1, 4, 1] / 6 average of the
+    /// samples along each axis (clamp-to-edge), a plane stays the plane.
+    #[test]
+    fn knot_field_is_the_spline_at_the_samples() {
+        let f = HeightField::from_fn(7, 5, DVec2::new(2.0, 3.0), |c, r| ((c * 31 + r * 17) % 13) as f32);
+        let k = knot_field(&f);
+        assert_eq!((k.columns, k.rows, k.spacing), (f.columns, f.rows, f.spacing));
+        let h = |c: i64, r: i64| f64::from(f.height(c.clamp(0, 6) as u32, r.clamp(0, 4) as u32));
+        let w = [1.0 / 6.0, 4.0 / 6.0, 1.0 / 6.0];
+        for r in 0..5i64 {
+            for c in 0..7i64 {
+                let mut want = 0.0;
+                for (j, wy) in w.iter().enumerate() {
+                    for (i, wx) in w.iter().enumerate() {
+                        want += wx * wy * h(c + i as i64 - 1, r + j as i64 - 1);
+                    }
+                }
+                let got = f64::from(k.height(c as u32, r as u32));
+                assert!((got - want).abs() < 1e-4, "({c}, {r}): {got} vs {want}");
+            }
+        }
+        let plane = HeightField::from_fn(6, 6, DVec2::ONE, |c, r| (3 * c + 2 * r) as f32);
+        let kp = knot_field(&plane);
+        for r in 1..5 {
+            for c in 1..5 {
+                assert!((kp.height(c, r) - plane.height(c, r)).abs() < 1e-4);
+            }
+        }
     }
 }

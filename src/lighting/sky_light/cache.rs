@@ -24,7 +24,7 @@ use crate::io::heightmap::HeightField;
 
 const MAGIC: &[u8; 8] = b"ALPGSKYL";
 /// Bumped whenever the bake's algorithm or layout changes.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 /// The largest cache file read (a 4097² field with 5 bands and its horizon
 /// maps is about 8 GiB; larger files are rebuilt, not read).
 const MAX_CACHE_BYTES: u64 = 8 << 30;

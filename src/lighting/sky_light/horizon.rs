@@ -1,6 +1,6 @@
 //! `sky_light.horizon` (§9.5; `glsl/lighting/horizon.comp`): per texel and
 //! for K azimuths `φ_k = 2πk/K` (+X towards +Y), the height field is
-//! marched outwards with steps growing by 10 % (at least one texel) to its
+//! marched outwards with steps growing by 3 % (at least one texel) to its
 //! edge, stopping early once nothing higher can follow, and the highest
 //! terrain elevation is kept: `z_h` (sine of the horizon elevation) and the
 //! distance to that horizon point (for the bounces, §9.4), as
@@ -9,7 +9,15 @@
 //! Every K/16-th azimuth also goes into the sun **horizon map** (Hoffman's
 //! horizon mapping): an RGBA32F image of 2×2 tiles of the field's size,
 //! tile `t` holding azimuths `4t..4t+3` (elevation angles in radians), read
-//! by `horizon_sun_visibility()` in `glsl/include/horizon.glsl`.
+//! by `horizon_sun_visibility()` in `glsl/include/horizon.glsl`: the
+//! shadows of `ShadowMode::Horizon`, and of `ShadowMode::Cascaded` beyond
+//! the last cascade (`distant_sun_visibility()` in
+//! `glsl/include/shadows.glsl`, §9.5). Traced once per terrain, it does not
+//! depend on the sun: a moving sun needs no new bake. 64 bytes per bake
+//! texel (the bake's grid, [`super::fit`]: at most the device's capacity,
+//! about 377 000 texels or 24 MiB on lavapipe), a sixth of what the
+//! transfer takes; 16 azimuths (22.5°, interpolated linearly) agree with
+//! a ray cast on 98–99.8 % of a distant view's pixels (docs/LIGHTING.md).
 
 use std::sync::Arc;
 
