@@ -1,5 +1,7 @@
 // The Preetham/Perez sky (§6.3; ALGORITHMS.md §6): Preetham, Shirley and
-// Smits 1999, "A practical analytic model for daylight". GPU twin of
+// Smits 1999, "A practical analytic model for daylight", and the CIE clear
+// (Perez coefficients of eq. 6.18) and overcast (perez_norm.w = 1: the
+// luminance Y_z (1 + 2 cos θ) / 3 of eq. 6.19) skies. GPU twin of
 // PreethamSky::radiance (src/lighting/preetham.rs), with the same clamps;
 // the CPU writes the constants (perez, zenith, perez_norm, sun).
 //   Y(θ,γ) = Y_z · F(θ,γ) / F(0,θ_s), likewise x and y, with the Perez
@@ -62,6 +64,10 @@ vec3 preetham_sky(uint lighting, vec3 dir) {
     float gamma = acos(clamp(dot(dir, sun), -1.0, 1.0));
     vec3 yxy = g_lighting[lighting].f.zenith.xyz * preetham_perez(lighting, cos_theta, gamma) *
                g_lighting[lighting].f.perez_norm.xyz;
+    if (g_lighting[lighting].f.perez_norm.w > 0.5) {
+        // The CIE overcast sky (eq. 6.19), Moon and Spencer.
+        yxy.x = g_lighting[lighting].f.zenith.x * (1.0 + 2.0 * cos_theta) / 3.0;
+    }
     return max(preetham_xyy_to_srgb(yxy.x, yxy.y, yxy.z), vec3(0.0)) * preetham_ground_factor(dir.z);
 }
 

@@ -8,7 +8,8 @@ use crate::{arg_err, invalid};
 
 /// The lighting of a frame. Keywords mirror the library's `Lighting` and
 /// the CLI's lighting options: `sun_elevation`/`sun_azimuth` (degrees;
-/// azimuth clockwise from +Y, north), `sky` ("physical" or "preetham"),
+/// azimuth clockwise from +Y, north), `sky` ("physical", "preetham",
+/// "cie-clear" or "cie-overcast"),
 /// `turbidity`, `exposure` ("auto" or an EV100 number), `shadows`
 /// ("cascaded", "horizon", "off"), `sky_light` ("sh", "ao", "patches",
 /// "reference", "off"), `aerial_perspective`. `Lighting.time_of_day(…)`
@@ -23,9 +24,11 @@ fn sky(name: &str) -> PyResult<engine::SkyModel> {
     match name {
         "physical" => Ok(engine::SkyModel::Physical),
         "preetham" => Ok(engine::SkyModel::Preetham),
+        "cie-clear" => Ok(engine::SkyModel::CieClear),
+        "cie-overcast" => Ok(engine::SkyModel::CieOvercast),
         _ => Err(invalid(
             "sky",
-            format!("{name:?}; expected \"physical\" or \"preetham\""),
+            format!("{name:?}; expected \"physical\", \"preetham\", \"cie-clear\" or \"cie-overcast\""),
         )),
     }
 }

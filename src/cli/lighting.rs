@@ -145,6 +145,10 @@ pub enum SkyArg {
     /// Rayleigh + Mie + ozone lookup tables (Hillaire 2020).
     #[default]
     Physical,
+    /// CIE clear sky (§6.3 eq. 6.18; Preetham's zenith and colours).
+    CieClear,
+    /// CIE overcast sky (§6.3 eq. 6.19): no direct sun, white sky light.
+    CieOvercast,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -184,6 +188,8 @@ pub fn lighting(args: &LightingArgs, base: Lighting) -> anyhow::Result<Lighting>
         sky: match args.sky {
             SkyArg::Preetham => SkyModel::Preetham,
             SkyArg::Physical => SkyModel::Physical,
+            SkyArg::CieClear => SkyModel::CieClear,
+            SkyArg::CieOvercast => SkyModel::CieOvercast,
         },
         shadows: match args.shadows {
             ShadowArg::Cascaded => ShadowMode::Cascaded,

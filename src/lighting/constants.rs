@@ -54,7 +54,8 @@ pub struct LightingFrame {
     pub perez: [[f32; 4]; 5],
     /// x: Y_z (cd/m²), y: x_z, z: y_z; w: turbidity.
     pub zenith: [f32; 4],
-    /// xyz: 1 / F(0, θ_s) for Y, x, y.
+    /// xyz: 1 / F(0, θ_s) for Y, x, y; w: 1 for the CIE overcast sky's
+    /// luminance `Y_z (1 + 2 cos θ) / 3` instead of the Perez one (§6.3).
     pub perez_norm: [f32; 4],
     /// rgb: β_R at the ground (1/m); w: Mie g.
     pub rayleigh: [f32; 4],

@@ -29,6 +29,22 @@
 //! * Sun: [`transmitted_sun`] (`solar`): the extraterrestrial disc times
 //!   the transmittances of Preetham's appendix A.1; its centre radiance and
 //!   irradiance under the limb-darkening profile here.
+//!
+//! The CIE skies of §6.3 ([`PreethamSky::cie_clear`],
+//! [`PreethamSky::cie_overcast`]) are evaluated by the same code:
+//! * clear (eq. 6.18): `Y = Y_z (0.91 + 10 e^(−3γ) + 0.45 cos²γ)(1 −
+//!   e^(−0.32/cos θ)) / ((0.91 + 10 e^(−3θ_s) + 0.45 cos²θ_s)(1 − e^(−0.32)))`
+//!   is the Perez distribution with A = −1, B = −0.32, C = 10/0.91, D = −3,
+//!   E = 0.45/0.91 (the factor 0.91 cancels in the ratio), so only the
+//!   luminance coefficients change; zenith luminance and the chromaticities
+//!   stay Preetham's at the turbidity (the CIE model gives luminance only;
+//!   the text points to tables for `Y_z`);
+//! * overcast (eq. 6.19): `Y = Y_z (1 + 2 cos θ) / 3`, flagged to the
+//!   shader by `perez_norm.w = 1`; `Y_z = 123 + 8600 sin h` cd/m² for a sun
+//!   at elevation h (Krochmann and Seidl's overcast zenith luminance), the
+//!   twilight fade below the horizon as above; chromaticity constant (D65
+//!   white); the sun is hidden (no disc, no direct light: everything is sky
+//!   light).
 
 use glam::Vec3;
 
@@ -90,6 +106,17 @@ const ZENITH_Y: [[f32; 4]; 3] = [
     [-0.04214, 0.08970, -0.04153, 0.00516],
     [0.15346, -0.26756, 0.06670, 0.26688],
 ];
+
+/// Perez A..E of the CIE clear sky's luminance (eq. 6.18; see the module).
+const CIE_CLEAR: [f32; 5] = [-1.0, -0.32, 10.0 / 0.91, -3.0, 0.45 / 0.91];
+/// Chromaticity of the CIE overcast sky: D65 white.
+const OVERCAST_CHROMATICITY: (f32, f32) = (0.3127, 0.3290);
+
+/// Zenith luminance (cd/m²) of an overcast sky for a sun at elevation
+/// `sin_h` (sine): Krochmann and Seidl, `123 + 8600 sin h`.
+pub fn overcast_zenith_luminance(sin_h: f32) -> f32 {
+    123.0 + 8600.0 * sin_h.max(0.0)
+}
 
 /// Checks a turbidity against the range the fit was made for.
 pub fn check_turbidity(turbidity: f32) -> Result<()> {
@@ -189,6 +216,8 @@ pub struct PreethamSky {
     zenith: Vec3,
     /// `1 / F(0, θ_s)` for Y, x, y.
     norm: Vec3,
+    /// The CIE overcast sky: Moon–Spencer luminance, no sun.
+    overcast: bool,
 }
 
 impl PreethamSky {
@@ -222,7 +251,51 @@ impl PreethamSky {
             coefficients,
             zenith: Vec3::new(y_zenith, x_z, y_z),
             norm,
+            overcast: false,
         })
+    }
+
+    /// The CIE clear sky (§6.3 eq. 6.18): Preetham's sky with the CIE
+    /// luminance distribution.
+    pub fn cie_clear(sun: Vec3, turbidity: f32) -> Result<PreethamSky> {
+        let mut sky = PreethamSky::new(sun, turbidity)?;
+        for (c, cie) in sky.coefficients.iter_mut().zip(CIE_CLEAR) {
+            c.x = cie;
+        }
+        let theta_s = sky.sun_formula.z.clamp(0.0, 1.0).acos();
+        sky.norm = perez(&sky.coefficients, 1.0, theta_s).recip();
+        Ok(sky)
+    }
+
+    /// The CIE overcast sky (§6.3 eq. 6.19): `Y_z (1 + 2 cos θ) / 3`, white,
+    /// no direct sun.
+    pub fn cie_overcast(sun: Vec3, turbidity: f32) -> Result<PreethamSky> {
+        let mut sky = PreethamSky::new(sun, turbidity)?;
+        let clear_zenith = zenith_luminance_formula(sky.sun_formula.z.clamp(0.0, 1.0).acos(), turbidity);
+        // The clear sky's twilight fade, carried over to the overcast zenith.
+        let fade = (sky.zenith.x / clear_zenith.max(1e-6)).min(1.0);
+        let overcast = overcast_zenith_luminance(sky.sun_formula.z) * fade;
+        sky.zenith = Vec3::new(
+            overcast.max(TWILIGHT_ZENITH_LUMINANCE),
+            OVERCAST_CHROMATICITY.0,
+            OVERCAST_CHROMATICITY.1,
+        );
+        sky.coefficients = [Vec3::ZERO; 5];
+        sky.norm = Vec3::ONE;
+        sky.overcast = true;
+        Ok(sky)
+    }
+
+    /// The sky of `model` for a sun along `sun` at `turbidity`; `None` for
+    /// the physical model (not an analytic sky).
+    pub fn for_model(model: crate::view::SkyModel, sun: Vec3, turbidity: f32) -> Result<Option<PreethamSky>> {
+        use crate::view::SkyModel;
+        match model {
+            SkyModel::Preetham => PreethamSky::new(sun, turbidity).map(Some),
+            SkyModel::CieClear => PreethamSky::cie_clear(sun, turbidity).map(Some),
+            SkyModel::CieOvercast => PreethamSky::cie_overcast(sun, turbidity).map(Some),
+            SkyModel::Physical => Ok(None),
+        }
     }
 
     /// The unit vector towards the sun.
@@ -256,7 +329,11 @@ impl PreethamSky {
         let dir = dir.normalize_or(Vec3::Z);
         let cos_theta = dir.z.max(COS_THETA_MIN);
         let gamma = dir.dot(self.sun_formula).clamp(-1.0, 1.0).acos();
-        self.zenith * perez(&self.coefficients, cos_theta, gamma) * self.norm
+        let mut yxy = self.zenith * perez(&self.coefficients, cos_theta, gamma) * self.norm;
+        if self.overcast {
+            yxy.x = self.zenith.x * (1.0 + 2.0 * cos_theta) / 3.0;
+        }
+        yxy
     }
 
     /// Sky radiance along `dir` (+Z up) without the sun disc: linear sRGB,
@@ -271,6 +348,9 @@ impl PreethamSky {
     /// Mean radiance of the sun's disc at the ground (linear sRGB, cd/m²):
     /// see [`transmitted_sun`].
     pub fn sun_mean_radiance(&self) -> Vec3 {
+        if self.overcast {
+            return Vec3::ZERO;
+        }
         transmitted_sun(self.sun, self.turbidity)
     }
 
@@ -297,7 +377,7 @@ impl PreethamSky {
             *row = c.extend(0.0).to_array();
         }
         frame.zenith = self.zenith.extend(self.turbidity).to_array();
-        frame.perez_norm = self.norm.extend(0.0).to_array();
+        frame.perez_norm = self.norm.extend(if self.overcast { 1.0 } else { 0.0 }).to_array();
     }
 }
 

@@ -204,10 +204,17 @@ impl SceneLighting {
     fn constants(&self, lighting: &FrameLighting) -> Result<LightingFrame> {
         let mut f = LightingFrame::zeroed_frame();
         let sun = lighting.sun;
+        // The Preetham sun (and, for the physical sky, its aerial constants'
+        // defaults) first; an analytic sky then writes its own constants.
         PreethamSky::new(sun, lighting.turbidity)?.fill(&mut f);
         f.mie[3] = self.field.ground;
         match lighting.sky {
-            SkyModel::Preetham => AerialCoefficients::for_turbidity(lighting.turbidity)?.fill(&mut f),
+            SkyModel::Preetham | SkyModel::CieClear | SkyModel::CieOvercast => {
+                if let Some(sky) = PreethamSky::for_model(lighting.sky, sun, lighting.turbidity)? {
+                    sky.fill(&mut f);
+                }
+                AerialCoefficients::for_turbidity(lighting.turbidity)?.fill(&mut f)
+            }
             SkyModel::Physical => {
                 // The same atmosphere scatters the sky, dims the sun and
                 // hazes the distance.
@@ -224,7 +231,7 @@ impl SceneLighting {
         }
         f.models = [
             match lighting.sky {
-                SkyModel::Preetham => SKY_PREETHAM,
+                SkyModel::Preetham | SkyModel::CieClear | SkyModel::CieOvercast => SKY_PREETHAM,
                 SkyModel::Physical => SKY_PHYSICAL,
             },
             match lighting.shadows {

@@ -24,6 +24,13 @@ pub enum SkyModel {
     /// tables (Hillaire 2020); right for a low sun.
     #[default]
     Physical,
+    /// The CIE clear sky (Pokrowski, improved by Kittler; §6.3 eq. 6.18):
+    /// its luminance distribution with Preetham's zenith luminance and
+    /// chromaticity at the turbidity.
+    CieClear,
+    /// The CIE overcast sky (Moon and Spencer; §6.3 eq. 6.19): luminance
+    /// `Y_z (1 + 2 cos θ) / 3`, no direct sun, white (D65).
+    CieOvercast,
 }
 
 /// Sun shadows.

@@ -266,6 +266,8 @@ fn switch_rows(ui: &mut egui::Ui, s: &mut Switches) {
         ui.label("sky");
         ui.selectable_value(&mut s.sky, SkyModel::Physical, "physical");
         ui.selectable_value(&mut s.sky, SkyModel::Preetham, "Preetham");
+        ui.selectable_value(&mut s.sky, SkyModel::CieClear, "CIE clear");
+        ui.selectable_value(&mut s.sky, SkyModel::CieOvercast, "CIE overcast");
     });
     ui.horizontal(|ui| {
         ui.label("view");

@@ -2,6 +2,7 @@
 //! (Moved from `tests/` in issue 26: integration tests use only the front door.)
 
 mod atmosphere;
+mod cie;
 mod distant;
 mod figures;
 mod reference;
