@@ -525,7 +525,7 @@ fn the_walk_reaches_every_library_file() {
         .collect();
     assert!(missed.is_empty(), "files no mod declaration reaches: {missed:?}");
     let test_only = |path: &str| files.iter().any(|f| f.path == src.join(path) && f.test);
-    assert!(test_only("terrain/raycast.rs"), "a #[cfg(test)] mod declaration");
+    assert!(test_only("lighting/reference/cpu.rs"), "a #[cfg(test)] mod declaration");
     assert!(
         test_only("texturing/quadtree_tests.rs"),
         "a #[cfg(test)] #[path] module"

@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 
 pub mod points;
+pub mod terrain;
 
 /// The repository root (test data lives under `tests/data`).
 pub fn repo_root() -> PathBuf {

@@ -13,11 +13,11 @@ pub mod ground;
 pub mod importance;
 pub mod lod;
 pub mod procedural;
-#[cfg(test)]
 pub mod raycast;
 pub mod shading;
 pub mod shadow;
 pub mod sketch_map;
+pub mod swimming;
 pub mod technique;
 pub mod visibility;
 pub mod warp;

@@ -7,10 +7,9 @@
 //! `cargo run --release -p alpenglow-bench --bin quad_area`
 
 use alpenglow::bench::{projected_quad_areas, zoom_positions, DebugScalar, LodFrame, View};
-use alpenglow::files::load_heightmap;
 use alpenglow::tools::profile::quantile;
-use alpenglow::{Camera, HeightmapOptions, LodMode, LodSettings, Scene};
-use glam::{DVec2, DVec3};
+use alpenglow::{Camera, LodMode, LodSettings, Scene};
+use alpenglow_bench::terrain::{jacksboro, low};
 
 const WIDTH: u32 = 1280;
 const HEIGHT: u32 = 720;
@@ -18,24 +17,12 @@ const SIDE: usize = 512;
 
 fn main() -> alpenglow::Result<()> {
     let default = Scene::default_terrain()?;
-    let dem = Scene::new(load_heightmap(
-        &alpenglow_bench::repo_root().join("tests/data/jacksboro-fault.png"),
-        &HeightmapOptions {
-            scale: 1.0,
-            offset: 0.0,
-            spacing: Some(DVec2::new(74.4, 92.6)),
-            ..Default::default()
-        },
-    )?);
+    let dem = jacksboro()?;
     let views: Vec<(&str, &Scene, Camera)> = vec![
         ("default scene, default camera", &default, default.default_camera()),
-        (
-            "default scene, low and grazing",
-            &default,
-            alpenglow_views::low(&default),
-        ),
+        ("default scene, low and grazing", &default, low(&default)),
         ("DEM, default camera", &dem, dem.default_camera()),
-        ("DEM, low and grazing", &dem, alpenglow_views::low(&dem)),
+        ("DEM, low and grazing", &dem, low(&dem)),
     ];
     println!("{SIDE}² vertices, {WIDTH}×{HEIGHT}: projected quad area in pixels (quads wholly in view)");
     for (name, scene, camera) in views {
@@ -64,24 +51,4 @@ fn main() -> alpenglow::Result<()> {
         }
     }
     Ok(())
-}
-
-mod alpenglow_views {
-    use super::*;
-
-    /// Low over the southern part of the terrain, looking north just below the horizon.
-    pub fn low(scene: &Scene) -> Camera {
-        let e = scene.heights.extent();
-        let (lo, hi) = scene.height_range();
-        let eye = DVec3::new(
-            e.x * 0.5,
-            e.y * 0.15,
-            f64::from(hi) + 0.02 * f64::from(hi - lo).max(10.0),
-        );
-        Camera {
-            eye,
-            target: eye + DVec3::new(0.0, 1000.0, -60.0),
-            ..scene.default_camera()
-        }
-    }
 }

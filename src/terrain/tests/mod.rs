@@ -4,5 +4,6 @@
 mod compute_raster;
 mod ground;
 mod reversed_depth;
+mod swimming;
 mod terrain;
 mod warp;
