@@ -49,7 +49,7 @@ layout(set = 0, binding = 2, std430) buffer TileBins { uint w[]; } g_tile_bins[]
 
 // One entry: the sort key (tile index << depth bits | quantised reach), the
 // splat's slot among the binned splats (glsl/include/single_pass_tiles.glsl)
-// and the tile's 4×2-pixel blocks its cut-off ellipse touches (bit per block).
+// and the tile's 4×2-pixel blocks its bounding box touches (bit per block).
 struct TileEntry {
     uint key;
     uint slot;

@@ -98,34 +98,18 @@ float splat_reach(SplatSetup v, uvec2 first, uvec2 last, float zf) {
     return most > 0.0 && reach > 0.0 ? reach : 0.0;
 }
 
-// The blocks of the tile at `origin` (bit y·BLOCKS_X + x) holding a pixel
-// centre of [first, last] inside the splat's cut-off ellipse
-// (x − x_t)ᵀ V⁻¹ (x − x_t) ≤ F_G² (`conic`, `centre`; `cutoff2` = F_G²),
-// the merge's first test: a pixel row at a time, the ellipse's span of the
-// row. Conservative: F_G² widened by 2⁻¹⁰ and the span by 1/64 pixel for
-// round-off, so no pixel the merge's test keeps is left out.
-uint tile_blocks(vec4 conic, vec2 centre, float cutoff2, uvec2 first, uvec2 last, uvec2 origin) {
-    uvec2 lo = max(first, origin), hi = min(last, origin + TILE_SIZE - 1u);
-    float widened = cutoff2 * (1.0 + 1.0 / 1024.0);
+// The blocks of the tile at `origin` (bit y·BLOCKS_X + x) that the pixels
+// [first, last] touch. (Testing each pixel row against the cut-off ellipse
+// gave tighter masks, but cost the scatter more than it saved the merge on
+// lavapipe, where a block the ellipse misses costs one uniform test there.)
+uint tile_blocks(uvec2 first, uvec2 last, uvec2 origin) {
+    uvec2 block = uvec2(BLOCK_W, BLOCK_H);
+    uvec2 lo = (max(first, origin) - origin) / block;
+    uvec2 hi = (min(last, origin + TILE_SIZE - 1u) - origin) / block;
+    uint columns = ((2u << hi.x) - 1u) & ~((1u << lo.x) - 1u);
     uint blocks = 0u;
     for (uint y = lo.y; y <= hi.y; ++y) {
-        // a·dx² + 2b·dy·dx + c·dy² ≤ F_G²: dx between the roots.
-        float dy = float(y) + 0.5 - centre.y;
-        float b_dy = conic.y * dy;
-        float disc = b_dy * b_dy - conic.x * (conic.z * dy * dy - widened);
-        if (!(disc >= 0.0)) {
-            continue;
-        }
-        float root = sqrt(disc);
-        float x0 = centre.x - 0.5 + (-b_dy - root) / conic.x - 1.0 / 64.0;
-        float x1 = centre.x - 0.5 + (-b_dy + root) / conic.x + 1.0 / 64.0;
-        float from = max(ceil(x0), float(lo.x)), to = min(floor(x1), float(hi.x));
-        if (!(from <= to)) {
-            continue;
-        }
-        uint c0 = (uint(from) - origin.x) / BLOCK_W, c1 = (uint(to) - origin.x) / BLOCK_W;
-        uint columns = ((2u << c1) - 1u) & ~((1u << c0) - 1u);
-        blocks |= columns << (((y - origin.y) / BLOCK_H) * BLOCKS_X);
+        blocks |= columns << (y * BLOCKS_X);
     }
     return blocks;
 }

@@ -12,7 +12,7 @@
 //                      group buffer; the splats passing the interval test
 //                      and drawn are counted as in every mode;
 //   phase 1 (scatter): each splat's entries (sort key, slot, the tile's
-//                      blocks its cut-off ellipse touches), one per tile in row order,
+//                      blocks its box touches), one per tile in row order,
 //                      written from its workgroup's offset
 //                      (points.single_pass.prefix) + the exclusive sum of
 //                      the entries of the workgroup's earlier invocations
@@ -137,9 +137,6 @@ void scatter(uint group, uint index, uint slot) {
     uint shift = g_tile_bins[bins].w[tiles + STATE_SHIFT];
     uint depth_bits = g_tile_bins[bins].w[tiles + STATE_DEPTH_BITS];
     uint reach = (box.z - least) >> shift;
-    vec4 conic = g_binned_splats[pc.bin.z].s[slot].conic;
-    vec2 centre = g_binned_splats[pc.bin.z].s[slot].centre.xy;
-    float cutoff = g_point_frame[pc.handles.y].depth.w;
     for (uint y = lo.y; y < hi.y; ++y) {
         for (uint x = lo.x; x < hi.x; ++x) {
             if (position >= capacity) {
@@ -153,7 +150,7 @@ void scatter(uint group, uint index, uint slot) {
                 continue;
             }
             uint key = ((y * grid.x + x) << depth_bits) | reach;
-            uint blocks = tile_blocks(conic, centre, cutoff * cutoff, first, last, uvec2(x, y) * TILE_SIZE);
+            uint blocks = tile_blocks(first, last, uvec2(x, y) * TILE_SIZE);
             g_tile_entries[pc.single.y].e[position] = TileEntry(key, slot, blocks);
             position += 1u;
         }

@@ -40,8 +40,8 @@
 //!    and the key's layout: the tile index in the high bits, the reach's
 //!    float bits less the frame's least below, shifted to fit;
 //! 5. `points.single_pass.scatter`: the same dispatches again, each kept
-//!    splat's entries (key, slot, the tile's 4×2-pixel blocks its cut-off
-//!    ellipse touches) written at positions fixed by the draws' order, none
+//!    splat's entries (key, slot, the tile's 4×2-pixel blocks its bounding
+//!    box touches) written at positions fixed by the draws' order, none
 //!    past the entry buffer's capacity (their tiles marked cut, counted);
 //! 6. `points.single_pass.radix{k}.{count,scan,scatter}` ([`radix`]): a
 //!    stable LSD radix sort of the keys, 8 bits a pass (the tile index and
