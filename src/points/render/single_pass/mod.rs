@@ -148,8 +148,18 @@ fn declare_clear<S: Provides<PointsFrame> + 'static>(
 
 /// Fails with a one-line error when the device cannot run `backend`.
 pub(super) fn check_backend(ctx: &Context, backend: SplatBackend) -> Result<()> {
-    if backend != SplatBackend::Interlock {
-        return Ok(());
+    if backend == SplatBackend::Compute {
+        let feature = crate::vulkan::SUBGROUP_COMPUTE;
+        return match ctx.has_feature(feature) {
+            true => Ok(()),
+            false => Err(Error::invalid(
+                "splat backend compute",
+                format!(
+                    "the device ({}) lacks {feature} (subgroup vote, arithmetic and ballot operations in compute shaders); use --splat ewa (three passes)",
+                    ctx.info().name
+                ),
+            )),
+        };
     }
     let missing: Vec<&str> = [
         (
