@@ -1,6 +1,6 @@
 // The sort of single-pass splatting's tile entries (dissertation §10.4;
 // glsl/include/single_pass_tiles.glsl): a stable LSD radix sort of the
-// entries' 32-bit keys (tile index high, quantised depth low), RADIX_BITS a
+// entries' 32-bit keys (tile index high, quantised reach low), RADIX_BITS a
 // pass, from the lowest digit up, each pass three dispatches with no CPU in
 // between (src/points/render/single_pass/radix.rs):
 //   count   (single_pass_radix_count.comp): per block of RADIX_BLOCK
@@ -15,13 +15,13 @@
 // position, and no barrier but a few per block.
 //
 // The bins buffer's sort state (words after the T tile counts):
-//   T + 0    ~(least depth bits) (atomicMax of the complement; 0 when cleared)
-//   T + 1    greatest depth bits
+//   T + 0    ~(least reach bits) (atomicMax of the complement; 0 when cleared)
+//   T + 1    greatest reach bits
 //   T + 2    entries of the frame, N (points.single_pass.prefix)
 //   T + 3    entries sorted, M = min(N, capacity)
-//   T + 4    depth shift: the key holds (depth bits − least) >> shift
-//   T + 5    least depth bits
-//   T + 6    the depth's bits in the key (32 − the tile index's bits)
+//   T + 4    depth shift: the key holds (reach bits − least) >> shift
+//   T + 5    least reach bits
+//   T + 6    the reach's bits in the key (the key's bits − the tile index's)
 //   T + 7    radix blocks: ceil(M / RADIX_BLOCK)
 // Layouts: src/points/render/single_pass/tiles.rs.
 #ifndef ALPENGLOW_SINGLE_PASS_RADIX_GLSL
@@ -47,12 +47,13 @@
 
 layout(set = 0, binding = 2, std430) buffer TileBins { uint w[]; } g_tile_bins[];
 
-// One entry: the sort key (tile index << depth bits | quantised depth), the
-// instance record and the splat's index in the draw.
+// One entry: the sort key (tile index << depth bits | quantised reach), the
+// splat's slot among the binned splats (glsl/include/single_pass_tiles.glsl)
+// and the tile's 4×2-pixel blocks its bounding box touches (bit per block).
 struct TileEntry {
     uint key;
-    uint record;
-    uint index;
+    uint slot;
+    uint blocks;
 };
 layout(set = 0, binding = 2, std430) buffer TileEntries { TileEntry e[]; } g_tile_entries[];
 

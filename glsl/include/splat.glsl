@@ -71,7 +71,10 @@ layout(push_constant) uniform Push {
                     // tiles: see glsl/include/single_pass_tiles.glsl
 #endif
 #ifdef SPLAT_SINGLE_PASS_BIN
-    uvec4 bin;      // single-pass tiles' binning (glsl/points/single_pass_bin.comp): group buffer, the draw's first group, -, -
+    uvec4 bin;      // single-pass tiles' binning (glsl/points/single_pass_bin.comp): group buffer, the draw's first group, binned splats, -
+#endif
+#ifdef SPLAT_SINGLE_PASS_MERGE
+    uvec4 merge;    // single-pass tiles' merge (glsl/points/single_pass_tile.comp): binned splats, -, -, -
 #endif
 } pc;
 

@@ -1,6 +1,6 @@
 #version 460
-// points.single_pass.clear (dissertation §10.4): every tile's count and the
-// sort state 0 before points.single_pass.count
+// points.single_pass.clear (dissertation §10.4): every tile's cut mark and
+// the sort state 0 before points.single_pass.count
 // (glsl/include/single_pass_tiles.glsl, glsl/include/single_pass_radix.glsl).
 #include "../include/heap.glsl"
 

@@ -6,11 +6,12 @@
 //     runs' sums): where points.single_pass.scatter writes each workgroup's
 //     entries, and the frame's entries N;
 //   - the entries sorted, M = min(N, capacity), and the radix sort's blocks;
-//   - the key's depth bits (32 − the tile index's bits) and the shift that
-//     fits the frame's depth range (greatest − least depth bits) into them;
-//   - the longest tile list, added to the frame's splat counters
-//     (PointFrameStats); the dropped entries are counted by
-//     points.single_pass.merge, which drops the lists the capacity cut.
+//   - the key's reach bits (the key's bits − the tile index's) and the shift that
+//     fits the frame's reach range (greatest − least reach bits) into them;
+//   - the splats of the draws past the binned splats' buffer (not binned)
+//     counted as dropped in the frame's splat counters (PointFrameStats;
+//     points.single_pass.scatter counts the entries past the capacity,
+//     points.single_pass.merge the rest of the lists it cut).
 // Only the counts decide all of it, never the order of the GPU's invocations.
 #include "../include/single_pass_radix.glsl"
 #include "../include/splat_counter.glsl"
@@ -21,11 +22,10 @@ layout(local_size_x = 256) in;
 
 layout(push_constant) uniform Push {
     uvec4 p;  // bins, tiles, capacity (entries), counter (0xffffffff: none)
-    uvec4 q;  // group buffer, groups of the frame's draws, -, -
+    uvec4 q;  // group buffer, groups of the frame's draws, splats of the draws not binned, key bits (whole radix digits)
 } pc;
 
 shared uint s_sum[INVOCATIONS];
-shared uint s_longest[INVOCATIONS];
 
 // a + b, saturated at 2³² − 1 (a sum past it cannot fit any capacity).
 uint add_saturated(uint a, uint b) {
@@ -44,11 +44,6 @@ void main() {
         sum = add_saturated(sum, g_tile_bins[groups].w[g]);
     }
     s_sum[t] = sum;
-    uint longest = 0u;
-    for (uint tile = t; tile < tiles; tile += INVOCATIONS) {
-        longest = max(longest, g_tile_bins[bins].w[tile]);
-    }
-    s_longest[t] = longest;
     barrier();
     if (t == 0u) {
         uint total = 0u;
@@ -56,14 +51,13 @@ void main() {
             uint s = s_sum[i];
             s_sum[i] = total;
             total = add_saturated(total, s);
-            longest = max(longest, s_longest[i]);
         }
         uint sorted = min(total, capacity);
         uint least = ~g_tile_bins[bins].w[tiles + STATE_LEAST_COMPLEMENT];
         uint greatest = g_tile_bins[bins].w[tiles + STATE_GREATEST];
         uint span = greatest >= least ? greatest - least : 0u;
         uint span_bits = span == 0u ? 0u : uint(findMSB(span)) + 1u;
-        uint depth_bits = 32u - (tiles > 1u ? uint(findMSB(tiles - 1u)) + 1u : 1u);
+        uint depth_bits = pc.q.w - (tiles > 1u ? uint(findMSB(tiles - 1u)) + 1u : 1u);
         g_tile_bins[bins].w[tiles + STATE_ENTRIES] = total;
         g_tile_bins[bins].w[tiles + STATE_SORTED] = sorted;
         g_tile_bins[bins].w[tiles + STATE_SHIFT] = span_bits > depth_bits ? span_bits - depth_bits : 0u;
@@ -72,7 +66,9 @@ void main() {
         g_tile_bins[bins].w[tiles + STATE_BLOCKS] = (sorted + RADIX_BLOCK - 1u) / RADIX_BLOCK;
         uint counter = pc.p.w;
         if (counter != 0xffffffffu) {
-            atomicMax(g_splat_counters[counter].longest_tile_list, longest);
+            if (pc.q.z != 0u) {
+                atomicAdd(g_splat_counters[counter].tile_entries_dropped, pc.q.z);
+            }
         }
     }
     barrier();

@@ -20,7 +20,15 @@ pub struct OptionalFeatures {
     pub fragment_stores_and_atomics: bool,
     /// `pipelineStatisticsQuery`: per-pass pipeline statistics (`--pipeline-stats`).
     pub pipeline_statistics_query: bool,
+    /// Subgroup vote, arithmetic and ballot operations in compute shaders
+    /// (`VkPhysicalDeviceSubgroupProperties`; a property, nothing to
+    /// enable): the compute backend of single-pass splatting (§10.4).
+    pub subgroup_compute: bool,
 }
+
+/// The name [`OptionalFeatures::subgroup_compute`] has in
+/// [`super::DeviceInfo::optional_features`].
+pub const SUBGROUP_COMPUTE: &str = "subgroupVoteArithmeticBallot";
 
 impl OptionalFeatures {
     /// The optional features `physical` offers.
@@ -35,6 +43,7 @@ impl OptionalFeatures {
             fragment_shader_pixel_interlock: pixel_interlock,
             fragment_stores_and_atomics: offered.fragment_stores_and_atomics == vk::TRUE,
             pipeline_statistics_query: offered.pipeline_statistics_query == vk::TRUE,
+            subgroup_compute: offered_subgroup_compute(instance, physical),
         }
     }
 
@@ -60,6 +69,7 @@ impl OptionalFeatures {
             ("fragmentShaderPixelInterlock", self.fragment_shader_pixel_interlock),
             ("fragmentStoresAndAtomics", self.fragment_stores_and_atomics),
             ("pipelineStatisticsQuery", self.pipeline_statistics_query),
+            (SUBGROUP_COMPUTE, self.subgroup_compute),
         ]
         .iter()
         .filter(|(_, on)| *on)
@@ -72,6 +82,21 @@ impl OptionalFeatures {
 /// path's visibility buffer) and of `fragmentShaderPixelInterlock` with its
 /// extension VK_EXT_fragment_shader_interlock (single-pass splatting's
 /// interlock backend, §10.4).
+/// Whether compute shaders have subgroup vote, arithmetic and ballot
+/// operations (Vulkan 1.1 guarantees only the basic ones).
+fn offered_subgroup_compute(instance: &ash::Instance, physical: vk::PhysicalDevice) -> bool {
+    let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
+    let mut properties = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
+    // SAFETY: plain query on a physical device of this instance (Vulkan ≥ 1.1,
+    // checked by `inspect`); the out-structs live across the call.
+    unsafe { instance.get_physical_device_properties2(physical, &mut properties) };
+    let needed = vk::SubgroupFeatureFlags::BASIC
+        | vk::SubgroupFeatureFlags::VOTE
+        | vk::SubgroupFeatureFlags::ARITHMETIC
+        | vk::SubgroupFeatureFlags::BALLOT;
+    subgroup.supported_stages.contains(vk::ShaderStageFlags::COMPUTE) && subgroup.supported_operations.contains(needed)
+}
+
 fn offered_single_pass_features(instance: &ash::Instance, physical: vk::PhysicalDevice) -> (bool, bool) {
     // SAFETY: plain query on a physical device of this instance.
     let extensions = unsafe { instance.enumerate_device_extension_properties(physical) }.unwrap_or_default();

@@ -25,6 +25,7 @@ pub(crate) use commands::BarrierBatch;
 pub use commands::{CommandRecorder, LoadOp};
 pub use context::{Context, ContextOptions, DeviceInfo};
 pub use device_select::DeviceSelector;
+pub(crate) use features::SUBGROUP_COMPUTE;
 pub use frames::{CompletedFrame, FrameRing, FRAMES_IN_FLIGHT};
 pub use image::{Image, ImageDesc, MemoryBlock};
 pub use memory::{AccessState, Barrier, Buffer, BufferDesc, MemoryLocation};

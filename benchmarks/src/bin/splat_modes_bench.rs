@@ -3,6 +3,10 @@
 //! and in compute (issue 29), in the same run:
 //! `cargo run --release -p alpenglow-bench --bin splat_modes_bench [-- --quick] [--instances N]`.
 //!
+//! `--frames N` times N frames (3 with `--quick`, else 8).
+//! `--compute-only` leaves out the hardware rasterizer's row (the ratios are
+//! then against the compute three passes, the first row).
+//!
 //! `--instances N` draws N copies of the leaves (sharing one splat list) on
 //! a grid 0.3 m apart, N ≥ 10 for 10⁶ splats and N ≥ 100 for 10⁷, from a
 //! distant view only (pulled back to see the grid).
@@ -188,12 +192,17 @@ fn instances(points: &mut PointScene, count: usize) -> usize {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "--quick");
+    let compute_only = args.iter().any(|a| a == "--compute-only");
     let count: usize = (args.iter().position(|a| a == "--instances"))
         .and_then(|i| args.get(i + 1))
         .map(|n| n.parse().expect("--instances N"))
         .unwrap_or(1)
         .max(1);
-    let frames = if quick { 3 } else { 8 };
+    let frames: usize = (args.iter().position(|a| a == "--frames"))
+        .and_then(|i| args.get(i + 1))
+        .map(|n| n.parse().expect("--frames N"))
+        .unwrap_or(if quick { 3 } else { 8 })
+        .max(1);
     let ctx = Context::new(&ContextOptions {
         validation: false,
         device: DeviceSelector::Best,
@@ -229,11 +238,15 @@ fn main() {
         1 => &[("distant", 2.0), ("close", 0.25)],
         _ => &[("distant", 2.0 * (side as f64 / 3.0).max(1.0))],
     };
-    let modes = modes(&ctx);
+    let mut modes = modes(&ctx);
+    if compute_only {
+        modes.retain(|m| m.raster != RasterPath::Hardware);
+    }
+    let reference_name = modes.first().map_or("", |m| m.name);
     for &(view, distance) in views {
         let camera = camera_at(distance);
         println!("\n{view} view ({distance} m):");
-        println!("| mode | splats drawn | GPU ms, median (best) | M splats/s, median (best) | × three-pass hardware, median (best) | FLIP vs three-pass hardware |");
+        println!("| mode | splats drawn | GPU ms, median (best) | M splats/s, median (best) | × {reference_name}, median (best) | FLIP vs {reference_name} |");
         println!("|---|---|---|---|---|---|");
         let mut reference: Option<(Measured, [f64; 2])> = None;
         let mut breakdown = Vec::new();

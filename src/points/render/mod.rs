@@ -12,12 +12,12 @@
 //! | `points.opaque` | opaque | opaque discs with ray–plane depth, shaded directly, with normal and ids |
 //! | `points.clear`, `points.opaque`, `points.opaque.resolve` | opaque, compute path | the nearest (depth, splat index) word per pixel by 64-bit `atomicMax`, the winner shaded per pixel ([`compute_opaque`]) |
 //! | `points.single_pass.triangles` | single-pass | hybrid triangles as opaque shaded triangles with depth, when the scene has any |
-//! | `points.single_pass.clear` | single-pass, compute | every tile's entry count and the sort state 0 (§10.4; interlock: every pixel's state z_d = +inf, sums 0) |
-//! | `points.single_pass.count` | single-pass, compute | per splat: EWA set-up, bounding box → 16×16-pixel tiles, each tile's count + 1, the depth range, each workgroup's entries |
+//! | `points.single_pass.clear` | single-pass, compute | every tile's cut mark and the sort state 0 (§10.4; interlock: every pixel's state z_d = +inf, sums 0) |
+//! | `points.single_pass.count` | single-pass, compute | per splat: EWA set-up kept with its pixels and reach (a lower bound of its samples' depth less z_f), the reach range, each workgroup's entries (8×8-pixel tiles the box touches) |
 //! | `points.single_pass.prefix` | single-pass, compute | one workgroup: each binning workgroup's first entry, the frame's entries, the sort key's layout |
-//! | `points.single_pass.scatter` | single-pass, compute | per splat again: (key = tile, depth; record, index) at positions fixed by draw order |
-//! | `points.single_pass.radix{0..3}.{count,scan,scatter}` | single-pass, compute | a stable LSD radix sort of the entries' keys, 8 bits a pass: each tile's list a slice, front to back |
-//! | `points.single_pass.merge` | single-pass, compute | a workgroup per tile: its sorted slice (dropped whole and counted if the capacity cut it), the fuzzy depth test (§10.4) front to back per pixel, normalised and shaded, written once |
+//! | `points.single_pass.scatter` | single-pass, compute | per kept splat: (key = tile, reach; slot; the tile's 4×2 blocks its box touches) at positions fixed by draw order |
+//! | `points.single_pass.radix{0..2}.{count,scan,scatter}` | single-pass, compute | a stable LSD radix sort of the entries' keys, 8 bits a pass (3 passes at 512², 4 from 2¹³ tiles): each tile's list a slice, front to back |
+//! | `points.single_pass.merge` | single-pass, compute | a workgroup per tile, no barrier: each subgroup walks the sorted slice (dropped whole and counted if the capacity cut it) from memory, the fuzzy depth test (§10.4) front to back per pixel until the reach passes every z_d, normalised and shaded, written once |
 //! | `points.single_pass` | single-pass, interlock | raster pass: every splat fragment merged with the fuzzy depth test (§10.4) in a pixel-ordered critical section |
 //! | `points.single_pass.resolve` | single-pass, interlock | compute: as `points.normalize`, from the pixel state |
 //!
@@ -72,8 +72,9 @@ pub enum SplatMode {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum SplatBackend {
     /// Compute passes, tile-binned (§10.4 with the tile order of 3D Gaussian
-    /// splatting): the splats' boxes binned into 16×16-pixel tiles, the
-    /// entries radix-sorted by (tile, centre distance; ties in draw order)
+    /// splatting): the splats' boxes binned into 8×8-pixel tiles, the
+    /// entries radix-sorted by (tile, reach: the nearest depth a sample can
+    /// have less z_f; ties in draw order)
     /// and each tile's list merged front to back per pixel in registers,
     /// then shaded. No locks,
     /// deterministic (two renders are byte-identical), the same on every

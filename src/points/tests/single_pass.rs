@@ -11,8 +11,8 @@
 //!   only where surfaces meet within z_fuzzy);
 //! * the compute backend (tile-binned, §10.4) is deterministic: two renders
 //!   are byte-identical;
-//! * a close-up whose tile lists exceed the shared-memory sort (sorted in
-//!   global memory) still matches the three-pass image;
+//! * a close-up with long tile lists (hundreds of entries per 8×8 tile,
+//!   many runs of the merge's walk) still matches the three-pass image;
 //! * an entry buffer too small for the frame drops whole tiles' lists,
 //!   reported in the statistics, the same on every run;
 //! * clip lines (§10.2.4) cut the single-pass splats exactly as the
@@ -199,15 +199,16 @@ fn single_pass_renders_are_byte_identical() {
     assert!(a.class == b.class && a.instance == b.instance, "ids differ");
 }
 
-/// A close-up at 64×64: long tile lists (over 896 entries, several radix
-/// blocks of the sort) and the image still matches the three-pass one.
+/// A close-up at 64×64: long tile lists (over 512 entries in an 8×8 tile,
+/// 64 runs and more of the merge's walk, the surfaces behind skipped by
+/// the reach) and the image still matches the three-pass one.
 #[test]
 fn long_tile_lists_match_three_passes() {
     let ([_, (_, stats)], covered) = three_and_single_pass_at(&bunny_scene(), &bunny_camera(0.3), "close-up", (64, 64));
     eprintln!("single pass: {}", stats.summary());
     assert!(covered > 64 * 64 / 4, "the bunny covers {covered} pixels");
     let longest = stats.longest_tile_list.expect("GPU counters");
-    assert!(longest > 896, "the longest tile list holds {longest} entries");
+    assert!(longest > 512, "the longest tile list holds {longest} entries");
     assert_eq!(stats.tile_entries_dropped, Some(0));
 }
 

@@ -19,35 +19,43 @@
 //! which a pixel's fragments arrive. Both backends fix that order:
 //!
 //! Passes of a view, compute backend ([`SplatBackend::Compute`], [`tiles`]):
-//! the splats binned into 16×16-pixel screen tiles, the tile entries sorted
-//! by (tile, depth) with a GPU radix sort, and each tile's slice merged
-//! front to back (the depth order of 3D Gaussian splatting's tile renderer,
-//! with §10.4's operator), deterministic and lock-free, one dispatch chain
-//! with no CPU round trip:
+//! the splats set up once and binned into 8×8-pixel screen tiles, the tile
+//! entries sorted by (tile, reach) with a GPU radix sort, and each tile's
+//! slice merged front to back (the tile order of 3D Gaussian splatting's
+//! renderer, with §10.4's operator), deterministic and lock-free, one
+//! dispatch chain with no CPU round trip. A splat's reach is a lower bound
+//! of the depth of its samples less its z_f: a pixel whose z_d is at most
+//! the reach of the next entry keeps its state to the end of the list (the
+//! operator drops every later fragment), so the walk stops there.
 //! 1. `points.single_pass.triangles` (only with hybrid triangles, §10.1.8):
 //!    the triangles opaque and shaded, with depth, so splats test against them;
-//! 2. `points.single_pass.clear`: every tile's entry count and the sort state 0;
+//! 2. `points.single_pass.clear`: every tile's cut mark and the sort state 0;
 //! 3. `points.single_pass.count`: a dispatch per planned draw, one
-//!    invocation per splat: the EWA set-up, its bounding box's tiles, each
-//!    tile's count + 1, the frame's depth range, each workgroup's entries
-//!    (and the interval-passed and drawn splats counted);
+//!    invocation per splat: the EWA set-up, kept with its pixels and reach
+//!    in the splat's slot for the later passes, the frame's reach range,
+//!    each workgroup's entries (the tiles its splats' boxes touch; and the
+//!    interval-passed and drawn splats counted);
 //! 4. `points.single_pass.prefix`: one workgroup: each binning workgroup's
 //!    first entry (an exclusive prefix in draw order), the frame's entries
-//!    and the key's layout: the tile index in the high bits, the centre
-//!    distance's float bits less the frame's least below, shifted to fit;
-//! 5. `points.single_pass.scatter`: the same dispatches again, each splat's
-//!    entries (key, record, index) written at positions fixed by the draws'
-//!    order, none past the entry buffer's capacity;
-//! 6. `points.single_pass.radix{0..3}.{count,scan,scatter}` ([`radix`]): a
-//!    stable LSD radix sort of the 32-bit keys, 8 bits a pass: equal keys
-//!    keep draw order, so the sorted entries are the same on every run;
+//!    and the key's layout: the tile index in the high bits, the reach's
+//!    float bits less the frame's least below, shifted to fit;
+//! 5. `points.single_pass.scatter`: the same dispatches again, each kept
+//!    splat's entries (key, slot, the tile's 4×2-pixel blocks its bounding
+//!    box touches) written at positions fixed by the draws' order, none
+//!    past the entry buffer's capacity (their tiles marked cut, counted);
+//! 6. `points.single_pass.radix{k}.{count,scan,scatter}` ([`radix`]): a
+//!    stable LSD radix sort of the keys, 8 bits a pass (the tile index and
+//!    at least 12 bits of reach): equal keys keep draw order, so the sorted
+//!    entries are the same on every run;
 //! 7. `points.single_pass.merge`: one workgroup per tile finds its slice of
-//!    the sorted entries by binary search (a list the capacity cut short is
-//!    dropped whole and counted, [`super::PointFrameStats::tile_entries_dropped`]),
-//!    and walks it in batches of 32 splats set up in shared memory: every
-//!    pixel applies the operator to the batch's splats whose boxes touch its
-//!    4×2-pixel block, in order, in registers, then is normalised, shaded
-//!    and written once.
+//!    the sorted entries by binary search (a cut list is dropped whole and
+//!    counted, [`super::PointFrameStats::tile_entries_dropped`]); each
+//!    subgroup (a 4×2-pixel block on a CPU driver's 8-wide rows) walks it
+//!    straight from memory, without shared memory or barriers, in runs of
+//!    one entry per invocation whose ballots give the entries touching its
+//!    blocks, up to the first whose reach is at least every pixel's z_d:
+//!    every pixel applies the operator to those splats in order, in
+//!    registers, then is normalised, shaded and written once.
 //!
 //! Interlock backend ([`SplatBackend::Interlock`], [`interlock`]):
 //! `points.single_pass.triangles` as above, `points.single_pass.clear`
@@ -140,8 +148,18 @@ fn declare_clear<S: Provides<PointsFrame> + 'static>(
 
 /// Fails with a one-line error when the device cannot run `backend`.
 pub(super) fn check_backend(ctx: &Context, backend: SplatBackend) -> Result<()> {
-    if backend != SplatBackend::Interlock {
-        return Ok(());
+    if backend == SplatBackend::Compute {
+        let feature = crate::vulkan::SUBGROUP_COMPUTE;
+        return match ctx.has_feature(feature) {
+            true => Ok(()),
+            false => Err(Error::invalid(
+                "splat backend compute",
+                format!(
+                    "the device ({}) lacks {feature} (subgroup vote, arithmetic and ballot operations in compute shaders); use --splat ewa (three passes)",
+                    ctx.info().name
+                ),
+            )),
+        };
     }
     let missing: Vec<&str> = [
         (

@@ -11,12 +11,15 @@
 //! nothing waits for it on the CPU; every sort pass is dispatched for the
 //! capacity and its workgroups past the entries return at once).
 //! `points.single_pass.scatter` writes the entries whose positions fall
-//! below the capacity, and `points.single_pass.merge` drops every tile
-//! whose list was cut short whole: those tiles show no splats, nothing is
-//! written out of bounds, the same tiles are dropped on every run, and
-//! their entries are counted into the frame's splat counters:
-//! [`PointFrameStats::tile_entries_dropped`] (logged as a warning when the
-//! frame's statistics are read).
+//! below the capacity and marks the tiles of the others cut, and
+//! `points.single_pass.merge` drops every cut tile's list whole: those
+//! tiles show no splats, nothing is written out of bounds, the same tiles
+//! are dropped on every run, and their entries are counted into the
+//! frame's splat counters: [`PointFrameStats::tile_entries_dropped`]
+//! (logged as a warning when the frame's statistics are read). The binned
+//! splats (the set-ups `points.single_pass.count` keeps, 128 bytes each)
+//! fill at most the device's storage buffer range; the draws past it are
+//! not binned and their splats counted there too.
 //!
 //! [`PointFrameStats::tile_entries_dropped`]: super::super::PointFrameStats::tile_entries_dropped
 
@@ -36,15 +39,19 @@ use crate::view::{Frame, Provides, SceneTargets};
 use crate::vulkan::{ComputePipeline, Context, MemoryLocation};
 
 /// Pixels per side of a screen tile (`TILE_SIZE` in glsl/include/single_pass_tiles.glsl).
-pub(crate) const TILE_SIZE: u32 = 16;
-/// Bytes of a tile entry (`TileEntry`: sort key, record, index).
+pub(crate) const TILE_SIZE: u32 = 8;
+/// Bytes of a tile entry (`TileEntry`: sort key, slot, blocks).
 const ENTRY_BYTES: u64 = 12;
+/// Bytes of a binned splat (`BinnedSplat` in glsl/include/single_pass_tiles.glsl):
+/// the set-up `points.single_pass.count` keeps for the scatter and the merge.
+const BINNED_SPLAT_BYTES: u64 = 128;
 /// Words of the sort state after the tiles' counts in the bins buffer
 /// (glsl/include/single_pass_radix.glsl).
 const STATE_WORDS: u32 = 8;
-/// Entries per splat the scene could plan (a splat's box touches about one
-/// to four tiles at the sizes an SPT selects).
-const ENTRIES_PER_SPLAT: u64 = 4;
+/// Entries per splat the scene could plan (a splat's box touches one to
+/// four tiles at the sizes an SPT selects, about nine in a 512² close-up
+/// of the bunny).
+const ENTRIES_PER_SPLAT: u64 = 12;
 /// Fewest entries of a buffer (768 KiB).
 const MIN_ENTRIES: u64 = 1 << 16;
 /// Most entries of a buffer (192 MiB; two of them), where the device's storage buffer range allows.
@@ -97,10 +104,14 @@ pub(crate) struct TileCapacity {
 
 impl TileCapacity {
     /// Workgroups of the binning passes a frame can dispatch: one word
-    /// each in the group buffer.
-    fn groups(&self) -> u32 {
+    /// each in the group buffer, and [`WORKGROUP_SIZE`] binned splats each
+    /// in a buffer of at most `max_range` bytes (the device's
+    /// `maxStorageBufferRange`; the draws past it are not binned, counted
+    /// as dropped).
+    fn groups(&self, max_range: u64) -> u32 {
         let groups = self.splats.div_ceil(u64::from(WORKGROUP_SIZE)) + self.draws;
-        u32::try_from(groups.max(1)).unwrap_or(u32::MAX)
+        let most = max_range / (BINNED_SPLAT_BYTES * u64::from(WORKGROUP_SIZE));
+        u32::try_from(groups.min(most).max(1)).unwrap_or(u32::MAX)
     }
 }
 
@@ -115,6 +126,8 @@ pub(super) struct TileBins {
     pub scratch: BufferId,
     /// One word per workgroup of the binning passes.
     groups: BufferId,
+    /// A binned splat per slot: [`WORKGROUP_SIZE`] per workgroup of the binning passes.
+    splats: BufferId,
     /// Per (digit, radix block) of the capacity: a count, then a position.
     pub digits: BufferId,
     /// Tiles per row and per column.
@@ -160,7 +173,7 @@ pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
     };
     let grid = [targets.width, targets.height].map(|n| n.div_ceil(TILE_SIZE).max(1));
     let entries = capacity.entries.max(1);
-    let group_capacity = capacity.groups();
+    let group_capacity = capacity.groups(ctx.max_storage_buffer_range());
     let buffer = |graph: &mut RenderGraph<Frame<S>>, what, size: u64| {
         let location = MemoryLocation::GpuOnly;
         graph.create_buffer(what, BufferInfo { size, location })
@@ -171,6 +184,11 @@ pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
         entries: buffer(graph, "splat tile entries", ENTRY_BYTES * u64::from(entries)),
         scratch: buffer(graph, "splat tile entries (sort)", ENTRY_BYTES * u64::from(entries)),
         groups: buffer(graph, "splat tile groups", 4 * u64::from(group_capacity)),
+        splats: buffer(
+            graph,
+            "binned splats",
+            BINNED_SPLAT_BYTES * u64::from(WORKGROUP_SIZE) * u64::from(group_capacity),
+        ),
         digits: buffer(graph, "splat tile digits", 4 * radix::DIGITS * blocks),
         grid,
         capacity: entries,
@@ -191,9 +209,9 @@ pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
     );
     let scatter = (name("points.single_pass.scatter"), PHASE_SCATTER);
     declare_binning(graph, scatter, (buffers, view), tiles, bin);
-    radix::declare(ctx, graph, name, tiles)?;
+    let sorted = radix::declare(ctx, graph, name, tiles)?;
     let merge = (name("points.single_pass.merge"), pipelines.merge);
-    declare_merge(graph, merge, (buffers, view), targets, (tiles, written));
+    declare_merge(graph, merge, (buffers, view), targets, (tiles, sorted, written));
     Ok(())
 }
 
@@ -203,26 +221,29 @@ pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct BinPush {
     single: SinglePassPush,
-    /// The group buffer, the draw's first workgroup in it.
+    /// The group buffer, the draw's first workgroup in it, the binned splats.
     bin: [u32; 4],
 }
 
 /// The first workgroup in the group buffer of each of the frame's draws
-/// (splat counts `counts`) that fit `group_capacity` workgroups (later
-/// draws are not binned; the capacity holds every draw a frame can plan),
-/// and the workgroups of those draws.
-fn draw_groups(counts: impl Iterator<Item = u32>, group_capacity: u32) -> (Vec<u32>, u32) {
+/// (splat counts `counts`) that fit `group_capacity` workgroups, the
+/// workgroups of those draws, and the splats of the later draws (not
+/// binned: the binned splats' buffer is full).
+fn draw_groups(counts: impl Iterator<Item = u32>, group_capacity: u32) -> (Vec<u32>, u32, u32) {
     let mut first = 0u32;
     let mut firsts = Vec::new();
+    let (mut unbinned, mut full) = (0u32, false);
     for count in counts {
         let groups = count.div_ceil(WORKGROUP_SIZE);
-        if first.saturating_add(groups) > group_capacity {
-            break;
+        full |= first.saturating_add(groups) > group_capacity;
+        if full {
+            unbinned = unbinned.saturating_add(count);
+            continue;
         }
         firsts.push(first);
         first += groups;
     }
-    (firsts, first)
+    (firsts, first, unbinned)
 }
 
 /// `points.single_pass.count` (`phase` [`PHASE_COUNT`]: the tiles' counts,
@@ -241,21 +262,19 @@ fn declare_binning<S: Provides<PointsFrame> + 'static>(
     let counting = phase == PHASE_COUNT;
     let mut builder = graph.pass(&name);
     let frame = builder.upload(view.frame, compute);
-    let (bins, groups) = match counting {
+    let (bins, groups, splats) = match counting {
         true => (
             builder.storage_buffer(tiles.bins, BufferAccess::StorageReadWrite(compute)),
             builder.storage_buffer(tiles.groups, BufferAccess::StorageWrite(compute)),
+            builder.storage_buffer(tiles.splats, BufferAccess::StorageWrite(compute)),
         ),
         false => (
-            builder.storage_buffer(tiles.bins, BufferAccess::StorageRead(compute)),
+            builder.storage_buffer(tiles.bins, BufferAccess::StorageReadWrite(compute)),
             builder.storage_buffer(tiles.groups, BufferAccess::StorageRead(compute)),
+            builder.storage_buffer(tiles.splats, BufferAccess::StorageRead(compute)),
         ),
     };
     let entries = (!counting).then(|| builder.storage_buffer(tiles.entries, BufferAccess::StorageWrite(compute)));
-    let buffers = PointBuffers {
-        counter: buffers.counter.filter(|_| counting),
-        ..buffers
-    };
     let (builder, splat) = buffers.read_by_at(builder, frame, (compute, compute));
     builder.record(move |pass, frame| {
         let plan = plan_of(frame, view.index)?;
@@ -265,9 +284,9 @@ fn declare_binning<S: Provides<PointsFrame> + 'static>(
                 splat: splat.push(pass, PASS_OPAQUE)?,
                 single: [pass.handle(bins)?, entries, phase, 0],
             },
-            bin: [pass.handle(groups)?, 0, 0, 0],
+            bin: [pass.handle(groups)?, 0, pass.handle(splats)?, 0],
         };
-        let (firsts, _) = draw_groups(plan.draws.iter().map(|d| d.count), tiles.group_capacity);
+        let (firsts, _, _) = draw_groups(plan.draws.iter().map(|d| d.count), tiles.group_capacity);
         let cmd = pass.cmd();
         cmd.bind_compute(&pipeline);
         for (d, first) in plan.draws.iter().zip(firsts) {
@@ -298,11 +317,16 @@ fn declare_prefix<S: Provides<PointsFrame> + 'static>(
     let counter = counter.map(|c| pass.storage_buffer(c, BufferAccess::StorageReadWrite(compute)));
     pass.record(move |ctx, frame| {
         let plan = plan_of(frame, view.index)?;
-        let (_, group_count) = draw_groups(plan.draws.iter().map(|d| d.count), tiles.group_capacity);
+        let (_, group_count, unbinned) = draw_groups(plan.draws.iter().map(|d| d.count), tiles.group_capacity);
         let counter = counter.map(|c| ctx.handle(c)).transpose()?.unwrap_or(NO_HANDLE);
         let push = [
             [ctx.handle(bins)?, tiles.tiles(), tiles.capacity, counter],
-            [ctx.handle(groups)?, group_count, 0, 0],
+            [
+                ctx.handle(groups)?,
+                group_count,
+                unbinned,
+                radix::key_bits(tiles.tiles()),
+            ],
         ];
         ctx.dispatch(&pipeline, &push, [1, 1, 1])
     });
@@ -317,6 +341,8 @@ struct MergePush {
     resolved: ResolvedPush,
     /// Bins, entries, depth buffer (sampled; [`NO_HANDLE`]: none), 1 to keep W where no splat is.
     single: [u32; 4],
+    /// The binned splats, 0, 0, 0.
+    merge: [u32; 4],
 }
 
 /// The heap bindings of `points.single_pass.merge`.
@@ -326,6 +352,7 @@ struct MergeBindings {
     splat: SplatBindings,
     bins: Binding,
     entries: Binding,
+    splats: Binding,
     depth: Option<Binding>,
     outputs: ResolvedTargets,
 }
@@ -343,6 +370,7 @@ impl MergeBindings {
                 depth,
                 u32::from(keep_weight),
             ],
+            merge: [pass.handle(self.splats)?, 0, 0, 0],
         })
     }
 }
@@ -357,7 +385,7 @@ fn declare_merge<S: Provides<PointsFrame> + 'static>(
     (name, pipeline): (String, ComputePipeline),
     (buffers, view): (PointBuffers, PointView),
     targets: &SceneTargets,
-    (tiles, written): (TileBins, Written),
+    (tiles, sorted, written): (TileBins, BufferId, Written),
 ) {
     let compute = Stage::Compute;
     let weight = match written.weight {
@@ -367,7 +395,8 @@ fn declare_merge<S: Provides<PointsFrame> + 'static>(
     let mut builder = graph.pass(&name);
     let shading = ShadingBindings::read_in(&mut builder, (&view, targets), compute);
     let bins = builder.storage_buffer(tiles.bins, BufferAccess::StorageRead(compute));
-    let entries = builder.storage_buffer(tiles.entries, BufferAccess::StorageRead(compute));
+    let entries = builder.storage_buffer(sorted, BufferAccess::StorageRead(compute));
+    let splats = builder.storage_buffer(tiles.splats, BufferAccess::StorageRead(compute));
     let depth = written.depth.then(|| builder.sample(view.depth, compute));
     let outputs = ResolvedTargets::declare(&mut builder, (&view, targets), weight);
     // The counter takes the entries of lists dropped for want of capacity.
@@ -377,6 +406,7 @@ fn declare_merge<S: Provides<PointsFrame> + 'static>(
         splat,
         bins,
         entries,
+        splats,
         depth,
         outputs,
     };
@@ -393,23 +423,23 @@ mod tests {
 
     #[test]
     fn push_constants_match_the_shader_block() {
-        // handles, mode, outputs, more, single.
-        assert_eq!(std::mem::size_of::<MergePush>(), 80);
+        // handles, mode, outputs, more, single, merge.
+        assert_eq!(std::mem::size_of::<MergePush>(), 96);
     }
 
     #[test]
     fn entry_capacity_is_clamped() {
         let range = u64::from(u32::MAX);
         assert_eq!(entry_capacity(0, range), 1 << 16);
-        assert_eq!(entry_capacity(100_000, range), 400_000);
+        assert_eq!(entry_capacity(100_000, range), 1_200_000);
         assert_eq!(entry_capacity(u64::MAX, range), 1 << 24);
         assert_eq!(entry_capacity(u64::MAX, 1 << 27), (1 << 27) / 12);
     }
 
     #[test]
     fn draws_get_consecutive_workgroups_within_the_capacity() {
-        assert_eq!(draw_groups([64, 1, 65, 0].into_iter(), 100), (vec![0, 1, 2, 4], 4));
-        assert_eq!(draw_groups([640, 64, 1].into_iter(), 10), (vec![0], 10));
-        assert_eq!(draw_groups(std::iter::empty(), 1), (vec![], 0));
+        assert_eq!(draw_groups([64, 1, 65, 0].into_iter(), 100), (vec![0, 1, 2, 4], 4, 0));
+        assert_eq!(draw_groups([640, 64, 1].into_iter(), 10), (vec![0], 10, 65));
+        assert_eq!(draw_groups(std::iter::empty(), 1), (vec![], 0, 0));
     }
 }
