@@ -16,6 +16,7 @@
 
 use glam::DVec2;
 
+use super::classify::PixelStatus;
 use super::tree::GeneratedLayer;
 use crate::error::Result;
 use crate::io::heightmap::HeightField;
@@ -50,12 +51,14 @@ pub fn layer_fractions(
     Ok(counts.iter().map(|&c| c as f64 / n).collect())
 }
 
-/// Every [`STRIDE`]-th pixel position of every [`STRIDE`]-th row.
-pub fn sample_positions(positions: &[DVec2], width: usize) -> Vec<DVec2> {
+/// Every [`STRIDE`]-th pixel position of every [`STRIDE`]-th row, those
+/// the mask excludes left out (the class areas are those outside it).
+pub fn sample_positions(positions: &[DVec2], width: usize, status: &[PixelStatus]) -> Vec<DVec2> {
     positions
         .iter()
         .enumerate()
         .filter(|(i, _)| (i % width.max(1)) % STRIDE == 0 && (i / width.max(1)) % STRIDE == 0)
+        .filter(|(i, _)| status.get(*i) != Some(&PixelStatus::Masked))
         .map(|(_, &p)| p)
         .collect()
 }
@@ -69,7 +72,7 @@ fn worst_error(fractions: &[f64], targets: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Scales the noise of `layers` (root first) until each level-1 layer
+/// Scales the noise of `layers` (root first) until each layer below the root
 /// dominates `targets[k]` of `positions` (module docs); returns the
 /// predicted fractions of the final layers.
 ///
