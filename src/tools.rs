@@ -28,7 +28,7 @@ pub mod spt {
 pub mod synth {
     pub use crate::synthesis::cost::{GrowthCost, SearchDevice};
     pub use crate::synthesis::fill::{check_hole_fill, fill_holes, fill_holes_cpu, plan_hole_fill, FillParams, Growth};
-    pub use crate::synthesis::free::{check_free_growth, grow_free_cpu, plan_free_growth, MAX_SIDE};
+    pub use crate::synthesis::free::{check_free_growth, grow_free_cpu, plan_free_growth, FREE_GROWTH, MAX_SIDE};
     pub use crate::synthesis::gpu::GpuSearch;
     pub use crate::synthesis::search::CpuSearch;
     pub use crate::synthesis::search::NeighbourhoodSearch;

@@ -10,7 +10,7 @@ use alpenglow::files::{encode_exr_height, encode_png_gray16, load_heightmap, loa
 use alpenglow::tools::budget::MemoryLimits;
 use alpenglow::tools::synth::{
     band_of, check_fields, check_free_growth, check_hole_fill, plan_free_growth, plan_hole_fill, plan_transition, Axis,
-    CpuSearch, FillParams, GpuSearch, Growth, GrowthCost, SearchDevice, TransitionParams,
+    CpuSearch, FillParams, GpuSearch, Growth, GrowthCost, SearchDevice, TransitionParams, FREE_GROWTH,
 };
 use alpenglow::{Context, HeightField, HeightmapOptions, RowOrder};
 use anyhow::{bail, Result};
@@ -84,9 +84,10 @@ pub struct GrowArgs {
     /// Seed of the candidate subsample and the random choice.
     #[arg(long, default_value_t = 1, value_name = "SEED")]
     pub seed: u32,
-    /// Most samples searched together in one wave (1: the text's sequential order).
-    #[arg(long, default_value_t = 256, value_name = "SAMPLES")]
-    pub batch: usize,
+    /// Most samples searched together in one wave (1: the text's
+    /// sequential order; default: fill and transition 256, grow 1).
+    #[arg(long, value_name = "SAMPLES")]
+    pub batch: Option<usize>,
     /// Most candidate windows (those nearest the unknown samples first).
     #[arg(long, default_value_t = 16384, value_name = "COUNT")]
     pub candidates: usize,
@@ -108,7 +109,7 @@ impl GrowArgs {
             lambda: self.lambda,
             epsilon: self.epsilon.unwrap_or(defaults.epsilon),
             seed: self.seed,
-            batch: self.batch,
+            batch: self.batch.unwrap_or(defaults.batch),
             candidates: self.candidates,
         }
     }
@@ -305,7 +306,7 @@ fn fill(args: FillArgs) -> Result<ExitCode> {
 fn grow_free(args: FreeArgs) -> Result<ExitCode> {
     let outputs = reserve_output(&args.out)?;
     let exemplar = load_heightmap(&args.exemplar, &heightmap_options(&args.heights))?;
-    let params = args.grow.params(FillParams::default());
+    let params = args.grow.params(FREE_GROWTH);
     let (columns, rows) = args.size;
     let named = |e: alpenglow::Error| match (&e, e.parameter()) {
         (alpenglow::Error::InvalidArgument { message, .. }, Some("exemplar")) => {

@@ -17,6 +17,14 @@
 //!   more than `--candidates`, that many chosen by a hash of the seed
 //!   (`super::exemplar::nearest_candidates` with equal distances).
 //! * **Spacing**: the exemplar's.
+//! * **One sample a wave** by default ([`FREE_GROWTH`], `--batch 1`, the
+//!   text's sequential order): in a wave of many samples, neighbours along
+//!   the front are matched against the state before the wave, each
+//!   without the other, and pick unrelated candidates. In a hole the
+//!   fronts are short and meet known ground; a free growth is all front,
+//!   and waves of 256 left speckle across the whole field in its
+//!   hillshade (slope KS 0.07 but incoherent ridges), gone with waves of
+//!   one (`src/synthesis/tests/free.rs` writes the hillshade).
 //!
 //! Deterministic for a seed: the seed window, the candidate subsample and
 //! the search's choices all derive from it.
@@ -27,6 +35,17 @@ use crate::random::SplitMix64;
 use crate::synthesis::exemplar::{nearest_candidates, slopes, texels, Normalisation};
 use crate::synthesis::fill::{FillParams, Growth};
 use crate::synthesis::search::Exemplar;
+
+/// The parameters of a free growth: those of hole filling, one sample a
+/// wave (module docs).
+pub const FREE_GROWTH: FillParams = FillParams {
+    window: 7,
+    lambda: 0.25,
+    epsilon: 0.1,
+    seed: 1,
+    batch: 1,
+    candidates: 16384,
+};
 
 /// Largest side of a grown field, in samples.
 pub const MAX_SIDE: u32 = 8192;

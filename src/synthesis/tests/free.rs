@@ -30,7 +30,7 @@ use super::fill::{crop, hillshade, ks, slope_curvature};
 use crate::io::heightmap::HeightField;
 use crate::random::SplitMix64;
 use crate::synthesis::fill::FillParams;
-use crate::synthesis::free::{grow_free_cpu, plan_free_growth};
+use crate::synthesis::free::{grow_free_cpu, plan_free_growth, FREE_GROWTH};
 
 /// Side of the grown field.
 const OUT: u32 = 64;
@@ -53,11 +53,14 @@ const BOUNDS: Bounds = Bounds {
     copy_rms: 0.02,
 };
 
+/// The growth's defaults (`FREE_GROWTH`: one sample a wave) with `seed`
+/// and at most 2048 candidates (of 14884), to keep the unoptimised build
+/// within seconds.
 fn params(seed: u32) -> FillParams {
     FillParams {
         seed,
         candidates: 2048,
-        ..FillParams::default()
+        ..FREE_GROWTH
     }
 }
 
