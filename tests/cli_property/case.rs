@@ -77,7 +77,7 @@ pub enum Output {
     Frames(PathBuf),
     /// An SPT file.
     Spt(PathBuf),
-    /// A height map of the input's size (`synth`).
+    /// A height map of the input's size (`synth`; `synth grow`: its `--size`).
     Height(PathBuf),
     /// A layer tree (TOML).
     Layers(PathBuf),

@@ -342,7 +342,8 @@ pub fn build_layers(
     let mut generated = tree::build(&classification, &functions, &provenance);
     if options.calibrate {
         let fractions = classification.fractions();
-        let targets: Vec<f64> = generated.layers.iter().map(|l| fractions[l.class]).collect();
+        let own: Vec<f64> = generated.layers.iter().map(|l| fractions[l.class]).collect();
+        let targets = calibrate::with_children(&generated.layers, own);
         let points = calibrate::sample_positions(&positions, registration.width as usize, &classification.status);
         generated.predicted =
             calibrate::calibrate(&mut generated.layers, &targets, tree::layer_tree, field, maps, &points)?;
@@ -351,7 +352,8 @@ pub fn build_layers(
             .map(|(l, f)| format!("{} {:.1} %", l.name, 100.0 * f))
             .collect();
         generated.header.push(format!(
-            "Noise bias calibrated to the class areas; predicted dominant-layer areas: {}.",
+            "Noise bias calibrated to the class areas; predicted dominant-layer areas (a level-1 layer's with its \
+             level-2 children's): {}.",
             shares.join(", ")
         ));
     }
