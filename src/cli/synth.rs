@@ -315,9 +315,12 @@ fn grow_free(args: FreeArgs) -> Result<ExitCode> {
         _ => e.into(),
     };
     check_free_growth(&exemplar, columns, rows, &params).map_err(named)?;
+    // The cost of filling the whole new field, its candidates the exemplar's windows.
+    let inside = |side: u32| (side + 1).saturating_sub(params.window) as usize;
+    let candidates = params.candidates.min(inside(exemplar.columns) * inside(exemplar.rows));
     let unknown = u64::from(columns) * u64::from(rows);
-    let cost = GrowthCost::fill(exemplar.columns, exemplar.rows, unknown, &params);
-    let search = prepare_search(&cost, &args.grow, &format!("--exemplar {}", args.exemplar.display()))?;
+    let cost = GrowthCost::fill(columns, rows, unknown, &FillParams { candidates, ..params });
+    let search = prepare_search(&cost, &args.grow, &format!("--size {columns}x{rows}"))?;
     let growth = progress::phase("planning the growth", || {
         plan_free_growth(&exemplar, columns, rows, &params)
     })
