@@ -1,7 +1,8 @@
 //! `alpenglow layers from-image` end to end (the library side is tested in
 //! `src/texturing/tests/layers_from_image.rs`): it writes a layer tree for
 //! the Rocky Mountain National Park pair (`tests/data/real-world/README.md`)
-//! and refuses bad input in one line naming the option.
+//! and refuses bad input in one line naming the option; `--level2` and
+//! `--mask` end to end.
 
 mod common;
 
