@@ -22,11 +22,13 @@ pub mod spt {
     pub use crate::points::build::spt::{build_spt, epsilon_from_pixels, SequentialPointTree, SptOptions};
 }
 
-/// Terrain synthesis by example: fill the holes of a DEM or grow a
-/// transition between two (`alpenglow synth fill|transition`).
+/// Terrain synthesis by example: fill the holes of a DEM, grow a new field
+/// from an exemplar or a transition between two (`alpenglow synth
+/// fill|grow|transition`).
 pub mod synth {
     pub use crate::synthesis::cost::{GrowthCost, SearchDevice};
     pub use crate::synthesis::fill::{check_hole_fill, fill_holes, fill_holes_cpu, plan_hole_fill, FillParams, Growth};
+    pub use crate::synthesis::free::{check_free_growth, grow_free_cpu, plan_free_growth, FREE_GROWTH, MAX_SIDE};
     pub use crate::synthesis::gpu::GpuSearch;
     pub use crate::synthesis::search::CpuSearch;
     pub use crate::synthesis::search::NeighbourhoodSearch;
@@ -45,7 +47,7 @@ pub mod layers {
         Constraint, MAX_BLUR_RADII, MAX_HEIGHT_BLUR, MAX_SAMPLES,
     };
     pub use crate::texturing::from_image::{
-        build_layers, load_rgb_image, ClassCount, FromImageOptions, PixelStatus, MAX_CLASSES,
+        build_layers, load_mask, load_rgb_image, ClassCount, FromImageOptions, PixelStatus, MAX_CLASSES,
     };
     pub use crate::texturing::reference::srgb8;
 }

@@ -2,7 +2,7 @@
 //! random and extreme values (NaN, ±inf, 0, -0, negatives, 1e308, 1e-300,
 //! u64::MAX + 1, each documented limit and just beyond it, comma lists
 //! with a bad element or a wrong count) for every numeric option of
-//! `render`, `bench`, `fly`, `spt build`, `synth fill`, `synth transition`
+//! `render`, `bench`, `fly`, `spt build`, `synth fill`, `synth grow`, `synth transition`
 //! and `layers from-image`, each mixed into a small valid command line
 //! (32×24 images, 33² terrains, a few frames, tiny input files) and run
 //! with the debug binary under `--validation`. A case passes when the run

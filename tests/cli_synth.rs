@@ -1,4 +1,4 @@
-//! End-to-end tests of `alpenglow synth fill` and `alpenglow synth
+//! End-to-end tests of `alpenglow synth fill`, `synth grow` and `synth
 //! transition` (§7.3) with the CPU search: outputs that keep the known
 //! samples exactly, voids of an EXR as the unknown samples, one-line
 //! errors that leave no file behind.
@@ -268,6 +268,82 @@ fn the_gpu_search_gives_the_cpu_twins_output_under_validation() {
         })
         .collect();
     assert_eq!(outputs[0], outputs[1], "GPU and CPU searches differ");
+}
+
+/// `synth grow`: a new 48×36 field from the 40² crop, the same for a seed
+/// with either search (the GPU's under validation), another for another
+/// seed; one-line errors for a size below the window, an exemplar with
+/// a void and a window larger than the exemplar.
+#[test]
+fn grow_makes_a_new_field_of_the_size_asked() {
+    let dir = fresh_dir("synth-grow");
+    let (exemplar, _, values) = fixture(&dir);
+    let exemplar = exemplar.display().to_string();
+    let grow = |name: &str, extra: &[&str]| {
+        let out = dir.join(name).display().to_string();
+        let mut a = vec![
+            "synth",
+            "grow",
+            "--exemplar",
+            &exemplar,
+            "--size",
+            "48x36",
+            "--out",
+            &out,
+        ];
+        a.extend_from_slice(&FAST[2..]);
+        a.extend_from_slice(extra);
+        (run(&a), out)
+    };
+    // Waves of 8 (not the default 1) keep the GPU run short.
+    let (cpu, cpu_out) = grow("cpu.exr", &["--search", "cpu", "--seed", "3", "--batch", "8"]);
+    assert_success("grow cpu", &cpu);
+    let (gpu, gpu_out) = grow("gpu.exr", &["--validation", "--seed", "3", "--batch", "8"]);
+    assert_success("grow gpu", &gpu);
+    assert_eq!(
+        std::fs::read(&cpu_out).unwrap(),
+        std::fs::read(&gpu_out).unwrap(),
+        "GPU and CPU differ"
+    );
+    let heights = read(Path::new(&cpu_out));
+    assert_eq!(heights.len(), 48 * 36);
+    let (lo, hi) = values.iter().fold((u16::MAX, 0), |(l, h), &v| (l.min(v), h.max(v)));
+    let margin = f32::from(hi - lo) * 0.25;
+    assert!(
+        heights
+            .iter()
+            .all(|&h| h >= f32::from(lo) - margin && h <= f32::from(hi) + margin),
+        "heights outside the exemplar's range"
+    );
+    let (other, other_out) = grow("other.exr", &["--search", "cpu", "--seed", "4"]);
+    assert_success("grow seed 4", &other);
+    assert_ne!(std::fs::read(&cpu_out).unwrap(), std::fs::read(&other_out).unwrap());
+
+    let outputs = fresh_dir("synth-grow-out");
+    let out = outputs.join("o.png").display().to_string();
+    let void = dir.join("void.exr");
+    let mut with_void: Vec<f32> = values.iter().map(|&v| f32::from(v)).collect();
+    with_void[5] = f32::NAN;
+    std::fs::write(&void, encode_exr_height(&with_void, SIDE, SIDE).unwrap()).unwrap();
+    let void = void.display().to_string();
+    for (what, exemplar, size, extra, needles) in [
+        ("small size", &exemplar, "5", &[][..], &["--size", "5×5"][..]),
+        ("bad size", &exemplar, "12y3", &[], &["--size", "12y3"]),
+        ("void", &void, "24", &[], &["void.exr"]),
+        (
+            "huge window",
+            &exemplar,
+            "48",
+            &["--window", "41"],
+            &["--window", "exemplar"],
+        ),
+    ] {
+        let mut a = vec!["synth", "grow", "--exemplar", exemplar, "--size", size, "--out", &out];
+        a.extend_from_slice(&FAST);
+        a.extend_from_slice(extra);
+        assert_one_line_error(what, &run(&a), needles);
+    }
+    assert_no_files_left("grow errors", &outputs);
 }
 
 /// Ctrl-C (SIGINT) ends a long growth at once and leaves no output: the

@@ -60,6 +60,8 @@ const FLAGS: &[(&str, &str)] = &[
     ("views", "--rig"),
     ("from_image.image", "--image"),
     ("from_image.classes", "--classes"),
+    ("from_image.level2", "--level2"),
+    ("from_image.mask", "--mask"),
     ("from_image.bins", "--bins"),
     ("from_image.value_weight", "--value-weight"),
     ("from_image.sun_azimuth_deg", "--sun-azimuth"),

@@ -12,7 +12,7 @@ use glam::DVec2;
 
 use alpenglow::files::{load_heightmap, InputLimits};
 use alpenglow::tools::layers::{
-    build_layers, load_rgb_image, ClassCount, FromImageOptions, PixelStatus, INPUT_NAMES, MAX_CLASSES,
+    build_layers, load_mask, load_rgb_image, ClassCount, FromImageOptions, PixelStatus, INPUT_NAMES, MAX_CLASSES,
 };
 use alpenglow::{HeightField, HeightmapOptions, RowOrder};
 
@@ -57,6 +57,16 @@ pub struct FromImageArgs {
     /// largest silhouette). Near-grey rock and snow come on top.
     #[arg(long, default_value = "auto", value_parser = parse_classes, value_name = "K|auto")]
     pub classes: ClassCount,
+    /// Level-2 layers: split every chromatic level-1 class with at least
+    /// 10 % of the pixels into K sub-classes (2..=4) by a second k-means
+    /// inside the class; the class keeps its largest sub-class's colour,
+    /// the others become its children (§8.3).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(2..=4), value_name = "K")]
+    pub level2: Option<u64>,
+    /// Pixels to leave out (e.g. cultivated land, §8.3): an image of the
+    /// colour image's size, excluded where non-zero (not black).
+    #[arg(long, value_name = "FILE")]
+    pub mask: Option<PathBuf>,
     /// The image's sun azimuth, degrees clockwise from north.
     #[arg(long = "sun-azimuth", default_value_t = 150.0, value_name = "DEGREES")]
     pub sun_azimuth: f64,
@@ -153,6 +163,10 @@ fn from_image(args: FromImageArgs) -> Result<ExitCode> {
     let limits = InputLimits::with_max_file_mib(args.max_input_mb);
     let (field, maps) = load_inputs(&args, limits)?;
     let image = load_rgb_image(&args.image, &limits)?;
+    let exclude = match &args.mask {
+        Some(path) => Some(load_mask(path, image.width(), image.height(), &limits)?),
+        None => None,
+    };
     let options = FromImageOptions {
         classes: args.classes,
         image_rows: row_order(args.rows),
@@ -164,6 +178,8 @@ fn from_image(args: FromImageArgs) -> Result<ExitCode> {
         seed: args.seed,
         calibrate: !args.no_calibration,
         value_weight: args.value_weight,
+        level2: args.level2.map(|k| k as usize),
+        exclude,
     };
     let started = Instant::now();
     let generated = build_layers(&image, &field, &maps, &options)?;
@@ -181,6 +197,9 @@ fn from_image(args: FromImageArgs) -> Result<ExitCode> {
     )];
     for (k, path) in &args.input_maps {
         sources.push(format!("Input map {}: {}.", INPUT_NAMES[*k], path.display()));
+    }
+    if let Some(path) = &args.mask {
+        sources.push(format!("Mask: {}.", path.display()));
     }
     let toml = generated.to_toml(&sources);
     outputs.stage(Some(&args.out), || Ok(toml.into_bytes()))?;

@@ -1,4 +1,4 @@
-//! `alpenglow synth fill` and `alpenglow synth transition`: height-field
+//! `alpenglow synth fill`, `synth grow` and `synth transition`: height-field
 //! synthesis by non-parametric sampling (dissertation §7.3;
 //! `alpenglow::tools::synth`).
 
@@ -9,8 +9,8 @@ use std::time::Instant;
 use alpenglow::files::{encode_exr_height, encode_png_gray16, load_heightmap, load_heightmap_with_voids};
 use alpenglow::tools::budget::MemoryLimits;
 use alpenglow::tools::synth::{
-    band_of, check_fields, check_hole_fill, plan_hole_fill, plan_transition, Axis, CpuSearch, FillParams, GpuSearch,
-    Growth, GrowthCost, SearchDevice, TransitionParams,
+    band_of, check_fields, check_free_growth, check_hole_fill, plan_free_growth, plan_hole_fill, plan_transition, Axis,
+    CpuSearch, FillParams, GpuSearch, Growth, GrowthCost, SearchDevice, TransitionParams, FREE_GROWTH,
 };
 use alpenglow::{Context, HeightField, HeightmapOptions, RowOrder};
 use anyhow::{bail, Result};
@@ -27,6 +27,9 @@ pub enum SynthCommand {
     /// Fill holes of a DEM by pixel growing (§7.3): the samples marked by
     /// --mask, or without it the voids of the input (NaN, no-data).
     Fill(FillArgs),
+    /// Grow a new height field of a given size from an exemplar alone
+    /// (§7.3, Fig. 7.1): pixel growing from one window of the exemplar.
+    Grow(FreeArgs),
     /// Join two height fields of the same size across a grown band (§7.3.3).
     Transition(TransitionArgs),
 }
@@ -81,9 +84,10 @@ pub struct GrowArgs {
     /// Seed of the candidate subsample and the random choice.
     #[arg(long, default_value_t = 1, value_name = "SEED")]
     pub seed: u32,
-    /// Most samples searched together in one wave (1: the text's sequential order).
-    #[arg(long, default_value_t = 256, value_name = "SAMPLES")]
-    pub batch: usize,
+    /// Most samples searched together in one wave (1: the text's
+    /// sequential order; default: fill and transition 256, grow 1).
+    #[arg(long, value_name = "SAMPLES")]
+    pub batch: Option<usize>,
     /// Most candidate windows (those nearest the unknown samples first).
     #[arg(long, default_value_t = 16384, value_name = "COUNT")]
     pub candidates: usize,
@@ -105,7 +109,7 @@ impl GrowArgs {
             lambda: self.lambda,
             epsilon: self.epsilon.unwrap_or(defaults.epsilon),
             seed: self.seed,
-            batch: self.batch,
+            batch: self.batch.unwrap_or(defaults.batch),
             candidates: self.candidates,
         }
     }
@@ -127,6 +131,36 @@ pub struct FillArgs {
     pub grow: GrowArgs,
     #[command(flatten)]
     pub heights: HeightArgs,
+}
+
+#[derive(Args, Debug)]
+pub struct FreeArgs {
+    /// The exemplar height field: PNG, EXR, GeoTIFF or SRTM .hgt (no voids).
+    #[arg(long, value_name = "FILE")]
+    pub exemplar: PathBuf,
+    /// The grown field: .png (16-bit, the exemplar's scale and offset) or .exr (float).
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Size of the new field in samples: COLUMNSxROWS, or N for N×N.
+    #[arg(long, value_parser = parse_size, value_name = "COLUMNSxROWS")]
+    pub size: (u32, u32),
+    #[command(flatten)]
+    pub grow: GrowArgs,
+    #[command(flatten)]
+    pub heights: HeightArgs,
+}
+
+/// `COLUMNSxROWS` or `N` of `--size`.
+fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let side = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("'{s}' is not N or COLUMNSxROWS"))
+    };
+    match s.split_once(['x', 'X', '×']) {
+        Some((c, r)) => Ok((side(c)?, side(r)?)),
+        None => side(s).map(|n| (n, n)),
+    }
 }
 
 /// The axis of `--axis`.
@@ -168,6 +202,7 @@ pub struct TransitionArgs {
 pub fn synth(command: SynthCommand) -> Result<ExitCode> {
     match command {
         SynthCommand::Fill(args) => fill(args),
+        SynthCommand::Grow(args) => grow_free(args),
         SynthCommand::Transition(args) => transition(args),
     }
 }
@@ -242,7 +277,7 @@ fn unknown_error(e: alpenglow::Error, args: &FillArgs) -> anyhow::Error {
 }
 
 fn fill(args: FillArgs) -> Result<ExitCode> {
-    let mut outputs = reserve_output(&args.out)?;
+    let outputs = reserve_output(&args.out)?;
     let (field, unknown) = load_fill_input(&args)?;
     let params = args.grow.params(FillParams::default());
     check_hole_fill(&field, &unknown, &params).map_err(|e| unknown_error(e, &args))?;
@@ -257,13 +292,7 @@ fn fill(args: FillArgs) -> Result<ExitCode> {
             args.input.display()
         );
     }
-    let started = Instant::now();
-    let filled = grow_with(growth, search)?;
-    let seconds = started.elapsed().as_secs_f64();
-    progress::phase("writing", || {
-        outputs.stage(Some(&args.out), || encode_field(&args.out, &filled, &args.heights))
-    })?;
-    outputs.commit()?;
+    let seconds = grow_and_write(growth, search, outputs, &args.out, &args.heights)?;
     println!(
         "{}: filled {total} of {}×{} samples in {seconds:.1} s → {}",
         args.input.display(),
@@ -271,6 +300,35 @@ fn fill(args: FillArgs) -> Result<ExitCode> {
         field.rows,
         args.out.display()
     );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn grow_free(args: FreeArgs) -> Result<ExitCode> {
+    let outputs = reserve_output(&args.out)?;
+    let exemplar = load_heightmap(&args.exemplar, &heightmap_options(&args.heights))?;
+    let params = args.grow.params(FREE_GROWTH);
+    let (columns, rows) = args.size;
+    let named = |e: alpenglow::Error| match (&e, e.parameter()) {
+        (alpenglow::Error::InvalidArgument { message, .. }, Some("exemplar")) => {
+            anyhow::anyhow!("--exemplar {}: {message}", args.exemplar.display())
+        }
+        _ => e.into(),
+    };
+    check_free_growth(&exemplar, columns, rows, &params).map_err(named)?;
+    // The cost of filling the whole new field, its candidates the exemplar's windows.
+    let inside = |side: u32| (side + 1).saturating_sub(params.window) as usize;
+    let candidates = params.candidates.min(inside(exemplar.columns) * inside(exemplar.rows));
+    let unknown = u64::from(columns) * u64::from(rows);
+    let cost = GrowthCost::fill(columns, rows, unknown, &FillParams { candidates, ..params });
+    let search = prepare_search(&cost, &args.grow, &format!("--size {columns}x{rows}"))?;
+    let growth = progress::phase("planning the growth", || {
+        plan_free_growth(&exemplar, columns, rows, &params)
+    })
+    .map_err(named)?;
+    let seconds = grow_and_write(growth, search, outputs, &args.out, &args.heights)?;
+    let (from, to) = (args.exemplar.display(), args.out.display());
+    let (c, r) = (exemplar.columns, exemplar.rows);
+    println!("{from}: grew {columns}×{rows} samples from its {c}×{r} in {seconds:.1} s → {to}");
     Ok(ExitCode::SUCCESS)
 }
 
@@ -366,6 +424,25 @@ fn prepare_search(cost: &GrowthCost, args: &GrowArgs, field: &str) -> Result<Sea
             Ok(Search::Gpu(ctx))
         }
     }
+}
+
+/// Grows `growth` with `search` and writes the result to `out`; returns
+/// the seconds the growth took.
+fn grow_and_write(
+    growth: Growth,
+    search: Search,
+    mut outputs: Outputs,
+    out: &Path,
+    heights: &HeightArgs,
+) -> Result<f64> {
+    let started = Instant::now();
+    let grown = grow_with(growth, search)?;
+    let seconds = started.elapsed().as_secs_f64();
+    progress::phase("writing", || {
+        outputs.stage(Some(out), || encode_field(out, &grown, heights))
+    })?;
+    outputs.commit()?;
+    Ok(seconds)
 }
 
 /// Grows `growth` with `search` (on the GPU: validated with `--validation`

@@ -241,6 +241,15 @@ impl Growth {
         Ok(self.field)
     }
 
+    /// [`Growth::grow`] with the CPU search.
+    pub fn grow_cpu(self, progress: &mut dyn FnMut(usize, usize)) -> Result<HeightField> {
+        let mut search = CpuSearch {
+            exemplar: self.exemplar.clone(),
+            config: self.search_config(),
+        };
+        self.grow(&mut search, progress)
+    }
+
     /// The query of sample `p` in the current state.
     fn query(&self, p: u32, weights: &[f32]) -> Query {
         let (w, h) = (self.field.columns as i64, self.field.rows as i64);
@@ -486,12 +495,7 @@ pub fn fill_holes_cpu(
     params: &FillParams,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<HeightField> {
-    let growth = plan_hole_fill(field, unknown, params)?;
-    let mut search = CpuSearch {
-        exemplar: growth.exemplar().clone(),
-        config: growth.search_config(),
-    };
-    growth.grow(&mut search, progress)
+    plan_hole_fill(field, unknown, params)?.grow_cpu(progress)
 }
 
 #[cfg(test)]

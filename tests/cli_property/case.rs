@@ -77,7 +77,7 @@ pub enum Output {
     Frames(PathBuf),
     /// An SPT file.
     Spt(PathBuf),
-    /// A height map of the input's size (`synth`).
+    /// A height map of the input's size (`synth`; `synth grow`: its `--size`).
     Height(PathBuf),
     /// A layer tree (TOML).
     Layers(PathBuf),
@@ -139,6 +139,7 @@ pub fn generate(id: u64, fixtures: &Fixtures, root: &Path) -> Case {
         Command::Fly,
         Command::SptBuild,
         Command::SynthFill,
+        Command::SynthGrow,
         Command::SynthTransition,
         Command::LayersFromImage,
     ]);
@@ -168,7 +169,7 @@ pub fn generate(id: u64, fixtures: &Fixtures, root: &Path) -> Case {
     match command {
         Command::Render | Command::Bench | Command::Fly => scene_command(&mut rng, (command, &chosen), fixtures, args),
         Command::SptBuild => spt_build(&mut rng, args),
-        Command::SynthFill | Command::SynthTransition => synth(&mut rng, command, fixtures, args),
+        Command::SynthFill | Command::SynthGrow | Command::SynthTransition => synth(&mut rng, command, fixtures, args),
         Command::LayersFromImage => layers_from_image(&mut rng, fixtures, args),
     }
     if command.uses_device() {
@@ -267,7 +268,8 @@ fn spt_build(rng: &mut Rng, (case, base, varied): CaseParts) {
     case.outputs.push(Output::Spt(spt));
 }
 
-/// `synth fill` of the DEM fixture or `synth transition` of two procedural terrains.
+/// `synth fill` of the DEM fixture, `synth grow` from it, or `synth
+/// transition` of two procedural terrains.
 fn synth(rng: &mut Rng, command: Command, fixtures: &Fixtures, (case, base, varied): CaseParts) {
     let out_dir = case.out_dir.clone();
     let out = |name: &str| out_dir.join(name);
@@ -278,6 +280,13 @@ fn synth(rng: &mut Rng, command: Command, fixtures: &Fixtures, (case, base, vari
         let (dem, mask) = (fixtures.path("dem.png"), fixtures.path("mask.png"));
         base.extend(["--input".into(), dem.clone(), "--mask".into(), mask.clone()]);
         case.files.extend([dem, mask]);
+    } else if command == Command::SynthGrow {
+        let dem = fixtures.path("dem.png");
+        base.extend(["--exemplar".into(), dem.clone()]);
+        if !is_varied("--size") {
+            push(&["--size", "24x20"], base);
+        }
+        case.files.push(dem);
     } else {
         let a = "procedural:fbm,size=33,seed=1".to_string();
         let b = "procedural:fbm,size=33,seed=2".to_string();

@@ -1,5 +1,5 @@
 //! The option space under test: every option of `render`, `bench`, `fly`,
-//! `spt build`, `synth fill`, `synth transition` and `layers from-image`
+//! `spt build`, `synth fill`, `synth grow`, `synth transition` and `layers from-image`
 //! that takes a value, split into the numeric ones (with their documented
 //! ranges, varied by the property test) and the others (files, names,
 //! modes: set by the test's base command lines only). The test
@@ -328,7 +328,7 @@ pub const SPT: &[Opt] = &[
 ];
 pub const SPT_OTHER: &[&str] = &["--sampling"];
 
-/// The options `synth fill` and `synth transition` share.
+/// The options `synth fill`, `synth grow` and `synth transition` share.
 pub const GROW: &[Opt] = &[
     opt("--window", int(3, 63, 15)),
     opt("--lambda", float(0.0, BIG)),
@@ -360,6 +360,11 @@ pub const GROW: &[Opt] = &[
 ];
 pub const FILL_OTHER: &[&str] = &["--input", "--mask", "--out", "--search", "--device", "--rows"];
 
+// Sides of the grown field: legal up to 8192, but above 48 (on the 33²
+// fixture) a debug build under load takes long; below the window an error.
+pub const FREE: &[Opt] = &[opt("--size", int(7, 8192, 48))];
+pub const FREE_OTHER: &[&str] = &["--exemplar", "--out", "--search", "--device", "--rows"];
+
 pub const TRANSITION: &[Opt] = &[opt("--band", float(0.0, BIG)), opt("--blur", int(0, U32, 16))];
 pub const TRANSITION_OTHER: &[&str] = &["--out", "--axis", "--search", "--device", "--rows"];
 
@@ -380,6 +385,7 @@ pub const LAYERS: &[Opt] = &[
     opt("--snow-min-altitude", float(-1e6, 1e6)),
     opt("--bins", int(1, 64, 64)),
     opt("--value-weight", float(0.0, 4.0)),
+    opt("--level2", int(2, 4, 4)),
     opt("--seed", int(0, U64, U64)),
     opt("--max-input-mb", int(1, U64, 1 << 40)),
 ];
@@ -388,6 +394,7 @@ pub const LAYERS_OTHER: &[&str] = &[
     "--heightmap",
     "--rows",
     "--input-map",
+    "--mask",
     "--out",
     "--class-map",
 ];
@@ -400,17 +407,19 @@ pub enum Command {
     Fly,
     SptBuild,
     SynthFill,
+    SynthGrow,
     SynthTransition,
     LayersFromImage,
 }
 
 impl Command {
-    pub const ALL: [Command; 7] = [
+    pub const ALL: [Command; 8] = [
         Command::Render,
         Command::Bench,
         Command::Fly,
         Command::SptBuild,
         Command::SynthFill,
+        Command::SynthGrow,
         Command::SynthTransition,
         Command::LayersFromImage,
     ];
@@ -423,6 +432,7 @@ impl Command {
             Command::Fly => &["fly"],
             Command::SptBuild => &["spt", "build"],
             Command::SynthFill => &["synth", "fill"],
+            Command::SynthGrow => &["synth", "grow"],
             Command::SynthTransition => &["synth", "transition"],
             Command::LayersFromImage => &["layers", "from-image"],
         }
@@ -434,6 +444,7 @@ impl Command {
             Command::Render | Command::Bench | Command::Fly => SCENE.to_vec(),
             Command::SptBuild => SPT.to_vec(),
             Command::SynthFill => GROW.to_vec(),
+            Command::SynthGrow => [GROW, FREE].concat(),
             Command::SynthTransition => [GROW, TRANSITION].concat(),
             Command::LayersFromImage => LAYERS.to_vec(),
         };
@@ -453,6 +464,7 @@ impl Command {
             Command::Fly => [SCENE_OTHER, FLY_OTHER].concat(),
             Command::SptBuild => SPT_OTHER.to_vec(),
             Command::SynthFill => FILL_OTHER.to_vec(),
+            Command::SynthGrow => FREE_OTHER.to_vec(),
             Command::SynthTransition => TRANSITION_OTHER.to_vec(),
             Command::LayersFromImage => LAYERS_OTHER.to_vec(),
         }

@@ -312,9 +312,16 @@ fn check_output(case: &Case, output: &Output) -> Result<(), String> {
                 offset: given("--height-offset", 0.0),
                 ..HeightmapOptions::default()
             };
+            // `synth grow` writes its `--size` (N or CxR), the others the input's 33².
+            let size = case.args.iter().position(|a| a == "--size").and_then(|i| {
+                let v = case.args.get(i + 1)?;
+                let (c, r) = v.split_once('x').unwrap_or((v, v));
+                Some((c.parse::<u32>().ok()?, r.parse::<u32>().ok()?))
+            });
+            let (columns, rows) = size.unwrap_or((33, 33));
             match load_heightmap(p, &opts) {
-                Ok(f) if (f.columns, f.rows) == (33, 33) => Ok(()),
-                Ok(f) => fail(p, format!("{}×{} samples, not 33×33", f.columns, f.rows)),
+                Ok(f) if (f.columns, f.rows) == (columns, rows) => Ok(()),
+                Ok(f) => fail(p, format!("{}×{} samples, not {columns}×{rows}", f.columns, f.rows)),
                 Err(e) => fail(p, format!("does not load: {e}")),
             }
         }

@@ -66,7 +66,7 @@ fn main() -> alpenglow::Result<()> {
         let (mut generated, t4) = timed(|| tree::build(&classes, &functions, &provenance));
         let fractions = classes.fractions();
         let targets: Vec<f64> = generated.layers.iter().map(|l| fractions[l.class]).collect();
-        let points = calibrate::sample_positions(&positions, registration.width as usize);
+        let points = calibrate::sample_positions(&positions, registration.width as usize, &classes.status);
         let (calibrated, t5) = timed(|| {
             calibrate::calibrate(
                 &mut generated.layers,

@@ -35,7 +35,7 @@ const KS_BOUND: f64 = 0.25;
 const SIDE: u32 = 128;
 
 /// The crop of the Jacksboro DEM (the rugged ridges south-west of the fault).
-fn crop() -> HeightField {
+pub(super) fn crop() -> HeightField {
     let full = load_heightmap(
         Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/jacksboro-fault.png")),
         &HeightmapOptions {
@@ -76,7 +76,7 @@ fn params(seed: u32, candidates: usize) -> FillParams {
 
 /// Slope (gradient magnitude) and curvature (5-point Laplacian, per m²) of
 /// `f` at an interior sample.
-fn slope_curvature(f: &HeightField, c: u32, r: u32) -> (f64, f64) {
+pub(super) fn slope_curvature(f: &HeightField, c: u32, r: u32) -> (f64, f64) {
     let h = |c: u32, r: u32| f64::from(f.height(c, r));
     let (dx, dy) = (f.spacing.x, f.spacing.y);
     let gx = (h(c + 1, r) - h(c - 1, r)) / (2.0 * dx);
@@ -88,7 +88,7 @@ fn slope_curvature(f: &HeightField, c: u32, r: u32) -> (f64, f64) {
 
 /// The two-sample Kolmogorov–Smirnov statistic: the largest distance
 /// between the empirical distribution functions of `a` and `b`.
-fn ks(mut a: Vec<f64>, mut b: Vec<f64>) -> f64 {
+pub(super) fn ks(mut a: Vec<f64>, mut b: Vec<f64>) -> f64 {
     a.sort_by(f64::total_cmp);
     b.sort_by(f64::total_cmp);
     let (mut i, mut j, mut d) = (0, 0, 0.0f64);
@@ -206,7 +206,7 @@ fn membrane(input: &HeightField, unknown: &[bool]) -> HeightField {
 }
 
 /// A grey hillshade of `f` (light from the north-west) as RGBA.
-fn hillshade(f: &HeightField) -> Vec<u8> {
+pub(super) fn hillshade(f: &HeightField) -> Vec<u8> {
     let light = glam::DVec3::new(-0.5, 0.5, 0.7).normalize();
     let mut rgba = Vec::with_capacity(f.heights.len() * 4);
     for r in 0..f.rows {

@@ -24,6 +24,11 @@
 //!   surrounds it). Lakes are flat, fully lit and keep their class.
 //! * **Cloud** (§8.3.2): snow below the minimum altitude is set aside the
 //!   same way ([`PixelStatus::Cloud`]).
+//! * **Excluded** (§8.3.2: the text leaves the land cultivated by humans
+//!   out of the distribution functions): pixels under the `--mask`
+//!   ([`PixelStatus::Masked`]) are neither clustered nor counted, and are
+//!   left out of the class areas ([`Classification::fractions`]); the class
+//!   map fills them like shade.
 
 use std::collections::VecDeque;
 
@@ -64,6 +69,8 @@ pub enum PixelStatus {
     Shade,
     /// Snow below the minimum altitude.
     Cloud,
+    /// Excluded by the mask (module docs).
+    Masked,
 }
 
 /// One surface type.
@@ -79,8 +86,10 @@ pub struct Class {
     pub linear: Vec3,
     /// Counted pixels.
     pub counted: usize,
-    /// Pixels of the class map (set-aside pixels filled in).
+    /// Pixels of the class map (set-aside pixels filled in, masked ones not).
     pub pixels: usize,
+    /// The class this one is a level-2 sub-class of (`super::level2`).
+    pub parent: Option<usize>,
 }
 
 /// The image's classification.
@@ -98,9 +107,9 @@ pub struct Classification {
 }
 
 impl Classification {
-    /// Share of the image each class covers in the class map.
+    /// Share of the image outside the mask each class covers in the class map.
     pub fn fractions(&self) -> Vec<f64> {
-        let n = self.labels.len().max(1) as f64;
+        let n = (self.labels.len() - self.count(PixelStatus::Masked)).max(1) as f64;
         self.classes.iter().map(|c| c.pixels as f64 / n).collect()
     }
 
@@ -144,6 +153,7 @@ enum Verdict {
     Grey,
     White,
     Shade,
+    Masked,
 }
 
 /// The value `V / clamp(R, 0.4, 1.5)` of a pixel of value `v` under modelled light `light`.
@@ -177,10 +187,15 @@ pub fn classify(
     options: &FromImageOptions,
 ) -> Result<Classification> {
     let pixels: Vec<[u8; 3]> = image.pixels().map(|p| p.0).collect();
-    let verdicts: Vec<Verdict> = pixels
-        .iter()
-        .zip(light)
-        .map(|(&p, &l)| verdict(p, l, options.shade_handling))
+    let excluded = |i: usize| options.exclude.as_ref().is_some_and(|m| m[i]);
+    let verdicts: Vec<Verdict> = (pixels.iter().zip(light).enumerate())
+        .map(|(i, (&p, &l))| {
+            if excluded(i) {
+                Verdict::Masked
+            } else {
+                verdict(p, l, options.shade_handling)
+            }
+        })
         .collect();
     let mut histogram = ColourHistogram::new(options.value_weight);
     for ((p, v), &l) in pixels.iter().zip(&verdicts).zip(light) {
@@ -208,6 +223,10 @@ pub fn classify(
                 status[i] = PixelStatus::Shade;
                 continue;
             }
+            Verdict::Masked => {
+                status[i] = PixelStatus::Masked;
+                continue;
+            }
             Verdict::Chromatic => {
                 let (h, s, value) = hsv(*p);
                 clusters.nearest(h, s, shade_normalised(value, light[i]))
@@ -224,7 +243,8 @@ pub fn classify(
         labels[i] = class as u8;
     }
     fill_set_aside(&mut labels, registration.width as usize)?;
-    let classes = summarise(&kinds, &clusters.centroids, &pixels, &labels, &status);
+    let parents = vec![None; kinds.len()];
+    let classes = summarise(&kinds, &parents, &clusters.centroids, &pixels, &labels, &status);
     Ok(Classification {
         registration: *registration,
         classes,
@@ -264,9 +284,11 @@ fn fill_set_aside(labels: &mut [u8], width: usize) -> Result<()> {
     Ok(())
 }
 
-/// Counts, mean colours and names of the classes.
-fn summarise(
+/// Counts, mean colours and names of the classes; a sub-class is named
+/// after its parent (`forest.2`: the parent keeps its largest sub-class).
+pub fn summarise(
     kinds: &[ClassKind],
+    parents: &[Option<usize>],
     centroids: &[(f64, f64, f64)],
     pixels: &[[u8; 3]],
     labels: &[u8],
@@ -277,7 +299,9 @@ fn summarise(
         let Some(entry) = sums.get_mut(usize::from(l)) else {
             continue;
         };
-        entry.2 += 1;
+        if *s != PixelStatus::Masked {
+            entry.2 += 1;
+        }
         if *s == PixelStatus::Counted {
             entry.0 += Vec3::from(p.map(srgb_to_linear));
             entry.1 += 1;
@@ -290,12 +314,18 @@ fn summarise(
         .enumerate()
         .map(|(k, (&kind, (sum, counted, total)))| {
             let linear = sum / counted.max(1) as f32;
-            let base = class_name(kind, linear);
-            let same = names.iter().filter(|n| n.split(' ').next() == Some(base)).count();
-            let name = if same == 0 {
-                base.to_string()
+            let parent = parents.get(k).copied().flatten();
+            let name = if let Some(p) = parent {
+                let siblings = parents[..k].iter().filter(|&&q| q == Some(p)).count();
+                format!("{}.{}", names.get(p).map_or("class", |n| n.as_str()), siblings + 2)
             } else {
-                format!("{base} {}", same + 1)
+                let base = class_name(kind, linear);
+                let same = names.iter().filter(|n| n.split(' ').next() == Some(base)).count();
+                if same == 0 {
+                    base.to_string()
+                } else {
+                    format!("{base} {}", same + 1)
+                }
             };
             names.push(name.clone());
             Class {
@@ -305,6 +335,7 @@ fn summarise(
                 linear,
                 counted,
                 pixels: total,
+                parent,
             }
         })
         .collect()

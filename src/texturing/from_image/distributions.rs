@@ -17,6 +17,9 @@
 //! * **Samples**: `n` equal bins over the domain, sample b being bin b's
 //!   value (the format puts it at the bin's centre). Only counted pixels
 //!   ([`super::PixelStatus::Counted`]) enter the histograms.
+//! * **Level 2**: a class's histograms count the pixels of its level-2
+//!   sub-classes too (`super::level2`): the parent layer covers the
+//!   whole class, its children refine it.
 //! * **Scaling**: `F_b = clamp(0.5 · h_b / mean(h), 0, 1)`, the mean over
 //!   all n bins (empty ones too), as in the text.
 
@@ -173,8 +176,11 @@ pub fn estimate(classification: &Classification, samples: &Samples, bins: usize)
     let map_domains = samples.maps.clone().map(|m| m.map(|v| (map_domain(&v), v)));
     let classes = (0..classification.classes.len())
         .map(|c| {
+            // A class's pixels include those of its level-2 sub-classes.
             let take = |i: usize| {
-                classification.status[i] == PixelStatus::Counted && usize::from(classification.labels[i]) == c
+                let label = usize::from(classification.labels[i]);
+                let parent = classification.classes.get(label).and_then(|l| l.parent);
+                classification.status[i] == PixelStatus::Counted && (label == c || parent == Some(c))
             };
             ClassFunctions {
                 altitude: distribution(&samples.altitude, take, altitude_domain, bins),

@@ -19,7 +19,13 @@
 //!    the class occurs, scaled to mean 0.5 and clamped (snow below a
 //!    minimum altitude is cloud and not counted);
 //! 5. [`tree`]: root = the most common class, one level-1 child per other
-//!    class with its mean colour (linear albedo), written as TOML.
+//!    class with its mean colour (linear albedo), written as TOML;
+//! 6. optionally [`level2`]: the larger level-1 classes split by a second
+//!    clustering inside each, the sub-classes their level-2 children.
+//!
+//! A mask (`FromImageOptions::exclude`, `--mask`) leaves pixels out of
+//! everything: the text excludes the land cultivated by humans from the
+//! distribution functions (§8.3.2).
 //!
 //! # Registration
 //! The image covers the height field's area pixel for pixel: its size is
@@ -35,6 +41,7 @@ pub mod calibrate;
 pub mod classify;
 pub mod distributions;
 pub mod kmeans;
+pub mod level2;
 pub mod shading;
 pub mod tree;
 
@@ -87,6 +94,12 @@ pub struct FromImageOptions {
     /// Weight of the shade-normalised value in the clustering space
     /// (`kmeans`); 0: hue and saturation alone.
     pub value_weight: f64,
+    /// Sub-classes per larger level-1 class ([`level2`], 2..=[`level2::MAX_SUBCLASSES`]);
+    /// `None`: no level 2.
+    pub level2: Option<usize>,
+    /// Pixels left out of the estimation (`true`), one per image pixel
+    /// row-major from image row 0 ([`load_mask`]); `None`: none.
+    pub exclude: Option<Vec<bool>>,
 }
 
 impl Default for FromImageOptions {
@@ -102,6 +115,8 @@ impl Default for FromImageOptions {
             seed: 1,
             calibrate: true,
             value_weight: 0.5,
+            level2: None,
+            exclude: None,
         }
     }
 }
@@ -133,6 +148,14 @@ impl FromImageOptions {
                 "from_image.value_weight",
                 format!("{} is out of range 0..=4", self.value_weight),
             ));
+        }
+        if let Some(k) = self.level2 {
+            if !(2..=level2::MAX_SUBCLASSES).contains(&k) {
+                return Err(Error::invalid(
+                    "from_image.level2",
+                    format!("{k} is out of range 2..={}", level2::MAX_SUBCLASSES),
+                ));
+            }
         }
         if self.snow_min_altitude.is_some_and(|a| !a.is_finite()) {
             return Err(Error::invalid("from_image.snow_min_altitude", "must be finite"));
@@ -229,6 +252,56 @@ pub fn load_rgb_image(path: &std::path::Path, limits: &crate::io::limits::InputL
     Ok(image.to_rgb8())
 }
 
+/// Reads a mask of pixels to leave out (PNG or JPEG, any colour type): a
+/// pixel is excluded where any colour channel is non-zero. Errors (one
+/// line, naming `path`): not an image, a size other than `width × height`
+/// (the colour image's), every pixel excluded.
+pub fn load_mask(
+    path: &std::path::Path,
+    width: u32,
+    height: u32,
+    limits: &crate::io::limits::InputLimits,
+) -> Result<Vec<bool>> {
+    let mask = load_rgb_image(path, limits)?;
+    if mask.dimensions() != (width, height) {
+        return Err(Error::input(
+            path,
+            format!(
+                "the mask is {}×{} pixels, the image {width}×{height}",
+                mask.width(),
+                mask.height()
+            ),
+        ));
+    }
+    let exclude: Vec<bool> = mask.pixels().map(|p| p.0 != [0; 3]).collect();
+    if exclude.iter().all(|&e| e) {
+        return Err(Error::input(path, "the mask excludes every pixel"));
+    }
+    Ok(exclude)
+}
+
+/// Checks `options.exclude` against `registration`.
+fn check_exclude(options: &FromImageOptions, registration: &Registration) -> Result<()> {
+    let Some(exclude) = &options.exclude else {
+        return Ok(());
+    };
+    if exclude.len() != registration.pixels() {
+        return Err(Error::invalid(
+            "from_image.mask",
+            format!(
+                "{} mask pixels for a {}×{} image",
+                exclude.len(),
+                registration.width,
+                registration.height
+            ),
+        ));
+    }
+    if exclude.iter().all(|&e| e) {
+        return Err(Error::invalid("from_image.mask", "the mask excludes every pixel"));
+    }
+    Ok(())
+}
+
 /// Surface layers estimated from `image` over `field` (module docs): the
 /// layer tree as TOML with the classification behind it. `maps` are the
 /// extra input maps ([`crate::surface::layers::INPUT_NAMES`] order),
@@ -243,12 +316,23 @@ pub fn build_layers(
     options.validate()?;
     field.validate(std::path::Path::new("height field"))?;
     let registration = Registration::new(image.width(), image.height(), field, options.image_rows)?;
+    check_exclude(options, &registration)?;
     let positions = registration.world_positions();
     let samples = distributions::Samples::at(field, maps, &positions)?;
     let light = shading::relative_illumination(field, &positions, options.sun_azimuth_deg, options.sun_elevation_deg);
     let (lo, hi) = field.min_max();
     let snow_min = options.snow_min_altitude.unwrap_or(lo + 0.6 * (hi - lo));
-    let classification = classify::classify(image, &registration, &light, &samples.altitude, snow_min, options)?;
+    let mut classification = classify::classify(image, &registration, &light, &samples.altitude, snow_min, options)?;
+    if let Some(k) = options.level2 {
+        level2::refine(
+            &mut classification,
+            image,
+            &light,
+            k,
+            options.value_weight,
+            options.seed,
+        );
+    }
     let functions = distributions::estimate(&classification, &samples, options.bins);
     let provenance = tree::Provenance {
         options: options.clone(),
@@ -258,8 +342,9 @@ pub fn build_layers(
     let mut generated = tree::build(&classification, &functions, &provenance);
     if options.calibrate {
         let fractions = classification.fractions();
-        let targets: Vec<f64> = generated.layers.iter().map(|l| fractions[l.class]).collect();
-        let points = calibrate::sample_positions(&positions, registration.width as usize);
+        let own: Vec<f64> = generated.layers.iter().map(|l| fractions[l.class]).collect();
+        let targets = calibrate::with_children(&generated.layers, own);
+        let points = calibrate::sample_positions(&positions, registration.width as usize, &classification.status);
         generated.predicted =
             calibrate::calibrate(&mut generated.layers, &targets, tree::layer_tree, field, maps, &points)?;
         let shares: Vec<String> = (generated.layers.iter())
@@ -267,7 +352,8 @@ pub fn build_layers(
             .map(|(l, f)| format!("{} {:.1} %", l.name, 100.0 * f))
             .collect();
         generated.header.push(format!(
-            "Noise bias calibrated to the class areas; predicted dominant-layer areas: {}.",
+            "Noise bias calibrated to the class areas; predicted dominant-layer areas (a level-1 layer's with its \
+             level-2 children's): {}.",
             shares.join(", ")
         ));
     }

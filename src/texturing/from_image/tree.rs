@@ -16,7 +16,10 @@
 //!   [`NOISE_SCALE`] at a wavelength of [`NOISE_CELLS`] sample spacings, so
 //!   borders between classes fray at the scale of the image's own texture;
 //!   no roughness (the altitude the functions read stays the surface's).
-//! * No deeper levels: the text's level-2 variations are arbitrary.
+//! * **Level 2** (with `--level2`, `super::level2`): after each refined
+//!   level-1 layer its sub-classes' layers, most pixels first, with their
+//!   own mean colours and sampled functions and the level-1 noise. The
+//!   level-1 order counts a class's sub-classes with it.
 
 use std::fmt::Write as _;
 
@@ -47,6 +50,8 @@ pub struct Provenance {
 pub struct GeneratedLayer {
     /// Index of its class in the classification.
     pub class: usize,
+    /// 0 for the root, 1 or 2.
+    pub level: usize,
     pub name: String,
     /// Linear albedo.
     pub color: Vec3,
@@ -62,7 +67,8 @@ pub struct GeneratedLayer {
 pub struct GeneratedLayers {
     pub classification: Classification,
     pub distributions: Distributions,
-    /// Root first, then the level-1 children in order.
+    /// Depth-first: root first, then the level-1 children in order, each
+    /// followed by its level-2 children.
     pub layers: Vec<GeneratedLayer>,
     /// Comment lines of the file's header (without `# `).
     pub header: Vec<String>,
@@ -77,19 +83,35 @@ pub fn build(
     distributions: &Distributions,
     provenance: &Provenance,
 ) -> GeneratedLayers {
-    let mut order: Vec<usize> = (0..classification.classes.len())
-        .filter(|&c| classification.classes[c].counted > 0)
+    let classes = &classification.classes;
+    let whole = |c: usize| -> usize {
+        (classes.iter())
+            .filter(|k| k.parent == Some(c))
+            .map(|k| k.counted)
+            .sum::<usize>()
+            + classes[c].counted
+    };
+    let mut level1: Vec<usize> = (0..classes.len())
+        .filter(|&c| classes[c].parent.is_none() && whole(c) > 0)
         .collect();
-    order.sort_by_key(|&c| std::cmp::Reverse(classification.classes[c].counted));
+    level1.sort_by_key(|&c| std::cmp::Reverse(whole(c)));
+    let mut order: Vec<(usize, usize)> = Vec::new();
+    for (rank, &c) in level1.iter().enumerate() {
+        order.push((c, usize::from(rank > 0)));
+        let mut children: Vec<usize> = (0..classes.len())
+            .filter(|&k| classes[k].parent == Some(c) && classes[k].counted > 0)
+            .collect();
+        children.sort_by_key(|&k| std::cmp::Reverse(classes[k].counted));
+        order.extend(children.into_iter().map(|k| (k, 2)));
+    }
     let wavelength = (NOISE_CELLS * provenance.spacing.max_element()) as f32;
     let layers = order
         .iter()
-        .enumerate()
-        .map(|(rank, &c)| {
-            let class = &classification.classes[c];
+        .map(|&(c, level)| {
+            let class = &classes[c];
             let functions = &distributions.classes[c];
             let mut constraints = Vec::new();
-            if rank > 0 {
+            if level > 0 {
                 constraints.push(("altitude", functions.altitude.clone()));
                 constraints.push(("slope", functions.slope.clone()));
                 for (k, map) in functions.maps.iter().enumerate() {
@@ -100,10 +122,11 @@ pub fn build(
             }
             GeneratedLayer {
                 class: c,
+                level,
                 name: class.name.clone(),
                 color: class.linear.clamp(Vec3::ZERO, Vec3::ONE),
-                noise_bias: if rank > 0 { NOISE_BIAS } else { 1.0 },
-                noise_scale: if rank > 0 { NOISE_SCALE } else { 0.0 },
+                noise_bias: if level > 0 { NOISE_BIAS } else { 1.0 },
+                noise_scale: if level > 0 { NOISE_SCALE } else { 0.0 },
                 noise_wavelength: wavelength.clamp(1e-3, 1e6),
                 constraints,
             }
@@ -156,7 +179,7 @@ fn header(classification: &Classification, provenance: &Provenance) -> Vec<Strin
         .zip(classification.fractions())
         .map(|(c, f)| format!("{} {:.1} %", c.name, 100.0 * f))
         .collect();
-    vec![
+    let mut lines = vec![
         "Surface layers estimated from a real image (alpenglow layers from-image; dissertation §8.3).".into(),
         format!(
             "Classes: k-means in the hue-saturation(-value, weight {}) histogram, {choice}; near-grey pixels \
@@ -174,7 +197,21 @@ fn header(classification: &Classification, provenance: &Provenance) -> Vec<Strin
             "Constraints: histograms where each class occurs ({} bins) scaled to mean 0.5, clamped; colours linear.",
             o.bins
         ),
-    ]
+    ];
+    if let Some(k) = o.level2 {
+        lines.push(format!(
+            "Level 2: chromatic level-1 classes with at least {:.0} % of the counted pixels split by k-means (k = {k}) \
+             inside the class; the class keeps its largest sub-class's colour, the others are its children.",
+            100.0 * super::level2::MIN_SHARE
+        ));
+    }
+    if o.exclude.is_some() {
+        lines.push(format!(
+            "Mask: {:.1} % of the pixels excluded (not clustered, not counted, not in the class areas).",
+            percent(classification.count(PixelStatus::Masked), n)
+        ));
+    }
+    lines
 }
 
 fn float(v: f32) -> String {
@@ -212,8 +249,12 @@ fn write_layer(out: &mut String, layer: &GeneratedLayer) {
 /// `layers` (root first) as TOML tables.
 pub fn layers_toml(layers: &[GeneratedLayer]) -> String {
     let mut out = String::new();
-    for (i, layer) in layers.iter().enumerate() {
-        out.push_str(if i == 0 { "\n[root]\n" } else { "\n[[root.children]]\n" });
+    for layer in layers {
+        out.push_str(match layer.level {
+            0 => "\n[root]\n",
+            1 => "\n[[root.children]]\n",
+            _ => "\n[[root.children.children]]\n",
+        });
         write_layer(&mut out, layer);
     }
     out
@@ -231,7 +272,7 @@ impl GeneratedLayers {
     }
 
     /// The tree as TOML: `sources` (e.g. the input files) and the header
-    /// as comments, then `[root]` and its `[[root.children]]`.
+    /// as comments, then `[root]`, its `[[root.children]]` and theirs.
     pub fn to_toml(&self, sources: &[String]) -> String {
         let mut out = String::new();
         for line in sources.iter().chain(&self.header) {
