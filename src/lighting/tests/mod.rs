@@ -6,6 +6,7 @@ mod cie;
 mod distant;
 mod figures;
 mod reference;
+mod sh_bands;
 mod shadows;
 mod sky_cache;
 mod sky_light;
