@@ -10,4 +10,5 @@ mod sh_bands;
 mod shadows;
 mod sky_cache;
 mod sky_light;
+mod soft_shadows;
 mod twins;
