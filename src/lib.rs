@@ -292,7 +292,7 @@ pub use view::Camera;
 /// # Ok::<(), alpenglow::Error>(())
 /// ```
 pub use view::Lighting;
-pub use view::{Exposure, ShadowMode, SkyLightMode, SkyModel, SunPosition};
+pub use view::{Exposure, ShadowMode, SkyLightMode, SkyModel, SunDisc, SunPosition};
 
 // --- What comes back ---
 

@@ -18,9 +18,20 @@ float horizon_elevation(uint map, vec2 t, vec2 texels, int j) {
     return h[j % 4];
 }
 
-// Sun visibility (0..1, softened over the sun's disc) at world point `world`:
-// the horizon elevation towards the sun's azimuth (linear between the two
-// nearest map azimuths), smoothstep over the disc's angular size.
+// The fraction of a uniform disc of radius 1 above a straight horizon at
+// signed distance x below its centre (x = −1: hidden, 1: whole): the
+// circular segment's area over π, 1/2 + (x·sqrt(1−x²) + asin x)/π.
+float sun_disc_fraction(float x) {
+    x = clamp(x, -1.0, 1.0);
+    return 0.5 + (x * sqrt(max(1.0 - x * x, 0.0)) + asin(x)) / 3.14159265358979;
+}
+
+// Sun visibility (0..1) at world point `world`: the horizon elevation h
+// towards the sun's azimuth (linear between the two nearest map azimuths)
+// against the sun's elevation e. With LIGHTING_SOFT_SUN the fraction of the
+// sun's disc (angular radius r) above the horizon, exact for a straight
+// horizon across the disc: sun_disc_fraction((e − h) / r); else a
+// smoothstep over the disc's angular size.
 float horizon_sun_visibility(uint lighting, vec3 world) {
     vec4 field = g_lighting[lighting].f.field;
     vec4 sun = g_lighting[lighting].f.sun;
@@ -37,6 +48,9 @@ float horizon_sun_visibility(uint lighting, vec3 world) {
     float h = mix(horizon_elevation(map, t, field.zw, j0), horizon_elevation(map, t, field.zw, j1), w);
     float elevation = asin(clamp(sun.z, -1.0, 1.0));
     float radius = max(sun.w, 1e-4);
+    if ((g_lighting[lighting].f.models.w & LIGHTING_SOFT_SUN) != 0u) {
+        return sun_disc_fraction((elevation - h) / radius);
+    }
     return smoothstep(h - radius, h + radius, elevation);
 }
 

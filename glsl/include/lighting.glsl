@@ -27,6 +27,7 @@ const uint LIGHTING_SUN_IN_ENVIRONMENT = 1u;  // the sun is part of the sky-ligh
 const uint LIGHTING_ALBEDO_OVERRIDE = 2u;     // every surface has albedo exposure.w
 const uint LIGHTING_NO_SUN_DIRECT = 4u;       // no direct sun term (sky light only)
 const uint LIGHTING_NO_AERIAL_PERSPECTIVE = 8u;
+const uint LIGHTING_SOFT_SUN = 16u;           // sun shadows with the disc's penumbra (shadows.glsl)
 
 struct LightingFrame {
     vec4 sun;              // xyz: unit vector towards the sun (+Z up); w: angular radius of the disc (rad)

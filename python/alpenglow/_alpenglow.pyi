@@ -153,6 +153,7 @@ class Lighting:
         turbidity: float = 3.0,
         exposure: Union[str, float, None] = None,
         shadows: str = "cascaded",
+        sun_disc: str = "hard",
         sky_light: str = "sh",
         aerial_perspective: bool = True,
     ) -> None: ...

@@ -20,7 +20,7 @@ pub use alpenglow::tools::solar::{parse_date, parse_time, solar_position, Clock}
 pub use alpenglow::{
     Camera, Context, ContextOptions, DeviceSelector, Distortion, Error, Exposure, FrameImages, HeightField,
     HeightmapOptions, Intrinsics, Lighting, ProceduralTerrain, RasterPath, Renderer, Result, Rig, RowOrder, Scene,
-    Settings, ShadowMode, SkyLightMode, SkyModel, SunPosition, TerrainModel, TexturingMode, VegetationOptions,
+    Settings, ShadowMode, SkyLightMode, SkyModel, SunDisc, SunPosition, TerrainModel, TexturingMode, VegetationOptions,
     ViewSpec,
 };
 use alpenglow::{FrameData, Output, Ticket as RingTicket, ViewData};

@@ -11,7 +11,8 @@ use crate::{arg_err, invalid};
 /// azimuth clockwise from +Y, north), `sky` ("physical", "preetham",
 /// "cie-clear" or "cie-overcast"),
 /// `turbidity`, `exposure` ("auto" or an EV100 number), `shadows`
-/// ("cascaded", "horizon", "off"), `sky_light` ("sh", "ao", "patches",
+/// ("cascaded", "horizon", "off"), `sun_disc` ("hard", or "soft": the
+/// penumbra of the sun's disc), `sky_light` ("sh", "ao", "patches",
 /// "reference", "off"), `aerial_perspective`. `Lighting.time_of_day(…)`
 /// places the sun by date, time and place.
 #[pyclass(module = "alpenglow", frozen, from_py_object)]
@@ -45,6 +46,14 @@ fn shadows(name: &str) -> PyResult<engine::ShadowMode> {
     }
 }
 
+fn sun_disc(name: &str) -> PyResult<engine::SunDisc> {
+    match name {
+        "hard" => Ok(engine::SunDisc::Hard),
+        "soft" => Ok(engine::SunDisc::Soft),
+        _ => Err(invalid("sun_disc", format!("{name:?}; expected \"hard\" or \"soft\""))),
+    }
+}
+
 fn sky_light(name: &str) -> PyResult<engine::SkyLightMode> {
     match name {
         "sh" => Ok(engine::SkyLightMode::Sh),
@@ -75,7 +84,7 @@ fn exposure(value: &Bound<'_, PyAny>) -> PyResult<engine::Exposure> {
 #[pymethods]
 impl Lighting {
     #[new]
-    #[pyo3(signature = (*, sun_elevation = 25.0, sun_azimuth = 231.0, sky = "physical", turbidity = 3.0, exposure = None, shadows = "cascaded", sky_light = "sh", aerial_perspective = true))]
+    #[pyo3(signature = (*, sun_elevation = 25.0, sun_azimuth = 231.0, sky = "physical", turbidity = 3.0, exposure = None, shadows = "cascaded", sun_disc = "hard", sky_light = "sh", aerial_perspective = true))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         sun_elevation: f32,
@@ -84,6 +93,7 @@ impl Lighting {
         turbidity: f32,
         exposure: Option<&Bound<'_, PyAny>>,
         shadows: &str,
+        sun_disc: &str,
         sky_light: &str,
         aerial_perspective: bool,
     ) -> PyResult<Lighting> {
@@ -96,6 +106,7 @@ impl Lighting {
             turbidity,
             exposure: exposure.map(self::exposure).transpose()?.unwrap_or_default(),
             shadows: self::shadows(shadows)?,
+            sun_disc: self::sun_disc(sun_disc)?,
             sky_light: self::sky_light(sky_light)?,
             aerial_perspective,
             ..engine::Lighting::default()

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 
 use alpenglow::tools::solar::{parse_date, parse_time, solar_position, Clock, SkyPreset};
-use alpenglow::{Exposure, Lighting, ShadowMode, SkyLightMode, SkyModel, SunPosition};
+use alpenglow::{Exposure, Lighting, ShadowMode, SkyLightMode, SkyModel, SunDisc, SunPosition};
 
 #[derive(Args, Debug, Clone, Default)]
 #[command(next_help_heading = "Lighting")]
@@ -44,6 +44,9 @@ pub struct LightingArgs {
     /// Sun shadows.
     #[arg(long, value_enum, default_value_t = ShadowArg::Cascaded, value_name = "METHOD")]
     pub shadows: ShadowArg,
+    /// Sun shadow edges: the penumbra of the sun's 0.53° disc, or hard (the shadow filter only).
+    #[arg(long = "sun-disc", value_enum, default_value_t = SunDiscArg::Hard, value_name = "EDGES")]
+    pub sun_disc: SunDiscArg,
     /// Sky light on the terrain (§9.3–9.5).
     #[arg(long, value_enum, default_value_t = LightingArg::Sh, value_name = "METHOD")]
     pub lighting: LightingArg,
@@ -162,6 +165,15 @@ pub enum ShadowArg {
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SunDiscArg {
+    /// Penumbrae of the disc (horizon map: disc fraction; cascades: blocker-distance filter).
+    Soft,
+    /// Edges as sharp as the shadow filter.
+    #[default]
+    Hard,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum LightingArg {
     /// Monte Carlo ray tracing of the height field (slow; still frames).
     Reference,
@@ -195,6 +207,10 @@ pub fn lighting(args: &LightingArgs, base: Lighting) -> anyhow::Result<Lighting>
             ShadowArg::Cascaded => ShadowMode::Cascaded,
             ShadowArg::Horizon => ShadowMode::Horizon,
             ShadowArg::Off => ShadowMode::Off,
+        },
+        sun_disc: match args.sun_disc {
+            SunDiscArg::Soft => SunDisc::Soft,
+            SunDiscArg::Hard => SunDisc::Hard,
         },
         sky_light: match args.lighting {
             LightingArg::Reference => SkyLightMode::Reference,

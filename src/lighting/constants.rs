@@ -39,6 +39,8 @@ pub const LIGHTING_SUN_IN_ENVIRONMENT: u32 = 1;
 pub const LIGHTING_ALBEDO_OVERRIDE: u32 = 2;
 pub const LIGHTING_NO_SUN_DIRECT: u32 = 4;
 pub const LIGHTING_NO_AERIAL_PERSPECTIVE: u32 = 8;
+/// Sun shadows with the penumbra of the sun's disc ([`crate::view::SunDisc::Soft`]).
+pub const LIGHTING_SOFT_SUN: u32 = 16;
 
 /// One view's lighting constants (std430, field for field as in GLSL).
 #[repr(C)]

@@ -10,6 +10,8 @@ pub mod constants;
 pub mod preetham;
 pub mod reference;
 pub mod sh;
+#[cfg(test)]
+pub(crate) mod sh_bands;
 pub mod shadows;
 pub mod sky;
 pub mod sky_light;

@@ -151,25 +151,33 @@ pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Projection `c_i = ∫ f y_i dω` of `f` onto `bands` bands: Gauss–Legendre
-/// in z (`n` nodes) × `2n` equally spaced azimuths, exact for polynomials
-/// of degree < 2n.
+/// The nodes of the sphere quadrature: Gauss–Legendre in z (`n` nodes) ×
+/// `2n` equally spaced azimuths, exact for polynomials of degree < 2n; each
+/// node as (unit direction, weight).
+#[cfg(test)]
+pub fn sphere_quadrature(n: usize) -> impl Iterator<Item = (DVec3, f64)> {
+    let na = 2 * n.max(1);
+    gauss_legendre(n).into_iter().flat_map(move |(z, wz)| {
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        (0..na).map(move |i| {
+            let phi = 2.0 * PI * (i as f64 + 0.5) / na as f64;
+            (DVec3::new(r * phi.cos(), r * phi.sin(), z), wz * 2.0 * PI / na as f64)
+        })
+    })
+}
+
+/// Projection `c_i = ∫ f y_i dω` of `f` onto `bands` bands by
+/// [`sphere_quadrature`] of `n`.
 #[cfg(test)]
 pub fn project(f: impl Fn(DVec3) -> f64, bands: usize, n: usize) -> Vec<f64> {
     let bands = bands.min(MAX_BANDS);
     let mut c = vec![0.0; bands * bands];
-    let na = 2 * n.max(1);
     let mut y = [0.0; MAX_COEFFICIENTS];
-    for (z, wz) in gauss_legendre(n) {
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        for i in 0..na {
-            let phi = 2.0 * PI * (i as f64 + 0.5) / na as f64;
-            let dir = DVec3::new(r * phi.cos(), r * phi.sin(), z);
-            let v = f(dir) * wz * 2.0 * PI / na as f64;
-            basis(dir, bands, &mut y);
-            for (c, y) in c.iter_mut().zip(y) {
-                *c += v * y;
-            }
+    for (dir, w) in sphere_quadrature(n) {
+        let v = f(dir) * w;
+        basis(dir, bands, &mut y);
+        for (c, y) in c.iter_mut().zip(y) {
+            *c += v * y;
         }
     }
     c

@@ -17,7 +17,9 @@ use super::shadows::ShadowFrame;
 use super::sky_light::SkyLight;
 use crate::error::{Error, Result};
 use crate::graph::{RenderGraph, UploadRegion};
-use crate::view::{pass_name, FrameContext, FrameLighting, ShadowMode, SkyLightMode, SkyModel, Technique, View};
+use crate::view::{
+    pass_name, FrameContext, FrameLighting, ShadowMode, SkyLightMode, SkyModel, SunDisc, Technique, View,
+};
 
 /// What the height field contributes to the constants.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -255,6 +257,9 @@ impl SceneLighting {
             } | match lighting.sun_in_sky_light {
                 true => LIGHTING_SUN_IN_ENVIRONMENT | LIGHTING_NO_SUN_DIRECT,
                 false => 0,
+            } | match lighting.sun_disc {
+                SunDisc::Hard => 0,
+                SunDisc::Soft => LIGHTING_SOFT_SUN,
             },
         ];
         f.exposure = [0.0, 0.0, lighting.snow_line, lighting.albedo_override.unwrap_or(0.0)];

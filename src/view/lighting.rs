@@ -44,6 +44,20 @@ pub enum ShadowMode {
     Off,
 }
 
+/// How sun shadows treat the sun's disc (angular radius
+/// [`crate::lighting::constants::SUN_ANGULAR_RADIUS`], 0.27°).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SunDisc {
+    /// Shadow edges as sharp as the shadow map's filter (PCF tent) and a
+    /// smoothstep over the disc at the horizon map's horizon.
+    #[default]
+    Hard,
+    /// Penumbrae of the disc: the horizon map gives the disc's fraction above
+    /// the horizon (a circular segment), the cascades filter with the disc
+    /// at the blocker's distance (percentage-closer soft shadows, §9.5).
+    Soft,
+}
+
 /// Sky light on the terrain (§9.3–9.5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum SkyLightMode {
@@ -90,6 +104,8 @@ pub struct Lighting {
     pub turbidity: f32,
     pub exposure: Exposure,
     pub shadows: ShadowMode,
+    /// Penumbrae of the sun's disc in the sun shadows.
+    pub sun_disc: SunDisc,
     pub sky_light: SkyLightMode,
     /// SH bands of [`SkyLightMode::Sh`]: 3 or 5.
     pub sh_bands: u32,
@@ -121,6 +137,7 @@ impl Default for Lighting {
             turbidity: 3.0,
             exposure: Exposure::default(),
             shadows: ShadowMode::default(),
+            sun_disc: SunDisc::default(),
             sky_light: SkyLightMode::default(),
             sh_bands: 5,
             bounces: 1,

@@ -33,7 +33,9 @@ pub use camera::{frustum_planes, Camera};
 pub(crate) use frame::frame_slots;
 pub use frame::{declare_views, per_view, Declare, Frame, FrameContext, Provides, Technique, ViewGraph};
 pub use lens::Intrinsics;
-pub use lighting::{Exposure, FrameLighting, Lighting, LightingSetup, ShadowMode, SkyLightMode, SkyModel, SunPosition};
+pub use lighting::{
+    Exposure, FrameLighting, Lighting, LightingSetup, ShadowMode, SkyLightMode, SkyModel, SunDisc, SunPosition,
+};
 pub use targets::{LightingBindings, LightingMap, SceneTargets, TargetFormats};
 
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};

@@ -274,6 +274,7 @@ pub const SCENE_OTHER: &[&str] = &[
     "--sky-preset",
     "--sky",
     "--shadows",
+    "--sun-disc",
     "--lighting",
     "--cache-dir",
     "--lod",

@@ -27,6 +27,11 @@ use crate::error::{Error, Result};
 use crate::lighting::constants::{LightingFrame, MAX_CASCADES};
 use crate::view::camera::Camera;
 
+/// The widest reach (texels) of the soft sun's blocker search and disc
+/// filter (`SOFT_MAX_TEXELS` in `glsl/include/shadows.glsl`): the casters
+/// draw that far around the receivers.
+pub const SOFT_FILTER_TEXELS: f64 = 24.0;
+
 /// How the shadow maps are laid out and filtered.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShadowSettings {
@@ -322,8 +327,10 @@ pub fn plan_cascades_into(
     let tan_y = (0.5 * camera.fov_y_deg.to_radians()).tan();
     let k = tan_y * (1.0 + aspect * aspect).sqrt();
     let quadrant = f64::from(settings.quadrant());
-    // Margin in texels: half a texel of snapping, the PCF tent and the normal offset.
-    let margin = 2.0 * f64::from(settings.pcf_radius) + 8.0;
+    // Margin in texels: half a texel of snapping, the PCF tent and the normal
+    // offset, or the soft sun's disc filter (at most SOFT_MAX_TEXELS = 24
+    // texels and a bilinear tap; glsl/include/shadows.glsl), whichever is wider.
+    let margin = (2.0 * f64::from(settings.pcf_radius) + 8.0).max(SOFT_FILTER_TEXELS + 2.0);
     let forward = camera.forward();
     let top = bounds.corners().iter().map(|p| p.dot(sun)).fold(f64::MIN, f64::max);
     let mut cascades = std::mem::take(&mut plan.cascades);

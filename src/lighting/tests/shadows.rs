@@ -8,7 +8,7 @@
 use std::sync::Arc;
 
 use crate::graph::{BufferAccess, ImageId, RenderGraph, Stage, UploadRegion};
-use crate::lighting::constants::{LightingFrame, SHADOWS_CASCADED, SUN_ANGULAR_RADIUS};
+use crate::lighting::constants::{LightingFrame, LIGHTING_SOFT_SUN, SHADOWS_CASCADED, SUN_ANGULAR_RADIUS};
 use crate::lighting::shadows::{record_cascades, SceneBounds, ShadowFrame, ShadowMaps, ShadowSettings};
 use crate::points::render::shadow::PointShadowFrame;
 use crate::points::render::shadow::PointShadows;
@@ -38,8 +38,36 @@ const BOX_MIN: DVec3 = DVec3::new(-60.0, -10.0, 0.0);
 const BOX_MAX: DVec3 = DVec3::new(60.0, 10.0, 30.0);
 const PLANE: f64 = 400.0;
 
+/// What a shadow run draws and how: the camera, the shadow settings, an
+/// optional box on the plane (min, max corners) and the lighting flags
+/// (`models.w`, e.g. `LIGHTING_SOFT_SUN`).
+pub(super) struct Setup {
+    pub camera: Camera,
+    pub settings: ShadowSettings,
+    pub wall: Option<(DVec3, DVec3)>,
+    pub flags: u32,
+}
+
+impl Setup {
+    /// The long box (or none) under [`camera`], 4 cascades over 500 m.
+    fn standard(with_box: bool) -> Setup {
+        Setup {
+            camera: camera(),
+            settings: ShadowSettings {
+                cascades: 4,
+                atlas_size: 1024,
+                max_distance: 500.0,
+                lambda: 0.75,
+                pcf_radius: 2,
+            },
+            wall: with_box.then_some((BOX_MIN, BOX_MAX)),
+            flags: 0,
+        }
+    }
+}
+
 /// Vertices (position, normal: 32 bytes, as the geometry image) and indices.
-fn mesh(with_box: bool) -> (Vec<[f32; 8]>, Vec<u32>) {
+fn mesh(wall: Option<(DVec3, DVec3)>) -> (Vec<[f32; 8]>, Vec<u32>) {
     let mut vertices = Vec::new();
     let mut indices = Vec::new();
     let mut quad = |corners: [DVec3; 4], n: DVec3| {
@@ -61,8 +89,7 @@ fn mesh(with_box: bool) -> (Vec<[f32; 8]>, Vec<u32>) {
         ],
         DVec3::Z,
     );
-    if with_box {
-        let (a, b) = (BOX_MIN, BOX_MAX);
+    if let Some((a, b)) = wall {
         let v = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
         quad(
             [v(a.x, a.y, b.z), v(b.x, a.y, b.z), v(b.x, b.y, b.z), v(a.x, b.y, b.z)],
@@ -88,18 +115,23 @@ fn mesh(with_box: bool) -> (Vec<[f32; 8]>, Vec<u32>) {
     (vertices, indices)
 }
 
-/// Whether the ray from `p` towards `sun` hits the box (slab test).
+/// Whether the ray from `p` towards `sun` hits the long box (slab test).
 fn ray_hits_box(p: DVec3, sun: DVec3) -> bool {
+    ray_hits(p, sun, (BOX_MIN, BOX_MAX))
+}
+
+/// Whether the ray from `p` towards `dir` hits the box `(min, max)` (slab test).
+pub(super) fn ray_hits(p: DVec3, sun: DVec3, (box_min, box_max): (DVec3, DVec3)) -> bool {
     let (mut t0, mut t1) = (1e-6f64, f64::INFINITY);
     for k in 0..3 {
         let (o, d) = (p[k], sun[k]);
         if d.abs() < 1e-12 {
-            if o < BOX_MIN[k] || o > BOX_MAX[k] {
+            if o < box_min[k] || o > box_max[k] {
                 return false;
             }
             continue;
         }
-        let (a, b) = ((BOX_MIN[k] - o) / d, (BOX_MAX[k] - o) / d);
+        let (a, b) = ((box_min[k] - o) / d, (box_max[k] - o) / d);
         t0 = t0.max(a.min(b));
         t1 = t1.min(a.max(b));
     }
@@ -159,8 +191,13 @@ fn probes(cam: &Camera, aspect: f64, distance: f64, with_box: bool) -> Vec<(DVec
 
 /// Declares `terrain.shadow`: the test mesh (`mesh(with_box)`) cast into
 /// every cascade of `atlas`.
-fn declare_mesh_caster(ctx: &Context, graph: &mut RenderGraph<Frame<Slots>>, with_box: bool, atlas: ImageId) {
-    let (vertices, indices) = mesh(with_box);
+fn declare_mesh_caster(
+    ctx: &Context,
+    graph: &mut RenderGraph<Frame<Slots>>,
+    wall: Option<(DVec3, DVec3)>,
+    atlas: ImageId,
+) {
+    let (vertices, indices) = mesh(wall);
     let index_count = indices.len() as u32;
     let vertex_buffer = Buffer::with_data(
         ctx,
@@ -207,7 +244,7 @@ fn declare_mesh_caster(ctx: &Context, graph: &mut RenderGraph<Frame<Slots>>, wit
 fn declare_probe(
     ctx: &Context,
     graph: &mut RenderGraph<Frame<Slots>>,
-    count: usize,
+    (count, flags): (usize, u32),
     atlas: ImageId,
 ) -> (UploadRegion, Arc<Buffer>) {
     let lighting = graph.upload_region("lighting", std::mem::size_of::<LightingFrame>() as u64);
@@ -237,7 +274,7 @@ fn declare_probe(
         let plan = frame.prepared::<ShadowFrame>()?.view(0)?;
         let mut constants = LightingFrame::zeroed();
         constants.sun = frame.lighting.sun_direction().extend(SUN_ANGULAR_RADIUS).to_array();
-        constants.models = [0, SHADOWS_CASCADED, 0, 0];
+        constants.models = [0, SHADOWS_CASCADED, 0, flags];
         plan.fill(&mut constants);
         constants.set_map_handle(LightingMap::ShadowAtlas, pass.handle(atlas)?);
         pass.write_upload_pod(lighting, &constants)?;
@@ -255,28 +292,22 @@ fn declare_probe(
 
 /// Renders the atlas of the scene and evaluates `sun_visibility` at every
 /// probe for each sun; returns per sun the probes' visibility and the plan.
-fn run(
+pub(super) fn run(
     ctx: &Context,
-    (with_box, points): (bool, Option<&PointScene>),
+    (setup, points): (&Setup, Option<&PointScene>),
     suns: &[(f32, f32)],
     probes: &[(DVec3, DVec3)],
 ) -> Vec<(Vec<f32>, crate::lighting::shadows::CascadePlan)> {
-    let settings = ShadowSettings {
-        cascades: 4,
-        atlas_size: 1024,
-        max_distance: 500.0,
-        lambda: 0.75,
-        pcf_radius: 2,
-    };
+    let settings = setup.settings;
     let mut bounds = SceneBounds {
         min: DVec3::new(-PLANE, -PLANE, 0.0),
-        max: DVec3::new(PLANE, PLANE, BOX_MAX.z),
+        max: DVec3::new(PLANE, PLANE, setup.wall.map_or(BOX_MAX.z, |w| w.1.z)),
     };
     let renderer = points.map(|scene| PointRenderer::new(ctx, scene, SplatSettings::default(), false).expect("points"));
     if let Some(b) = renderer.as_ref().and_then(PointShadows::bounds) {
         bounds = bounds.union(b);
     }
-    let view = View::new(camera(), 320, 200);
+    let view = View::new(setup.camera, 320, 200);
     let mut shadows = ShadowMaps::new(settings, bounds).expect("shadow maps");
     let mut graph = RenderGraph::<Frame<Slots>>::new();
     let target = shadows.declare_view(ctx, &mut graph, (0, &view)).expect("atlas");
@@ -285,12 +316,12 @@ fn run(
         p.declare(ViewGraph::new(ctx, &mut graph, (0, &view)), target)
             .expect("points.shadow");
     }
-    declare_mesh_caster(ctx, &mut graph, with_box, target.atlas);
-    let (probe_region, out) = declare_probe(ctx, &mut graph, probes.len(), target.atlas);
+    declare_mesh_caster(ctx, &mut graph, setup.wall, target.atlas);
+    let (probe_region, out) = declare_probe(ctx, &mut graph, (probes.len(), setup.flags), target.atlas);
     let mut baked = graph.bake(ctx).expect("bake");
     let mut frames = FrameRing::new(ctx).expect("frames");
     let mut results = Vec::new();
-    let cam = camera();
+    let cam = setup.camera;
     for (index, &(elevation_deg, azimuth_deg)) in suns.iter().enumerate() {
         let lighting_request = Lighting {
             sun: SunPosition::Angles {
@@ -338,7 +369,10 @@ fn sun_visibility_agrees_with_a_ray_cast() {
         let probes = probes(&cam, 1.6, 500.0, true);
         assert!(probes.len() > 500, "{} probes", probes.len());
         let suns = [(30.0f32, 180.0f32), (15.0, 230.0), (20.0, 160.0)];
-        for ((vis, plan), &(elevation, azimuth)) in run(&ctx, (true, None), &suns, &probes).iter().zip(&suns) {
+        for ((vis, plan), &(elevation, azimuth)) in run(&ctx, (&Setup::standard(true), None), &suns, &probes)
+            .iter()
+            .zip(&suns)
+        {
             let sun = sun_direction(elevation, azimuth).as_dvec3();
             let (mut checked, mut shadowed, mut wrong) = (0, 0, Vec::new());
             for (&(p, _), &v) in probes.iter().zip(vis) {
@@ -379,22 +413,34 @@ fn sun_visibility_agrees_with_a_ray_cast() {
     assert_validation_clean(&report);
 }
 
+/// Both sun discs: the hard PCF from 10°, the soft disc filter (its
+/// receiver-plane bias) from 5°.
 #[test]
 fn a_lit_plane_has_no_acne() {
     let (ctx, report) = validated_context();
     {
         let probes = probes(&camera(), 1.6, 500.0, false);
-        let suns: Vec<(f32, f32)> = [10.0, 20.0, 35.0, 50.0, 65.0, 80.0]
-            .iter()
-            .enumerate()
-            .map(|(k, &e)| (e, 37.0 + 61.0 * k as f32))
-            .collect();
-        for ((vis, _), (elevation, azimuth)) in run(&ctx, (false, None), &suns, &probes).iter().zip(&suns) {
-            let min = vis.iter().copied().fold(f32::INFINITY, f32::min);
-            assert!(
-                min >= 0.999,
-                "sun {elevation}°/{azimuth}°: visibility {min} on a lit plane"
-            );
+        let modes: [(u32, &[f32]); 2] = [
+            (0, &[10.0, 20.0, 35.0, 50.0, 65.0, 80.0]),
+            (LIGHTING_SOFT_SUN, &[5.0, 10.0, 20.0, 35.0, 50.0, 80.0]),
+        ];
+        for (flags, elevations) in modes {
+            let setup = Setup {
+                flags,
+                ..Setup::standard(false)
+            };
+            let suns: Vec<(f32, f32)> = elevations
+                .iter()
+                .enumerate()
+                .map(|(k, &e)| (e, 37.0 + 61.0 * k as f32))
+                .collect();
+            for ((vis, _), (elevation, azimuth)) in run(&ctx, (&setup, None), &suns, &probes).iter().zip(&suns) {
+                let min = vis.iter().copied().fold(f32::INFINITY, f32::min);
+                assert!(
+                    min >= 0.999,
+                    "flags {flags}, sun {elevation}°/{azimuth}°: visibility {min} on a lit plane"
+                );
+            }
         }
     }
     drop(ctx);
@@ -422,7 +468,12 @@ fn point_objects_cast_shadows() {
         let probes = vec![(under, DVec3::Z), (DVec3::new(-150.0, 0.0, 0.0), DVec3::Z)];
         let depth = (under - cam.eye).dot(cam.forward());
         assert!(depth > 0.0 && depth < 500.0);
-        let results = run(&ctx, (false, Some(&scene)), &[(elevation, azimuth)], &probes);
+        let results = run(
+            &ctx,
+            (&Setup::standard(false), Some(&scene)),
+            &[(elevation, azimuth)],
+            &probes,
+        );
         let vis = &results[0].0;
         assert!(
             vis[0] < 0.05,
