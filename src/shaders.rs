@@ -68,10 +68,14 @@ pub const SPLAT_ACCUMULATE_FRAG: SpirV = spirv!("points/accumulate.frag");
 pub const SPLAT_OPAQUE_FRAG: SpirV = spirv!("points/opaque.frag");
 /// points.single_pass.clear (§10.4), compute backend: every tile's entry count 0.
 pub const SPLAT_SINGLE_PASS_BINS_CLEAR: SpirV = spirv!("points/single_pass_bins_clear.comp");
-/// points.single_pass.count and .scatter (§10.4), compute backend: the splats binned into tiles.
+/// points.single_pass.count (§10.4), compute backend: the splats set up and counted into tiles.
 pub const SPLAT_SINGLE_PASS_BIN: SpirV = spirv!("points/single_pass_bin.comp");
+/// points.single_pass.scatter (§10.4), compute backend: the splats' tile entries written, no barrier.
+pub const SPLAT_SINGLE_PASS_SCATTER: SpirV = spirv!("points/single_pass_scatter.comp");
 /// points.single_pass.prefix (§10.4), compute backend: the binning workgroups' entry offsets, the sort's state.
 pub const SPLAT_SINGLE_PASS_PREFIX: SpirV = spirv!("points/single_pass_prefix.comp");
+/// points.single_pass.ranges (§10.4), compute backend: each tile's slice of the sorted entries.
+pub const SPLAT_SINGLE_PASS_RANGES: SpirV = spirv!("points/single_pass_ranges.comp");
 /// points.single_pass.radix<k>.count (§10.4), compute backend: each radix block's digit counts.
 pub const SPLAT_SINGLE_PASS_RADIX_COUNT: SpirV = spirv!("points/single_pass_radix_count.comp");
 /// points.single_pass.radix<k>.scan (§10.4), compute backend: each (digit, block)'s output position.

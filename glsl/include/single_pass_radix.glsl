@@ -23,6 +23,8 @@
 //   T + 5    least reach bits
 //   T + 6    the reach's bits in the key (the key's bits − the tile index's)
 //   T + 7    radix blocks: ceil(M / RADIX_BLOCK)
+// then, from T + STATE_WORDS, each tile's slice [first, end) of the sorted
+// entries (two words a tile; (0, 0): empty), points.single_pass.ranges.
 // Layouts: src/points/render/single_pass/tiles.rs.
 #ifndef ALPENGLOW_SINGLE_PASS_RADIX_GLSL
 #define ALPENGLOW_SINGLE_PASS_RADIX_GLSL
@@ -37,6 +39,9 @@
 #define STATE_LEAST 5u
 #define STATE_DEPTH_BITS 6u
 #define STATE_BLOCKS 7u
+#define STATE_WORDS 8u
+// No tile: a tile index is below 2³¹ (the key holds at least one bit of reach).
+#define NO_TILE 0xffffffffu
 
 #define RADIX_BITS 8u
 #define RADIX_DIGITS 256u

@@ -53,7 +53,8 @@ struct BinnedSplat {
     vec4 clip0;     // cos θ0·t_u + sin θ0·t_v (u·cos θ0 + v·sin θ0 = (X − p_k)·clip0), c1
     vec4 clip1;     // cos θ1·t_u + sin θ1·t_v, 0
     vec4 color;     // linear albedo, 0
-    uvec4 box;      // first pixel (x | y << 16; NOT_BINNED: none), last pixel, reach's bits, 0
+    uvec4 box;      // first pixel (x | y << 16; NOT_BINNED: none), last pixel, reach's bits,
+                    // the entries of the binning workgroup's earlier invocations
 };
 layout(set = 0, binding = 2, std430) buffer BinnedSplats { BinnedSplat s[]; } g_binned_splats[];
 

@@ -1,43 +1,33 @@
 #version 460
-// points.single_pass.count and points.single_pass.scatter (dissertation
-// §10.4): one invocation per splat of the draw (one dispatch per planned
-// draw), its bounding box's tiles (glsl/include/single_pass_tiles.glsl):
-//   phase 0 (count):   the EWA set-up of glsl/include/splat_setup.glsl,
-//                      kept with the splat's pixels and reach as a
-//                      BinnedSplat in its slot (the scatter and the merge
-//                      read it instead of setting the splat up again); the
-//                      least and greatest reach kept (reduced per
-//                      workgroup), the workgroup's entries (the
-//                      sum of its splats' tiles) written to its word of the
-//                      group buffer; the splats passing the interval test
-//                      and drawn are counted as in every mode;
-//   phase 1 (scatter): each splat's entries (sort key, slot, the tile's
-//                      blocks its box touches), one per tile in row order,
-//                      written from its workgroup's offset
-//                      (points.single_pass.prefix) + the exclusive sum of
-//                      the entries of the workgroup's earlier invocations
-//                      (within the subgroup, then the earlier subgroups'):
-//                      positions fixed by the draws' order, the same on
-//                      every run; none at or past the capacity (their
-//                      tiles marked cut, the entries counted as dropped).
+// points.single_pass.count (dissertation §10.4): one invocation per splat
+// of the draw (one dispatch per planned draw), its bounding box's tiles
+// (glsl/include/single_pass_tiles.glsl): the EWA set-up of
+// glsl/include/splat_setup.glsl, kept with the splat's pixels, reach and
+// the exclusive sum of the entries of the workgroup's earlier invocations
+// (within the subgroup, then the earlier subgroups') as a BinnedSplat in
+// its slot (points.single_pass.scatter and .merge read it instead of
+// setting the splat up again, and the scatter needs no barrier); the least
+// and greatest reach kept (reduced per workgroup), the workgroup's entries
+// (the sum of its splats' tiles) written to its word of the group buffer;
+// the splats passing the interval test and drawn are counted as in every
+// mode.
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #define SPLAT_SINGLE_PASS
 #define SPLAT_SINGLE_PASS_BIN
 #include "../include/single_pass_tiles.glsl"
-
-#define PHASE_COUNT 0u
 
 layout(local_size_x = 64) in;
 
 // Push constants (the splat passes' block, splat.glsl):
 //   handles = (splats, point frame, counter (NO_HANDLE: none), Gaussian table),
 //   mode.w = the draw's instance record,
-//   single = (bins, entries, phase, splats of the draw),
+//   single = (bins, -, -, splats of the draw),
 //   bin = (group buffer: one word per workgroup of the frame's draws, the
 //          draw's first workgroup in it, binned splats, -).
 
-// Count: each invocation's entries; scatter: each subgroup's.
+// Each invocation's entries, and each subgroup's.
 shared uint s_entries[BIN_WORKGROUP_SIZE];
+shared uint s_subgroup_entries[BIN_WORKGROUP_SIZE];
 // Each invocation's ~(reach bits) and reach bits (0: not binned, a no-op
 // for the atomicMax below), reduced once per workgroup: two atomics a
 // workgroup on the frame's reach range, not two a splat.
@@ -56,7 +46,7 @@ BinnedSplat binned_splat(SplatSetup v, uvec2 first, uvec2 last, uint reach) {
                        uvec4(first.x | first.y << 16, last.x | last.y << 16, reach, 0u));
 }
 
-// Phase 0: the set-up kept, the counts.
+// The set-up kept, the counts.
 void count(uint group, uint index, uint slot) {
     uint bins = pc.single.x;
     uvec2 grid = tile_grid();
@@ -78,18 +68,28 @@ void count(uint group, uint index, uint slot) {
     uint reach = binned ? floatBitsToUint(splat_reach(v, first, last, zf)) : 0u;
     BinnedSplat kept = binned_splat(v, first, last, reach);
     kept.box.x = binned ? kept.box.x : NOT_BINNED;
+    s_least_complement[gl_LocalInvocationIndex] = binned ? ~reach : 0u;
+    s_greatest[gl_LocalInvocationIndex] = reach;
+    uvec2 lo = first / TILE_SIZE, hi = last / TILE_SIZE + 1u;
+    uvec2 box = binned ? hi - lo : uvec2(0u);
+    uint entries = box.x * box.y;
+    s_entries[gl_LocalInvocationIndex] = entries;
+    uint before = subgroupExclusiveAdd(entries);
+    uint subgroup_entries = subgroupAdd(entries);
+    if (subgroupElect()) {
+        s_subgroup_entries[gl_SubgroupID] = subgroup_entries;
+    }
+    barrier();
+    for (uint i = 0u; i < gl_SubgroupID; ++i) {
+        before += s_subgroup_entries[i];
+    }
+    kept.box.w = before;
     // Outside any divergent branch (a CPU driver stores every invocation's
     // words unmasked); the workgroups of the draw's last row past its
     // splats (uniform) would write into the next draw's slots.
     if (group * BIN_WORKGROUP_SIZE < pc.single.w) {
         g_binned_splats[pc.bin.z].s[slot] = kept;
     }
-    s_least_complement[gl_LocalInvocationIndex] = binned ? ~reach : 0u;
-    s_greatest[gl_LocalInvocationIndex] = reach;
-    uvec2 lo = first / TILE_SIZE, hi = last / TILE_SIZE + 1u;
-    uvec2 box = binned ? hi - lo : uvec2(0u);
-    s_entries[gl_LocalInvocationIndex] = box.x * box.y;
-    barrier();
     if (gl_LocalInvocationIndex == 0u && group * BIN_WORKGROUP_SIZE < pc.single.w) {
         uint sum = 0u, least_complement = 0u, greatest = 0u;
         for (uint i = 0u; i < BIN_WORKGROUP_SIZE; ++i) {
@@ -105,66 +105,10 @@ void count(uint group, uint index, uint slot) {
     }
 }
 
-// Phase 1: the entries written.
-void scatter(uint group, uint index, uint slot) {
-    uint bins = pc.single.x;
-    uvec2 grid = tile_grid();
-    uint tiles = grid.x * grid.y;
-    uvec4 box = index < pc.single.w ? g_binned_splats[pc.bin.z].s[slot].box : uvec4(NOT_BINNED);
-    bool binned = box.x != NOT_BINNED;
-    uvec2 first = uvec2(box.x & 0xffffu, box.x >> 16), last = uvec2(box.y & 0xffffu, box.y >> 16);
-    uvec2 lo = first / TILE_SIZE, hi = last / TILE_SIZE + 1u;
-    uvec2 size = binned ? hi - lo : uvec2(0u);
-    uint entries = size.x * size.y;
-    uint before = subgroupExclusiveAdd(entries);
-    uint subgroup_entries = subgroupAdd(entries);
-    if (subgroupElect()) {
-        s_entries[gl_SubgroupID] = subgroup_entries;
-    }
-    barrier();
-    if (!binned) {
-        return;
-    }
-    for (uint i = 0u; i < gl_SubgroupID; ++i) {
-        before += s_entries[i];
-    }
-    uint start = g_tile_bins[pc.bin.x].w[pc.bin.y + group];
-    uint position = start + before;
-    // Saturated: a sum past 2³² − 1 cannot fit any capacity anyway.
-    position = position < start ? 0xffffffffu : position;
-    uint capacity = g_tile_bins[bins].w[tiles + STATE_SORTED];
-    uint least = g_tile_bins[bins].w[tiles + STATE_LEAST];
-    uint shift = g_tile_bins[bins].w[tiles + STATE_SHIFT];
-    uint depth_bits = g_tile_bins[bins].w[tiles + STATE_DEPTH_BITS];
-    uint reach = (box.z - least) >> shift;
-    for (uint y = lo.y; y < hi.y; ++y) {
-        for (uint x = lo.x; x < hi.x; ++x) {
-            if (position >= capacity) {
-                // Past the capacity: the tile's list is cut (the merge
-                // drops it whole), the entry counted as dropped.
-                atomicOr(g_tile_bins[bins].w[y * grid.x + x], 1u);
-                if (pc.handles.z != NO_HANDLE) {
-                    atomicAdd(g_splat_counters[pc.handles.z].tile_entries_dropped, 1u);
-                }
-                position += position == 0xffffffffu ? 0u : 1u;
-                continue;
-            }
-            uint key = ((y * grid.x + x) << depth_bits) | reach;
-            uint blocks = tile_blocks(first, last, uvec2(x, y) * TILE_SIZE);
-            g_tile_entries[pc.single.y].e[position] = TileEntry(key, slot, blocks);
-            position += 1u;
-        }
-    }
-}
-
 void main() {
     // Dispatches wider than the 65535-workgroup limit use rows of workgroups.
     uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
     uint index = group * BIN_WORKGROUP_SIZE + gl_LocalInvocationIndex;
     uint slot = (pc.bin.y + group) * BIN_WORKGROUP_SIZE + gl_LocalInvocationIndex;
-    if (pc.single.z == PHASE_COUNT) {
-        count(group, index, slot);
-    } else {
-        scatter(group, index, slot);
-    }
+    count(group, index, slot);
 }

@@ -3,7 +3,7 @@
 // workgroup per 8×8-pixel tile, one invocation per pixel. The tile's list
 // is its slice of the sorted entries (glsl/include/single_pass_tiles.glsl,
 // glsl/include/single_pass_radix.glsl: front to back by reach, ties in
-// draw order), found by two binary searches for the tile's keys; a list the
+// draw order), as points.single_pass.ranges wrote its bounds; a list the
 // entry buffer's capacity cut short is dropped whole (and counted). Each
 // subgroup (one SIMD row of a CPU driver: a 4×2-pixel block) walks the list
 // straight from memory, no shared memory and no barrier: the entries whose
@@ -106,32 +106,14 @@ void merge_splat(inout PixelState p, uint slot, vec3 ray, vec2 centre, float sto
     }
 }
 
-// The first of the `sorted` entries whose key is at least `key`.
-uint lower_bound(uint key, uint sorted) {
-    uint lo = 0u, hi = sorted;
-    while (lo < hi) {
-        uint mid = (lo + hi) / 2u;
-        if (g_tile_entries[pc.single.y].e[mid].key < key) {
-            lo = mid + 1u;
-        } else {
-            hi = mid;
-        }
-    }
-    return lo;
-}
-
 // The tile's slice [first, end) of the sorted entries; empty when the
 // capacity cut it short (points.single_pass.scatter marked the tile and
 // counted the entries past the capacity; the ones kept are counted here),
 // and the longest list into the frame's counters, once per tile.
 uvec2 tile_list(uint tile, uint tiles) {
     uint bins = pc.single.x;
-    uint sorted = g_tile_bins[bins].w[tiles + STATE_SORTED];
-    uint depth_bits = g_tile_bins[bins].w[tiles + STATE_DEPTH_BITS];
-    uint first = lower_bound(tile << depth_bits, sorted);
-    // The last tile index may end the key space.
-    uint next = tile + 1u;
-    uint end = (next >> (32u - depth_bits)) != 0u ? sorted : lower_bound(next << depth_bits, sorted);
+    uint first = g_tile_bins[bins].w[tiles + STATE_WORDS + 2u * tile];
+    uint end = g_tile_bins[bins].w[tiles + STATE_WORDS + 2u * tile + 1u];
     bool cut = g_tile_bins[bins].w[tile] != 0u;
     if (gl_LocalInvocationIndex == 0u && pc.handles.z != NO_HANDLE) {
         if (cut) {

@@ -12,11 +12,12 @@
 //! | `points.opaque` | opaque | opaque discs with ray–plane depth, shaded directly, with normal and ids |
 //! | `points.clear`, `points.opaque`, `points.opaque.resolve` | opaque, compute path | the nearest (depth, splat index) word per pixel by 64-bit `atomicMax`, the winner shaded per pixel ([`compute_opaque`]) |
 //! | `points.single_pass.triangles` | single-pass | hybrid triangles as opaque shaded triangles with depth, when the scene has any |
-//! | `points.single_pass.clear` | single-pass, compute | every tile's cut mark and the sort state 0 (§10.4; interlock: every pixel's state z_d = +inf, sums 0) |
+//! | `points.single_pass.clear` | single-pass, compute | every tile's cut mark, range and the sort state 0 (§10.4; interlock: every pixel's state z_d = +inf, sums 0) |
 //! | `points.single_pass.count` | single-pass, compute | per splat: EWA set-up kept with its pixels and reach (a lower bound of its samples' depth less z_f), the reach range, each workgroup's entries (8×8-pixel tiles the box touches) |
 //! | `points.single_pass.prefix` | single-pass, compute | one workgroup: each binning workgroup's first entry, the frame's entries, the sort key's layout |
 //! | `points.single_pass.scatter` | single-pass, compute | per kept splat: (key = tile, reach; slot; the tile's 4×2 blocks its box touches) at positions fixed by draw order |
 //! | `points.single_pass.radix{0..2}.{count,scan,scatter}` | single-pass, compute | a stable LSD radix sort of the entries' keys, 8 bits a pass (3 passes at 512², 4 from 2¹³ tiles): each tile's list a slice, front to back |
+//! | `points.single_pass.ranges` | single-pass, compute | per sorted entry: where its tile's slice starts and ends, into the tile's range words |
 //! | `points.single_pass.merge` | single-pass, compute | a workgroup per tile, no barrier: each subgroup walks the sorted slice (dropped whole and counted if the capacity cut it) from memory, the fuzzy depth test (§10.4) front to back per pixel until the reach passes every z_d, normalised and shaded, written once |
 //! | `points.single_pass` | single-pass, interlock | raster pass: every splat fragment merged with the fuzzy depth test (§10.4) in a pixel-ordered critical section |
 //! | `points.single_pass.resolve` | single-pass, interlock | compute: as `points.normalize`, from the pixel state |

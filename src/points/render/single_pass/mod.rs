@@ -29,7 +29,8 @@
 //! operator drops every later fragment), so the walk stops there.
 //! 1. `points.single_pass.triangles` (only with hybrid triangles, §10.1.8):
 //!    the triangles opaque and shaded, with depth, so splats test against them;
-//! 2. `points.single_pass.clear`: every tile's cut mark and the sort state 0;
+//! 2. `points.single_pass.clear`: every tile's cut mark, the sort state
+//!    and every tile's range 0;
 //! 3. `points.single_pass.count`: a dispatch per planned draw, one
 //!    invocation per splat: the EWA set-up, kept with its pixels and reach
 //!    in the splat's slot for the later passes, the frame's reach range,
@@ -47,8 +48,10 @@
 //!    stable LSD radix sort of the keys, 8 bits a pass (the tile index and
 //!    at least 12 bits of reach): equal keys keep draw order, so the sorted
 //!    entries are the same on every run;
-//! 7. `points.single_pass.merge`: one workgroup per tile finds its slice of
-//!    the sorted entries by binary search (a cut list is dropped whole and
+//! 7. `points.single_pass.ranges`: each tile's slice of the sorted entries
+//!    (where its tile index starts and ends) into its range words;
+//! 8. `points.single_pass.merge`: one workgroup per tile reads its slice of
+//!    the sorted entries (a cut list is dropped whole and
 //!    counted, [`super::PointFrameStats::tile_entries_dropped`]); each
 //!    subgroup (a 4×2-pixel block on a CPU driver's 8-wide rows) walks it
 //!    straight from memory, without shared memory or barriers, in runs of

@@ -105,7 +105,7 @@ enum Step {
 }
 
 /// Workgroups for one per radix block of the capacity: (per row, rows).
-fn block_groups(blocks: u32) -> [u32; 3] {
+pub(super) fn block_groups(blocks: u32) -> [u32; 3] {
     let rows = blocks.div_ceil(MAX_GROUPS_X).max(1);
     [blocks.div_ceil(rows).max(1), rows, 1]
 }

@@ -45,8 +45,8 @@ const ENTRY_BYTES: u64 = 12;
 /// Bytes of a binned splat (`BinnedSplat` in glsl/include/single_pass_tiles.glsl):
 /// the set-up `points.single_pass.count` keeps for the scatter and the merge.
 const BINNED_SPLAT_BYTES: u64 = 128;
-/// Words of the sort state after the tiles' counts in the bins buffer
-/// (glsl/include/single_pass_radix.glsl).
+/// Words of the sort state after the tiles' cut marks in the bins buffer
+/// (glsl/include/single_pass_radix.glsl); each tile's range (two words) follows.
 const STATE_WORDS: u32 = 8;
 /// Entries per splat the scene could plan (a splat's box touches one to
 /// four tiles at the sizes an SPT selects, about nine in a 512² close-up
@@ -56,9 +56,12 @@ const ENTRIES_PER_SPLAT: u64 = 12;
 const MIN_ENTRIES: u64 = 1 << 16;
 /// Most entries of a buffer (192 MiB; two of them), where the device's storage buffer range allows.
 const MAX_ENTRIES: u64 = 1 << 24;
-/// `pc.single.z` of `points.single_pass.count` and `.scatter`.
-const PHASE_COUNT: u32 = 0;
-const PHASE_SCATTER: u32 = 1;
+/// Which of the binning passes (`points.single_pass.count`, `.scatter`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Binning {
+    Count,
+    Scatter,
+}
 
 #[cfg(test)]
 thread_local! {
@@ -118,7 +121,8 @@ impl TileCapacity {
 /// A view's tiles and its buffers.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct TileBins {
-    /// One word per tile, then [`STATE_WORDS`] (`glsl/include/single_pass_radix.glsl`).
+    /// One word per tile, then [`STATE_WORDS`], then two per tile (its
+    /// slice of the sorted entries; `glsl/include/single_pass_radix.glsl`).
     pub bins: BufferId,
     /// `capacity` entries: the binning's output and the sorted entries.
     pub entries: BufferId,
@@ -141,6 +145,11 @@ impl TileBins {
         self.grid[0] * self.grid[1]
     }
 
+    /// Words of the bins buffer: a cut mark per tile, the sort state, a range per tile.
+    fn bin_words(&self) -> u32 {
+        3 * self.tiles() + STATE_WORDS
+    }
+
     /// Radix blocks of the capacity: the stride of the digit rows.
     pub fn blocks(&self) -> u32 {
         self.capacity.div_ceil(RADIX_BLOCK)
@@ -151,7 +160,9 @@ impl TileBins {
 struct Pipelines {
     clear: ComputePipeline,
     bin: ComputePipeline,
+    scatter: ComputePipeline,
     prefix: ComputePipeline,
+    ranges: ComputePipeline,
     merge: ComputePipeline,
 }
 
@@ -168,7 +179,9 @@ pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
     let pipelines = Pipelines {
         clear: ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS_BINS_CLEAR)?,
         bin: ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS_BIN)?,
+        scatter: ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS_SCATTER)?,
         prefix: ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS_PREFIX)?,
+        ranges: ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS_RANGES)?,
         merge: ComputePipeline::new(ctx, shaders::SPLAT_SINGLE_PASS_TILE)?,
     };
     let grid = [targets.width, targets.height].map(|n| n.div_ceil(TILE_SIZE).max(1));
@@ -180,7 +193,11 @@ pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
     };
     let blocks = u64::from(entries.div_ceil(RADIX_BLOCK));
     let tiles = TileBins {
-        bins: buffer(graph, "splat tile bins", 4 * u64::from(grid[0] * grid[1] + STATE_WORDS)),
+        bins: buffer(
+            graph,
+            "splat tile bins",
+            4 * u64::from(3 * grid[0] * grid[1] + STATE_WORDS),
+        ),
         entries: buffer(graph, "splat tile entries", ENTRY_BYTES * u64::from(entries)),
         scratch: buffer(graph, "splat tile entries (sort)", ENTRY_BYTES * u64::from(entries)),
         groups: buffer(graph, "splat tile groups", 4 * u64::from(group_capacity)),
@@ -194,12 +211,11 @@ pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
         capacity: entries,
         group_capacity,
     };
-    // Every tile's count and the sort state 0.
-    let cleared = (&[tiles.bins][..], tiles.tiles() + STATE_WORDS);
+    // Every tile's cut mark, the sort state and every tile's range 0.
+    let cleared = (&[tiles.bins][..], tiles.bin_words());
     declare_clear(graph, &name("points.single_pass.clear"), cleared, pipelines.clear);
-    let bin = std::sync::Arc::new(pipelines.bin);
-    let count = (name("points.single_pass.count"), PHASE_COUNT);
-    declare_binning(graph, count, (buffers, view), tiles, bin.clone());
+    let count = (name("points.single_pass.count"), Binning::Count);
+    declare_binning(graph, count, (buffers, view), tiles, pipelines.bin);
     declare_prefix(
         graph,
         &name("points.single_pass.prefix"),
@@ -207,9 +223,15 @@ pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
         tiles,
         pipelines.prefix,
     );
-    let scatter = (name("points.single_pass.scatter"), PHASE_SCATTER);
-    declare_binning(graph, scatter, (buffers, view), tiles, bin);
+    let scatter = (name("points.single_pass.scatter"), Binning::Scatter);
+    declare_binning(graph, scatter, (buffers, view), tiles, pipelines.scatter);
     let sorted = radix::declare(ctx, graph, name, tiles)?;
+    declare_ranges(
+        graph,
+        &name("points.single_pass.ranges"),
+        (tiles, sorted),
+        pipelines.ranges,
+    );
     let merge = (name("points.single_pass.merge"), pipelines.merge);
     declare_merge(graph, merge, (buffers, view), targets, (tiles, sorted, written));
     Ok(())
@@ -246,20 +268,21 @@ fn draw_groups(counts: impl Iterator<Item = u32>, group_capacity: u32) -> (Vec<u
     (firsts, first, unbinned)
 }
 
-/// `points.single_pass.count` (`phase` [`PHASE_COUNT`]: the tiles' counts,
-/// the depth range, each workgroup's entries, and the splats counted) or
-/// `points.single_pass.scatter` ([`PHASE_SCATTER`]: the entries written):
-/// one dispatch per planned draw, one invocation per splat
-/// (`glsl/points/single_pass_bin.comp`).
+/// `points.single_pass.count` ([`Binning::Count`]: the set-ups kept, the
+/// depth range, each workgroup's entries, and the splats counted;
+/// `glsl/points/single_pass_bin.comp`) or `points.single_pass.scatter`
+/// ([`Binning::Scatter`]: the entries written, no barrier;
+/// `glsl/points/single_pass_scatter.comp`): one dispatch per planned draw,
+/// one invocation per splat.
 fn declare_binning<S: Provides<PointsFrame> + 'static>(
     graph: &mut RenderGraph<Frame<S>>,
-    (name, phase): (String, u32),
+    (name, binning): (String, Binning),
     (buffers, view): (PointBuffers, PointView),
     tiles: TileBins,
-    pipeline: std::sync::Arc<ComputePipeline>,
+    pipeline: ComputePipeline,
 ) {
     let compute = Stage::Compute;
-    let counting = phase == PHASE_COUNT;
+    let counting = binning == Binning::Count;
     let mut builder = graph.pass(&name);
     let frame = builder.upload(view.frame, compute);
     let (bins, groups, splats) = match counting {
@@ -282,7 +305,7 @@ fn declare_binning<S: Provides<PointsFrame> + 'static>(
         let mut push = BinPush {
             single: SinglePassPush {
                 splat: splat.push(pass, PASS_OPAQUE)?,
-                single: [pass.handle(bins)?, entries, phase, 0],
+                single: [pass.handle(bins)?, entries, 0, 0],
             },
             bin: [pass.handle(groups)?, 0, pass.handle(splats)?, 0],
         };
@@ -329,6 +352,26 @@ fn declare_prefix<S: Provides<PointsFrame> + 'static>(
             ],
         ];
         ctx.dispatch(&pipeline, &push, [1, 1, 1])
+    });
+}
+
+/// `points.single_pass.ranges`: each tile's slice of the `sorted` entries
+/// into its range words of the bins buffer, one workgroup per radix block
+/// (dispatched for the capacity, as the sort's steps: the blocks past the
+/// frame's entries return at once; `glsl/points/single_pass_ranges.comp`).
+fn declare_ranges<S: Provides<PointsFrame> + 'static>(
+    graph: &mut RenderGraph<Frame<S>>,
+    name: &str,
+    (tiles, sorted): (TileBins, BufferId),
+    pipeline: ComputePipeline,
+) {
+    let compute = Stage::Compute;
+    let mut pass = graph.pass(name);
+    let bins = pass.storage_buffer(tiles.bins, BufferAccess::StorageReadWrite(compute));
+    let entries = pass.storage_buffer(sorted, BufferAccess::StorageRead(compute));
+    pass.record(move |ctx, _| {
+        let push = [ctx.handle(bins)?, tiles.tiles(), ctx.handle(entries)?, 0];
+        ctx.dispatch(&pipeline, &push, radix::block_groups(tiles.blocks()))
     });
 }
 
