@@ -322,7 +322,7 @@ impl ProceduralTerrain {
         for j in 0..PEAK_SAMPLES {
             for i in 0..PEAK_SAMPLES {
                 // Off the noise lattice (an irrational offset), where noise is zero.
-                let p = DVec2::new(i as f64 * step + 0.318_309_886, j as f64 * step + 0.577_215_664);
+                let p = DVec2::new(i as f64 * step + 0.371_9, j as f64 * step + 0.592_3);
                 let f = self.combine(table, |k| {
                     let q = p * table[k].frequency + table[k].shift;
                     gradient_noise(self.seed, q.x, q.y)
