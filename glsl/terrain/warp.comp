@@ -24,6 +24,7 @@
 #include "../include/heap.glsl"
 #include "../include/terrain_detail.glsl"
 #include "../include/bspline_height.glsl"
+#include "../include/detail_window.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -40,6 +41,7 @@ layout(push_constant) uniform Push {
     uvec4 grid;      // output side N, sketch side n, atlas columns, atlas rows
     vec4 spacing;    // atlas dx, dy, detail amplitude (× d0), detail H
     vec4 extent;     // terrain x max, y max, d0, detail on (1) / off (0)
+    DetailWindow window;  // the streamed detail window (detail_window.glsl)
 } pc;
 
 shared vec4 s_position[10][10];  // xyz, w = split octave
@@ -71,7 +73,9 @@ void main() {
         ivec2 g = clamp(group + local, ivec2(0), ivec2(side - 1));
         vec3 p = phi(g);
         vec2 grad;
-        float h = bspline_height(pc.handles.x, pc.grid.zw, pc.spacing.xy, p.xy, grad);
+        vec2 coarse_grad;
+        float coarse = bspline_height(pc.handles.x, pc.grid.zw, pc.spacing.xy, p.xy, coarse_grad);
+        float h = detail_height(pc.window, p.xy, coarse, coarse_grad, grad);
         // Largest distance to the four grid neighbours, heights from the
         // atlas gradient.
         float d2 = 0.0;
