@@ -31,9 +31,11 @@ float detail_bspline(DetailWindow w, vec2 g, out vec2 grad) {
 }
 
 // Height at world xy: `coarse` (with gradient `coarse_grad`) from the
-// resident atlas, blended into the window where it holds the point.
-float detail_height(DetailWindow w, vec2 xy, float coarse, vec2 coarse_grad, out vec2 grad) {
+// resident atlas, blended into the window where it holds the point;
+// `weight` the window's share (0 to 1).
+float detail_height(DetailWindow w, vec2 xy, float coarse, vec2 coarse_grad, out vec2 grad, out float weight) {
     grad = coarse_grad;
+    weight = 0.0;
     if (w.spacing.w < 0.5) {
         return coarse;
     }
@@ -42,7 +44,7 @@ float detail_height(DetailWindow w, vec2 xy, float coarse, vec2 coarse_grad, out
     vec2 x0 = detail_smooth(g.x - w.valid.x, band), x1 = detail_smooth(w.valid.z - g.x, band);
     vec2 y0 = detail_smooth(g.y - w.valid.y, band), y1 = detail_smooth(w.valid.w - g.y, band);
     float wx = x0.x * x1.x, wy = y0.x * y1.x;
-    float weight = wx * wy;
+    weight = wx * wy;
     if (weight <= 0.0) {
         return coarse;
     }

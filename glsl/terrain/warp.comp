@@ -75,7 +75,15 @@ void main() {
         vec2 grad;
         vec2 coarse_grad;
         float coarse = bspline_height(pc.handles.x, pc.grid.zw, pc.spacing.xy, p.xy, coarse_grad);
-        float h = detail_height(pc.window, p.xy, coarse, coarse_grad, grad);
+        float window;
+        float h = detail_height(pc.window, p.xy, coarse, coarse_grad, grad, window);
+        // Where the window's samples are drawn they replace the procedural
+        // octaves coarser than their spacing (the ones between d0 and it):
+        // geometry adds octaves from o_window, shading from the split up.
+        float o_window = 0.0;
+        if (window > 0.0) {
+            o_window = window * max(log2(d0 / min(pc.window.spacing.x, pc.window.spacing.y)), 0.0);
+        }
         // Largest distance to the four grid neighbours, heights from the
         // atlas gradient.
         float d2 = 0.0;
@@ -87,9 +95,10 @@ void main() {
             d2 = max(d2, dot(dxy, dxy) + dz * dz);
         }
         float split = clamp(log2(d0 / max(sqrt(d2), 1e-6)) - SPLIT_BIAS, 0.0, float(MAX_DETAIL_OCTAVES));
+        split = max(split, min(o_window, float(MAX_DETAIL_OCTAVES)));
         if (pc.extent.w > 0.5) {
             vec2 dgrad;
-            h += detail_octaves(pc.handles.w, p.xy, d0, pc.spacing.z, pc.spacing.w, 0.0, split, dgrad);
+            h += detail_octaves(pc.handles.w, p.xy, d0, pc.spacing.z, pc.spacing.w, o_window, split, dgrad);
             grad += dgrad;
         }
         s_position[local.y][local.x] = vec4(p.xy, h, split);

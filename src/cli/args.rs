@@ -356,7 +356,8 @@ pub struct TerrainArgs {
     pub resident_side: u32,
     /// Height pyramids (.hpyr): side in samples of the detail window, a
     /// finer level streamed around the camera over the resident one (0:
-    /// off; rounded up to whole tiles). `render` waits for its tiles.
+    /// off; rounded up to whole tiles). `render` waits for its tiles;
+    /// `fly` and `bench` draw the resident level until they arrive.
     #[arg(long = "detail-window", default_value_t = alpenglow::files::DEFAULT_DETAIL_WINDOW, value_name = "SAMPLES", value_parser = clap::value_parser!(u32).range(0..=8192))]
     pub detail_window: u32,
     /// Which rasterizer draws the terrain and the EWA splats: compute
