@@ -37,4 +37,5 @@ pub use crate::io::pyramid::{
 pub use crate::points::build::input::{load_points_file, PointInput};
 pub use crate::points::build::spt_file::{read_spt, write_spt};
 pub use crate::points::scene::load_point_object;
+pub use crate::terrain::detail::{DEFAULT_DETAIL_WINDOW, MAX_DETAIL_WINDOW};
 pub use crate::view::camera_path::load_keyframes;

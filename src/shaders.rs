@@ -16,6 +16,8 @@ macro_rules! spirv {
 
 /// terrain.warp: warp and zoom of the geometry image into the vertex buffer (compute).
 pub const TERRAIN_WARP: SpirV = spirv!("terrain/warp.comp");
+/// terrain.detail: the streamed tiles into the detail window (compute).
+pub const TERRAIN_DETAIL_UPLOAD: SpirV = spirv!("terrain/detail_upload.comp");
 /// terrain.draw: vertex stage.
 pub const TERRAIN_DRAW_VERT: SpirV = spirv!("terrain/draw.vert");
 /// terrain.draw: fragment stage.

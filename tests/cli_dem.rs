@@ -70,7 +70,12 @@ fn a_pyramid_renders_as_its_source_does() {
     };
     let (from_png, w, h) = render(&jacksboro(), &["--spacing", "74.4,92.6"], "png.png");
     let (from_pyramid, ..) = render(&pyramid, &[], "pyramid.png");
-    let (coarse, ..) = render(&pyramid, &["--resident-side", "128"], "coarse.png");
+    let coarse_only = ["--resident-side", "128", "--detail-window", "0"];
+    let (coarse, ..) = render(&pyramid, &coarse_only, "coarse.png");
+    // Level 2 resident and a finer level streamed in the detail window (by
+    // default; level 1, the finest whose 1024 samples span 32 heights of
+    // the overview camera).
+    let (streamed, ..) = render(&pyramid, &["--resident-side", "128"], "streamed.png");
     // Level 0 differs from the PNG only by the 1/256 m quantum: the same image.
     let (same, _) = common::mean_flip(&from_png, &from_pyramid, w, h);
     assert!(same <= 0.005, "pyramid level 0 vs PNG: mean FLIP {same}");
@@ -79,6 +84,14 @@ fn a_pyramid_renders_as_its_source_does() {
     assert!(
         different > 4.0 * same.max(0.002),
         "level 2 vs PNG: mean FLIP {different}"
+    );
+    // The window brings level 1 back (measured 0.037 against 0.046; the
+    // lighting's baked maps still come from level 2).
+    let (window, _) = common::mean_flip(&from_png, &streamed, w, h);
+    eprintln!("mean FLIP against the PNG: level 0 {same}, level 2 {different}, level 2 + window {window}");
+    assert!(
+        window < 0.9 * different,
+        "level 2 + detail window vs PNG: mean FLIP {window}"
     );
 }
 

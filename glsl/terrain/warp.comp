@@ -24,6 +24,7 @@
 #include "../include/heap.glsl"
 #include "../include/terrain_detail.glsl"
 #include "../include/bspline_height.glsl"
+#include "../include/detail_window.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -40,6 +41,7 @@ layout(push_constant) uniform Push {
     uvec4 grid;      // output side N, sketch side n, atlas columns, atlas rows
     vec4 spacing;    // atlas dx, dy, detail amplitude (× d0), detail H
     vec4 extent;     // terrain x max, y max, d0, detail on (1) / off (0)
+    DetailWindow window;  // the streamed detail window (detail_window.glsl)
 } pc;
 
 shared vec4 s_position[10][10];  // xyz, w = split octave
@@ -71,7 +73,17 @@ void main() {
         ivec2 g = clamp(group + local, ivec2(0), ivec2(side - 1));
         vec3 p = phi(g);
         vec2 grad;
-        float h = bspline_height(pc.handles.x, pc.grid.zw, pc.spacing.xy, p.xy, grad);
+        vec2 coarse_grad;
+        float coarse = bspline_height(pc.handles.x, pc.grid.zw, pc.spacing.xy, p.xy, coarse_grad);
+        float window;
+        float h = detail_height(pc.window, p.xy, coarse, coarse_grad, grad, window);
+        // Where the window's samples are drawn they replace the procedural
+        // octaves coarser than their spacing (the ones between d0 and it):
+        // geometry adds octaves from o_window, shading from the split up.
+        float o_window = 0.0;
+        if (window > 0.0) {
+            o_window = window * max(log2(d0 / min(pc.window.spacing.x, pc.window.spacing.y)), 0.0);
+        }
         // Largest distance to the four grid neighbours, heights from the
         // atlas gradient.
         float d2 = 0.0;
@@ -83,9 +95,10 @@ void main() {
             d2 = max(d2, dot(dxy, dxy) + dz * dz);
         }
         float split = clamp(log2(d0 / max(sqrt(d2), 1e-6)) - SPLIT_BIAS, 0.0, float(MAX_DETAIL_OCTAVES));
+        split = max(split, min(o_window, float(MAX_DETAIL_OCTAVES)));
         if (pc.extent.w > 0.5) {
             vec2 dgrad;
-            h += detail_octaves(pc.handles.w, p.xy, d0, pc.spacing.z, pc.spacing.w, 0.0, split, dgrad);
+            h += detail_octaves(pc.handles.w, p.xy, d0, pc.spacing.z, pc.spacing.w, o_window, split, dgrad);
             grad += dgrad;
         }
         s_position[local.y][local.x] = vec4(p.xy, h, split);

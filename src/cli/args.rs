@@ -354,6 +354,12 @@ pub struct TerrainArgs {
     /// memory then does not grow with the field.
     #[arg(long = "resident-side", default_value_t = alpenglow::files::DEFAULT_RESIDENT_SIDE, value_name = "SAMPLES", value_parser = clap::value_parser!(u32).range(2..=16384))]
     pub resident_side: u32,
+    /// Height pyramids (.hpyr): side in samples of the detail window, a
+    /// finer level streamed around the camera over the resident one (0:
+    /// off; rounded up to whole tiles). `render` waits for its tiles;
+    /// `fly` and `bench` draw the resident level until they arrive.
+    #[arg(long = "detail-window", default_value_t = alpenglow::files::DEFAULT_DETAIL_WINDOW, value_name = "SAMPLES", value_parser = clap::value_parser!(u32).range(0..=8192))]
+    pub detail_window: u32,
     /// Which rasterizer draws the terrain and the EWA splats: compute
     /// shaders (the terrain into a visibility buffer, then one shading pass
     /// per pixel; the splats and their shadows with 64-bit atomics; needs

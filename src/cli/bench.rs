@@ -35,7 +35,9 @@ pub(super) fn bench(args: BenchArgs) -> Result<ExitCode> {
     outputs.add(args.trace.as_deref(), "--trace")?;
     check_frames(args.frames, args.warmup)?;
     let (rig, specs) = views(&args.scene)?;
-    let scene = load_scene(&args.scene)?;
+    let mut scene = load_scene(&args.scene)?;
+    // Frames along a path never wait for the detail window's tiles.
+    scene.set_detail_window(args.scene.terrain.detail_window, false)?;
     let cameras = rig::frame_cameras(rig.as_ref(), &camera(&args.scene, &scene)?)?;
     // The frames after the settling ones: warm-up, then timed.
     let mut capture = FrameCapture::new(&args.renderdoc, u64::from(args.warmup) + u64::from(args.frames))?;

@@ -93,7 +93,9 @@ pub fn fly(args: FlyArgs) -> Result<ExitCode> {
         outputs.add_dir(dir, "--out-dir")?;
     }
     let (rig, specs) = views(&args.scene)?;
-    let scene = load_scene(&args.scene)?;
+    let mut scene = load_scene(&args.scene)?;
+    // Frames along a path never wait for the detail window's tiles.
+    scene.set_detail_window(args.scene.terrain.detail_window, false)?;
     let base = camera(&args.scene, &scene)?;
     let (path, source) = match (&args.path, args.orbit) {
         (Some(file), _) => (load_keyframes(file)?, format!("--path {}", file.display())),

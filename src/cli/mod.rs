@@ -237,7 +237,9 @@ fn load_terrain(args: &SceneArgs) -> Result<Scene> {
     match &args.heightmap {
         Some(path) if is_pyramid(path) => {
             let pyramid = alpenglow::files::HeightPyramid::open(path)?;
-            Ok(Scene::from_pyramid(&pyramid, args.terrain.resident_side)?)
+            let mut scene = Scene::from_pyramid(&pyramid, args.terrain.resident_side)?;
+            scene.set_detail_window(args.terrain.detail_window, true)?;
+            Ok(scene)
         }
         Some(path) => {
             let field = load_heightmap(

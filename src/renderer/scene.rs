@@ -16,6 +16,7 @@ use crate::points::scene::PointInstance;
 use crate::points::scene::{scatter_rocks, PointScene};
 use crate::points::vegetation::{plant_scene, VegetationOptions, VegetationReport};
 use crate::surface::layers::vegetation::subtree_shares;
+use crate::terrain::detail::{DetailSource, DEFAULT_DETAIL_WINDOW, MAX_DETAIL_WINDOW};
 use crate::terrain::geometry_image::TerrainSettings;
 use crate::terrain::ground::Ground;
 use crate::terrain::procedural::ProceduralTerrain;
@@ -99,6 +100,9 @@ pub struct Scene {
     /// resolution (its spacing is ignored); values in the units the layers'
     /// hats use.
     pub input_maps: [Option<HeightField>; 3],
+    /// Where detail finer than `heights` streams from near the camera
+    /// (a height pyramid's finer levels, [`crate::terrain::detail`]).
+    pub detail: Option<DetailSource>,
 }
 
 impl Scene {
@@ -213,7 +217,35 @@ impl Scene {
             field.spacing.y
         );
         field.validate(pyramid.path())?;
-        Ok(Scene::new(field))
+        let detail = DetailSource {
+            path: pyramid.path().to_path_buf(),
+            resident_level: level,
+            window: DEFAULT_DETAIL_WINDOW,
+            wait: true,
+        };
+        Ok(Scene {
+            detail: Some(detail),
+            ..Scene::new(field)
+        })
+    }
+
+    /// Sets the detail window of a scene from a height pyramid
+    /// ([`crate::terrain::detail`]): `side` samples a side (0: none, at
+    /// most [`MAX_DETAIL_WINDOW`], rounded up to whole tiles); `wait`: frames wait
+    /// for its tiles (deterministic), else they draw the resident level
+    /// until the tiles arrive. Nothing for other scenes.
+    pub fn set_detail_window(&mut self, side: u32, wait: bool) -> Result<()> {
+        if side > MAX_DETAIL_WINDOW {
+            return Err(Error::invalid(
+                "detail window",
+                format!("{side} samples (at most {MAX_DETAIL_WINDOW})"),
+            ));
+        }
+        if let Some(detail) = &mut self.detail {
+            detail.window = side;
+            detail.wait = wait;
+        }
+        Ok(())
     }
 
     /// A scene of `heights` with the default sun and no point objects.
@@ -225,6 +257,7 @@ impl Scene {
             sun_direction: Vec3::new(-0.55, 0.45, 0.42).normalize(),
             layers: crate::surface::layers::LayerTree::default_tree(),
             input_maps: [None, None, None],
+            detail: None,
         }
     }
 

@@ -248,6 +248,9 @@ fn warped_terrain(
     };
     let field = Arc::new(scene.heights.clone());
     let mut terrain = Terrain::new(ctx, graph, field, settings.terrain, &texturing)?;
+    if let Some(source) = &scene.detail {
+        terrain.stream_detail(ctx, graph, source)?;
+    }
     if settings.raster.uses_compute(ctx)? {
         let shading = match points {
             Some(p) if p.sums_shaded_by_ground(ctx) => ComputeShading::WithSplats,

@@ -154,6 +154,8 @@ pub struct WarpPush {
     pub spacing: [f32; 4],
     /// Terrain rectangle x, y (metres), d0, detail on (1) or off (0).
     pub extent: [f32; 4],
+    /// The streamed detail window (off: zeros; set per frame).
+    pub window: crate::terrain::detail::DetailPush,
 }
 
 /// Indices of the two triangles of every grid cell, counter-clockwise seen
@@ -280,6 +282,7 @@ impl GeometryImage {
                 self.atlas_spacing(),
                 if settings.detail { 1.0 } else { 0.0 },
             ],
+            window: Default::default(),
         }
     }
 }
@@ -297,6 +300,8 @@ pub struct WarpPass {
     pub vertices: BufferId,
     /// The push constants but for the handles ([`GeometryImage::warp_push`]).
     pub push: WarpPush,
+    /// The streamed detail window, if the terrain has one.
+    pub window: Option<ImageId>,
 }
 
 /// Declares `terrain.warp` for one view (§7.4.2 "Warp and Zoom"): the
@@ -315,10 +320,18 @@ pub fn declare_warp_pass<S: Provides<TerrainFrame> + 'static>(
     let noise = builder.sample(pass.noise, Stage::Compute);
     let upload = builder.upload(pass.upload, Stage::Compute);
     let vertices = builder.storage_buffer(pass.vertices, BufferAccess::StorageWrite(Stage::Compute));
+    let window = pass.window.map(|w| builder.sample(w, Stage::Compute));
     builder.record(move |ctx, frame| {
         // The view's warp upload is this frame's only when it was prepared.
-        frame.prepared::<crate::terrain::TerrainFrame>()?.view(pass.view)?;
+        let prepared = frame.prepared::<crate::terrain::TerrainFrame>()?;
+        prepared.view(pass.view)?;
+        let mut detail = prepared.detail.push;
+        detail.grid[0] = window.map(|w| ctx.handle(w)).transpose()?.unwrap_or(0);
+        if window.is_none() {
+            detail.spacing[3] = 0.0;
+        }
         let push = WarpPush {
+            window: detail,
             handles: [
                 ctx.handle(atlas)?,
                 ctx.handle(upload)?,

@@ -8,6 +8,7 @@
 //! with the other techniques (`crate::surface::bspline`,
 //! `crate::surface::wavelet_noise`).
 
+pub mod detail;
 pub mod geometry_image;
 pub mod ground;
 pub mod importance;

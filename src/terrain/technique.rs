@@ -16,6 +16,7 @@ use crate::lighting::technique::PreparedLighting;
 use crate::surface::gpu_layout::{LayerTable, TexturingFrame, TexturingMode};
 use crate::surface::input_maps::InputMaps;
 use crate::surface::layers::LayerTree;
+use crate::terrain::detail::{declare_detail_upload, DetailSource, DetailUploads, DetailWindow};
 use crate::terrain::geometry_image::{declare_warp_pass, GeometryImage, TerrainSettings, WarpPass};
 use crate::terrain::lod::LodFrame;
 use crate::terrain::shading::{declare_draw_pass, DrawPass, SurfaceInputs, TerrainDrawPush};
@@ -85,11 +86,15 @@ pub struct Terrain {
     spare: Vec<TerrainViewFrame>,
     /// None: the hardware path (`terrain.draw`).
     compute: Option<ComputePath>,
+    /// The streamed detail window ([`Terrain::stream_detail`]).
+    detail: Option<(DetailWindow, crate::terrain::detail::DetailDevice)>,
 }
 
 /// What the terrain passes read this frame.
 pub struct TerrainFrame {
     pub views: Vec<TerrainViewFrame>,
+    /// What `terrain.detail` uploads and the window `terrain.warp` reads.
+    pub detail: DetailUploads,
 }
 
 /// One view's prepared push constants of `terrain.draw` (its handles come
@@ -136,7 +141,30 @@ impl Terrain {
             views: Vec::new(),
             spare: Vec::new(),
             compute: None,
+            detail: None,
         })
+    }
+
+    /// Streams detail finer than the resident field from `source` near
+    /// the camera ([`crate::terrain::detail`]): declares `terrain.detail`.
+    /// Before any [`Terrain::declare_warp`]; nothing when `source` asks
+    /// for no window or the resident level is the finest.
+    pub fn stream_detail<S: Provides<TerrainFrame> + 'static>(
+        &mut self,
+        ctx: &Context,
+        graph: &mut RenderGraph<Frame<S>>,
+        source: &DetailSource,
+    ) -> Result<()> {
+        if !self.views.is_empty() {
+            return Err(Error::Graph(
+                "terrain: the detail window is declared before the views".into(),
+            ));
+        }
+        if let Some(window) = DetailWindow::open(source)? {
+            let device = declare_detail_upload(ctx, graph, &window)?;
+            self.detail = Some((window, device));
+        }
+        Ok(())
     }
 
     /// Rasterizes and shades the terrain in compute shaders (the visibility
@@ -239,6 +267,7 @@ impl Terrain {
             upload: warp,
             vertices,
             push: self.geometry.warp_push(),
+            window: self.detail.as_ref().map(|(_, d)| d.image),
         };
         declare_warp_pass(ctx, graph, &pass_name("terrain.warp", &view.name), pass)?;
         let compute = self.compute.as_ref().map(|_| {
@@ -295,6 +324,21 @@ impl Terrain {
 }
 
 impl Terrain {
+    /// The detail window of the frame's first view's camera: the tiles
+    /// that arrived into the upload region, the window's constants.
+    fn prepare_detail(&mut self, frame: &mut FrameContext<'_, '_>) -> Result<DetailUploads> {
+        let (Some((window, device)), Some(view)) = (&mut self.detail, frame.views.first()) else {
+            return Ok(DetailUploads::default());
+        };
+        let uploads = window.update(view.camera.eye, &self.geometry.field)?;
+        device.write(&uploads, window.tile_side(), frame.uploads)?;
+        Ok(DetailUploads {
+            tiles: uploads.len() as u32,
+            tile_side: window.tile_side(),
+            push: window.push(),
+        })
+    }
+
     /// The CPU LOD of every view (§7.4.2: sketch map, importance, warp),
     /// the views in parallel threads: they share only the height field.
     fn plan_views(&mut self, views: &[View]) -> Result<()> {
@@ -394,6 +438,7 @@ impl Technique for Terrain {
         views.clear();
         let settings = self.geometry.settings;
         self.plan_views(frame.views)?;
+        let detail = self.prepare_detail(frame)?;
         for (k, state) in self.views.iter().enumerate() {
             let view = frame
                 .views
@@ -426,7 +471,7 @@ impl Technique for Terrain {
                 draw,
             });
         }
-        Ok(TerrainFrame { views })
+        Ok(TerrainFrame { views, detail })
     }
 
     fn recycle(&mut self, previous: TerrainFrame) {

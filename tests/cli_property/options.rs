@@ -184,6 +184,12 @@ pub const SCENE: &[Opt] = &[
         scene: Scene::Heightmap,
         ..opt("--resident-side", int(2, 16384, 16384))
     },
+    // Also only read for height pyramids; above 1024 a window's image and
+    // upload region grow past what a property run needs.
+    Opt {
+        scene: Scene::Heightmap,
+        ..opt("--detail-window", int(0, 8192, 1024))
+    },
     // A 2048² grid (4 M vertices warped per frame) is legal but ran past
     // 60 s on lavapipe in a debug build under load; 2049 and more are
     // generated.

@@ -31,13 +31,14 @@
 //! The index of a 65536² field (87 381 tiles of 256²) is 2 MiB; of a
 //! 100 000² field (10¹⁰ samples) 5 MiB. Writing holds about
 //! `2 · tile_side · columns · 4 B` ([`writer`]); reading holds the index
-//! and the tiles asked for ([`cache::TileCache`] bounds them).
+//! and the tiles asked for ([`stream::TileCache`] bounds them).
 
 pub(crate) mod format;
 #[cfg(feature = "gdal")]
 mod gdal_rows;
 pub mod mosaic;
 mod reader;
+pub mod stream;
 #[cfg(test)]
 mod tests;
 mod writer;

@@ -2,3 +2,4 @@
 //! (Moved from `tests/` in issue 26: integration tests use only the front door.)
 
 mod aovs;
+mod detail;
