@@ -28,7 +28,7 @@ layout(set = 0, binding = 2, std430) readonly buffer PointFrame {
     vec4 k_inv[3];            // rows of K⁻¹
     vec4 depth;               // P22, P32 (camera z → depth), visibility offset (× splat radius), cutoff F_G
     vec4 viewport;            // width, height, largest point size, near
-    uvec4 lighting;           // x: the view's LightingFrame (storage), y: 1 shaded, 0 unlit
+    uvec4 lighting;           // x: the view's LightingFrame (storage), y: 1 shaded, 0 unlit, z: splat kernel (SPLAT_KERNEL_*)
     vec4 camera_to_world[3];  // rows of the camera → world rotation
     vec4 eye;                 // world eye position, w: 1 = two-sided splats, 0 = back faces culled
     Instance instances[];

@@ -13,6 +13,12 @@
 //   small), Q' = T⁻ᵀ·diag(1, 1, −F_G²)·T⁻¹, ellipse centre x_t and
 //   Q''' = (F_G² / rhs)·Q'', resampling covariance V = Q'''⁻¹ + I;
 // ill-conditioned splats (near edge-on, or not an ellipse) are culled.
+// With the affine kernel (the frame's lighting.z = SPLAT_KERNEL_AFFINE; the
+// approximation of Zwicker et al. 2001 that §10.2 and Figs. 10.15–10.17 set
+// against the perspective-accurate one) the object-space Gaussian is instead
+// mapped through the Jacobian J of the projection at the splat centre:
+// V = J·[t_u t_v]·[t_u t_v]ᵀ·Jᵀ + I, centred on the projected centre; the
+// ray–plane depth and clip lines below stay the same for both kernels.
 //
 // splat_sample_at: the view ray through a pixel meets the splat's plane
 // (ray–plane depth), the tangent coordinates of that point are tested
@@ -42,6 +48,34 @@ struct SplatSetup {
 
 // Smallest |cos| between the view ray and the splat normal (≈ 0.6° from edge-on).
 const float MIN_COS_VIEW = 0.01;
+
+#define SPLAT_KERNEL_PERSPECTIVE 0u
+#define SPLAT_KERNEL_AFFINE 1u
+
+// The perspective-accurate screen ellipse of the (scale-normalised) T
+// (§10.2.2): its centre offset x_t and the kernel covariance Q'''⁻¹ in
+// pixels²; false when it is no ellipse.
+bool perspective_conic(mat3 T, float cutoff, out vec2 xt, out mat2 cov) {
+    xt = vec2(0.0);
+    cov = mat2(0.0);
+    mat3 Ti = inverse(T);
+    mat3 Qh = mat3(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -cutoff * cutoff);
+    mat3 Q = transpose(Ti) * Qh * Ti;
+    float a = Q[0][0], b = Q[0][1], cc = Q[1][1], d = Q[2][0], e = Q[2][1], fq = -Q[2][2];
+    float delta = a * cc - b * b;
+    if (!(delta > 0.0 && a > 0.0)) {
+        return false;
+    }
+    xt = vec2(b * e - cc * d, b * d - a * e) / delta;
+    float rhs = fq - d * xt.x - e * xt.y;
+    if (!(rhs > 0.0)) {
+        return false;
+    }
+    // Q''' and its inverse (the screen-space kernel covariance), in pixels².
+    float k3 = cutoff * cutoff / rhs;
+    cov = inverse(mat2(a, b, b, cc) * k3);
+    return true;
+}
 
 // The set-up of splat `splat_index` of instance record `record`.
 uint splat_setup_of(uint record, uint splat_index, out SplatSetup o) {
@@ -81,23 +115,17 @@ uint splat_setup_of(uint record, uint splat_index, out SplatSetup o) {
     // Q' is homogeneous in T: normalise T's scale before inverting.
     float t_scale = max(max(length(T[0]), length(T[1])), abs(T[2].z));
     T /= t_scale;
-    mat3 Ti = inverse(T);
-    mat3 Qh = mat3(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -cutoff * cutoff);
-    mat3 Q = transpose(Ti) * Qh * Ti;
-    float a = Q[0][0], b = Q[0][1], cc = Q[1][1], d = Q[2][0], e = Q[2][1], fq = -Q[2][2];
-    float delta = a * cc - b * b;
-    if (!(delta > 0.0 && a > 0.0)) {
+    vec2 xt;
+    mat2 cov;
+    if (g_point_frame[f].lighting.z == SPLAT_KERNEL_AFFINE) {
+        // The Jacobian of the (recentred) projection at p_k is the top rows
+        // of T's recentred K over c.z; the tangent axes have length σ.
+        mat2 m = mat2(T[0].xy, T[1].xy) / T[2].z;
+        cov = m * transpose(m);
+        xt = vec2(0.0);
+    } else if (!perspective_conic(T, cutoff, xt, cov)) {
         return SPLAT_SETUP_CULLED;
     }
-    vec2 xt = vec2(b * e - cc * d, b * d - a * e) / delta;
-    float rhs = fq - d * xt.x - e * xt.y;
-    if (!(rhs > 0.0)) {
-        return SPLAT_SETUP_CULLED;
-    }
-    // Q''' and its inverse (the screen-space kernel covariance), in pixels².
-    float k3 = cutoff * cutoff / rhs;
-    mat2 q3 = mat2(a, b, b, cc) * k3;
-    mat2 cov = inverse(q3);
     mat2 V = cov + mat2(1.0);
     float det_v = determinant(V);
     float det_cov = determinant(cov);

@@ -160,6 +160,15 @@ pub enum SplatBackendArg {
     Interlock,
 }
 
+/// Screen-space splat kernel (§10.2, Figs. 10.15–10.17).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SplatKernelArg {
+    /// Perspective-accurate: the exact projection of each splat's ellipse.
+    Perspective,
+    /// Affine EWA (Zwicker et al. 2001): the Jacobian of the projection at the splat centre.
+    Affine,
+}
+
 /// Primitive carrying a splat (§10.3).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SplatPrimitiveArg {
@@ -208,6 +217,14 @@ pub struct PointArgs {
         value_name = "BACKEND"
     )]
     pub splat_backend: SplatBackendArg,
+    /// Screen-space splat kernel (screen-space primitives only).
+    #[arg(
+        long = "splat-kernel",
+        value_enum,
+        default_value = "perspective",
+        value_name = "KERNEL"
+    )]
+    pub splat_kernel: SplatKernelArg,
     /// SPT error threshold in pixels of this image (r_min = e_g / ε).
     #[arg(long, default_value_t = 1.0, value_name = "PIXELS")]
     pub epsilon: f32,

@@ -85,6 +85,7 @@ const FLAGS: &[(&str, &str)] = &[
     ("terrain.detail_amplitude", "--detail-amplitude"),
     ("points.epsilon", "--epsilon"),
     ("points.primitive", "--splat-primitive"),
+    ("points.kernel", "--splat-kernel"),
     ("points.transform", "--points-transform"),
     ("lighting.sun_elevation", "--sun-elevation"),
     ("lighting.sun_azimuth", "--sun-azimuth"),
@@ -234,6 +235,16 @@ mod tests {
                 .validate()
                 .unwrap_err(),
                 "invalid --epsilon: ",
+            ),
+            (
+                SplatSettings {
+                    kernel: alpenglow::SplatKernel::Affine,
+                    primitive: alpenglow::SplatPrimitive::ObjectQuad,
+                    ..SplatSettings::default()
+                }
+                .validate()
+                .unwrap_err(),
+                "invalid --splat-kernel: ",
             ),
             (alpenglow::validate_size(0, 32).unwrap_err(), "invalid --width: "),
         ];

@@ -8,11 +8,11 @@ use alpenglow::files::load_point_object;
 use alpenglow::tools::budget::MemoryLimits;
 use alpenglow::tools::spt::{sampling_footprint, SamplingMethod};
 use alpenglow::{
-    PointLoadOptions, PointTransform, Scene, SplatBackend, SplatMode, SplatPrimitive, SplatSettings, VegetationOptions,
-    ViewSpec,
+    PointLoadOptions, PointTransform, Scene, SplatBackend, SplatKernel, SplatMode, SplatPrimitive, SplatSettings,
+    VegetationOptions, ViewSpec,
 };
 
-use super::args::{PointArgs, SplatArg, SplatBackendArg, SplatPrimitiveArg, VegetationArg};
+use super::args::{PointArgs, SplatArg, SplatBackendArg, SplatKernelArg, SplatPrimitiveArg, VegetationArg};
 
 /// Adds the plants of the scene's layer tree when `--vegetation` says so
 /// (default: on for the built-in terrain); call after the layers and input
@@ -126,6 +126,10 @@ pub fn splat_settings(args: &PointArgs, views: &[ViewSpec], fov_y_deg: f64) -> R
             SplatPrimitiveArg::Instanced => SplatPrimitive::Instanced,
             SplatPrimitiveArg::ObjectQuad => SplatPrimitive::ObjectQuad,
             SplatPrimitiveArg::ObjectInstanced => SplatPrimitive::ObjectInstanced,
+        },
+        kernel: match args.splat_kernel {
+            SplatKernelArg::Perspective => SplatKernel::Perspective,
+            SplatKernelArg::Affine => SplatKernel::Affine,
         },
         shaded: !args.no_shading,
         two_sided: args.two_sided,

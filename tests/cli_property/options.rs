@@ -276,6 +276,7 @@ pub const SCENE_OTHER: &[&str] = &[
     "--splat",
     "--splat-primitive",
     "--splat-backend",
+    "--splat-kernel",
     "--vegetation",
     "--sky-preset",
     "--sky",

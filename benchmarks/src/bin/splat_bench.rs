@@ -22,7 +22,11 @@
 //!    several distances: splats and triangles drawn, GPU time
 //!    (`-- --hybrid` runs only this part).
 //!
-//! `-- --primitives` runs only part 1 and the SPT rate.
+//! `-- --primitives` runs only part 1 and the SPT rate; `-- --kernels` only
+//! part 5.
+//! 5. The perspective-accurate kernel against the affine EWA approximation
+//!    (§10.2, Figs. 10.15–10.17): part 1's close view of every leaf, EWA
+//!    quads, on the hardware rasterizer and the compute path.
 //!
 //! GPU times are the medians of the points passes' timestamps over the timed
 //! frames (the passes that draw the view: visibility, accumulation and
@@ -35,7 +39,7 @@ use alpenglow::tools::profile::median;
 use alpenglow::tools::spt::epsilon_from_pixels;
 use alpenglow::{
     Camera, Context, ContextOptions, DeviceSelector, PointLoadOptions, PointObject, PointScene, PointTransform,
-    RasterPath, Renderer, Scene, Settings, SplatMode, SplatPrimitive, SplatSettings,
+    RasterPath, Renderer, Scene, Settings, SplatKernel, SplatMode, SplatPrimitive, SplatSettings,
 };
 
 use alpenglow_bench::points::{all_leaves, camera_at};
@@ -121,6 +125,7 @@ fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
     let hybrid_only = std::env::args().any(|a| a == "--hybrid");
     let primitives_only = std::env::args().any(|a| a == "--primitives");
+    let kernels_only = std::env::args().any(|a| a == "--kernels");
     let frames = if quick { 3 } else { 10 };
     let ctx = Context::new(&ContextOptions {
         validation: false,
@@ -147,6 +152,10 @@ fn main() {
     let flat = single(leaves);
     let close = camera_at(0.25);
 
+    if kernels_only {
+        kernels(&ctx, &flat, &close, frames);
+        return;
+    }
     table_10_3(&ctx, &flat, &close, frames);
     if primitives_only {
         spt_rate(&ctx, &bunny, frames);
@@ -182,6 +191,32 @@ fn main() {
         m.cpu_ms * 1e3 / scene.points.instances.len() as f64
     );
     hybrid_against_points(&ctx, &options, &models, frames);
+    kernels(&ctx, &flat, &close, frames);
+}
+
+/// Part 5: the two splat kernels (§10.2) on both rasterizer paths.
+fn kernels(ctx: &Context, flat: &Scene, close: &Camera, frames: usize) {
+    println!("\n5. Splat kernels, {SIDE}² window, every leaf, EWA quads, two-sided:");
+    println!("| path | kernel | splats drawn | GPU ms median (best) |");
+    println!("|---|---|---|---|");
+    for raster in [RasterPath::Hardware, RasterPath::Compute] {
+        for kernel in SplatKernel::ALL {
+            let settings = SplatSettings {
+                kernel,
+                two_sided: true,
+                ..SplatSettings::default()
+            };
+            let m = measure_on(ctx, (flat, close), (settings, raster), frames);
+            println!(
+                "| {} | {} | {} | {:.1} ({:.1}) |",
+                raster.name(),
+                kernel.name(),
+                m.drawn,
+                m.gpu_ms,
+                m.best_ms
+            );
+        }
+    }
 }
 
 /// Part 1: Table 10.3, the text's primitive set and alpenglow's, in both modes.

@@ -82,7 +82,8 @@ pub struct FrameHeader {
     /// Width, height, largest point size, near plane.
     pub viewport: [f32; 4],
     /// x: storage handle of the view's lighting constants (written by the
-    /// shading pass that declares them); y: 1 shaded, 0 unlit (albedo).
+    /// shading pass that declares them); y: 1 shaded, 0 unlit (albedo);
+    /// z: the splat kernel ([`super::SplatKernel::code`]).
     pub lighting: [u32; 4],
     /// Rows of the camera → world rotation.
     pub camera_to_world: [[f32; 4]; 3],
@@ -156,7 +157,7 @@ pub fn frame_header(view: &View, settings: &SplatSettings, max_point_size: f32) 
         k_inv: rows(k_inv),
         depth: [p22 as f32, p32 as f32, settings.visibility_offset, settings.cutoff],
         viewport: [width as f32, height as f32, max_point_size, near as f32],
-        lighting: [0, settings.shaded as u32, 0, 0],
+        lighting: [0, settings.shaded as u32, settings.kernel.code(), 0],
         camera_to_world: rows(view3.transpose()),
         eye: camera
             .eye

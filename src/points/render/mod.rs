@@ -89,6 +89,42 @@ pub enum SplatBackend {
     Interlock,
 }
 
+/// The screen-space reconstruction kernel of a splat (§10.2, Figs. 10.15–10.17).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SplatKernel {
+    /// Perspective-accurate splatting (§10.2.2): the exact projection of the
+    /// splat's cut-off ellipse (a conic through the homogeneous map T),
+    /// convolved with the screen-space low-pass filter.
+    #[default]
+    Perspective,
+    /// The affine EWA approximation of Zwicker et al. 2001 that the text
+    /// compares it with: the object-space Gaussian mapped through the
+    /// Jacobian of the projection at the splat centre, convolved with the
+    /// low-pass filter, centred on the projected centre. Cheaper to set up,
+    /// but its footprints shrink and shift against the true ones at grazing
+    /// angles and near silhouettes.
+    Affine,
+}
+
+impl SplatKernel {
+    pub const ALL: [SplatKernel; 2] = [SplatKernel::Perspective, SplatKernel::Affine];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SplatKernel::Perspective => "perspective",
+            SplatKernel::Affine => "affine",
+        }
+    }
+
+    /// The kernel's code in the frame header (`SPLAT_KERNEL_*` in splat_setup.glsl).
+    pub(crate) fn code(self) -> u32 {
+        match self {
+            SplatKernel::Perspective => 0,
+            SplatKernel::Affine => 1,
+        }
+    }
+}
+
 /// The primitive that carries a splat (§10.3, Table 10.3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum SplatPrimitive {
@@ -188,6 +224,9 @@ pub struct SplatSettings {
     pub epsilon: Option<f32>,
     /// The single-pass mode's backend (§10.4); ignored by the other modes.
     pub backend: SplatBackend,
+    /// The screen-space kernel of the screen-space primitives (every mode
+    /// and path); the object-space primitives take only the perspective one.
+    pub kernel: SplatKernel,
 }
 
 impl Default for SplatSettings {
@@ -202,6 +241,7 @@ impl Default for SplatSettings {
             normal_clusters: false,
             epsilon: None,
             backend: SplatBackend::Compute,
+            kernel: SplatKernel::Perspective,
         }
     }
 }
@@ -215,6 +255,17 @@ impl SplatSettings {
                 format!(
                     "{}: single-pass splatting rasterises its splats itself (compute) or as quads (interlock); \
                      the primitive applies to the ewa and opaque modes",
+                    self.primitive.name()
+                ),
+            ));
+        }
+        if self.kernel != SplatKernel::Perspective && self.primitive.is_object_space() {
+            return Err(Error::invalid(
+                "points.kernel",
+                format!(
+                    "{}: the {} primitive draws object-space quads with the kernel in a texture (§10.3); \
+                     only the screen-space primitives (point, quad, instanced) take the affine kernel",
+                    self.kernel.name(),
                     self.primitive.name()
                 ),
             ));

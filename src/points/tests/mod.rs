@@ -2,6 +2,7 @@
 //! (Moved from `tests/` in issue 26: integration tests use only the front door.)
 
 mod hybrid;
+mod kernel;
 mod primitives;
 mod render;
 mod single_pass;
