@@ -188,6 +188,7 @@ pub use renderer::scene::DEFAULT_ROCKS;
 /// ```
 pub use renderer::Scene;
 pub use surface::layers::LayerTree;
+pub use terrain::detail::StreamedGround;
 pub use terrain::ground::Ground;
 pub use terrain::procedural::{ProceduralTerrain, TerrainModel};
 

@@ -16,7 +16,7 @@ use crate::points::scene::PointInstance;
 use crate::points::scene::{scatter_rocks, PointScene};
 use crate::points::vegetation::{plant_scene, VegetationOptions, VegetationReport};
 use crate::surface::layers::vegetation::subtree_shares;
-use crate::terrain::detail::{DetailSource, DEFAULT_DETAIL_WINDOW, MAX_DETAIL_WINDOW};
+use crate::terrain::detail::{DetailSource, StreamedGround, DEFAULT_DETAIL_WINDOW, MAX_DETAIL_WINDOW};
 use crate::terrain::geometry_image::TerrainSettings;
 use crate::terrain::ground::Ground;
 use crate::terrain::procedural::ProceduralTerrain;
@@ -285,23 +285,52 @@ impl Scene {
     /// Height (metres) of the ground at world `(x, y)` as the terrain is
     /// drawn with the default [`TerrainSettings`]: the B-spline with its
     /// procedural detail at the finest level (`crate::terrain::ground`
-    /// says how far a drawn view may differ). Errors, naming the point,
-    /// outside the terrain. Each call builds the noise tile (a few
-    /// milliseconds; a query on a built [`Ground`] takes about a
-    /// microsecond): for many queries or other settings use [`Scene::ground`].
+    /// says how far a drawn view may differ). On a scene streamed from a
+    /// height pyramid with a detail window, the B-spline of the pyramid's
+    /// finest level, whose real samples replace the octaves they cover
+    /// ([`Scene::streamed_ground`]). Errors, naming the point, outside the
+    /// terrain. Each call builds the noise tile (a few milliseconds; a
+    /// query on a built [`Ground`] takes about a microsecond): for many
+    /// queries or other settings use [`Scene::ground`] or
+    /// [`Scene::streamed_ground`].
     pub fn ground_height(&self, x: f64, y: f64) -> Result<f64> {
-        self.ground(&TerrainSettings::default())?.height(x, y)
+        let terrain = TerrainSettings::default();
+        match self.streamed_ground(&terrain)? {
+            Some(mut streamed) => streamed.height(x, y),
+            None => self.ground(&terrain)?.height(x, y),
+        }
     }
 
     /// Unit upward normal of [`Scene::ground_height`]'s surface at `(x, y)`.
     pub fn ground_normal(&self, x: f64, y: f64) -> Result<DVec3> {
-        self.ground(&TerrainSettings::default())?.normal(x, y)
+        let terrain = TerrainSettings::default();
+        match self.streamed_ground(&terrain)? {
+            Some(mut streamed) => streamed.normal(x, y),
+            None => self.ground(&terrain)?.normal(x, y),
+        }
     }
 
-    /// The ground as drawn with `terrain` (the renderer's
-    /// [`crate::renderer::RenderSettings::terrain`]), for repeated queries.
+    /// The ground of the resident field as drawn with `terrain` (the
+    /// renderer's [`crate::renderer::RenderSettings::terrain`]), for
+    /// repeated queries. Where the scene streams detail
+    /// ([`Scene::streamed_ground`] is `Some`), the drawn ground near the
+    /// camera is that one.
     pub fn ground(&self, terrain: &TerrainSettings) -> Result<Ground<'_>> {
         Ground::new(&self.heights, terrain)
+    }
+
+    /// The ground of a scene streamed from a height pyramid with a detail
+    /// window (issue 31 item 1): the pyramid's finest level read tile by
+    /// tile through a small cache, with the detail octaves finer than its
+    /// spacing ([`StreamedGround`]). `None` for other scenes, for a window
+    /// of 0, or when the resident level is already the finest.
+    pub fn streamed_ground(&self, terrain: &TerrainSettings) -> Result<Option<StreamedGround<'_>>> {
+        match &self.detail {
+            Some(source) if source.window > 0 && source.resident_level > 0 => {
+                StreamedGround::open(&self.heights, terrain, source).map(Some)
+            }
+            _ => Ok(None),
+        }
     }
 
     /// A camera that shows the whole terrain: from beyond its southern edge,

@@ -104,6 +104,15 @@ impl Axis {
     }
 }
 
+/// One axis of [`sample_bspline`]'s look-up for samples held elsewhere
+/// (a streamed pyramid level): the four clamped tap indices, the
+/// fractional position `t` and whether `coord` lay inside `[0, n−1]`
+/// samples (else the derivative along the axis is zero).
+pub(crate) fn bspline_axis(coord: f64, spacing: f64, samples: u32) -> ([u32; 4], f64, bool) {
+    let a = Axis::new(coord, spacing, samples);
+    (a.taps, a.t, a.inside)
+}
+
 /// Tensor product `Σ_j wy[j] Σ_i wx[i] h(cx[i], ry[j])`.
 fn tensor(field: &HeightField, ax: &Axis, wx: &[f64; 4], ay: &Axis, wy: &[f64; 4]) -> f64 {
     let mut sum = 0.0;

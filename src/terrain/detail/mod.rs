@@ -36,6 +36,7 @@
 //!   window's tiles arrived (the CLI's `render` and the tests); without it
 //!   frames never wait on the disk.
 
+mod ground;
 mod pass;
 #[cfg(test)]
 pub(crate) mod tests;
@@ -52,6 +53,7 @@ use crate::surface::bspline::sample_bspline;
 #[cfg(test)]
 use crate::surface::bspline::{cubic_bspline_derivative_weights, cubic_bspline_weights, sample_bspline_gradient};
 
+pub use ground::StreamedGround;
 pub use pass::{declare_detail_upload, DetailDevice, DetailPush, DetailUploads};
 
 /// Default window side in samples (`--detail-window`).
