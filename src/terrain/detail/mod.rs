@@ -20,6 +20,8 @@
 //!   [`CACHE_WINDOWS`]× the window's tiles; `prepare` takes what arrived,
 //!   writes it into the frame's upload region (`terrain.detail` copies it
 //!   into the image) and into a host mirror of the image (the CPU twin).
+//!   A frame that does not wait uploads at most [`UPLOAD_BUDGET_TILES`],
+//!   nearest to the eye first, so a jump of the window spreads over frames.
 //! * **Coarser until finer arrives.** The *active* rectangle is the part of
 //!   the window the image holds: the whole window once its tiles are all
 //!   uploaded, until then what the previous active rectangle and the new
@@ -66,6 +68,10 @@ pub const GROUND_PER_EYE_HEIGHT: f64 = 32.0;
 pub const BLEND_BAND: f64 = 32.0;
 /// The host cache holds this many windows' tiles.
 pub const CACHE_WINDOWS: usize = 2;
+/// Most tiles a frame that does not wait uploads (1 MiB of R32F at 256²
+/// tiles): a window that jumps (a new level, a teleport) fills over
+/// several frames, nearest tiles first, instead of stalling one.
+pub const UPLOAD_BUDGET_TILES: usize = 4;
 
 /// Where a scene's detail streams from.
 #[derive(Clone, Debug, PartialEq)]
@@ -220,13 +226,24 @@ impl DetailWindow {
             self.active = None;
             return Ok(Vec::new());
         };
-        let keys: Vec<TileKey> = wanted.keys().collect();
+        // Nearest to the eye first: those are requested, and within the
+        // budget uploaded, first.
+        let mut keys: Vec<TileKey> = wanted.keys().collect();
+        let ((_, _), spacing) = self.levels[wanted.level as usize];
+        let eye_tile = eye.truncate() / (spacing * f64::from(self.tile)) - 0.5;
+        keys.sort_by_key(|k| {
+            let d = DVec2::new(f64::from(k.x), f64::from(k.y)) - eye_tile;
+            (d.length_squared() * 1024.0) as u64
+        });
         for &key in &keys {
             self.stream.request(key)?;
         }
         if self.wait {
             self.stream.wait_for(&keys)?;
         }
+        // A waiting frame takes the whole window (deterministic); others
+        // at most the budget.
+        let budget = if self.wait { keys.len() } else { UPLOAD_BUDGET_TILES };
         let mut uploads = Vec::new();
         for &key in &keys {
             let slot = self.slot(key);
@@ -235,7 +252,7 @@ impl DetailWindow {
             let Some(tile) = self.stream.cache().get(key) else {
                 continue;
             };
-            if held {
+            if held || uploads.len() >= budget {
                 continue;
             }
             let tile = tile.clone();

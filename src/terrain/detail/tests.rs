@@ -158,7 +158,9 @@ fn the_host_cache_stays_within_its_bound_along_a_drive() {
     for step in 0..120 {
         let t = f64::from(step) / 119.0;
         let e = eye(&f, 60.0 + 900.0 * t, 100.0 + 800.0 * t * t, 4.0 + 20.0 * t);
-        uploaded += f.window.update(e, &f.resident).unwrap().len();
+        let uploads = f.window.update(e, &f.resident).unwrap().len();
+        assert!(uploads <= UPLOAD_BUDGET_TILES, "step {step}: {uploads} tiles uploaded");
+        uploaded += uploads;
         let (tiles, capacity) = f.window.cache_tiles();
         assert!(
             tiles <= capacity,
@@ -172,6 +174,18 @@ fn the_host_cache_stays_within_its_bound_along_a_drive() {
     }
     assert!(most_pending <= capacity);
     assert!(uploaded >= 16, "{uploaded} tiles uploaded along the drive");
+    // Standing still, the budgeted frames fill the whole window, nearest
+    // tiles first.
+    let e = eye(&f, 960.0, 900.0, 24.0);
+    let mut frames = 0;
+    while f.window.active() != f.window.wanted() || frames == 0 {
+        let uploads = f.window.update(e, &f.resident).unwrap();
+        assert!(uploads.len() <= UPLOAD_BUDGET_TILES);
+        frames += 1;
+        assert!(frames < 200, "the window never filled");
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    assert!(f.window.active().is_some());
     // The mirror never holds more than the window's image.
     assert_eq!(f.window.mirror.len(), 256 * 256);
 }
