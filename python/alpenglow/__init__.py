@@ -30,6 +30,7 @@ from ._alpenglow import (
     encode_png,
     write_exr,
     write_heightmap,
+    write_pyramid,
     write_png,
 )
 
@@ -49,6 +50,7 @@ __all__ = [
     "encode_png",
     "write_exr",
     "write_heightmap",
+    "write_pyramid",
     "write_png",
 ]
 

@@ -16,6 +16,8 @@ use std::path::Path;
 
 pub use alpenglow::files::{check_spacing, load_heightmap, InputLimits};
 use alpenglow::files::{encode_exr_height, encode_exr_samples, encode_png_rgba8, write_bytes_atomically, ExrSamples};
+use alpenglow::files::{write_pyramid, FieldRows, HeightPyramid, PyramidOptions};
+pub use alpenglow::files::{DEFAULT_DETAIL_WINDOW, DEFAULT_HEIGHT_STEP, DEFAULT_RESIDENT_SIDE, DEFAULT_TILE_SIDE};
 pub use alpenglow::tools::solar::{parse_date, parse_time, solar_position, Clock};
 pub use alpenglow::{
     Camera, Context, ContextOptions, DeviceSelector, Distortion, Error, Exposure, FrameImages, HeightField,
@@ -66,6 +68,25 @@ pub fn scene_procedural(model: &str, seed: u64, size: u32, spacing: f64) -> Resu
 pub fn write_heightmap(path: &Path, heights: &[f32], columns: u32, rows: u32) -> Result<()> {
     let bytes = encode_exr_height(heights, columns, rows)?;
     write_bytes_atomically(path, &bytes)
+}
+
+/// A scene streamed from the height pyramid at `path` (`.hpyr`): its
+/// finest level with at most `resident_side` samples a side resident, a
+/// detail window of `detail_window` samples (0: none) of a finer level
+/// around the camera; frames wait for the window's tiles (deterministic).
+pub fn scene_from_pyramid(path: &Path, resident_side: u32, detail_window: u32) -> Result<Scene> {
+    let pyramid = HeightPyramid::open(path)?;
+    let mut scene = Scene::from_pyramid(&pyramid, resident_side)?;
+    scene.set_detail_window(detail_window, true)?;
+    Ok(scene)
+}
+
+/// Writes a height field as a tiled, compressed, checksummed pyramid
+/// (what `alpenglow dem import` writes) and returns its level count.
+pub fn write_height_pyramid(path: &Path, field: &HeightField, tile_side: u32, height_step: f64) -> Result<u32> {
+    let options = PyramidOptions { tile_side, height_step };
+    let summary = write_pyramid(path, &mut FieldRows::new(field, path), &options)?;
+    Ok(summary.levels)
 }
 
 /// The PNG of an sRGB RGBA8 image (the CLI's encoder).

@@ -61,5 +61,6 @@ fn _alpenglow(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(frames::encode_png, m)?)?;
     m.add_function(wrap_pyfunction!(frames::encode_exr, m)?)?;
     m.add_function(wrap_pyfunction!(scene::write_heightmap, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::write_pyramid, m)?)?;
     Ok(())
 }

@@ -120,6 +120,11 @@ fn spacing_pair(spacing: &Bound<'_, PyAny>) -> PyResult<(f64, f64)> {
     Ok(pair)
 }
 
+/// `spacing` as (dx, dy), 1 m each when it is not given.
+fn spacing_or_unit(spacing: Option<&Bound<'_, PyAny>>) -> PyResult<(f64, f64)> {
+    spacing.map_or(Ok((1.0, 1.0)), spacing_pair)
+}
+
 #[pymethods]
 impl Scene {
     /// A height field from `h`, a float32 array of shape (rows, cols) in
@@ -128,10 +133,7 @@ impl Scene {
     #[staticmethod]
     #[pyo3(signature = (h, spacing = None))]
     fn from_heights(py: Python<'_>, h: &Bound<'_, PyAny>, spacing: Option<&Bound<'_, PyAny>>) -> PyResult<Scene> {
-        let spacing = match spacing {
-            Some(s) => spacing_pair(s)?,
-            None => (1.0, 1.0),
-        };
+        let spacing = spacing_or_unit(spacing)?;
         let (values, cols, rows) = height_array("heights", h)?;
         let inner = py
             .detach(|| engine::scene_from_heights(values, cols, rows, spacing))
@@ -187,6 +189,21 @@ impl Scene {
         Ok(Scene {
             inner: engine::Scene::new(field),
         })
+    }
+
+    /// A scene streamed from a height pyramid (`.hpyr`, written by
+    /// `alpenglow dem import` or `write_pyramid`): its finest level with at
+    /// most `resident_side` samples a side stays in memory, and a detail
+    /// window of `detail_window` samples (0: none) of a finer level follows
+    /// the camera; frames wait for the window's tiles, so they are
+    /// deterministic. `ground_height` answers from the finest level.
+    #[staticmethod]
+    #[pyo3(signature = (path, resident_side = engine::DEFAULT_RESIDENT_SIDE, detail_window = engine::DEFAULT_DETAIL_WINDOW))]
+    fn from_pyramid(py: Python<'_>, path: PathBuf, resident_side: u32, detail_window: u32) -> PyResult<Scene> {
+        let inner = py
+            .detach(|| engine::scene_from_pyramid(&path, resident_side, detail_window))
+            .map_err(lib_err)?;
+        Ok(Scene { inner })
     }
 
     /// A procedural terrain: `model` one of "fbm", "multifractal",
@@ -292,4 +309,27 @@ pub fn write_heightmap(py: Python<'_>, path: PathBuf, h: &Bound<'_, PyAny>) -> P
     let (values, cols, rows) = height_array("heights", h)?;
     py.detach(|| engine::write_heightmap(&path, &values, cols, rows))
         .map_err(lib_err)
+}
+
+/// Writes `h` (float32 (rows, cols), row 0 at y = 0, `spacing` (dx, dy) or
+/// one number) as a height pyramid that `Scene.from_pyramid(path)` streams:
+/// tiles of `tile_side` samples, heights quantised to `height_step` metres.
+/// Returns the number of levels.
+#[pyfunction]
+#[pyo3(signature = (path, h, spacing = None, tile_side = engine::DEFAULT_TILE_SIDE, height_step = engine::DEFAULT_HEIGHT_STEP))]
+pub fn write_pyramid(
+    py: Python<'_>,
+    path: PathBuf,
+    h: &Bound<'_, PyAny>,
+    spacing: Option<&Bound<'_, PyAny>>,
+    tile_side: u32,
+    height_step: f64,
+) -> PyResult<u32> {
+    let spacing = spacing_or_unit(spacing)?;
+    let (values, cols, rows) = height_array("heights", h)?;
+    let scene = py
+        .detach(|| engine::scene_from_heights(values, cols, rows, spacing))
+        .map_err(arg_err)?;
+    py.detach(|| engine::write_height_pyramid(&path, &scene.heights, tile_side, height_step))
+        .map_err(arg_err)
 }
