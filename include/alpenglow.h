@@ -472,6 +472,38 @@ enum ag_status ag_scene_from_file(const char *path,
                                   struct ag_scene **out);
 
 /**
+ * A scene streamed from a height pyramid (`.hpyr`, written by
+ * `alpenglow dem import`): its finest level with at most `resident_side`
+ * samples a side (2..=16384; 4096 is the CLI's default) stays in memory,
+ * and a detail window of `detail_window` samples (0: none, at most 8192;
+ * 1024 is the default) of a finer level follows the camera. Frames wait
+ * for the window's tiles (deterministic). Errors name the file
+ * (`AG_ERROR_INPUT`) or the option (`AG_ERROR_INVALID_ARGUMENT`).
+ *
+ * # Safety
+ * `path` is NULL or a NUL-terminated string; `out` is NULL or writable.
+ */
+enum ag_status ag_scene_from_pyramid(const char *path,
+                                     uint32_t resident_side,
+                                     uint32_t detail_window,
+                                     struct ag_scene **out);
+
+/**
+ * The height (metres) of the ground at world `(x, y)` as drawn, with
+ * every procedural detail octave: where to put a car's wheels. On a scene
+ * from `ag_scene_from_pyramid` with a detail window, from the pyramid's
+ * finest level, read tile by tile. Each call takes a few milliseconds.
+ * Errors (`AG_ERROR_INVALID_ARGUMENT`) name a point outside the terrain.
+ *
+ * # Safety
+ * `scene` is NULL or a live scene; `height` is NULL or writable.
+ */
+enum ag_status ag_scene_ground_height(const struct ag_scene *scene,
+                                      double x,
+                                      double y,
+                                      double *height);
+
+/**
  * A `size`×`size` procedural terrain: `model` is "fbm", "multifractal",
  * "heterogeneous", "hybrid" or "ridged", samples `spacing` metres apart.
  *

@@ -54,6 +54,19 @@ pub fn scene_from_file(path: &Path, options: &FileOptions) -> Outcome<Scene> {
     Ok(Scene::from_file(path, &options)?)
 }
 
+/// A scene streamed from a height pyramid (`.hpyr`): the finest level
+/// with at most `resident_side` samples a side resident, a detail window
+/// of `detail_window` samples (0: none); frames wait for its tiles.
+pub fn scene_from_pyramid(path: &Path, resident_side: u32, detail_window: u32) -> Outcome<Scene> {
+    Ok(Scene::from_pyramid_file(path, resident_side, detail_window)?)
+}
+
+/// The ground's height at `(x, y)` as drawn (streamed scenes: from the
+/// pyramid's finest level).
+pub fn ground_height(scene: &Scene, x: f64, y: f64) -> Outcome<f64> {
+    Ok(scene.ground_height(x, y)?)
+}
+
 /// A `size`² procedural terrain of `model` ("fbm", "multifractal",
 /// "heterogeneous", "hybrid", "ridged") with `seed`, `spacing` metres apart.
 pub fn scene_procedural(model: &str, seed: u32, size: u32, spacing: f64) -> Outcome<Scene> {

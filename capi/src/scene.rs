@@ -24,6 +24,17 @@ unsafe fn hand_out(out: *mut *mut ag_scene, scene: Outcome<Scene>) -> Outcome<ag
     Ok(ag_status::AG_OK)
 }
 
+/// Clears `out` (NULL until a scene is made) and reads `path`.
+///
+/// # Safety
+/// `path` is NULL or a NUL-terminated string; `out` is NULL or writable.
+unsafe fn file_path(path: *const c_char, out: *mut *mut ag_scene) -> Outcome<PathBuf> {
+    // SAFETY: the caller passes NULL or a writable pointer.
+    unsafe { put(out, "out", std::ptr::null_mut()) }?;
+    // SAFETY: the caller passes NULL or a NUL-terminated string.
+    Ok(PathBuf::from(unsafe { str_arg(path, "path") }?))
+}
+
 /// A scene from `columns`×`rows` heights in metres, row-major, row 0 at
 /// y = 0, samples `spacing_x`, `spacing_y` metres apart. The heights are
 /// copied. Errors (`AG_ERROR_INVALID_ARGUMENT`, naming `heights` or
@@ -72,10 +83,8 @@ pub unsafe extern "C" fn ag_scene_from_file(
     out: *mut *mut ag_scene,
 ) -> ag_status {
     guard(|| {
-        // SAFETY: the caller passes NULL or a writable pointer.
-        unsafe { put(out, "out", std::ptr::null_mut()) }?;
-        // SAFETY: the caller passes NULL or a NUL-terminated string.
-        let path = PathBuf::from(unsafe { str_arg(path, "path") }?);
+        // SAFETY: the caller passes NULL or a NUL-terminated path and NULL or a writable `out`.
+        let path = unsafe { file_path(path, out) }?;
         let options = match options.is_null() {
             true => crate::types::ag_heightmap_options_default(),
             // SAFETY: not NULL; the caller guarantees a valid struct.
@@ -93,6 +102,54 @@ pub unsafe extern "C" fn ag_scene_from_file(
         };
         // SAFETY: `out` was checked writable above.
         unsafe { hand_out(out, adapter::scene_from_file(&path, &file_options)) }
+    })
+}
+
+/// A scene streamed from a height pyramid (`.hpyr`, written by
+/// `alpenglow dem import`): its finest level with at most `resident_side`
+/// samples a side (2..=16384; 4096 is the CLI's default) stays in memory,
+/// and a detail window of `detail_window` samples (0: none, at most 8192;
+/// 1024 is the default) of a finer level follows the camera. Frames wait
+/// for the window's tiles (deterministic). Errors name the file
+/// (`AG_ERROR_INPUT`) or the option (`AG_ERROR_INVALID_ARGUMENT`).
+///
+/// # Safety
+/// `path` is NULL or a NUL-terminated string; `out` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ag_scene_from_pyramid(
+    path: *const c_char,
+    resident_side: u32,
+    detail_window: u32,
+    out: *mut *mut ag_scene,
+) -> ag_status {
+    guard(|| {
+        // SAFETY: the caller passes NULL or a NUL-terminated path and NULL or a writable `out`.
+        let path = unsafe { file_path(path, out) }?;
+        let scene = adapter::scene_from_pyramid(&path, resident_side, detail_window);
+        // SAFETY: `out` was checked writable above.
+        unsafe { hand_out(out, scene) }
+    })
+}
+
+/// The height (metres) of the ground at world `(x, y)` as drawn, with
+/// every procedural detail octave: where to put a car's wheels. On a scene
+/// from `ag_scene_from_pyramid` with a detail window, from the pyramid's
+/// finest level, read tile by tile. Each call takes a few milliseconds.
+/// Errors (`AG_ERROR_INVALID_ARGUMENT`) name a point outside the terrain.
+///
+/// # Safety
+/// `scene` is NULL or a live scene; `height` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ag_scene_ground_height(scene: *const ag_scene, x: f64, y: f64, height: *mut f64) -> ag_status {
+    guard(|| {
+        // SAFETY: the caller passes NULL or a writable pointer.
+        unsafe { put(height, "height", f64::NAN) }?;
+        // SAFETY: the caller passes NULL or a live handle.
+        let scene = unsafe { arg(scene, "scene") }?;
+        let value = adapter::ground_height(&scene.scene, x, y)?;
+        // SAFETY: checked writable above.
+        unsafe { put(height, "height", value) }?;
+        Ok(ag_status::AG_OK)
     })
 }
 

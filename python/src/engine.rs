@@ -16,7 +16,7 @@ use std::path::Path;
 
 pub use alpenglow::files::{check_spacing, load_heightmap, InputLimits};
 use alpenglow::files::{encode_exr_height, encode_exr_samples, encode_png_rgba8, write_bytes_atomically, ExrSamples};
-use alpenglow::files::{write_pyramid, FieldRows, HeightPyramid, PyramidOptions};
+use alpenglow::files::{write_pyramid, FieldRows, PyramidOptions};
 pub use alpenglow::files::{DEFAULT_DETAIL_WINDOW, DEFAULT_HEIGHT_STEP, DEFAULT_RESIDENT_SIDE, DEFAULT_TILE_SIDE};
 pub use alpenglow::tools::solar::{parse_date, parse_time, solar_position, Clock};
 pub use alpenglow::{
@@ -75,10 +75,7 @@ pub fn write_heightmap(path: &Path, heights: &[f32], columns: u32, rows: u32) ->
 /// detail window of `detail_window` samples (0: none) of a finer level
 /// around the camera; frames wait for the window's tiles (deterministic).
 pub fn scene_from_pyramid(path: &Path, resident_side: u32, detail_window: u32) -> Result<Scene> {
-    let pyramid = HeightPyramid::open(path)?;
-    let mut scene = Scene::from_pyramid(&pyramid, resident_side)?;
-    scene.set_detail_window(detail_window, true)?;
-    Ok(scene)
+    Scene::from_pyramid_file(path, resident_side, detail_window)
 }
 
 /// Writes a height field as a tiled, compressed, checksummed pyramid

@@ -235,12 +235,11 @@ fn load_terrain(args: &SceneArgs) -> Result<Scene> {
         return Ok(Scene::new(spec.generate()?));
     }
     match &args.heightmap {
-        Some(path) if is_pyramid(path) => {
-            let pyramid = alpenglow::files::HeightPyramid::open(path)?;
-            let mut scene = Scene::from_pyramid(&pyramid, args.terrain.resident_side)?;
-            scene.set_detail_window(args.terrain.detail_window, true)?;
-            Ok(scene)
-        }
+        Some(path) if is_pyramid(path) => Ok(Scene::from_pyramid_file(
+            path,
+            args.terrain.resident_side,
+            args.terrain.detail_window,
+        )?),
         Some(path) => {
             let field = load_heightmap(
                 path,

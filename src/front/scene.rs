@@ -84,6 +84,26 @@ impl Scene {
         Ok(Scene::new(load_heightmap(path.as_ref(), options)?))
     }
 
+    /// A scene streamed from the height pyramid at `path` (`.hpyr`, from
+    /// `alpenglow dem import` or [`crate::files::write_pyramid`]): its
+    /// finest level with at most `resident_side` samples a side stays in
+    /// memory ([`Scene::from_pyramid`]), and a detail window of
+    /// `detail_window` samples (0: none) of a finer level follows the
+    /// camera; frames wait for the window's tiles (deterministic; see
+    /// [`Scene::set_detail_window`]). Errors name the file or the option.
+    ///
+    /// ```no_run
+    /// let scene = alpenglow::Scene::from_pyramid_file("region.hpyr", 4096, 1024)?;
+    /// let z = scene.ground_height(1200.0, 800.0)?; // from the finest level
+    /// # Ok::<(), alpenglow::Error>(())
+    /// ```
+    pub fn from_pyramid_file(path: impl AsRef<Path>, resident_side: u32, detail_window: u32) -> Result<Scene> {
+        let pyramid = crate::io::pyramid::HeightPyramid::open(path.as_ref())?;
+        let mut scene = Scene::from_pyramid(&pyramid, resident_side)?;
+        scene.set_detail_window(detail_window, true)?;
+        Ok(scene)
+    }
+
     /// A scene of a procedural terrain: `model` (one of
     /// [`TerrainModel::ALL`]'s names: `fbm`, `multifractal`,
     /// `heterogeneous`, `hybrid`, `ridged`) with `seed` and the other
