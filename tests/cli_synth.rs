@@ -272,7 +272,8 @@ fn the_gpu_search_gives_the_cpu_twins_output_under_validation() {
 
 /// `synth grow`: a new 48×36 field from the 40² crop, the same for a seed
 /// with either search (the GPU's under validation), another for another
-/// seed; one-line errors for a size below the window, an exemplar with
+/// seed, and with `--lambda inf` (slopes only) the same on both searches;
+/// one-line errors for a size below the window, a NaN λ, an exemplar with
 /// a void and a window larger than the exemplar.
 #[test]
 fn grow_makes_a_new_field_of_the_size_asked() {
@@ -318,6 +319,23 @@ fn grow_makes_a_new_field_of_the_size_asked() {
     let (other, other_out) = grow("other.exr", &["--search", "cpu", "--seed", "4"]);
     assert_success("grow seed 4", &other);
     assert_ne!(std::fs::read(&cpu_out).unwrap(), std::fs::read(&other_out).unwrap());
+    // `--lambda inf`: slopes only (Fig. 7.4's last panel), the same on both searches.
+    let (flat_cpu, flat_cpu_out) = grow(
+        "inf-cpu.exr",
+        &["--search", "cpu", "--seed", "3", "--batch", "8", "--lambda", "inf"],
+    );
+    assert_success("grow λ inf cpu", &flat_cpu);
+    let (flat_gpu, flat_gpu_out) = grow(
+        "inf-gpu.exr",
+        &["--validation", "--seed", "3", "--batch", "8", "--lambda", "inf"],
+    );
+    assert_success("grow λ inf gpu", &flat_gpu);
+    assert_eq!(
+        std::fs::read(&flat_cpu_out).unwrap(),
+        std::fs::read(&flat_gpu_out).unwrap(),
+        "λ inf: GPU and CPU differ"
+    );
+    assert_ne!(std::fs::read(&cpu_out).unwrap(), std::fs::read(&flat_cpu_out).unwrap());
 
     let outputs = fresh_dir("synth-grow-out");
     let out = outputs.join("o.png").display().to_string();
@@ -329,6 +347,7 @@ fn grow_makes_a_new_field_of_the_size_asked() {
     for (what, exemplar, size, extra, needles) in [
         ("small size", &exemplar, "5", &[][..], &["--size", "5×5"][..]),
         ("bad size", &exemplar, "12y3", &[], &["--size", "12y3"]),
+        ("nan lambda", &exemplar, "24", &["--lambda", "nan"], &["--lambda"]),
         ("void", &void, "24", &[], &["void.exr"]),
         (
             "huge window",

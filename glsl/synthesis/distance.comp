@@ -65,7 +65,9 @@ void main() {
                     precise float dhx = tap.y - texel.y;
                     precise float dhy = tap.z - texel.z;
                     precise float slopes = dhx * dhx + dhy * dhy;
-                    precise float term = tap.w * (dh * dh + lambda * slopes);
+                    // lambda = +inf: slopes only (Fig. 7.4's "no height criterion").
+                    precise float mismatch = isinf(lambda) ? slopes : dh * dh + lambda * slopes;
+                    precise float term = tap.w * mismatch;
                     precise float next = sum[k] + term;
                     sum[k] = next;
                 }

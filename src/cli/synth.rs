@@ -75,7 +75,8 @@ pub struct GrowArgs {
     /// Window side n in samples, odd (default: fill 7, transition 11).
     #[arg(long, value_name = "SAMPLES")]
     pub window: Option<u32>,
-    /// Weight λ of the slope channels against the height channel (both normalised).
+    /// Weight λ of the slope channels against the height channel (both
+    /// normalised); inf: slopes only, no height criterion (Fig. 7.4).
     #[arg(long, default_value_t = 0.25, value_name = "WEIGHT")]
     pub lambda: f32,
     /// Tolerance ε: candidates within (1+ε) of the best match (default: fill 0.1, transition 0.5).

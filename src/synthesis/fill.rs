@@ -49,7 +49,8 @@ use crate::synthesis::search::{Choice, CpuSearch, Exemplar, NeighbourhoodSearch,
 pub struct FillParams {
     /// Window side n (odd, ≥ 3), `--window`.
     pub window: u32,
-    /// Weight λ of the (normalised) slope channels, `--lambda`.
+    /// Weight λ of the (normalised) slope channels, `--lambda` (+∞:
+    /// slopes only, no height term; Fig. 7.4's last panel).
     pub lambda: f32,
     /// Candidate tolerance ε, `--epsilon`.
     pub epsilon: f32,
@@ -108,10 +109,10 @@ impl FillParams {
                 format!("{n} is larger than the {columns}×{rows} height field"),
             ));
         }
-        if !(self.lambda.is_finite() && self.lambda >= 0.0) {
+        if self.lambda.is_nan() || self.lambda < 0.0 {
             return Err(Error::invalid(
                 "--lambda",
-                format!("{}: must be finite and ≥ 0", self.lambda),
+                format!("{}: must be ≥ 0 (or inf: slopes only)", self.lambda),
             ));
         }
         if !(self.epsilon.is_finite() && self.epsilon >= 0.0) {

@@ -8,6 +8,8 @@
 //!
 //! ```text
 //! s(c)   = Σ_t w_t·[(h_t − h'_t)² + λ·((hx_t − hx'_t)² + (hy_t − hy'_t)²)]
+//!          (λ = +∞: Σ_t w_t·[(hx_t − hx'_t)² + (hy_t − hy'_t)²], slopes only,
+//!          the text's "no height criterion" of Fig. 7.4)
 //! d(c)   = s(c) / Σ_t w_t
 //! best   = min_c s(c)
 //! accept = { c : s(c) ≤ (1 + ε)·best }
@@ -65,7 +67,8 @@ impl Exemplar {
 pub struct SearchConfig {
     /// Window side n (odd).
     pub window: u32,
-    /// Weight λ of the derivative channels.
+    /// Weight λ of the derivative channels (+∞: derivatives only, no
+    /// height term).
     pub lambda: f32,
     /// Candidate tolerance ε ≥ 0.
     pub epsilon: f32,
@@ -137,10 +140,10 @@ pub fn check(exemplar: &Exemplar, config: &SearchConfig, queries: &[Query]) -> R
             format!("{n} is not an odd number of samples"),
         ));
     }
-    if !(config.lambda.is_finite() && config.lambda >= 0.0) {
+    if config.lambda.is_nan() || config.lambda < 0.0 {
         return Err(Error::invalid(
             "--lambda",
-            format!("{} is not a finite number ≥ 0", config.lambda),
+            format!("{} is not a number ≥ 0 (or inf)", config.lambda),
         ));
     }
     if !(config.epsilon.is_finite() && config.epsilon >= 0.0) {
@@ -186,8 +189,9 @@ pub fn total_weight(query: &Query) -> f32 {
 }
 
 /// s(c) of the module docs for the window centred at texel `centre`: taps
-/// in order, each term `w·(dh² + λ·(dhx² + dhy²))` added to the running sum
-/// (the GPU keeps exactly this order and rounding).
+/// in order, each term `w·(dh² + λ·(dhx² + dhy²))` (`w·(dhx² + dhy²)` for
+/// λ = +∞) added to the running sum (the GPU keeps exactly this order and
+/// rounding).
 pub fn weighted_mismatch(exemplar: &Exemplar, config: &SearchConfig, query: &Query, centre: u32) -> f32 {
     let n = config.window as i64;
     let r = n / 2;
@@ -204,7 +208,13 @@ pub fn weighted_mismatch(exemplar: &Exemplar, config: &SearchConfig, query: &Que
             let dh = tap[0] - texel[0];
             let dhx = tap[1] - texel[1];
             let dhy = tap[2] - texel[2];
-            sum += tap[3] * (dh * dh + config.lambda * (dhx * dhx + dhy * dhy));
+            let slopes = dhx * dhx + dhy * dhy;
+            let mismatch = if config.lambda.is_infinite() {
+                slopes
+            } else {
+                dh * dh + config.lambda * slopes
+            };
+            sum += tap[3] * mismatch;
         }
     }
     sum

@@ -12,6 +12,9 @@ pub mod detail;
 pub mod geometry_image;
 pub mod ground;
 pub mod importance;
+// Fig. 6.1's value and lattice convolution noise: only its tests use them.
+#[cfg(test)]
+mod lattice_noise;
 pub mod lod;
 pub mod procedural;
 pub mod raycast;

@@ -32,7 +32,7 @@ fn mix(mut z: u64) -> u64 {
 }
 
 /// Hash of lattice point `(i, j)` under `seed`.
-fn hash(seed: u64, i: i64, j: i64) -> u64 {
+pub(super) fn hash(seed: u64, i: i64, j: i64) -> u64 {
     let a = mix(seed ^ (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
     mix(a ^ (j as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f))
 }

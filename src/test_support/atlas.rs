@@ -90,3 +90,28 @@ pub fn check_texels_against_cpu(
     );
     entries.len()
 }
+
+/// The colour textures `atlas` (of `atlas_size`² texels) with only the
+/// inner texels of the tiles `table` draws from kept, the rest black:
+/// slots no tile uses hold whatever the memory held. Textures without a
+/// used tile are left out; returns `(texture index, RGBA8)` pairs.
+pub fn used_tiles(atlas: &[Vec<u8>], atlas_size: u32, table: &PageTable) -> Vec<(usize, Vec<u8>)> {
+    let mut out: Vec<Option<Vec<u8>>> = vec![None; atlas.len()];
+    for e in &table.entries {
+        let t = e.texture as usize;
+        let image = out[t].get_or_insert_with(|| (0..atlas_size * atlas_size).flat_map(|_| [0, 0, 0, 255]).collect());
+        let (x0, y0, n) = (
+            e.atlas_origin[0] as u32,
+            e.atlas_origin[1] as u32,
+            e.inner_texels as u32,
+        );
+        for y in y0..(y0 + n).min(atlas_size) {
+            let row = ((y * atlas_size + x0) * 4) as usize..((y * atlas_size + (x0 + n).min(atlas_size)) * 4) as usize;
+            image[row.clone()].copy_from_slice(&atlas[t][row]);
+        }
+    }
+    out.into_iter()
+        .enumerate()
+        .filter_map(|(i, t)| t.map(|t| (i, t)))
+        .collect()
+}

@@ -136,6 +136,19 @@ pub fn dump_pngs(images: &[(&str, &[u8])], width: u32, height: u32) {
     }
 }
 
+/// RGBA8 images of `width` columns and the same height, side by side.
+pub fn side_by_side(images: &[Vec<u8>], width: u32) -> Vec<u8> {
+    let row = width as usize * 4;
+    let rows = images[0].len() / row;
+    (0..rows)
+        .flat_map(|r| {
+            images
+                .iter()
+                .flat_map(move |i| i[r * row..(r + 1) * row].iter().copied())
+        })
+        .collect()
+}
+
 /// Per-pixel FLIP error between two sRGB RGBA8 images of the same size (alpha ignored).
 pub fn flip_errors(reference_rgba: &[u8], test_rgba: &[u8], width: u32, height: u32) -> Vec<f32> {
     let rgb = |rgba: &[u8]| -> Vec<u8> { rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect() };

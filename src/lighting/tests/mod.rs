@@ -12,3 +12,4 @@ mod sky_cache;
 mod sky_light;
 mod soft_shadows;
 mod twins;
+mod visibility_sh;

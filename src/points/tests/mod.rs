@@ -5,5 +5,6 @@ mod hybrid;
 mod kernel;
 mod primitives;
 mod render;
+mod rock_levels;
 mod single_pass;
 mod vegetation;

@@ -64,15 +64,15 @@ fn params(seed: u32) -> FillParams {
     }
 }
 
-fn interior(f: &HeightField) -> impl Iterator<Item = (u32, u32)> + '_ {
+pub(super) fn interior(f: &HeightField) -> impl Iterator<Item = (u32, u32)> + '_ {
     (1..f.rows - 1).flat_map(move |r| (1..f.columns - 1).map(move |c| (c, r)))
 }
 
-fn slopes(f: &HeightField) -> Vec<f64> {
+pub(super) fn slopes(f: &HeightField) -> Vec<f64> {
     interior(f).map(|(c, r)| slope_curvature(f, c, r).0).collect()
 }
 
-fn heights(f: &HeightField) -> Vec<f64> {
+pub(super) fn heights(f: &HeightField) -> Vec<f64> {
     f.heights.iter().map(|&h| f64::from(h)).collect()
 }
 
@@ -96,7 +96,7 @@ fn variogram(f: &HeightField, lag: u32) -> f64 {
 }
 
 /// The largest ratio (either way) of the variograms at lags 1, 2, 4, 8.
-fn variogram_mismatch(a: &HeightField, b: &HeightField) -> f64 {
+pub(super) fn variogram_mismatch(a: &HeightField, b: &HeightField) -> f64 {
     [1, 2, 4, 8]
         .iter()
         .map(|&l| {

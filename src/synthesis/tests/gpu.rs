@@ -106,7 +106,7 @@ fn gpu_choices_equal_the_cpu_twins() {
     for (window, known, count) in [(3, 1.0, 60), (7, 0.6, 50), (11, 0.4, 40), (17, 0.5, 12)] {
         let exemplar = Arc::new(random_exemplar(&mut rng, 41, 33, window));
         let queries = random_queries(&mut rng, &exemplar, window, count, known);
-        for (lambda, epsilon) in [(0.0, 0.0), (0.7, 0.0), (0.7, 0.05), (2.0, 1e3)] {
+        for (lambda, epsilon) in [(0.0, 0.0), (0.7, 0.0), (0.7, 0.05), (2.0, 1e3), (f32::INFINITY, 0.05)] {
             let config = SearchConfig {
                 window,
                 lambda,
@@ -329,6 +329,7 @@ fn bad_input_is_a_one_line_error() {
         (4, 1.0, 0.0, "--window"),
         (0, 1.0, 0.0, "--window"),
         (5, -1.0, 0.0, "--lambda"),
+        (5, f32::NAN, 0.0, "--lambda"),
         (5, 1.0, f32::NAN, "--epsilon"),
     ] {
         let bad = SearchConfig {

@@ -7,13 +7,17 @@
 //! driven by a rainfall input map, under validation; and a tree of sampled
 //! functions (§8.3) on altitude, slope and rainfall, whose direct-mode frame
 //! (the same evaluation per pixel) also matches the atlas frame.
+//!
+//! With `ALPENGLOW_DUMP=DIR` the colour textures of the atlas, as read back
+//! and compared, are written as `N-TREE-atlas-texture-I.png` (Fig. 8.7):
+//! the inner texels of the tiles the frame draws from, the rest black.
 
 use crate::io::heightmap::{load_heightmap, HeightmapOptions};
 use crate::renderer::{Camera, FrameImages, RenderSettings, Renderer, Scene};
 use crate::surface::gpu_layout::TexturingMode;
 use crate::surface::layers::LayerTree;
 use crate::terrain::geometry_image::TerrainSettings;
-use crate::test_support::atlas::check_texels_against_cpu;
+use crate::test_support::atlas::{check_texels_against_cpu, used_tiles};
 use crate::test_support::{assert_validation_clean, data, dump_pngs, jacksboro_field, mean_flip, validated_context};
 use crate::texturing::generation::TextureStreaming;
 use crate::texturing::reference::ReferenceSurface;
@@ -62,6 +66,11 @@ fn render(name: &str, scene: &Scene, camera: &Camera, mode: TexturingMode, readb
     if let Some((atlas, table, atlas_size)) = atlas {
         let tiles = check_texels_against_cpu(name, scene, &atlas, atlas_size, &table);
         assert!(tiles > 5, "{name}: only {tiles} tiles");
+        // Fig. 8.7 (a part of the texture atlas): the tiles in use, as read back.
+        for (i, texture) in used_tiles(&atlas, atlas_size, &table) {
+            let what = format!("{}-atlas-texture-{i}", name.replace(' ', "-"));
+            dump_pngs(&[(&what, &texture)], atlas_size, atlas_size);
+        }
     }
     images
 }
