@@ -5,20 +5,28 @@
 //! procedural detail, §7.4.3), looking along the path; every step renders
 //! through [`Renderer`].
 //!
-//! `cargo run --release --example drive -- [--steps N] [--width W] [--height H] [--views 6|1] [--raster PATH]`
-//! (default: a `ring6` rig of 320×240 views, 300 steps). Prints the median, p99 and largest
+//! `cargo run --release --example drive -- [--steps N] [--width W] [--height H] [--views 6|1] [--raster PATH] [--pyramid FILE|procedural:SIDE]`
+//! (default: a `ring6` rig of 320×240 views, 300 steps). `--pyramid`
+//! drives across a streamed region instead (issue 31 item 1): a height
+//! pyramid (`alpenglow dem import`), or a procedural one of SIDE² 1 m
+//! samples written to the temporary directory first; 4096² resident, a
+//! 1024² detail window that frames do not wait for, the ground query from
+//! the finest level ([`alpenglow::StreamedGround`]), the path from the
+//! region's centre. Prints the median, p99 and largest
 //! frame time per step: wall-clock (CPU: ground query, prepare, record,
 //! submit, and any wait for a free frame slot) and GPU (the sum of the
 //! frame's pass timestamps from [`Renderer::finish`]).
 
 use std::time::Instant;
 
-use alpenglow::files::load_heightmap;
+use std::path::PathBuf;
+
+use alpenglow::files::{load_heightmap, write_ridge_region, DEFAULT_DETAIL_WINDOW, DEFAULT_RESIDENT_SIDE};
 use alpenglow::glam::{DVec2, DVec3};
 use alpenglow::tools::profile::{median, quantile, summarize};
 use alpenglow::{
-    Camera, Context, ContextOptions, DeviceSelector, Ground, HeightmapOptions, RasterPath, Renderer, Rig, Scene,
-    Settings, ViewSpec,
+    Camera, Context, ContextOptions, DeviceSelector, HeightmapOptions, RasterPath, Renderer, Rig, Scene, Settings,
+    ViewSpec,
 };
 
 /// Car speed (m/s) and the fixed step (s).
@@ -42,6 +50,8 @@ struct Args {
     views: u32,
     /// The terrain's rasterizer (`--raster hardware|compute|auto`).
     raster: RasterPath,
+    /// `--pyramid FILE|procedural:SIDE`: a streamed region.
+    pyramid: Option<String>,
 }
 
 /// `--steps N --width W --height H`; errors name the argument.
@@ -52,6 +62,7 @@ fn parse_args() -> Result<Args, String> {
         height: 200,
         views: 6,
         raster: RasterPath::Hardware,
+        pyramid: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -75,6 +86,7 @@ fn parse_args() -> Result<Args, String> {
                     _ => return Err(format!("{flag}: {value:?} is not hardware, compute or auto")),
                 }
             }
+            "--pyramid" => args.pyramid = Some(value),
             "--width" => {
                 args.width = number(1)?
                     .try_into()
@@ -87,7 +99,7 @@ fn parse_args() -> Result<Args, String> {
             }
             _ => {
                 return Err(format!(
-                    "unknown argument {flag:?} (use --steps, --width, --height, --views, --raster)"
+                    "unknown argument {flag:?} (use --steps, --width, --height, --views, --raster, --pyramid)"
                 ))
             }
         }
@@ -122,19 +134,61 @@ impl Car {
     }
 }
 
-/// The car's camera: the driver's eye at `xy` looking along `heading`, 3° down.
-fn car_camera(ground: &Ground, xy: DVec2, heading: f64) -> alpenglow::Result<Camera> {
-    let eye = xy.extend(ground.height(xy.x, xy.y)? + EYE_HEIGHT);
+/// The car's camera: the driver's eye `EYE_HEIGHT` above the ground
+/// height `ground` at `xy`, looking along `heading`, 3° down.
+fn car_camera(ground: f64, xy: DVec2, heading: f64) -> Camera {
+    let eye = xy.extend(ground + EYE_HEIGHT);
     let pitch = 3f64.to_radians();
     let forward = DVec2::from_angle(heading).extend(0.0) * pitch.cos() - DVec3::Z * pitch.sin();
-    Ok(Camera {
+    Camera {
         eye,
         target: eye + forward,
         up: DVec3::Z,
         fov_y_deg: 60.0,
         near: 0.1,
         far: 100_000.0,
-    })
+    }
+}
+
+/// A procedural height pyramid of `side`² samples 1 m apart
+/// ([`write_ridge_region`]), written once into the temporary directory.
+fn procedural_pyramid(side: u32) -> alpenglow::Result<PathBuf> {
+    let path = std::env::temp_dir().join(format!("alpenglow-drive-{side}.hpyr"));
+    if !path.exists() {
+        write_ridge_region(&path, side)?;
+    }
+    Ok(path)
+}
+
+/// The scene, where the car starts, and the region's name.
+fn load_scene(args: &Args) -> alpenglow::Result<(Scene, DVec2, String)> {
+    let Some(pyramid) = &args.pyramid else {
+        let dem = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/jacksboro-fault.png");
+        let heights = load_heightmap(
+            &dem,
+            &HeightmapOptions {
+                scale: 1.0,
+                offset: 0.0,
+                spacing: Some(DVec2::new(74.4, 92.6)),
+                ..Default::default()
+            },
+        )?;
+        return Ok((Scene::new(heights), START, "the Jacksboro DEM".into()));
+    };
+    let path = match pyramid.strip_prefix("procedural:") {
+        Some(side) => {
+            let side = side.parse().ok().filter(|s| (2..=65536).contains(s)).ok_or_else(|| {
+                alpenglow::Error::invalid("--pyramid", format!("{side:?} is not a side in 2..=65536"))
+            })?;
+            procedural_pyramid(side)?
+        }
+        None => PathBuf::from(pyramid),
+    };
+    let mut scene = Scene::from_pyramid_file(&path, DEFAULT_RESIDENT_SIDE, DEFAULT_DETAIL_WINDOW)?;
+    // Frames along the path never wait for the window's tiles.
+    scene.set_detail_window(DEFAULT_DETAIL_WINDOW, false)?;
+    let centre = scene.heights.extent() / 2.0;
+    Ok((scene, centre, path.display().to_string()))
 }
 
 /// One row of the table: median, p99, largest and first value (ms).
@@ -149,17 +203,7 @@ fn row(name: &str, values: &[f64]) {
 }
 
 fn run(args: &Args) -> alpenglow::Result<()> {
-    let dem = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/jacksboro-fault.png");
-    let heights = load_heightmap(
-        &dem,
-        &HeightmapOptions {
-            scale: 1.0,
-            offset: 0.0,
-            spacing: Some(DVec2::new(74.4, 92.6)),
-            ..Default::default()
-        },
-    )?;
-    let scene = Scene::new(heights);
+    let (scene, start, region) = load_scene(args)?;
     let ctx = Context::new(&ContextOptions {
         validation: false,
         device: DeviceSelector::Best,
@@ -172,16 +216,21 @@ fn run(args: &Args) -> alpenglow::Result<()> {
     let mut settings = Settings::for_views(specs.clone());
     settings.readback = false;
     settings.raster = args.raster;
-    let ground = scene.ground(&settings.terrain)?;
+    let resident_ground = scene.ground(&settings.terrain)?;
+    let mut streamed_ground = scene.streamed_ground(&settings.terrain)?;
+    let mut ground = |xy: DVec2| match streamed_ground.as_mut() {
+        Some(streamed) => streamed.height(xy.x, xy.y),
+        None => resident_ground.height(xy.x, xy.y),
+    };
     let started = Instant::now();
     let mut renderer = Renderer::new(&ctx, &scene, settings)?;
     let setup = started.elapsed().as_secs_f64();
     let mut wall = Vec::with_capacity(args.steps);
     let frames_per_step = 1;
-    let mut car = Car { s: 0.0, xy: START };
+    let mut car = Car { s: 0.0, xy: start };
     for _ in 0..args.steps {
         let t = Instant::now();
-        let camera = car_camera(&ground, car.xy, car.heading())?;
+        let camera = car_camera(ground(car.xy)?, car.xy, car.heading());
         let cameras = match &rig {
             Some(rig) => rig.cameras(&camera)?,
             None => vec![camera],
@@ -202,7 +251,7 @@ fn run(args: &Args) -> alpenglow::Result<()> {
         .collect();
     let info = ctx.info();
     println!(
-        "drive: {} steps of 1/30 s at {SPEED} m/s ({:.0} m over the Jacksboro DEM), {} view(s) of {}×{}, {} ({})",
+        "drive: {} steps of 1/30 s at {SPEED} m/s ({:.0} m over {region}), {} view(s) of {}×{}, {} ({})",
         args.steps,
         SPEED * DT * args.steps as f64,
         specs.len(),

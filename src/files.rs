@@ -31,8 +31,9 @@ pub use crate::io::limits::InputLimits;
 #[cfg(feature = "gdal")]
 pub use crate::io::pyramid::GdalRows;
 pub use crate::io::pyramid::{
-    write_pyramid, FieldRows, FieldShape, FnRows, HeightPyramid, HeightRows, HgtMosaic, PyramidOptions, PyramidSummary,
-    PyramidTile, TileKey, DEFAULT_HEIGHT_STEP, DEFAULT_RESIDENT_SIDE, DEFAULT_TILE_SIDE,
+    write_pyramid, write_ridge_region, FieldRows, FieldShape, FnRows, HeightPyramid, HeightRows, HgtMosaic,
+    PyramidOptions, PyramidSummary, PyramidTile, TileKey, DEFAULT_HEIGHT_STEP, DEFAULT_RESIDENT_SIDE,
+    DEFAULT_TILE_SIDE,
 };
 pub use crate::points::build::input::{load_points_file, PointInput};
 pub use crate::points::build::spt_file::{read_spt, write_spt};

@@ -12,8 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use alpenglow::files::{write_pyramid, FieldShape, FnRows, PyramidOptions};
-use alpenglow::glam::DVec2;
+use alpenglow::files::write_ridge_region;
 use common::cli::*;
 
 fn jacksboro() -> PathBuf {
@@ -153,41 +152,11 @@ fn peak_rss(pid: u32) -> Option<u64> {
     Some(line.split_whitespace().nth(1)?.parse::<u64>().ok()? * 1024)
 }
 
-/// A procedural `side²` field at 1 m written as a pyramid: ridges across x
-/// and y (sums of sines), heights on the file's quantum so that the planar
-/// predictor leaves nothing to code.
+/// A procedural `side²` field at 1 m written as a pyramid
+/// ([`write_ridge_region`]).
 fn procedural_pyramid(dir: &Path, side: u32) -> PathBuf {
-    let quantum = 1.0 / 256.0;
-    let profile = |phase: f32| -> Vec<f32> {
-        (0..side)
-            .map(|i| {
-                let x = i as f32;
-                let h = 500.0 * (x / 2900.0 + phase).sin()
-                    + 220.0 * (x / 1100.0 + 2.0 * phase).sin()
-                    + 60.0 * (x / 330.0 - phase).sin()
-                    + 12.0 * (x / 77.0).sin();
-                (h / quantum).round() * quantum
-            })
-            .collect()
-    };
-    let (across, along) = (profile(0.3), profile(1.7));
     let path = dir.join(format!("procedural-{side}.hpyr"));
-    let mut source = FnRows {
-        shape: FieldShape {
-            columns: side,
-            rows: side,
-            spacing: DVec2::ONE,
-            origin: path.clone(),
-        },
-        fill: |r: u32, row: &mut [f32]| {
-            row.copy_from_slice(&across);
-            let offset = along[r as usize] + 600.0;
-            for h in row.iter_mut() {
-                *h += offset;
-            }
-        },
-    };
-    write_pyramid(&path, &mut source, &PyramidOptions::default()).unwrap();
+    write_ridge_region(&path, side).unwrap();
     path
 }
 

@@ -38,6 +38,7 @@ pub(crate) mod format;
 mod gdal_rows;
 pub mod mosaic;
 mod reader;
+mod ridges;
 pub mod stream;
 #[cfg(test)]
 mod tests;
@@ -52,6 +53,7 @@ use glam::DVec2;
 pub use gdal_rows::GdalRows;
 pub use mosaic::HgtMosaic;
 pub use reader::HeightPyramid;
+pub use ridges::write_ridge_region;
 pub use writer::write_pyramid;
 
 use crate::error::{Error, Result};
