@@ -22,7 +22,11 @@
 // hybrid triangles) hides is dropped first, as in three-pass accumulation.
 // The walk ends early once the next entry's reach (a lower bound of its
 // samples' depth less its z_f, splat_reach) is at least every pixel's z_d:
-// the operator drops all the later fragments (the surfaces behind).
+// the operator drops all the later fragments (the surfaces behind). Per
+// splat the same bound skips the fragments' work when no pixel of the
+// subgroup both lies inside the kernel's cut-off and has z_d above the
+// splat's reach (those pixels would drop the fragment: the block goes on
+// walking for its other pixels, e.g. the ones no splat has covered yet).
 // Finally each pixel is normalised and shaded once, exactly as
 // points.normalize (glsl/include/splat_resolve.glsl): no pixel state in
 // memory. The ids are those of the splat that last set z_d. Every step
@@ -54,20 +58,23 @@ struct PixelState {
     uint record;
 };
 
-// The operator on pixel state `p` for the binned splat in `slot` at the
-// pixel centred at `centre` (view ray `ray`), whose depth buffer holds
-// `stored`: the tests of splat_sample_at (kernel cut-off first, then the
-// ray–plane point and the clip lines), then the depth buffer's, then the
-// text's.
-void merge_splat(inout PixelState p, uint slot, vec3 ray, vec2 centre, float stored, float cutoff2) {
+// The operator on pixel state `p` for the binned splat in `slot` (reach
+// `reach`, splat_reach) at the pixel centred at `centre` (view ray `ray`),
+// whose depth buffer holds `stored`: the tests of splat_sample_at (kernel
+// cut-off first, then the ray–plane point and the clip lines), then the
+// depth buffer's, then the text's (§10.4). A pixel with z_d ≤ reach would
+// drop the fragment (z − z_f ≥ reach ≥ z_d), so the subgroup skips the
+// splat when no pixel is both inside the cut-off and above the reach.
+void merge_splat(inout PixelState p, uint slot, float reach, vec3 ray, vec2 centre, float stored, float cutoff2) {
     uint h = pc.merge.x;
     vec4 conic = g_binned_splats[h].s[slot].conic;
     vec4 c = g_binned_splats[h].s[slot].centre;
     vec2 d = centre - c.xy;
     float r2 = conic.x * d.x * d.x + 2.0 * conic.y * d.x * d.y + conic.z * d.y * d.y;
     // Uniform: the subgroup skips the rest at once when none of its
-    // pixels is inside (a CPU driver then jumps over it).
-    if (!subgroupAny(r2 <= cutoff2)) {
+    // pixels is inside and in front of the reach (a CPU driver then jumps
+    // over it); the skipped fragments would all be dropped: exact.
+    if (!subgroupAny(r2 <= cutoff2 && reach < p.zd)) {
         return;
     }
     if (r2 > cutoff2) {
@@ -175,7 +182,9 @@ void main() {
         while (touching != 0u) {
             uint t = findLSB(touching);
             touching &= touching - 1u;
-            merge_splat(p, g_tile_entries[pc.single.y].e[base + t].slot, ray, centre, stored, cutoff2);
+            TileEntry walked = g_tile_entries[pc.single.y].e[base + t];
+            float walked_reach = uintBitsToFloat((((walked.key & reach_mask) << shift) + least));
+            merge_splat(p, walked.slot, walked_reach, ray, centre, stored, cutoff2);
         }
         if (beyond != 0u) {
             break;
