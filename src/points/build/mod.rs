@@ -19,3 +19,4 @@ pub mod rocks;
 pub mod sampling;
 pub mod spt;
 pub mod spt_file;
+pub mod spt_view;

@@ -7,3 +7,4 @@ mod primitives;
 mod render;
 mod single_pass;
 mod vegetation;
+mod view_error;
