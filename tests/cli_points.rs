@@ -193,6 +193,51 @@ fn renders_the_affine_kernel_and_names_it_for_object_space_primitives() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// `--spt-error view-dependent` (§10.1.4, §10.1.7) renders the bunny under
+/// validation with fewer splats passing the interval test than the default
+/// isotropic error; with an object-space primitive it is a one-line error
+/// naming the option, with nothing written.
+#[test]
+fn renders_the_view_dependent_error_and_names_it_for_object_space_primitives() {
+    let dir = fresh_dir("points-spt-error");
+    let exr_path = dir.join("o.exr");
+    let exr = exr_path.display().to_string();
+    let mut passed = Vec::new();
+    for error in ["isotropic", "view-dependent"] {
+        let extra = ["--spt-error", error, "--exr", &exr];
+        let out = run(&bunny_render_args(&dir, &extra));
+        assert_success(&format!("render {}", extra.join(" ")), &out);
+        assert_bunny_covered(&exr_path, error);
+        let stdout = text(&out.stdout);
+        let count = stdout
+            .split(" pass the interval test")
+            .next()
+            .and_then(|head| head.rsplit(' ').next())
+            .and_then(|n| n.parse::<u64>().ok())
+            .unwrap_or_else(|| panic!("no interval count in {stdout}"));
+        passed.push(count);
+    }
+    assert!(
+        passed[1] < passed[0],
+        "view-dependent {} not < isotropic {}",
+        passed[1],
+        passed[0]
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    let dir = fresh_dir("points-spt-error-object");
+    let args = bunny_render_args(
+        &dir,
+        &["--spt-error", "view-dependent", "--splat-primitive", "object-instanced"],
+    );
+    assert_one_line_error(
+        "--spt-error view-dependent --splat-primitive object-instanced",
+        &run(&args),
+        &["invalid --spt-error: view-dependent"],
+    );
+    assert_no_files_left("--spt-error view-dependent with object-instanced", &dir);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 /// An SPT file from `spt build` renders; bad point inputs and transforms
 /// are one-line errors naming the file or the option, and nothing is written.
 #[test]
