@@ -182,14 +182,17 @@ fn renders_the_affine_kernel_and_names_it_for_object_space_primitives() {
         assert_bunny_covered(&exr_path, &format!("{splat} affine"));
     }
     std::fs::remove_dir_all(&dir).unwrap();
-    let dir = fresh_dir("points-affine-object");
-    let args = bunny_render_args(&dir, &["--splat-kernel", "affine", "--splat-primitive", "object-quad"]);
-    assert_one_line_error(
-        "--splat-kernel affine --splat-primitive object-quad",
-        &run(&args),
-        &["invalid --splat-kernel: affine"],
-    );
-    assert_no_files_left("--splat-kernel affine with object-quad", &dir);
+    assert_object_space_refuses(["--splat-kernel", "affine"], "object-quad");
+}
+
+/// `option value` with the object-space `primitive` is a one-line error
+/// naming the option, and nothing is written.
+fn assert_object_space_refuses([option, value]: [&str; 2], primitive: &str) {
+    let dir = fresh_dir("points-object-space-refusal");
+    let args = bunny_render_args(&dir, &[option, value, "--splat-primitive", primitive]);
+    let what = format!("{option} {value} --splat-primitive {primitive}");
+    assert_one_line_error(&what, &run(&args), &[&format!("invalid {option}: {value}")]);
+    assert_no_files_left(&what, &dir);
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -224,18 +227,7 @@ fn renders_the_view_dependent_error_and_names_it_for_object_space_primitives() {
         passed[0]
     );
     std::fs::remove_dir_all(&dir).unwrap();
-    let dir = fresh_dir("points-spt-error-object");
-    let args = bunny_render_args(
-        &dir,
-        &["--spt-error", "view-dependent", "--splat-primitive", "object-instanced"],
-    );
-    assert_one_line_error(
-        "--spt-error view-dependent --splat-primitive object-instanced",
-        &run(&args),
-        &["invalid --spt-error: view-dependent"],
-    );
-    assert_no_files_left("--spt-error view-dependent with object-instanced", &dir);
-    std::fs::remove_dir_all(dir).unwrap();
+    assert_object_space_refuses(["--spt-error", "view-dependent"], "object-instanced");
 }
 
 /// An SPT file from `spt build` renders; bad point inputs and transforms
