@@ -13,6 +13,7 @@ pub mod clusters;
 pub mod estimate;
 pub mod hybrid;
 pub mod input;
+pub mod mesh_out;
 pub mod plan;
 pub mod plants;
 pub mod rocks;
