@@ -57,6 +57,8 @@ mod tests {
         };
         let mesh = generate_rock(&params).unwrap();
         assert_eq!(mesh.triangles.len(), 196_608);
+        // A closed genus-0 triangle mesh: V − E + F = 2 with E = 3F/2.
+        assert_eq!(mesh.positions.len(), 196_608 / 2 + 2);
         let path = std::env::temp_dir().join(format!("alpenglow-rock-{}.obj", std::process::id()));
         write_obj(&mesh, &path).unwrap();
         let back = load_obj(&path).unwrap();
