@@ -197,7 +197,7 @@ pub use terrain::procedural::{ProceduralTerrain, TerrainModel};
 /// A submitted frame: pass it to [`Renderer::read`] (and friends) for its images.
 pub use graph::FrameOutcome;
 pub use lighting::shadows::ShadowSettings;
-pub use points::render::{SplatBackend, SplatKernel, SplatMode, SplatPrimitive, SplatSettings};
+pub use points::render::{SplatBackend, SplatKernel, SplatMode, SplatPrimitive, SplatSettings, SptError};
 pub use post::motion_blur::MotionBlurSettings;
 /// The one settings type of a [`Renderer`]: image size or views, anti-aliasing,
 /// motion blur, readback, and every technique's settings. `#[non_exhaustive]`:

@@ -15,7 +15,9 @@
 /// build's cost, build the tree (`alpenglow spt build`).
 pub mod spt {
     pub use crate::points::build::estimate::complete_cloud;
+    pub use crate::points::build::mesh_out::write_obj;
     pub use crate::points::build::plan::{plan_build, BuildCost};
+    pub use crate::points::build::rocks::{generate_rock, RockParams, MAX_SUBDIVISIONS};
     pub use crate::points::build::sampling::{
         sample_mesh_reporting, sampling_footprint, SamplingMethod, SamplingOptions,
     };

@@ -182,15 +182,52 @@ fn renders_the_affine_kernel_and_names_it_for_object_space_primitives() {
         assert_bunny_covered(&exr_path, &format!("{splat} affine"));
     }
     std::fs::remove_dir_all(&dir).unwrap();
-    let dir = fresh_dir("points-affine-object");
-    let args = bunny_render_args(&dir, &["--splat-kernel", "affine", "--splat-primitive", "object-quad"]);
-    assert_one_line_error(
-        "--splat-kernel affine --splat-primitive object-quad",
-        &run(&args),
-        &["invalid --splat-kernel: affine"],
-    );
-    assert_no_files_left("--splat-kernel affine with object-quad", &dir);
+    assert_object_space_refuses(["--splat-kernel", "affine"], "object-quad");
+}
+
+/// `option value` with the object-space `primitive` is a one-line error
+/// naming the option, and nothing is written.
+fn assert_object_space_refuses([option, value]: [&str; 2], primitive: &str) {
+    let dir = fresh_dir("points-object-space-refusal");
+    let args = bunny_render_args(&dir, &[option, value, "--splat-primitive", primitive]);
+    let what = format!("{option} {value} --splat-primitive {primitive}");
+    assert_one_line_error(&what, &run(&args), &[&format!("invalid {option}: {value}")]);
+    assert_no_files_left(&what, &dir);
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `--spt-error view-dependent` (§10.1.4, §10.1.7) renders the bunny under
+/// validation with fewer splats passing the interval test than the default
+/// isotropic error; with an object-space primitive it is a one-line error
+/// naming the option, with nothing written.
+#[test]
+fn renders_the_view_dependent_error_and_names_it_for_object_space_primitives() {
+    let dir = fresh_dir("points-spt-error");
+    let exr_path = dir.join("o.exr");
+    let exr = exr_path.display().to_string();
+    let mut passed = Vec::new();
+    for error in ["isotropic", "view-dependent"] {
+        let extra = ["--spt-error", error, "--exr", &exr];
+        let out = run(&bunny_render_args(&dir, &extra));
+        assert_success(&format!("render {}", extra.join(" ")), &out);
+        assert_bunny_covered(&exr_path, error);
+        let stdout = text(&out.stdout);
+        let count = stdout
+            .split(" pass the interval test")
+            .next()
+            .and_then(|head| head.rsplit(' ').next())
+            .and_then(|n| n.parse::<u64>().ok())
+            .unwrap_or_else(|| panic!("no interval count in {stdout}"));
+        passed.push(count);
+    }
+    assert!(
+        passed[1] < passed[0],
+        "view-dependent {} not < isotropic {}",
+        passed[1],
+        passed[0]
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_object_space_refuses(["--spt-error", "view-dependent"], "object-instanced");
 }
 
 /// An SPT file from `spt build` renders; bad point inputs and transforms

@@ -12,10 +12,11 @@
 struct Splat {
     vec4 position_rmin;  // object-space centre, r_min
     vec4 normal_rmax;    // object-space unit normal, r_max
-    vec4 radius_color;   // disk radius (object units), colour bits, 0, 0
+    vec4 radius_color;   // disk radius (object units), colour bits, view-dependent error bits, parent (glsl/include/spt_interval.glsl)
     vec4 clip;           // clip lines (unused by the caster)
 };
 layout(set = 0, binding = 2, std430) readonly buffer Splats { Splat s[]; } g_splats[];
+#include "spt_interval.glsl"
 
 
 struct ShadowInstance {
@@ -24,7 +25,7 @@ struct ShadowInstance {
 };
 
 layout(set = 0, binding = 2, std430) readonly buffer ShadowPoints {
-    vec4 eye;      // world eye position of the view
+    vec4 eye;      // world eye position of the view; w: the interval test (uint bits, SPT_ERROR_*)
     ShadowInstance instances[];
 } g_shadow_points[];
 
@@ -46,8 +47,9 @@ bool caster_disc(uvec2 buffers, uint record, uint splat_index, vec4 sun_texel, o
     uint first = floatBitsToUint(inst.params.y);
     Splat s = g_splats[buffers.x].s[first + splat_index];
     vec3 centre = (inst.model * vec4(s.position_rmin.xyz, 1.0)).xyz;
-    float r = length(centre - g_shadow_points[buffers.y].eye.xyz) / scale;
-    if (!(s.position_rmin.w <= r && r < s.normal_rmax.w)) {
+    vec4 eye = g_shadow_points[buffers.y].eye;
+    float r = length(centre - eye.xyz) / scale;
+    if (!spt_interval(buffers.x, first + splat_index, r, floatBitsToUint(eye.w), inst.model, eye.xyz)) {
         return false;
     }
     vec3 n = normalize(mat3(inst.model) * s.normal_rmax.xyz);

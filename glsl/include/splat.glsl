@@ -12,7 +12,7 @@
 struct Splat {
     vec4 position_rmin;  // object-space centre, r_min
     vec4 normal_rmax;    // object-space unit normal, r_max
-    vec4 radius_color;   // disk radius (object units), sRGB colour (uint bits: r | g << 8 | b << 16), 0, 0
+    vec4 radius_color;   // disk radius (object units), sRGB colour (uint bits: r | g << 8 | b << 16), view-dependent error bits, parent (spt_interval.glsl)
     vec4 clip;           // θ0, c0, θ1, c1: keep u·cos θ + v·sin θ ≤ c (c = FLT_MAX: no line)
 };
 
@@ -28,7 +28,7 @@ layout(set = 0, binding = 2, std430) readonly buffer PointFrame {
     vec4 k_inv[3];            // rows of K⁻¹
     vec4 depth;               // P22, P32 (camera z → depth), visibility offset (× splat radius), cutoff F_G
     vec4 viewport;            // width, height, largest point size, near
-    uvec4 lighting;           // x: the view's LightingFrame (storage), y: 1 shaded, 0 unlit, z: splat kernel (SPLAT_KERNEL_*)
+    uvec4 lighting;           // x: the view's LightingFrame (storage), y: 1 shaded, 0 unlit, z: splat kernel (SPLAT_KERNEL_*), w: interval test (SPT_ERROR_*)
     vec4 camera_to_world[3];  // rows of the camera → world rotation
     vec4 eye;                 // world eye position, w: 1 = two-sided splats, 0 = back faces culled
     Instance instances[];

@@ -7,7 +7,7 @@
 // so every mode draws the same kernels.
 //
 // splat_setup: the exact interval test r_min ≤ r < r_max with r the splat's
-// eye distance (§10.1.6), culling (near plane, near edge-on, back faces unless
+// eye distance (§10.1.6; or the view-dependent one, glsl/include/spt_interval.glsl), culling (near plane, near edge-on, back faces unless
 // two-sided) and the EWA set-up (§10.2.2):
 //   T = K·[t_u t_v p_k] (centred on the projected centre to keep round-off
 //   small), Q' = T⁻ᵀ·diag(1, 1, −F_G²)·T⁻¹, ellipse centre x_t and
@@ -27,6 +27,7 @@
 #define ALPENGLOW_SPLAT_SETUP_GLSL
 
 #include "splat.glsl"
+#include "spt_interval.glsl"
 
 // What the per-pixel kernel needs of a splat (the three-pass mode passes it
 // as flat varyings).
@@ -85,10 +86,10 @@ uint splat_setup_of(uint record, uint splat_index, out SplatSetup o) {
     uint first = floatBitsToUint(inst.params.y);
     Splat s = g_splats[pc.handles.x].s[first + splat_index];
 
-    // Interval test (§10.1.6) on the eye distance in object units.
+    // Interval test (§10.1.6; view-dependent: §10.1.7) on the eye distance in object units.
     vec3 p = (inst.model_view * vec4(s.position_rmin.xyz, 1.0)).xyz;
     float r = length(p) / scale;
-    if (!(s.position_rmin.w <= r && r < s.normal_rmax.w)) {
+    if (!spt_interval(pc.handles.x, first + splat_index, r, g_point_frame[f].lighting.w, inst.model_view, vec3(0.0))) {
         return SPLAT_SETUP_OUTSIDE_INTERVAL;
     }
     float near = g_point_frame[f].viewport.w;

@@ -169,6 +169,15 @@ pub enum SplatKernelArg {
     Affine,
 }
 
+/// Error of the SPT interval test (§10.1.4, §10.1.7).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SptErrorArg {
+    /// The geometric error e_g = sqrt(e_p² + e_t²), the same at every view angle.
+    Isotropic,
+    /// e_p·sin α + e_t·cos α (α: view vector to normal), tested per splat: fewer splats.
+    ViewDependent,
+}
+
 /// Primitive carrying a splat (§10.3).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SplatPrimitiveArg {
@@ -225,6 +234,9 @@ pub struct PointArgs {
         value_name = "KERNEL"
     )]
     pub splat_kernel: SplatKernelArg,
+    /// Error of the SPT interval test (screen-space primitives only for view-dependent).
+    #[arg(long = "spt-error", value_enum, default_value = "isotropic", value_name = "ERROR")]
+    pub spt_error: SptErrorArg,
     /// SPT error threshold in pixels of this image (r_min = e_g / ε).
     #[arg(long, default_value_t = 1.0, value_name = "PIXELS")]
     pub epsilon: f32,

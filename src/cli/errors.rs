@@ -86,6 +86,7 @@ const FLAGS: &[(&str, &str)] = &[
     ("points.epsilon", "--epsilon"),
     ("points.primitive", "--splat-primitive"),
     ("points.kernel", "--splat-kernel"),
+    ("points.error", "--spt-error"),
     ("points.transform", "--points-transform"),
     ("lighting.sun_elevation", "--sun-elevation"),
     ("lighting.sun_azimuth", "--sun-azimuth"),
@@ -245,6 +246,16 @@ mod tests {
                 .validate()
                 .unwrap_err(),
                 "invalid --splat-kernel: ",
+            ),
+            (
+                SplatSettings {
+                    error: alpenglow::SptError::ViewDependent,
+                    primitive: alpenglow::SplatPrimitive::ObjectInstanced,
+                    ..SplatSettings::default()
+                }
+                .validate()
+                .unwrap_err(),
+                "invalid --spt-error: ",
             ),
             (alpenglow::validate_size(0, 32).unwrap_err(), "invalid --width: "),
         ];

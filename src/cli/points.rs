@@ -9,10 +9,12 @@ use alpenglow::tools::budget::MemoryLimits;
 use alpenglow::tools::spt::{sampling_footprint, SamplingMethod};
 use alpenglow::{
     PointLoadOptions, PointTransform, Scene, SplatBackend, SplatKernel, SplatMode, SplatPrimitive, SplatSettings,
-    VegetationOptions, ViewSpec,
+    SptError, VegetationOptions, ViewSpec,
 };
 
-use super::args::{PointArgs, SplatArg, SplatBackendArg, SplatKernelArg, SplatPrimitiveArg, VegetationArg};
+use super::args::{
+    PointArgs, SplatArg, SplatBackendArg, SplatKernelArg, SplatPrimitiveArg, SptErrorArg, VegetationArg,
+};
 
 /// Adds the plants of the scene's layer tree when `--vegetation` says so
 /// (default: on for the built-in terrain); call after the layers and input
@@ -130,6 +132,10 @@ pub fn splat_settings(args: &PointArgs, views: &[ViewSpec], fov_y_deg: f64) -> R
         kernel: match args.splat_kernel {
             SplatKernelArg::Perspective => SplatKernel::Perspective,
             SplatKernelArg::Affine => SplatKernel::Affine,
+        },
+        error: match args.spt_error {
+            SptErrorArg::Isotropic => SptError::Isotropic,
+            SptErrorArg::ViewDependent => SptError::ViewDependent,
         },
         shaded: !args.no_shading,
         two_sided: args.two_sided,

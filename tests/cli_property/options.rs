@@ -277,6 +277,7 @@ pub const SCENE_OTHER: &[&str] = &[
     "--splat-primitive",
     "--splat-backend",
     "--splat-kernel",
+    "--spt-error",
     "--vegetation",
     "--sky-preset",
     "--sky",

@@ -23,10 +23,14 @@
 //!    (`-- --hybrid` runs only this part).
 //!
 //! `-- --primitives` runs only part 1 and the SPT rate; `-- --kernels` only
-//! part 5.
+//! part 5; `-- --spt-error` only part 6.
 //! 5. The perspective-accurate kernel against the affine EWA approximation
 //!    (§10.2, Figs. 10.15–10.17): part 1's close view of every leaf, EWA
 //!    quads, on the hardware rasterizer and the compute path.
+//! 6. The isotropic SPT error against the view-dependent one (§10.1.4,
+//!    §10.1.7): the bunny's tree at several distances and the field of 64
+//!    bunnies, EWA quads on both paths: splats passing the interval test,
+//!    drawn, GPU time.
 //!
 //! GPU times are the medians of the points passes' timestamps over the timed
 //! frames (the passes that draw the view: visibility, accumulation and
@@ -39,7 +43,7 @@ use alpenglow::tools::profile::median;
 use alpenglow::tools::spt::epsilon_from_pixels;
 use alpenglow::{
     Camera, Context, ContextOptions, DeviceSelector, PointLoadOptions, PointObject, PointScene, PointTransform,
-    RasterPath, Renderer, Scene, Settings, SplatKernel, SplatMode, SplatPrimitive, SplatSettings,
+    RasterPath, Renderer, Scene, Settings, SplatKernel, SplatMode, SplatPrimitive, SplatSettings, SptError,
 };
 
 use alpenglow_bench::points::{all_leaves, camera_at};
@@ -65,6 +69,7 @@ struct Measured {
     /// on a shared machine).
     best_ms: f64,
     prefix: u64,
+    passed: u64,
     drawn: u64,
     triangles: u64,
     cpu_ms: f64,
@@ -109,6 +114,7 @@ fn measure_on(
         gpu_ms,
         best_ms,
         prefix: last.prefix_splats,
+        passed: last.interval_passed.unwrap_or(0),
         drawn: last.drawn_splats.unwrap_or(0),
         triangles: last.triangles_drawn.unwrap_or(0),
         cpu_ms: median(stats.iter().skip(warmup).map(|s| s.cpu_ms)),
@@ -126,6 +132,7 @@ fn main() {
     let hybrid_only = std::env::args().any(|a| a == "--hybrid");
     let primitives_only = std::env::args().any(|a| a == "--primitives");
     let kernels_only = std::env::args().any(|a| a == "--kernels");
+    let spt_error_only = std::env::args().any(|a| a == "--spt-error");
     let frames = if quick { 3 } else { 10 };
     let ctx = Context::new(&ContextOptions {
         validation: false,
@@ -154,6 +161,10 @@ fn main() {
 
     if kernels_only {
         kernels(&ctx, &flat, &close, frames);
+        return;
+    }
+    if spt_error_only {
+        spt_errors(&ctx, &bunny, frames);
         return;
     }
     table_10_3(&ctx, &flat, &close, frames);
@@ -192,6 +203,41 @@ fn main() {
     );
     hybrid_against_points(&ctx, &options, &models, frames);
     kernels(&ctx, &flat, &close, frames);
+    spt_errors(&ctx, &tree_scene.points.objects[0], frames);
+}
+
+/// Part 6: the isotropic and the view-dependent SPT error (§10.1.4, §10.1.7).
+fn spt_errors(ctx: &Context, bunny: &PointObject, frames: usize) {
+    println!("\n6. SPT error, {SIDE}² window, EWA quads, back faces culled:");
+    println!("| scene | path | error | splats in prefixes | pass the interval test | drawn | GPU ms median (best) |");
+    println!("|---|---|---|---|---|---|---|");
+    let mut views: Vec<(String, Scene, Camera)> = [0.25, 1.0, 4.0]
+        .map(|d| (format!("bunny at {d} m"), single(bunny.clone()), camera_at(d)))
+        .into();
+    let (field, field_camera) = bunny_field(bunny);
+    views.push(("64 bunnies, 2.7–6.5 m".into(), field, field_camera));
+    let mut paths = vec![RasterPath::Hardware];
+    if ctx.has_feature("shaderBufferInt64Atomics") {
+        paths.push(RasterPath::Compute);
+    }
+    for (name, scene, camera) in &views {
+        for &raster in &paths {
+            for error in SptError::ALL {
+                let settings = SplatSettings {
+                    error,
+                    ..SplatSettings::default()
+                };
+                let m = measure_on(ctx, (scene, camera), (settings, raster), frames);
+                let counts = [m.prefix, m.passed, m.drawn].map(|c| c.to_string()).join(" | ");
+                let timing = format!("{:.1} ({:.1})", m.gpu_ms, m.best_ms);
+                println!(
+                    "| {name} | {} | {} | {counts} | {timing} |",
+                    raster.name(),
+                    error.name()
+                );
+            }
+        }
+    }
 }
 
 /// Part 5: the two splat kernels (§10.2) on both rasterizer paths.
@@ -270,27 +316,7 @@ fn table_10_3(ctx: &Context, flat: &Scene, close: &Camera, frames: usize) {
 /// primitives, §10.1.7; and EWA quads): splats sent (prefixes) and drawn per
 /// second.
 fn spt_rate(ctx: &Context, bunny: &PointObject, frames: usize) {
-    let standing = PointTransform::parse("r=90,0,0").unwrap();
-    let mut points = PointScene {
-        objects: vec![bunny.clone()],
-        ..PointScene::default()
-    };
-    for j in 0..8 {
-        for i in 0..8 {
-            let translation = DVec3::new(0.5 * (i as f64 - 3.5), 0.5 * j as f64, 0.0);
-            let transform = PointTransform {
-                translation,
-                ..standing
-            };
-            points.instances.push(PointInstance { object: 0, transform });
-        }
-    }
-    let scene = Scene::points_only(points);
-    let camera = Camera {
-        eye: DVec3::new(0.0, -2.5, 1.2),
-        target: DVec3::new(0.0, 1.75, 0.0),
-        ..camera_at(1.0)
-    };
+    let (scene, camera) = bunny_field(bunny);
     println!("\nSPT rate: 64 bunny instances at 2.7–6.5 m, {SIDE}² window, back faces culled:");
     println!(
         "| mode | primitive | shaded | splats sent (prefixes) | splats drawn | GPU ms median (best) | M splats/s sent | M splats/s drawn median (best) |"
@@ -333,6 +359,32 @@ fn spt_rate(ctx: &Context, bunny: &PointObject, frames: usize) {
             m.drawn as f64 / m.best_ms / 1e3
         );
     }
+}
+
+/// 64 standing instances of `bunny` on an 8 × 8 grid 0.5 m apart, and a
+/// camera that sees them at 2.7–6.5 m.
+fn bunny_field(bunny: &PointObject) -> (Scene, Camera) {
+    let standing = PointTransform::parse("r=90,0,0").unwrap();
+    let mut points = PointScene {
+        objects: vec![bunny.clone()],
+        ..PointScene::default()
+    };
+    for j in 0..8 {
+        for i in 0..8 {
+            let translation = DVec3::new(0.5 * (i as f64 - 3.5), 0.5 * j as f64, 0.0);
+            let transform = PointTransform {
+                translation,
+                ..standing
+            };
+            points.instances.push(PointInstance { object: 0, transform });
+        }
+    }
+    let camera = Camera {
+        eye: DVec3::new(0.0, -2.5, 1.2),
+        target: DVec3::new(0.0, 1.75, 0.0),
+        ..camera_at(1.0)
+    };
+    (Scene::points_only(points), camera)
 }
 
 /// Part 4: each model with and without its triangles (EWA quads).

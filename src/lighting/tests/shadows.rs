@@ -12,7 +12,7 @@ use crate::lighting::constants::{LightingFrame, LIGHTING_SOFT_SUN, SHADOWS_CASCA
 use crate::lighting::shadows::{record_cascades, SceneBounds, ShadowFrame, ShadowMaps, ShadowSettings};
 use crate::points::render::shadow::PointShadowFrame;
 use crate::points::render::shadow::PointShadows;
-use crate::points::render::{PointRenderer, SplatSettings};
+use crate::points::render::{PointRenderer, SplatSettings, SptError};
 use crate::points::scene::{PointScene, PointTransform};
 use crate::shaders;
 use crate::terrain::shadow::shadow_pipeline;
@@ -294,7 +294,7 @@ fn declare_probe(
 /// probe for each sun; returns per sun the probes' visibility and the plan.
 pub(super) fn run(
     ctx: &Context,
-    (setup, points): (&Setup, Option<&PointScene>),
+    (setup, points): (&Setup, Option<(&PointScene, SptError)>),
     suns: &[(f32, f32)],
     probes: &[(DVec3, DVec3)],
 ) -> Vec<(Vec<f32>, crate::lighting::shadows::CascadePlan)> {
@@ -303,7 +303,13 @@ pub(super) fn run(
         min: DVec3::new(-PLANE, -PLANE, 0.0),
         max: DVec3::new(PLANE, PLANE, setup.wall.map_or(BOX_MAX.z, |w| w.1.z)),
     };
-    let renderer = points.map(|scene| PointRenderer::new(ctx, scene, SplatSettings::default(), false).expect("points"));
+    let renderer = points.map(|(scene, error)| {
+        let settings = SplatSettings {
+            error,
+            ..SplatSettings::default()
+        };
+        PointRenderer::new(ctx, scene, settings, false).expect("points")
+    });
     if let Some(b) = renderer.as_ref().and_then(PointShadows::bounds) {
         bounds = bounds.union(b);
     }
@@ -468,19 +474,24 @@ fn point_objects_cast_shadows() {
         let probes = vec![(under, DVec3::Z), (DVec3::new(-150.0, 0.0, 0.0), DVec3::Z)];
         let depth = (under - cam.eye).dot(cam.forward());
         assert!(depth > 0.0 && depth < 500.0);
-        let results = run(
-            &ctx,
-            (&Setup::standard(false), Some(&scene)),
-            &[(elevation, azimuth)],
-            &probes,
-        );
-        let vis = &results[0].0;
-        assert!(
-            vis[0] < 0.05,
-            "the ground under the bunny towards the sun is lit: {}",
-            vis[0]
-        );
-        assert!(vis[1] > 0.99, "open ground is shadowed: {}", vis[1]);
+        // The casters take the view's level of detail, with either SPT error
+        // (the view-dependent one reads each splat's parent, §10.1.7).
+        for error in SptError::ALL {
+            let results = run(
+                &ctx,
+                (&Setup::standard(false), Some((&scene, error))),
+                &[(elevation, azimuth)],
+                &probes,
+            );
+            let vis = &results[0].0;
+            assert!(
+                vis[0] < 0.05,
+                "{}: the ground under the bunny towards the sun is lit: {}",
+                error.name(),
+                vis[0]
+            );
+            assert!(vis[1] > 0.99, "{}: open ground is shadowed: {}", error.name(), vis[1]);
+        }
     }
     drop(ctx);
     assert_validation_clean(&report);

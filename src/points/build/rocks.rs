@@ -41,7 +41,7 @@
 //!
 //! A hull of n points has `2n' − 4` faces for its n' ≤ n extreme points;
 //! after k rounds the mesh has `4ᵏ` times as many, e.g. at most
-//! 36 · 4⁶ = 147 456 triangles for 20 points and 6 rounds. Everything is
+//! 36 · 4⁷ = 589 824 triangles for 20 points and 7 rounds. Everything is
 //! computed in `f64` from the seed alone, so a parameter set gives the same
 //! rock on every run.
 
@@ -57,6 +57,11 @@ use crate::random::SplitMix64;
 /// on a degenerate hull.
 pub const MAX_ATTEMPTS: u32 = 16;
 
+/// Most rounds of subdivision: 7 gives the text's rock of Fig. 10.11
+/// (12 · 4⁷ = 196 608 triangles from 8 hull points; at most 36 · 4⁷ =
+/// 589 824 for 20).
+pub const MAX_SUBDIVISIONS: u32 = 7;
+
 /// Largest accepted [`RockParams::size`] in metres.
 pub const MAX_SIZE: f32 = 1.0e4;
 
@@ -67,7 +72,7 @@ pub struct RockParams {
     pub seed: u64,
     /// Number of random points whose convex hull is the base shape, 4..=20.
     pub points: u32,
-    /// Rounds of 1-to-4 subdivision, 0..=6.
+    /// Rounds of 1-to-4 subdivision, 0..=[`MAX_SUBDIVISIONS`].
     pub subdivisions: u32,
     /// Displacement amplitude of the first round relative to `size`, 0..=1
     /// (e.g. 0.15).
@@ -107,10 +112,10 @@ impl RockParams {
                 format!("{} is outside 4..=20", self.points),
             ));
         }
-        if self.subdivisions > 6 {
+        if self.subdivisions > MAX_SUBDIVISIONS {
             return Err(Error::invalid(
                 "rock subdivisions",
-                format!("{} is outside 0..=6", self.subdivisions),
+                format!("{} is outside 0..={MAX_SUBDIVISIONS}", self.subdivisions),
             ));
         }
         let unit = |what: &str, v: f32| {
@@ -936,7 +941,7 @@ mod tests {
             RockParams { points: 3, ..ok },
             RockParams { points: 21, ..ok },
             RockParams { points: 0, ..ok },
-            RockParams { subdivisions: 7, ..ok },
+            RockParams { subdivisions: 8, ..ok },
             RockParams {
                 subdivisions: u32::MAX,
                 ..ok

@@ -67,8 +67,8 @@
 //!   error is raised to the diameter: `e_g = max(e_g, d)`. This forces small
 //!   splats where the colour varies, so the averaging that the node would do
 //!   only ever blurs over about ε in the image. Only `e_g` is raised; `e_p`
-//!   and `e_t` stay geometric (a view-dependent test `e_p·sin α + e_t·cos α`
-//!   would have to apply the colour term itself).
+//!   and `e_t` stay geometric (the view-dependent test `e_p·sin α + e_t·cos α`
+//!   of [`super::spt_view`] keeps the stored interval for such nodes).
 //!
 //! Because d bounds the children only in the node's plane, e_p can exceed d
 //! (children stacked along n). The text's bound `e_g ≤ d` holds for its

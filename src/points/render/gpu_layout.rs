@@ -7,7 +7,8 @@ use glam::{DMat3, DMat4, DVec3};
 
 use super::SplatSettings;
 use crate::points::build::hybrid::HybridMesh;
-use crate::points::build::spt::SptNode;
+use crate::points::build::spt::{SptNode, NO_PARENT};
+use crate::points::build::spt_view::view_error_bits;
 use crate::view::View;
 
 /// One splat: an SPT node (§10.1.3) as the vertex stage reads it.
@@ -18,21 +19,45 @@ pub struct GpuSplat {
     pub position_rmin: [f32; 4],
     /// Object-space unit normal, r_max.
     pub normal_rmax: [f32; 4],
-    /// Disk radius, sRGB colour (u32 bits `r | g << 8 | b << 16`), 0, 0.
+    /// Disk radius, sRGB colour (u32 bits `r | g << 8 | b << 16`),
+    /// view-dependent error bits, parent index (u32 bits; see [`pack_nodes`]).
     pub radius_color: [f32; 4],
     /// Clip lines (`crate::points::build::clip::ClipLines::packed`).
     pub clip: [f32; 4],
 }
 
-/// The splat list of `nodes`, in list order (decreasing r_max, per normal cluster when clustered).
-pub fn pack_nodes(nodes: &[SptNode]) -> Vec<GpuSplat> {
+/// The splat list of `nodes`, in list order (decreasing r_max, per normal
+/// cluster when clustered). With `view_dependent = Some((first, isotropic))`
+/// each record also carries its view-dependent error bits
+/// ([`view_error_bits`], all isotropic for hybrid objects) and its parent's
+/// index in the splat buffer (the list starts at `first`; the root's is its
+/// own) for the view-dependent test (glsl/include/spt_interval.glsl);
+/// otherwise those two words are 0.
+pub fn pack_nodes(nodes: &[SptNode], view_dependent: Option<(u32, bool)>) -> Vec<GpuSplat> {
     nodes
         .iter()
-        .map(|n| GpuSplat {
-            position_rmin: n.position.extend(n.r_min).to_array(),
-            normal_rmax: n.normal.extend(n.r_max).to_array(),
-            radius_color: [0.5 * n.diameter, color_bits(n.color), 0.0, 0.0],
-            clip: n.clip.packed(),
+        .enumerate()
+        .map(|(i, n)| {
+            let (bits, parent) = match view_dependent {
+                // Hybrid lists may have lost parents; their isotropic nodes never read them.
+                Some((_, true)) => (view_error_bits(n, true), 0),
+                Some((first, false)) => {
+                    let parent = if n.parent == NO_PARENT { i as u32 } else { n.parent };
+                    (view_error_bits(n, false), first.saturating_add(parent))
+                }
+                None => (0, 0),
+            };
+            GpuSplat {
+                position_rmin: n.position.extend(n.r_min).to_array(),
+                normal_rmax: n.normal.extend(n.r_max).to_array(),
+                radius_color: [
+                    0.5 * n.diameter,
+                    color_bits(n.color),
+                    f32::from_bits(bits),
+                    f32::from_bits(parent),
+                ],
+                clip: n.clip.packed(),
+            }
         })
         .collect()
 }
@@ -83,7 +108,8 @@ pub struct FrameHeader {
     pub viewport: [f32; 4],
     /// x: storage handle of the view's lighting constants (written by the
     /// shading pass that declares them); y: 1 shaded, 0 unlit (albedo);
-    /// z: the splat kernel ([`super::SplatKernel::code`]).
+    /// z: the splat kernel ([`super::SplatKernel::code`]); w: the interval
+    /// test ([`super::SptError::code`]).
     pub lighting: [u32; 4],
     /// Rows of the camera → world rotation.
     pub camera_to_world: [[f32; 4]; 3],
@@ -157,7 +183,7 @@ pub fn frame_header(view: &View, settings: &SplatSettings, max_point_size: f32) 
         k_inv: rows(k_inv),
         depth: [p22 as f32, p32 as f32, settings.visibility_offset, settings.cutoff],
         viewport: [width as f32, height as f32, max_point_size, near as f32],
-        lighting: [0, settings.shaded as u32, settings.kernel.code(), 0],
+        lighting: [0, settings.shaded as u32, settings.kernel.code(), settings.error.code()],
         camera_to_world: rows(view3.transpose()),
         eye: camera
             .eye

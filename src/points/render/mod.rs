@@ -125,6 +125,41 @@ impl SplatKernel {
     }
 }
 
+/// The error a sequential point tree's interval test uses (§10.1.4, §10.1.7).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SptError {
+    /// The geometric error `e_g = sqrt(e_p² + e_t²)`: the stored interval
+    /// `r_min ≤ r < r_max`, the same at every view angle.
+    #[default]
+    Isotropic,
+    /// The split error `e_p·sin α + e_t·cos α` (α between the view vector
+    /// and the node's normal), tested exactly in the vertex stage against
+    /// the node's and its parent's view-dependent `r_min`
+    /// ([`crate::points::build::spt_view`]): fewer splats where surfaces
+    /// are seen face-on (bumps) or at grazing angles (flat parts); the
+    /// CPU prefix is the isotropic one.
+    ViewDependent,
+}
+
+impl SptError {
+    pub const ALL: [SptError; 2] = [SptError::Isotropic, SptError::ViewDependent];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SptError::Isotropic => "isotropic",
+            SptError::ViewDependent => "view-dependent",
+        }
+    }
+
+    /// The test's code in the frame header (`SPT_ERROR_*` in spt_interval.glsl).
+    pub(crate) fn code(self) -> u32 {
+        match self {
+            SptError::Isotropic => 0,
+            SptError::ViewDependent => 1,
+        }
+    }
+}
+
 /// The primitive that carries a splat (§10.3, Table 10.3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum SplatPrimitive {
@@ -227,6 +262,10 @@ pub struct SplatSettings {
     /// The screen-space kernel of the screen-space primitives (every mode
     /// and path); the object-space primitives take only the perspective one.
     pub kernel: SplatKernel,
+    /// The error of the interval test (§10.1.4, §10.1.7); view-dependent
+    /// needs a screen-space primitive (every mode and path, and the shadow
+    /// casters).
+    pub error: SptError,
 }
 
 impl Default for SplatSettings {
@@ -242,6 +281,7 @@ impl Default for SplatSettings {
             epsilon: None,
             backend: SplatBackend::Compute,
             kernel: SplatKernel::Perspective,
+            error: SptError::Isotropic,
         }
     }
 }
@@ -266,6 +306,17 @@ impl SplatSettings {
                     "{}: the {} primitive draws object-space quads with the kernel in a texture (§10.3); \
                      only the screen-space primitives (point, quad, instanced) take the affine kernel",
                     self.kernel.name(),
+                    self.primitive.name()
+                ),
+            ));
+        }
+        if self.error != SptError::Isotropic && self.primitive.is_object_space() {
+            return Err(Error::invalid(
+                "points.error",
+                format!(
+                    "{}: the {} primitive reads each splat as vertex attributes without its parent; \
+                     only the screen-space primitives (point, quad, instanced) take the view-dependent test",
+                    self.error.name(),
                     self.primitive.name()
                 ),
             ));

@@ -28,7 +28,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
 
 use super::selection::{keeps_instance, ObjectLayout};
-use super::PointRenderer;
+use super::{PointRenderer, SptError};
 use crate::error::{Error, Result};
 use crate::graph::{stride_groups, BufferAccess, BufferId, RenderGraph, Stage, UploadRegion};
 use crate::lighting::shadows::{
@@ -46,7 +46,7 @@ use crate::vulkan::{Buffer, ComputePipeline, GraphicsPipeline};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 struct ShadowHeader {
-    /// World eye position of the view.
+    /// World eye position of the view; w: the interval test (u32 bits, [`SptError::code`]).
     eye: [f32; 4],
 }
 
@@ -97,6 +97,8 @@ pub struct PointShadows {
     splats: Arc<Buffer>,
     splats_id: Option<BufferId>,
     settings: ShadowSettings,
+    /// The views' interval test (the casters take the level of detail the view draws).
+    error: SptError,
     bounds: SceneBounds,
     views: Vec<ShadowView>,
     /// Reused every frame (no allocation in steady state): the cascades
@@ -134,6 +136,7 @@ impl PointShadows {
             splats: splats.clone(),
             splats_id: None,
             settings: *shadows.settings(),
+            error: renderer.spt_error(),
             bounds: shadows.bounds(),
             views: Vec::new(),
             scratch_plan: None,
@@ -382,7 +385,12 @@ impl Technique for PointShadows {
                 self.scratch_plan = Some(plan);
             }
             let header = ShadowHeader {
-                eye: view.camera.eye.as_vec3().extend(0.0).to_array(),
+                eye: view
+                    .camera
+                    .eye
+                    .as_vec3()
+                    .extend(f32::from_bits(self.error.code()))
+                    .to_array(),
             };
             frame.uploads.write_pod(v.region, &header)?;
             if !records.is_empty() {

@@ -15,7 +15,7 @@ use super::selection::{plan_frame_into, FramePlan, ObjectLayout};
 use super::single_pass::{check_backend, declare_single_pass, entry_capacity, TileCapacity};
 use super::stats::{PointFrameStats, StatsLog};
 use super::triangles::TriangleBuffer;
-use super::{SplatMode, SplatPrimitive, SplatSettings};
+use super::{SplatMode, SplatPrimitive, SplatSettings, SptError};
 use crate::error::{Error, Result};
 use crate::graph::UploadRegion;
 use crate::points::build::clusters::{cluster_normals, CLUSTER_COUNT};
@@ -111,9 +111,11 @@ impl PointRenderer {
             let clusters = settings
                 .normal_clusters
                 .then(|| Arc::new(cluster_normals(&object.tree)));
+            let view_dependent =
+                (settings.error == SptError::ViewDependent).then_some((first, object.hybrid.is_some()));
             match &clusters {
-                Some(c) => splats.extend(pack_nodes(&c.nodes)),
-                None => splats.extend(pack_nodes(&object.tree.nodes)),
+                Some(c) => splats.extend(pack_nodes(&c.nodes, view_dependent)),
+                None => splats.extend(pack_nodes(&object.tree.nodes, view_dependent)),
             }
             layouts.push(ObjectLayout {
                 first,
@@ -178,6 +180,11 @@ impl PointRenderer {
             spare: Vec::new(),
             compute,
         })
+    }
+
+    /// The error of the interval test (the shadow casters use the view's).
+    pub(super) fn spt_error(&self) -> SptError {
+        self.settings.error
     }
 
     /// The scene, where each object's list is, and the splat buffer: what

@@ -1,6 +1,7 @@
 //! White-box tests of the point renderer and vegetation, under validation.
 //! (Moved from `tests/` in issue 26: integration tests use only the front door.)
 
+mod color_density;
 mod hybrid;
 mod kernel;
 mod primitives;
@@ -8,3 +9,4 @@ mod render;
 mod rock_levels;
 mod single_pass;
 mod vegetation;
+mod view_error;

@@ -13,7 +13,7 @@
 //! most 32).
 //!
 //! With `ALPENGLOW_DUMP=DIR`: `N-rock-levels.png`, the rock at 0, 1, 2, 4
-//! and 6 subdivisions side by side.
+//! and 7 subdivisions side by side.
 
 use glam::{DVec2, DVec3};
 
@@ -22,8 +22,8 @@ use crate::points::TriangleMesh;
 
 /// Side of one panel.
 const SIDE: u32 = 128;
-/// The subdivision rounds drawn (the text's last, 7, is beyond the limit of 6).
-const LEVELS: [u32; 5] = [0, 1, 2, 4, 6];
+/// The subdivision rounds drawn: the text's.
+const LEVELS: [u32; 5] = [0, 1, 2, 4, 7];
 
 /// The view: an orthographic camera looking along `-eye`, `up` +z.
 struct View {
