@@ -26,7 +26,11 @@
 //! everything the real camera sees stays covered. The distance term
 //! near the real eye is then off by up to `reach` (its `min_distance` of
 //! one sketch texel limits that): the price is accuracy, a mean depth
-//! error 1.3–2.1× the plain plan's (`docs/PERFORMANCE.md`).
+//! error 1.2–2.1× the plain plan's (`docs/PERFORMANCE.md`), which is why
+//! it is off by default ([`DEFAULT_SNAP`]; `--lod-snap 1`,
+//! [`ANCHORED_SNAP`], turns it on). Only translation is anchored: a
+//! camera that turns, or changes its field of view, is planned again
+//! every frame.
 
 use glam::{DVec2, DVec3};
 

@@ -211,8 +211,8 @@ fn jittered_warp_swims_more() {
 /// most half as much as the plain per-frame plan, in depth and in colour.
 /// Between replans the mesh is world-static: most pairs change nothing.
 /// The price is accuracy: the plan is made for an eye up to `0.87 G` away
-/// (measured: 1.3–1.9× the plain plan's mean depth error, still a third of
-/// the uniform grid's; `docs/PERFORMANCE.md`).
+/// (measured: 1.2–2.1× the plain plan's mean depth error, still less than
+/// half the uniform grid's; `docs/PERFORMANCE.md`), bounded here by 2×.
 #[test]
 fn anchored_plan_swims_at_most_half_as_much() {
     let field = field();
