@@ -230,7 +230,9 @@ pub use renderer::RenderSettings as Settings;
 pub use renderer::Renderer;
 pub use surface::gpu_layout::TexturingMode;
 pub use terrain::geometry_image::{TerrainSettings, TerrainView};
-pub use terrain::lod::{ImportanceFactors, LodMode, LodSettings};
+pub use terrain::lod::{
+    ImportanceFactors, LodMode, LodSettings, ANCHORED_SNAP as ANCHORED_LOD_SNAP, DEFAULT_SNAP as DEFAULT_LOD_SNAP,
+};
 pub use terrain::sketch_map::SketchAlignment;
 pub use terrain::visibility::RasterPath;
 pub use texturing::generation::TextureStreaming;

@@ -403,6 +403,14 @@ pub struct TerrainArgs {
     /// Sketch map side in texels.
     #[arg(long, default_value_t = 128, value_name = "TEXELS", value_parser = clap::builder::RangedI64ValueParser::<usize>::new().range(0..))]
     pub sketch: usize,
+    /// Anchors the terrain's LOD plan to the world against swimming
+    /// (§7.4.3, §7.4.5): the plan's eye snaps to a grid of this many
+    /// sketch texels of the whole terrain and the mesh is planned again
+    /// only when it moves to another grid point (0, the default: planned
+    /// for the eye every frame, as in the text; 1 cuts the swimming 5–8×
+    /// but makes the mesh near the eye coarser). 0..=1024.
+    #[arg(long = "lod-snap", default_value_t = alpenglow::DEFAULT_LOD_SNAP, value_name = "TEXELS")]
+    pub lod_snap: f64,
     /// Terrain colouring: the surface-layer tree cached in a texture atlas
     /// (atlas, §8.2), the same tree evaluated per pixel (direct, the atlas's
     /// reference), or classic surface types (§7.4.3).

@@ -82,6 +82,7 @@ const FLAGS: &[(&str, &str)] = &[
     ("view.name", "--rig"),
     ("terrain.grid_side", "--grid"),
     ("terrain.lod.sketch_side", "--sketch"),
+    ("terrain.lod.snap", "--lod-snap"),
     ("terrain.detail_amplitude", "--detail-amplitude"),
     ("points.epsilon", "--epsilon"),
     ("points.primitive", "--splat-primitive"),

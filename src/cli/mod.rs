@@ -276,6 +276,7 @@ fn terrain_settings(args: &TerrainArgs, debug: &TerrainDebugArgs) -> Result<Terr
         grid_side: args.grid,
         lod: LodSettings {
             sketch_side: args.sketch,
+            snap: args.lod_snap,
             mode: match debug.lod {
                 LodArg::Warped => LodMode::Warped,
                 LodArg::Uniform => LodMode::Uniform,

@@ -21,7 +21,7 @@ use crate::graph::{BufferAccess, BufferId, ImageId, RenderGraph, Stage, UploadRe
 use crate::io::heightmap::HeightField;
 use crate::shaders;
 use crate::surface::wavelet_noise::{self, NOISE_TILE};
-use crate::terrain::lod::{DebugScalar, LodSettings};
+use crate::terrain::lod::{DebugScalar, LodSettings, MAX_SNAP};
 use crate::terrain::TerrainFrame;
 use crate::view::{pass_name, Frame, Provides, ViewIndex};
 use crate::vulkan::{
@@ -117,6 +117,12 @@ impl TerrainSettings {
             return Err(Error::invalid(
                 "terrain.lod.sketch_side",
                 format!("{} (must be 4..=1024)", self.lod.sketch_side),
+            ));
+        }
+        if !(self.lod.snap.is_finite() && (0.0..=MAX_SNAP).contains(&self.lod.snap)) {
+            return Err(Error::invalid(
+                "terrain.lod.snap",
+                format!("{} (must be in 0..={MAX_SNAP})", self.lod.snap),
             ));
         }
         if !(self.detail_amplitude.is_finite() && self.detail_amplitude >= 0.0 && self.detail_amplitude <= 10.0) {
@@ -361,6 +367,12 @@ mod tests {
         let ok = TerrainSettings::default();
         assert!(ok.validate().is_ok());
         assert!(TerrainSettings { grid_side: 1, ..ok }.validate().is_err());
+        let snap = |snap| TerrainSettings {
+            lod: LodSettings { snap, ..ok.lod },
+            ..ok
+        };
+        assert!(snap(0.0).validate().is_ok() && snap(MAX_SNAP).validate().is_ok());
+        assert!(snap(-1.0).validate().is_err() && snap(f64::NAN).validate().is_err());
         assert!(TerrainSettings {
             detail_amplitude: f32::NAN,
             ..ok

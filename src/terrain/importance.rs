@@ -103,6 +103,17 @@ impl Frustum {
         Ok(Frustum { planes, band })
     }
 
+    /// The frustum with every plane moved `slack` metres outwards: it
+    /// contains the frustum of every translate of the camera by at most
+    /// `slack` (a plane through the moved eye with the same normal is at
+    /// most that far from the original).
+    pub fn widened(mut self, slack: f64) -> Frustum {
+        for plane in &mut self.planes {
+            plane.offset += slack;
+        }
+        self
+    }
+
     /// `S_f(p)`: 1 inside all planes; outside, `1 − smoothstep(0, band, d)`
     /// for the largest outside distance `d` (so 0 beyond the band).
     pub fn factor(&self, p: DVec3) -> f64 {

@@ -3,8 +3,36 @@
 //! warp. Its result, the warping function `Φ` sampled on the sketch grid, is
 //! what the GPU's warp-and-zoom pass ([`crate::terrain::geometry_image`])
 //! interpolates up to the output grid.
+//!
+//! # World-anchored plans (§7.4.3, §7.4.5: swimming)
+//!
+//! The importance of eq. 7.4 is `C / dist` from the eye: scale-free, so a
+//! plan made for every frame's own eye slides every vertex over the surface
+//! at about the camera's speed, and the interpolation error under each
+//! pixel changes all the time ("the vertices of the warped grid slide over
+//! the surface as the camera moves"). With [`LodSettings::snap`] `> 0` the
+//! plan is made for the eye snapped to a world grid of spacing `G` (the
+//! camera translated by the snap offset, its orientation kept) and made
+//! again only when the snapped eye changes: between such replans the mesh
+//! is world-static and does not swim at all; at a replan every vertex
+//! jumps once. Sliding over a distance `S` costs about `S / cell` times
+//! the peak-to-peak interpolation error per pixel, the jump at most that
+//! error once, so a grid coarser than the far field's cells (where the
+//! swimming is, at distant silhouettes) cuts the mean per-frame change by
+//! about `cell / G` (`docs/PERFORMANCE.md`, "Swimming"). The real eye is
+//! somewhere in the grid cell around the planned one (a cube of side `G`,
+//! up to `reach = G·√3/2` away): the sketch region grows by `reach` on
+//! every side and the frustum factor's planes move `reach` outwards, so
+//! everything the real camera sees stays covered. The distance term
+//! near the real eye is then off by up to `reach` (its `min_distance` of
+//! one sketch texel limits that): the price is accuracy, a mean depth
+//! error 1.2–2.1× the plain plan's (`docs/PERFORMANCE.md`), which is why
+//! it is off by default ([`DEFAULT_SNAP`]; `--lod-snap 1`,
+//! [`ANCHORED_SNAP`], turns it on). Only translation is anchored: a
+//! camera that turns, or changes its field of view, is planned again
+//! every frame.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
@@ -63,7 +91,26 @@ pub struct LodSettings {
     pub mode: LodMode,
     pub factors: ImportanceFactors,
     pub alignment: SketchAlignment,
+    /// Spacing of the world grid the plan's eye is snapped to, in sketch
+    /// texels of a map over the whole terrain (`extent / (side − 1)`); 0:
+    /// the plan follows the eye every frame (the text). See the module
+    /// documentation.
+    pub snap: f64,
 }
+
+/// Default [`LodSettings::snap`]: off (the text's per-frame plan). The
+/// anchored plan costs accuracy near the eye: as the default it put some
+/// of the 300 cameras 2 m above the ground of
+/// `src/terrain/tests/ground.rs` under the drawn ground and failed the
+/// distant-ridge test of `src/terrain/tests/reversed_depth.rs`. So it is
+/// asked for; [`ANCHORED_SNAP`] is the measured choice.
+pub const DEFAULT_SNAP: f64 = 0.0;
+/// The snap that cuts the swimming 5–8× and keeps the density of Fig. 7.12
+/// (`docs/PERFORMANCE.md`, "Swimming"): one whole-terrain sketch texel.
+pub const ANCHORED_SNAP: f64 = 1.0;
+/// Largest [`LodSettings::snap`] (a grid that coarse anchors the plan to
+/// one point of the terrain).
+pub const MAX_SNAP: f64 = 1024.0;
 
 impl Default for LodSettings {
     fn default() -> Self {
@@ -72,8 +119,46 @@ impl Default for LodSettings {
             mode: LodMode::Warped,
             factors: ImportanceFactors::default(),
             alignment: SketchAlignment::View,
+            snap: DEFAULT_SNAP,
         }
     }
+}
+
+impl LodSettings {
+    /// The camera the plan is made for and the half-size of the grid cell
+    /// around its eye in which the real eye is: `camera` itself and 0
+    /// without snapping, else `camera` moved so that its eye sits on the
+    /// grid of [`LodSettings::snap`].
+    pub fn anchored_camera(&self, field: &HeightField, camera: &Camera) -> Result<(Camera, f64)> {
+        if !(self.snap.is_finite() && (0.0..=MAX_SNAP).contains(&self.snap)) {
+            return Err(Error::invalid(
+                "terrain.lod.snap",
+                format!("{} sketch texels (must be in 0..={MAX_SNAP})", self.snap),
+            ));
+        }
+        if self.snap == 0.0 {
+            return Ok((*camera, 0.0));
+        }
+        let spacing = self.snap * field.extent().max_element() / (self.sketch_side.max(2) - 1) as f64;
+        let eye = (camera.eye / spacing).round() * spacing;
+        let moved = Camera {
+            eye,
+            target: camera.target + (eye - camera.eye),
+            ..*camera
+        };
+        Ok((moved, 0.5 * spacing))
+    }
+}
+
+/// What a plan depends on: the same key gives the same plan.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct PlanKey {
+    camera: Camera,
+    aspect: f64,
+    settings: LodSettings,
+    debug: DebugScalar,
+    /// The field's sample counts and spacing.
+    field: (u32, u32, DVec2),
 }
 
 /// The result of one frame's CPU stage.
@@ -85,6 +170,8 @@ pub struct LodFrame {
     pub warp: WarpResult,
     /// Per sketch texel `(Φx, Φy, debug scalar, 0)`, what the GPU reads.
     pub upload: Vec<[f32; 4]>,
+    /// What the current plan was made for (None: no plan yet).
+    key: Option<PlanKey>,
 }
 
 /// The per-type upper bound `I_s` of eq. 7.4. Surface type here is the
@@ -119,19 +206,33 @@ fn surface_bound(sketch: &SketchMap, max_distance_importance: f64) -> Vec<f64> {
 }
 
 /// The importance map of eq. 7.4 on `sketch` for `camera`, with the
-/// factors `f` on.
-fn sketch_importance(sketch: &SketchMap, camera: &Camera, aspect: f64, f: ImportanceFactors) -> Result<Vec<f64>> {
+/// factors `f` on, for any eye in the cube of half-size `cell` around
+/// `camera.eye`: the frustum factor's planes move out by the cube's reach
+/// `√3·cell` ([`Frustum::widened`]); distances are measured from
+/// `camera.eye` (measuring them to the cube, so that the ground near any
+/// eye in it gets the full near-field density, spreads that density over
+/// the cube and made the mesh less accurate, not more).
+pub(crate) fn sketch_importance(
+    sketch: &SketchMap,
+    camera: &Camera,
+    (aspect, cell): (f64, f64),
+    f: ImportanceFactors,
+) -> Result<Vec<f64>> {
+    let slack = 3f64.sqrt() * cell;
     let n = sketch.n;
     let texel = (sketch.region.side_s.length().max(sketch.region.side_t.length()) / (n - 1) as f64).max(1e-6);
     let frustum = if f.frustum {
-        Some(Frustum::perspective(
-            camera.eye,
-            camera.forward(),
-            camera.up,
-            camera.fov_y_deg.to_radians(),
-            aspect,
-            2.0 * texel,
-        )?)
+        Some(
+            Frustum::perspective(
+                camera.eye,
+                camera.forward(),
+                camera.up,
+                camera.fov_y_deg.to_radians(),
+                aspect,
+                2.0 * texel,
+            )?
+            .widened(slack),
+        )
     } else {
         None
     };
@@ -160,8 +261,16 @@ fn sketch_importance(sketch: &SketchMap, camera: &Camera, aspect: f64, f: Import
 }
 
 impl LodFrame {
+    /// Forgets what the current plan was made for: the next
+    /// [`LodFrame::plan`] plans again (benchmarks of the CPU stage).
+    pub fn invalidate(&mut self) {
+        self.key = None;
+    }
+
     /// Runs sketch map, importance map and warp for `camera` into `self`
-    /// (buffers reused from frame to frame).
+    /// (buffers reused from frame to frame); with [`LodSettings::snap`] for
+    /// the anchored camera, and nothing at all while that and the other
+    /// inputs are those of the current plan (module documentation).
     pub fn plan(
         &mut self,
         field: &HeightField,
@@ -174,10 +283,24 @@ impl LodFrame {
         if !(4..=1024).contains(&n) {
             return Err(Error::invalid("sketch map size", format!("{n} (must be 4..=1024)")));
         }
-        let sketch = SketchMap::for_view(field, camera, aspect, settings.alignment, n)?;
+        let (anchored, cell) = settings.anchored_camera(field, camera)?;
+        let key = PlanKey {
+            camera: anchored,
+            aspect,
+            settings: *settings,
+            debug,
+            field: (field.columns, field.rows, field.spacing),
+        };
+        if self.key == Some(key) {
+            return Ok(());
+        }
+        self.key = None;
+        let camera = &anchored;
+        let reach = 3f64.sqrt() * cell;
+        let sketch = SketchMap::for_view_with_margin(field, camera, aspect, (settings.alignment, reach), n)?;
         // A uniform grid needs the importance map only for the debug views.
         let importance = if settings.mode == LodMode::Warped || debug != DebugScalar::None {
-            sketch_importance(&sketch, camera, aspect, settings.factors)?
+            sketch_importance(&sketch, camera, (aspect, cell), settings.factors)?
         } else {
             Vec::new()
         };
@@ -217,6 +340,7 @@ impl LodFrame {
         }));
         self.importance = importance;
         self.sketch = Some(sketch);
+        self.key = Some(key);
         Ok(())
     }
 }

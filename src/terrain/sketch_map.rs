@@ -75,7 +75,27 @@ impl SketchRegion {
 
     /// The region of `camera` (aspect = width / height) over `field`.
     pub fn for_view(field: &HeightField, camera: &Camera, aspect: f64, alignment: SketchAlignment) -> Result<Self> {
+        Self::for_view_with_margin(field, camera, aspect, alignment, 0.0)
+    }
+
+    /// [`SketchRegion::for_view`] with the enclosing square grown by
+    /// `margin` metres on every side before the clip to the terrain: the
+    /// region of a world-anchored plan ([`crate::terrain::lod::LodSettings::snap`])
+    /// then covers every eye within `margin` of the planning camera's.
+    pub fn for_view_with_margin(
+        field: &HeightField,
+        camera: &Camera,
+        aspect: f64,
+        alignment: SketchAlignment,
+        margin: f64,
+    ) -> Result<Self> {
         camera.validate()?;
+        if !(margin.is_finite() && margin >= 0.0) {
+            return Err(Error::invalid(
+                "sketch map margin",
+                format!("{margin} (must be finite and ≥ 0)"),
+            ));
+        }
         if !(aspect.is_finite() && aspect > 0.0) {
             return Err(Error::invalid(
                 "aspect ratio",
@@ -125,7 +145,7 @@ impl SketchRegion {
         }
         // Enclosing square, then clipped to the terrain's rectangle.
         let centre = 0.5 * (min + max);
-        let half = 0.5 * (max - min).max_element();
+        let half = 0.5 * (max - min).max_element() + margin;
         let (mut smin, mut smax) = (centre - half, centre + half);
         let terrain = [
             DVec2::ZERO,
@@ -216,6 +236,18 @@ impl SketchMap {
         n: usize,
     ) -> Result<SketchMap> {
         SketchMap::resample(field, SketchRegion::for_view(field, camera, aspect, alignment)?, n)
+    }
+
+    /// [`SketchMap::for_view`] over [`SketchRegion::for_view_with_margin`].
+    pub fn for_view_with_margin(
+        field: &HeightField,
+        camera: &Camera,
+        aspect: f64,
+        (alignment, margin): (SketchAlignment, f64),
+        n: usize,
+    ) -> Result<SketchMap> {
+        let region = SketchRegion::for_view_with_margin(field, camera, aspect, alignment, margin)?;
+        SketchMap::resample(field, region, n)
     }
 }
 

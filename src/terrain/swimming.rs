@@ -22,7 +22,9 @@
 //! `terrain.draw` does). A pixel counts when the ray cast hits the terrain
 //! (static ground; the scene has nothing else) and both meshes cover it;
 //! [`Swimming`] holds the means over all counted pixels of all `K − 1`
-//! pairs. A world-static mesh swims 0 exactly, whatever the camera does; so
+//! pairs; [`Swimming::worst_depth`] and [`Swimming::worst_colour`] the
+//! largest mean of a single pair (the pop of a world-anchored plan's
+//! replan, [`crate::terrain::lod`]). A world-static mesh swims 0 exactly, whatever the camera does; so
 //! does the ray-cast reference itself (its surface never changes). The
 //! accuracy [`Swimming::error`], the mean `|D(M_k, C_k) − R(C_k)| / R(C_k)`
 //! over all `K` frames, is reported alongside: a remedy must not buy
@@ -255,6 +257,11 @@ pub struct Swimming {
     pub error: f64,
     /// Pixels counted for `depth` and `colour`, over all pairs.
     pub pixels: usize,
+    /// The largest mean relative depth change of a single pair (the pop
+    /// of a replan where the others do not change).
+    pub worst_depth: f64,
+    /// The largest mean luminance change of a single pair.
+    pub worst_colour: f64,
 }
 
 /// Measures the swimming along `cameras` (at least two) at `width×height`:
@@ -289,15 +296,28 @@ pub fn measure(
                 error_pixels += 1;
             }
         }
-        if let Some(before) = previous.as_ref().map(|m| rasterize(m, &view)) {
+        // An unchanged mesh draws the same image: no need to draw it twice.
+        let before = match &previous {
+            Some(m) if *m == current => Some(now.clone()),
+            Some(m) => Some(rasterize(m, &view)),
+            None => None,
+        };
+        if let Some(before) = before {
+            let (mut depth, mut colour, mut pixels) = (0.0, 0.0, 0usize);
             for (p, &r) in reference.iter().enumerate() {
                 let (a, b) = (before.depth[p], now.depth[p]);
                 if a.is_finite() && b.is_finite() && r.is_finite() {
-                    sums.depth += (b - a).abs() / r;
-                    sums.colour += (now.luminance[p] - before.luminance[p]).abs();
-                    sums.pixels += 1;
+                    depth += (b - a).abs() / r;
+                    colour += (now.luminance[p] - before.luminance[p]).abs();
+                    pixels += 1;
                 }
             }
+            let n = pixels.max(1) as f64;
+            sums.worst_depth = sums.worst_depth.max(depth / n);
+            sums.worst_colour = sums.worst_colour.max(colour / n);
+            sums.depth += depth;
+            sums.colour += colour;
+            sums.pixels += pixels;
         }
         previous = Some(current);
     }
@@ -306,6 +326,6 @@ pub fn measure(
         depth: sums.depth / pixels,
         colour: sums.colour / pixels,
         error: error_sum / error_pixels.max(1) as f64,
-        pixels: sums.pixels,
+        ..sums
     })
 }

@@ -195,6 +195,7 @@ pub const SCENE: &[Opt] = &[
     // generated.
     opt("--grid", int(2, 2048, 1024)),
     opt("--sketch", int(4, 1024, 1024)),
+    opt("--lod-snap", float(0.0, 1024.0)),
     Opt {
         scene: Scene::Heightmap,
         ..opt("--max-input-mb", int(1, U64, 1 << 40))

@@ -4,42 +4,93 @@
 //! grid, the uniform grid of the same vertex count and a world-static mesh
 //! (a vertex at every height-field sample: like the ray-cast reference, 0
 //! by construction), on the default procedural terrain and the Jacksboro
-//! DEM, forward and sideways. The metric is defined in
-//! `src/terrain/swimming.rs` (`alpenglow::bench::measure_swimming`). No GPU
-//! needed; about three minutes on two cores.
+//! DEM, forward and sideways; and the renderer's world-anchored plan
+//! (`LodSettings::snap`, `--lod-snap`, the §7.4.3/§7.4.5 remedy) against the
+//! plain per-frame warp. Besides the mean per-frame change it prints the
+//! worst single pair (the pop of a replan). The metric is defined in
+//! `src/terrain/swimming.rs` (`alpenglow::bench::measure_swimming`). No
+//! GPU needed.
 //!
-//! `cargo run --release -p alpenglow-bench --bin swimming`
+//! `cargo run --release -p alpenglow-bench --bin swimming [-- OPTIONS]`:
+//! `--frames K` (default 96: several replans at the default snap),
+//! `--size WxH` (default 320x180), `--snap A,B,…` (snaps of the anchored
+//! rows, in whole-terrain sketch texels; default 1, `--lod-snap 1`),
+//! `--warped-only` (leave out the uniform and world-static rows).
 
 use alpenglow::bench::{camera_path, measure_swimming, DebugScalar, LodFrame, Mesh, Swimming};
 use alpenglow::{Camera, HeightField, LodMode, LodSettings, Scene};
 use alpenglow_bench::terrain::{jacksboro, low};
 use glam::{DVec2, DVec3};
 
-const WIDTH: u32 = 320;
-const HEIGHT: u32 = 180;
 /// Output grid side (the renderer's default).
 const SIDE: usize = 512;
-const FRAMES: usize = 24;
 /// Camera step per frame, in height-field spacings.
 const STEP: f64 = 0.25;
 
 /// How a frame's mesh is made.
 #[derive(Clone, Copy, Debug)]
 enum Planner {
-    /// The per-frame LOD of the renderer in this mode.
-    Lod(LodMode),
+    /// The per-frame LOD of the renderer in this mode with this snap.
+    Lod(LodMode, f64),
     /// One vertex per height-field sample, the same every frame.
     WorldStatic,
 }
 
-fn run(field: &HeightField, cameras: &[Camera], planner: Planner) -> alpenglow::Result<Swimming> {
-    let aspect = f64::from(WIDTH) / f64::from(HEIGHT);
+/// The command line's options.
+struct Options {
+    frames: usize,
+    size: (u32, u32),
+    snaps: Vec<f64>,
+    warped_only: bool,
+}
+
+fn options() -> alpenglow::Result<Options> {
+    let bad = |what: &str, v: &str| alpenglow::Error::invalid(what, format!("{v:?}"));
+    let mut o = Options {
+        frames: 96,
+        size: (320, 180),
+        snaps: vec![alpenglow::ANCHORED_LOD_SNAP],
+        warped_only: false,
+    };
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut k = 0;
+    while k < args.len() {
+        let value = args.get(k + 1).map_or("", String::as_str);
+        match args[k].as_str() {
+            "--frames" => o.frames = value.parse().map_err(|_| bad("--frames", value))?,
+            "--size" => {
+                let (w, h) = value.split_once('x').ok_or_else(|| bad("--size", value))?;
+                o.size = (
+                    w.parse().map_err(|_| bad("--size", value))?,
+                    h.parse().map_err(|_| bad("--size", value))?,
+                );
+            }
+            "--snap" => {
+                o.snaps = (value.split(','))
+                    .map(|v| v.parse().map_err(|_| bad("--snap", value)))
+                    .collect::<alpenglow::Result<_>>()?;
+            }
+            "--warped-only" => {
+                o.warped_only = true;
+                k += 1;
+                continue;
+            }
+            other => return Err(bad("swimming option", other)),
+        }
+        k += 2;
+    }
+    Ok(o)
+}
+
+fn run(field: &HeightField, cameras: &[Camera], size: (u32, u32), planner: Planner) -> alpenglow::Result<Swimming> {
+    let aspect = f64::from(size.0) / f64::from(size.1);
     let mut frame = LodFrame::default();
     let mut fixed: Option<Mesh> = None;
-    measure_swimming(field, cameras, (WIDTH, HEIGHT), |_, camera| match planner {
-        Planner::Lod(mode) => {
+    measure_swimming(field, cameras, size, |_, camera| match planner {
+        Planner::Lod(mode, snap) => {
             let settings = LodSettings {
                 mode,
+                snap,
                 ..Default::default()
             };
             frame.plan(field, camera, aspect, &settings, DebugScalar::None)?;
@@ -61,6 +112,7 @@ fn run(field: &HeightField, cameras: &[Camera], planner: Planner) -> alpenglow::
 }
 
 fn main() -> alpenglow::Result<()> {
+    let o = options()?;
     let default = Scene::default_terrain()?;
     let dem = jacksboro()?;
     // Along the valley of the fault (the terrain tests' view).
@@ -74,28 +126,38 @@ fn main() -> alpenglow::Result<()> {
         ("default terrain, low", &default, low(&default)),
         ("Jacksboro DEM, valley", &dem, valley),
     ];
+    let (frames, (width, height)) = (o.frames, o.size);
     println!(
-        "{FRAMES} frames, {WIDTH}×{HEIGHT}, {SIDE}² vertices, steps of {STEP} height-field spacing per frame\n\
-         depth: mean relative depth change ×1e3; colour: mean |Δ luminance| in 8-bit levels; \
-         error: mean relative depth error against the ray cast ×1e3"
+        "{frames} frames, {width}×{height}, {SIDE}² vertices, steps of {STEP} height-field spacing per frame\n\
+         depth: mean relative depth change ×1e3 (worst pair); colour: mean |Δ luminance| in 8-bit levels \
+         (worst pair); error: mean relative depth error against the ray cast ×1e3"
     );
+    let mut planners = Vec::new();
+    if !o.warped_only {
+        planners.push(("uniform".to_string(), Planner::Lod(LodMode::Uniform, 0.0)));
+    }
+    planners.push(("warped".to_string(), Planner::Lod(LodMode::Warped, 0.0)));
+    for &snap in &o.snaps {
+        planners.push((format!("anchored, snap {snap}"), Planner::Lod(LodMode::Warped, snap)));
+    }
+    if !o.warped_only {
+        planners.push(("world-static mesh".to_string(), Planner::WorldStatic));
+    }
     for (name, scene, start) in starts {
         let d0 = scene.heights.spacing.min_element();
         for (path, step) in [
             ("forward", DVec2::new(STEP * d0, 0.0)),
             ("sideways", DVec2::new(0.0, STEP * d0)),
         ] {
-            let cameras = camera_path(start, step, FRAMES);
-            for (label, planner) in [
-                ("uniform", Planner::Lod(LodMode::Uniform)),
-                ("warped", Planner::Lod(LodMode::Warped)),
-                ("world-static mesh", Planner::WorldStatic),
-            ] {
-                let s = run(&scene.heights, &cameras, planner)?;
+            let cameras = camera_path(start, step, frames);
+            for (label, planner) in &planners {
+                let s = run(&scene.heights, &cameras, (width, height), *planner)?;
                 println!(
-                    "  {name:<22} {path:<9} {label:<18} depth {:>6.3}  colour {:>6.3}  error {:>6.3}  ({} pixels)",
+                    "  {name:<22} {path:<9} {label:<20} depth {:>6.3} ({:>6.3})  colour {:>6.3} ({:>6.3})  error {:>6.3}  ({} pixels)",
                     1e3 * s.depth,
+                    1e3 * s.worst_depth,
                     255.0 * s.colour,
+                    255.0 * s.worst_colour,
                     1e3 * s.error,
                     s.pixels
                 );

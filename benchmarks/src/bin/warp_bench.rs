@@ -117,6 +117,8 @@ fn main() -> alpenglow::Result<()> {
     report(
         "whole CPU stage per frame (plan)",
         time(|| {
+            // A replan every time (the plan of an unchanged key is kept).
+            frame.invalidate();
             black_box(
                 frame
                     .plan(&scene.heights, &camera, aspect, &settings, DebugScalar::None)
