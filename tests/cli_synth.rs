@@ -135,32 +135,50 @@ fn fill_takes_the_voids_of_an_exr_without_a_mask() {
     }
 }
 
-#[test]
-fn transition_keeps_a_and_b_on_their_sides() {
-    let dir = fresh_dir("synth-transition");
+/// A and B of the transition tests written to `dir`: two crops, and the
+/// arguments `A B --out OUT` for `out` (named in `dir`).
+struct TransitionInputs {
+    b: PathBuf,
+    va: Vec<u16>,
+    vb: Vec<u16>,
+    paths: [String; 4],
+}
+
+fn transition_inputs(dir: &Path, out: &str) -> TransitionInputs {
     let (a, b) = (dir.join("a.png"), dir.join("b.png"));
     let (va, vb) = (crop(60, 150), crop(250, 20));
     write_png(&a, &va, SIDE, SIDE);
     write_png(&b, &vb, SIDE, SIDE);
-    let out = dir.join("joined.png");
-    // 10 samples of 74.4 m: columns 15..25.
     let paths = [
         a.display().to_string(),
         b.display().to_string(),
         "--out".into(),
-        out.display().to_string(),
+        dir.join(out).display().to_string(),
     ];
-    let run_out = run(&args(&["transition", "--band", "744", "--window", "7"], &paths));
-    assert_success("transition", &run_out);
-    let joined = read(&out);
+    TransitionInputs { b, va, vb, paths }
+}
+
+/// Asserts that `joined` holds A west of the band (columns 15..25: 10
+/// samples of 74.4 m) and B east of it exactly.
+fn assert_a_and_b_kept(joined: &[f32], inputs: &TransitionInputs) {
     for (i, &h) in joined.iter().enumerate() {
         let c = i as u32 % SIDE;
         if c < 15 {
-            assert_eq!(h, f32::from(va[i]), "A at {i}");
+            assert_eq!(h, f32::from(inputs.va[i]), "A at {i}");
         } else if c >= 25 {
-            assert_eq!(h, f32::from(vb[i]), "B at {i}");
+            assert_eq!(h, f32::from(inputs.vb[i]), "B at {i}");
         }
     }
+}
+
+#[test]
+fn transition_keeps_a_and_b_on_their_sides() {
+    let dir = fresh_dir("synth-transition");
+    let inputs = transition_inputs(&dir, "joined.png");
+    let run_out = run(&args(&["transition", "--band", "744", "--window", "7"], &inputs.paths));
+    assert_success("transition", &run_out);
+    assert_a_and_b_kept(&read(&dir.join("joined.png")), &inputs);
+    let b = &inputs.b;
     // A procedural A against a file B of the same grid.
     let exr = dir.join("procedural.exr");
     let paths = [
@@ -172,6 +190,52 @@ fn transition_keeps_a_and_b_on_their_sides() {
     let run_out = run(&args(&["transition", "--band", "744", "--window", "7"], &paths));
     assert_success("procedural transition", &run_out);
     assert_eq!(read(&exr).len(), (SIDE * SIDE) as usize);
+}
+
+/// `--steps K` (Fig. 7.6): K intermediate fields beside --out, A and B as
+/// given in each, the band grown further from step to step (a sample once
+/// grown keeps its height; those grown later differ from the last step).
+#[test]
+fn transition_writes_intermediate_steps() {
+    let dir = fresh_dir("synth-transition-steps");
+    let inputs = transition_inputs(&dir, "joined.exr");
+    let extra = [
+        "transition",
+        "--band",
+        "744",
+        "--window",
+        "7",
+        "--batch",
+        "16",
+        "--steps",
+        "3",
+    ];
+    let run_out = run(&args(&extra, &inputs.paths));
+    assert_success("transition --steps", &run_out);
+    let steps: Vec<Vec<f32>> = (1..=3)
+        .map(|i| read(&dir.join(format!("joined-step-{i}.exr"))))
+        .collect();
+    let in_band = |i: usize| (15..25).contains(&(i as u32 % SIDE));
+    let mut later = Vec::new();
+    for step in &steps {
+        assert_a_and_b_kept(step, &inputs);
+        let differ = (0..step.len())
+            .filter(|&i| in_band(i) && step[i] != steps[2][i])
+            .count();
+        later.push(differ);
+    }
+    let band = (10 * SIDE) as usize;
+    println!("band samples differing from step 3: {later:?} of {band}");
+    assert!(
+        later[0] > later[1] && later[1] > 0 && later[2] == 0,
+        "the band does not grow from step to step: {later:?}"
+    );
+    // Step 1 has about a quarter of the band grown, step 3 three quarters.
+    assert!(
+        later[0] >= band / 4 && later[0] <= 3 * band / 4,
+        "step 1 differs from step 3 at {} of {band}",
+        later[0]
+    );
 }
 
 #[test]

@@ -374,6 +374,10 @@ pub struct TerrainArgs {
     /// B-spline surface alone.
     #[arg(long = "no-terrain-detail")]
     pub no_terrain_detail: bool,
+    /// Procedural detail in the geometry only: no per-pixel bump mapping
+    /// of the octaves finer than the mesh (Fig. 7.14, centre).
+    #[arg(long = "no-detail-shading", conflicts_with = "no_terrain_detail")]
+    pub no_detail_shading: bool,
     /// Amplitude of the procedural detail, as a fraction of the
     /// height-sample spacing (0.15: 15 cm for 1 m samples).
     #[arg(long = "detail-amplitude", default_value_t = 0.15, value_name = "FRACTION")]

@@ -293,6 +293,7 @@ fn terrain_settings(args: &TerrainArgs, debug: &TerrainDebugArgs) -> Result<Terr
             },
         },
         detail: !args.no_terrain_detail,
+        detail_shading: !args.no_detail_shading,
         detail_amplitude: args.detail_amplitude,
         view: match debug.view {
             ViewArg::Shaded => TerrainView::Shaded,

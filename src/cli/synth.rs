@@ -193,6 +193,11 @@ pub struct TransitionArgs {
     /// Radius in samples of the Gaussian blur of the grown band (σ = R/2; 0: none).
     #[arg(long, default_value_t = 2, value_name = "SAMPLES")]
     pub blur: u32,
+    /// Also write K intermediate steps of the growth (Fig. 7.6) beside --out,
+    /// as STEM-step-I.EXT (I = 1..K, the band 1/(K+1), …, K/(K+1) grown;
+    /// its ungrown samples the smooth ramp, no blur).
+    #[arg(long, default_value_t = 0, value_name = "K", value_parser = clap::value_parser!(u32).range(0..=16))]
+    pub steps: u32,
     #[command(flatten)]
     pub grow: GrowArgs,
     #[command(flatten)]
@@ -362,11 +367,28 @@ fn transition(args: TransitionArgs) -> Result<ExitCode> {
     let search = prepare_search(&cost, &args.grow, &format!("{} and {}", args.a, args.b))?;
     let (growth, transition) = progress::phase("planning the transition", || plan_transition(&a, &b, &params))?;
     drop(b);
+    let step_paths = step_paths(&args.out, args.steps);
+    for path in &step_paths {
+        outputs.add(Some(path), "--steps")?;
+    }
+    let total = growth.unknown_count();
+    let mut steps: Vec<HeightField> = Vec::new();
+    let mut observe = |field: &HeightField, unknown: &[bool]| {
+        let left = unknown.iter().filter(|&&u| u).count();
+        // Step I is written when the grown share first reaches I/(K+1).
+        while steps.len() < step_paths.len() && (total - left) * (step_paths.len() + 1) >= (steps.len() + 1) * total {
+            steps.push(transition.partial(field, unknown));
+        }
+        Ok(())
+    };
     let started = Instant::now();
-    let residual = grow_with(growth, search)?;
+    let residual = grow_with(growth, search, &mut observe)?;
     let joined = progress::phase("blurring the band", || transition.finish(&residual, params.blur_radius));
     let seconds = started.elapsed().as_secs_f64();
     progress::phase("writing", || {
+        for (path, step) in step_paths.iter().zip(&steps) {
+            outputs.stage(Some(path), || encode_field(path, step, &args.heights))?;
+        }
         outputs.stage(Some(&args.out), || encode_field(&args.out, &joined, &args.heights))
     })?;
     outputs.commit()?;
@@ -437,7 +459,7 @@ fn grow_and_write(
     heights: &HeightArgs,
 ) -> Result<f64> {
     let started = Instant::now();
-    let grown = grow_with(growth, search)?;
+    let grown = grow_with(growth, search, &mut |_, _| Ok(()))?;
     let seconds = started.elapsed().as_secs_f64();
     progress::phase("writing", || {
         outputs.stage(Some(out), || encode_field(out, &grown, heights))
@@ -448,7 +470,26 @@ fn grow_and_write(
 
 /// Grows `growth` with `search` (on the GPU: validated with `--validation`
 /// when asked), with a progress bar on stderr when it is a terminal.
-fn grow_with(growth: Growth, search: Search) -> Result<HeightField> {
+/// The files of `--steps K` beside `out`: STEM-step-I.EXT, I = 1..=K.
+fn step_paths(out: &Path, steps: u32) -> Vec<PathBuf> {
+    let stem = out
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = out
+        .extension()
+        .map(|e| e.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    (1..=steps)
+        .map(|i| out.with_file_name(format!("{stem}-step-{i}.{ext}")))
+        .collect()
+}
+
+fn grow_with(
+    growth: Growth,
+    search: Search,
+    observe: &mut dyn FnMut(&HeightField, &[bool]) -> alpenglow::Result<()>,
+) -> Result<HeightField> {
     let bar = progress::bar(growth.unknown_count() as u64, "{pos}/{len} samples grown");
     let mut report = |done: usize, _| bar.set_position(done as u64);
     let grown = match search {
@@ -457,13 +498,13 @@ fn grow_with(growth: Growth, search: Search) -> Result<HeightField> {
                 exemplar: growth.exemplar().clone(),
                 config: growth.search_config(),
             };
-            growth.grow(&mut search, &mut report)?
+            growth.grow_observed(&mut search, &mut report, observe)?
         }
         Search::Gpu(ctx) => {
             let validation = ctx.validation_report();
             let grown = {
                 let mut search = GpuSearch::new(&ctx, growth.exemplar().clone(), growth.search_config())?;
-                growth.grow(&mut search, &mut report)?
+                growth.grow_observed(&mut search, &mut report, observe)?
             };
             drop(ctx);
             super::check_validation(validation)?;

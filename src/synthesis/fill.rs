@@ -205,9 +205,20 @@ impl Growth {
     /// answers (`filled` then counts the samples searched); returns the
     /// grown field.
     pub fn grow(
+        self,
+        search: &mut dyn NeighbourhoodSearch,
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Result<HeightField> {
+        self.grow_observed(search, progress, &mut |_, _| Ok(()))
+    }
+
+    /// [`Growth::grow`], showing `observe` the field and its unknown
+    /// samples after each wave (the intermediate steps of Fig. 7.6).
+    pub fn grow_observed(
         mut self,
         search: &mut dyn NeighbourhoodSearch,
         progress: &mut dyn FnMut(usize, usize),
+        observe: &mut dyn FnMut(&HeightField, &[bool]) -> Result<()>,
     ) -> Result<HeightField> {
         let total = self.unknown_count();
         let weights = tap_weights(self.params.window);
@@ -238,6 +249,7 @@ impl Growth {
             order.mark_known(&wave, &self.unknown);
             done += wave.len();
             progress(done, total);
+            observe(&self.field, &self.unknown)?;
         }
         Ok(self.field)
     }

@@ -189,6 +189,27 @@ impl Transition {
         }
         blur_band(&out, &self.band, blur)
     }
+
+    /// An intermediate step of the growth (Fig. 7.6): the band's grown
+    /// samples `base + residual`, its unknown ones the smooth base (the
+    /// blurred ramp), unblurred; A's and B's samples as given.
+    pub fn partial(&self, residual: &HeightField, unknown: &[bool]) -> HeightField {
+        let mut out = self.composed.clone();
+        for r in 0..out.rows {
+            for c in 0..out.columns {
+                if self.band.contains(c, r) {
+                    let i = (r * out.columns + c) as usize;
+                    let grown = if unknown[i] {
+                        0.0
+                    } else {
+                        f64::from(residual.heights[i])
+                    };
+                    out.heights[i] = (self.base[i] + grown) as f32;
+                }
+            }
+        }
+        out
+    }
 }
 
 /// Prepares growing the transition between `a` and `b`: the growth of the

@@ -80,6 +80,10 @@ pub struct TerrainSettings {
     pub lod: LodSettings,
     /// Procedural displacement and bump mapping (`--no-terrain-detail`).
     pub detail: bool,
+    /// With `detail`, the octaves finer than the mesh bump-map the normal
+    /// per pixel (`--no-detail-shading` turns this off: detail in geometry
+    /// only, the centre panel of Fig. 7.14).
+    pub detail_shading: bool,
     /// Detail amplitude relative to the atlas spacing: octave k has
     /// amplitude `amplitude · d0 · 2^(−k·H)`.
     pub detail_amplitude: f32,
@@ -96,6 +100,7 @@ impl Default for TerrainSettings {
             grid_side: DEFAULT_GRID_SIDE,
             lod: LodSettings::default(),
             detail: true,
+            detail_shading: true,
             detail_amplitude: 0.15,
             detail_h: 0.9,
             noise_seed: wavelet_noise::DEFAULT_NOISE_SEED,
@@ -141,9 +146,14 @@ impl TerrainSettings {
     }
 
     /// What `terrain.draw` reads of the settings (`TerrainTexturing.draw`):
-    /// view, detail on (0/1), grid side.
+    /// view, bump mapping on (0/1: `detail` and `detail_shading`), grid side.
     pub fn draw_constants(&self) -> [u32; 4] {
-        [self.view.code(), u32::from(self.detail), self.grid_side, 0]
+        [
+            self.view.code(),
+            u32::from(self.detail && self.detail_shading),
+            self.grid_side,
+            0,
+        ]
     }
 }
 

@@ -375,7 +375,11 @@ pub const FILL_OTHER: &[&str] = &["--input", "--mask", "--out", "--search", "--d
 pub const FREE: &[Opt] = &[opt("--size", int(7, 8192, 48))];
 pub const FREE_OTHER: &[&str] = &["--exemplar", "--out", "--search", "--device", "--rows"];
 
-pub const TRANSITION: &[Opt] = &[opt("--band", float(0.0, BIG)), opt("--blur", int(0, U32, 16))];
+pub const TRANSITION: &[Opt] = &[
+    opt("--band", float(0.0, BIG)),
+    opt("--blur", int(0, U32, 16)),
+    opt("--steps", int(0, 16, 4)),
+];
 pub const TRANSITION_OTHER: &[&str] = &["--out", "--axis", "--search", "--device", "--rows"];
 
 pub const LAYERS: &[Opt] = &[

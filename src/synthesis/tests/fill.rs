@@ -20,8 +20,9 @@
 //!   interpolation of the holes fails the statistics bound, and a constant
 //!   fill (the mean height) fails the seam bound.
 //!
-//! The filled field's hillshade is written to
-//! `target/tmp/synthesis-fill-hillshade.png` for a look.
+//! Hillshades of the holes (white), the filled field and the original
+//! crop are written side by side to `target/tmp/synthesis-fill-hillshade.png`
+//! (Fig. 7.2).
 
 use std::path::Path;
 
@@ -227,20 +228,24 @@ fn filled_holes_match_the_terrain_without_seams() {
     let input = crop();
     let unknown = holes();
     let out = fill_holes_cpu(&input, &unknown, &params(1, 4096), &mut |_, _| {}).unwrap();
+    // Fig. 7.2: the holes (white), the filled field, the original crop.
     let side_by_side: Vec<u8> = {
-        let (a, b) = (hillshade(&input), hillshade(&out));
+        let mut holed = hillshade(&input);
+        for (i, _) in unknown.iter().enumerate().filter(|(_, &u)| u) {
+            holed[4 * i..4 * i + 4].fill(255);
+        }
+        let panels = [holed, hillshade(&out), hillshade(&input)];
         let row = SIDE as usize * 4;
         (0..SIDE as usize)
             .flat_map(|r| {
-                a[r * row..(r + 1) * row]
+                panels
                     .iter()
-                    .chain(&b[r * row..(r + 1) * row])
-                    .copied()
+                    .flat_map(move |p| p[r * row..(r + 1) * row].iter().copied())
             })
             .collect()
     };
     let shade_path = crate::test_support::target_tmp().join("synthesis-fill-hillshade.png");
-    crate::io::image_out::write_png_rgba8(&shade_path, &side_by_side, 2 * SIDE, SIDE).unwrap();
+    crate::io::image_out::write_png_rgba8(&shade_path, &side_by_side, 3 * SIDE, SIDE).unwrap();
 
     for (i, (a, b)) in input.heights.iter().zip(&out.heights).enumerate() {
         if !unknown[i] {

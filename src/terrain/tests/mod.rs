@@ -2,6 +2,7 @@
 //! (Moved from `tests/` in issue 26: integration tests use only the front door.)
 
 mod compute_raster;
+mod detail_panels;
 mod ground;
 mod reversed_depth;
 mod swimming;

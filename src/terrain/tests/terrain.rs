@@ -57,7 +57,12 @@ pub(super) fn views(scene: &Scene) -> Vec<(&'static str, Camera)> {
     ]
 }
 
-fn render(scene: &Scene, cameras: &[Camera], (terrain, raster): (TerrainSettings, RasterPath)) -> Vec<FrameImages> {
+/// The frames of `cameras` at 192×108 under validation (also Fig. 7.14's panels).
+pub(super) fn render(
+    scene: &Scene,
+    cameras: &[Camera],
+    (terrain, raster): (TerrainSettings, RasterPath),
+) -> Vec<FrameImages> {
     let (ctx, report) = validated_context();
     let frames = {
         let settings = RenderSettings {
