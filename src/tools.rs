@@ -49,7 +49,9 @@ pub mod layers {
         Constraint, MAX_BLUR_RADII, MAX_HEIGHT_BLUR, MAX_SAMPLES,
     };
     pub use crate::texturing::from_image::{
-        build_layers, load_mask, load_rgb_image, ClassCount, FromImageOptions, PixelStatus, MAX_CLASSES,
+        build_layers, load_mask, load_rgb_image,
+        plot::{plot_distributions, plot_hue_saturation},
+        ClassCount, FromImageOptions, PixelStatus, MAX_CLASSES,
     };
     pub use crate::texturing::reference::srgb8;
 }

@@ -39,11 +39,31 @@ fn the_command_writes_a_tree_and_refuses_bad_input_in_one_line() {
             .output()
             .expect("run")
     };
-    let ok = run("real-world/rmnp-rgb.png", &["--classes", "3", "--no-calibration"]);
+    let (histograms, hs) = (dir.join("histograms.png"), dir.join("hs.png"));
+    let ok = run(
+        "real-world/rmnp-rgb.png",
+        &[
+            "--classes",
+            "3",
+            "--no-calibration",
+            "--histograms",
+            histograms.to_str().unwrap(),
+            "--hs-histogram",
+            hs.to_str().unwrap(),
+        ],
+    );
     assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
     let text = std::fs::read_to_string(&out).expect("written");
     assert!(text.starts_with("# Image: ") && text.contains("k = 3 given"), "{text}");
     assert_eq!(LayerTree::parse(&text, "written").expect("parses").layers.len(), 5);
+    // Fig. 8.13: a row of 64 + 2 + 8 pixels per class (3 + snow and rock),
+    // two panels (altitude, slope) of 4 pixels per bin (the default 48
+    // bins) after a 32-pixel swatch, 8-pixel margins.
+    let plot = image::open(&histograms).expect("histograms PNG").to_rgba8();
+    assert_eq!((plot.width(), plot.height()), (8 + 32 + 8 + 2 * (192 + 8), 8 + 5 * 74));
+    // Fig. 8.12: 180 hue × 100 saturation bins and the colour table.
+    let hs = image::open(&hs).expect("hue-saturation PNG").to_rgba8();
+    assert_eq!((hs.width(), hs.height()), (3 * 8 + 2 * 180, 2 * 8 + 100));
     for (image, extra, expected) in [
         ("real-world/rmnp-rgb.png", &["--classes", "9"][..], "--classes"),
         ("real-world/rmnp-rgb.png", &["--bins", "65"][..], "invalid --bins"),

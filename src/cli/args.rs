@@ -256,6 +256,10 @@ pub struct PointArgs {
     /// triangles, drawn where they are larger than the error threshold.
     #[arg(long)]
     pub hybrid: bool,
+    /// With --hybrid: draw the points red, the triangles in their colours
+    /// (Fig. 10.8, left: where points replace small triangles).
+    #[arg(long = "hybrid-red-points", requires = "hybrid")]
+    pub hybrid_red_points: bool,
     /// Procedural boulders scattered over the built-in terrain (0: none).
     #[arg(long, default_value_t = 300, value_name = "COUNT", value_parser = clap::builder::RangedI64ValueParser::<usize>::new().range(0..))]
     pub rocks: usize,

@@ -103,6 +103,17 @@ pub struct FromImageArgs {
     /// pixels set aside as shade or cloud in magenta) as PNG.
     #[arg(long = "class-map", value_name = "FILE")]
     pub class_map: Option<PathBuf>,
+    /// Also write the distribution histograms (Fig. 8.13) as PNG: a row per
+    /// class (its colour swatch first), a panel per quantity (altitude,
+    /// slope, the input maps in rainfall, radiation, temperature order),
+    /// the written samples as bars from 0 to 1 over the quantity's domain.
+    #[arg(long = "histograms", value_name = "FILE")]
+    pub histograms: Option<PathBuf>,
+    /// Also write the image's hue–saturation histogram (Fig. 8.12; hue
+    /// left to right, saturation up, darker for more pixels, near greys at
+    /// violet) beside its colour table as PNG.
+    #[arg(long = "hs-histogram", value_name = "FILE")]
+    pub hs_histogram: Option<PathBuf>,
 }
 
 /// `K|auto` of `--classes`.
@@ -160,6 +171,8 @@ fn from_image(args: FromImageArgs) -> Result<ExitCode> {
     let mut outputs = Outputs::default();
     outputs.add(Some(&args.out), "--out")?;
     outputs.add_image(args.class_map.as_deref(), "--class-map")?;
+    outputs.add_image(args.histograms.as_deref(), "--histograms")?;
+    outputs.add_image(args.hs_histogram.as_deref(), "--hs-histogram")?;
     let limits = InputLimits::with_max_file_mib(args.max_input_mb);
     let (field, maps) = load_inputs(&args, limits)?;
     let image = load_rgb_image(&args.image, &limits)?;
@@ -218,6 +231,15 @@ fn from_image(args: FromImageArgs) -> Result<ExitCode> {
             })
             .collect();
         outputs.stage_image(Some(path), &rgba, image.width(), image.height())?;
+    }
+    if let Some(path) = &args.histograms {
+        let colours: Vec<_> = generated.classification.classes.iter().map(|c| c.linear).collect();
+        let plot = alpenglow::tools::layers::plot_distributions(&generated.distributions, &colours);
+        outputs.stage_image(Some(path), &plot.rgba, plot.width, plot.height)?;
+    }
+    if let Some(path) = &args.hs_histogram {
+        let plot = alpenglow::tools::layers::plot_hue_saturation(&image);
+        outputs.stage_image(Some(path), &plot.rgba, plot.width, plot.height)?;
     }
     outputs.commit()?;
     let c = &generated.classification;

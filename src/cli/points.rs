@@ -84,6 +84,7 @@ pub fn add_points(args: &PointArgs, scene: &mut Scene, builtin: bool) -> Result<
     let options = PointLoadOptions {
         mesh_samples: args.samples,
         hybrid: args.hybrid,
+        hybrid_points_color: args.hybrid_red_points.then_some([230, 20, 20]),
         ..PointLoadOptions::default()
     };
     for (i, path) in args.points.iter().enumerate() {

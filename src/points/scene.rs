@@ -248,6 +248,11 @@ pub struct PointLoadOptions {
     /// Keep a mesh's triangles for hybrid point–polygon rendering (§10.1.8);
     /// point clouds and SPT files have none and stay points only.
     pub hybrid: bool,
+    /// With `hybrid`: every point of the object in this sRGB colour, so the
+    /// points that replace small triangles stand out (Fig. 10.8's red);
+    /// None: the surface's own colours. Set after the tree is built: the
+    /// selection (§10.1.9's colour term included) stays as without it.
+    pub hybrid_points_color: Option<[u8; 3]>,
 }
 
 impl Default for PointLoadOptions {
@@ -258,6 +263,7 @@ impl Default for PointLoadOptions {
             seed: 1,
             spt: SptOptions::default(),
             hybrid: false,
+            hybrid_points_color: None,
         }
     }
 }
@@ -284,7 +290,10 @@ pub fn load_point_object(path: &Path, options: &PointLoadOptions) -> Result<Poin
     };
     let surfels = match load_points_file(path)? {
         PointInput::Mesh(mesh) if options.hybrid => {
-            let (tree, hybrid) = build_hybrid(&mesh, &sampling, &options.spt, &mut |_| {}).map_err(in_file)?;
+            let (mut tree, hybrid) = build_hybrid(&mesh, &sampling, &options.spt, &mut |_| {}).map_err(in_file)?;
+            if let Some(color) = options.hybrid_points_color {
+                tree.nodes.iter_mut().for_each(|n| n.color = color);
+            }
             return Ok(PointObject {
                 hybrid: Some(Arc::new(hybrid)),
                 ..PointObject::new(name, tree)

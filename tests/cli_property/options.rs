@@ -411,6 +411,8 @@ pub const LAYERS_OTHER: &[&str] = &[
     "--mask",
     "--out",
     "--class-map",
+    "--histograms",
+    "--hs-histogram",
 ];
 
 /// A command under test.

@@ -9,6 +9,7 @@ mod reference;
 mod sh_bands;
 mod shadows;
 mod sky_cache;
+mod sky_hemisphere;
 mod sky_light;
 mod soft_shadows;
 mod twins;

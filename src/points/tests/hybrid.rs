@@ -165,3 +165,53 @@ fn hybrid_bunny_matches_points_only() {
         }
     }
 }
+
+/// Fig. 10.8: the hybrid bunny with its points red
+/// (`PointLoadOptions::hybrid_points_color`, `--hybrid-red-points`), its
+/// triangles in their own colour. Far away no triangle is drawn and all of
+/// it is red; up close the triangles take over and less of it is red than
+/// at the middle distance, where both show. A pixel is red where its red
+/// channel is at least twice its green and blue (the bunny is grey).
+/// `ALPENGLOW_DUMP=DIR` writes the three frames.
+#[test]
+fn hybrid_points_drawn_red_show_where_points_replace_triangles() {
+    let mut points = PointScene::default();
+    let object = {
+        let options = crate::points::scene::PointLoadOptions {
+            mesh_samples: 20_000,
+            hybrid: true,
+            hybrid_points_color: Some([230, 20, 20]),
+            ..Default::default()
+        };
+        crate::points::scene::load_point_object(&crate::test_support::data("models/stanford-bunny.obj"), &options)
+            .expect("bunny")
+    };
+    points.add(object, PointTransform::parse("r=90,0,0").unwrap());
+    let scene = Scene::points_only(points);
+    let on = (SplatSettings::default(), RasterPath::Hardware);
+    let mut shares = Vec::new();
+    for distance in [0.25, 1.0, 6.0] {
+        let (frame, stats) = render_points_on(&scene, &bunny_camera(distance), on, (WIDTH, HEIGHT));
+        dump_pngs(
+            &[(&format!("fig-10-8-red-points-{distance}m"), &frame.rgba8)],
+            WIDTH,
+            HEIGHT,
+        );
+        let cover = covered(&frame);
+        let red = (frame.rgba8.chunks_exact(4).zip(&cover))
+            .filter(|(p, &c)| c && u16::from(p[0]) >= 2 * u16::from(p[1]) && u16::from(p[0]) >= 2 * u16::from(p[2]))
+            .count();
+        let share = red as f64 / cover.iter().filter(|&&c| c).count().max(1) as f64;
+        eprintln!(
+            "at {distance} m: {:.1} % of the bunny red; {}",
+            100.0 * share,
+            stats.summary()
+        );
+        shares.push(share);
+    }
+    assert!(shares[2] >= 0.95, "far away the bunny is not all points: {shares:?}");
+    assert!(
+        shares[0] < shares[1] && shares[1] < shares[2] && shares[1] > 0.05,
+        "the red share does not grow with the distance: {shares:?}"
+    );
+}

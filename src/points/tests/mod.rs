@@ -3,6 +3,7 @@
 
 mod color_density;
 mod hybrid;
+mod isocontours;
 mod kernel;
 mod primitives;
 mod render;

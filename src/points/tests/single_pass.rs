@@ -79,10 +79,34 @@ fn clip_lines_cut_single_pass_splats_as_three_pass_ones() {
     let unclipped = |p: Vec3| clipped(p).map(|_| ClipLines::NONE);
     let camera = grazing_camera();
     let size = (crate::test_support::plane::WIDTH, crate::test_support::plane::HEIGHT);
-    let render = |scene: &Scene, mode| covered(&render_points(scene, &camera, unlit(mode), size).0);
+    let render = |scene: &Scene, mode| render_points(scene, &camera, unlit(mode), size).0;
     let scene = plane_scene_clipped(SPACING, clipped);
-    let (three, single) = (render(&scene, SplatMode::Ewa), render(&scene, SplatMode::SinglePass));
-    let overhanging = render(&plane_scene_clipped(SPACING, unclipped), SplatMode::SinglePass);
+    let (three, single_frame) = (render(&scene, SplatMode::Ewa), render(&scene, SplatMode::SinglePass));
+    let overhanging_frame = render(&plane_scene_clipped(SPACING, unclipped), SplatMode::SinglePass);
+    // Fig. 10.21: the covered pixels (grey) without clip lines (left; red:
+    // the splats' overhang beyond the edge) and with them (right).
+    let mask = |frame: &FrameImages, other: Option<&FrameImages>| -> Vec<u8> {
+        let weight = |f: &FrameImages, i: usize| f.weight.as_ref().is_some_and(|w| w[i] > 0.0);
+        (0..frame.depth.len())
+            .flat_map(|i| match (weight(frame, i), other.map(|o| weight(o, i))) {
+                (false, _) => [255, 255, 255, 255],
+                (true, Some(false)) => [220, 30, 30, 255],
+                (true, _) => [110, 110, 110, 255],
+            })
+            .collect()
+    };
+    crate::test_support::dump_pngs(
+        &[
+            (
+                "fig-10-21-without-clip-lines",
+                &mask(&overhanging_frame, Some(&single_frame)),
+            ),
+            ("fig-10-21-with-clip-lines", &mask(&single_frame, None)),
+        ],
+        size.0,
+        size.1,
+    );
+    let (three, single, overhanging) = (covered(&three), covered(&single_frame), covered(&overhanging_frame));
     eprintln!(
         "covered pixels: clipped three passes {three}, single pass {single}; unclipped single pass {overhanging}"
     );

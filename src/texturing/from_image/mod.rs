@@ -42,6 +42,7 @@ pub mod classify;
 pub mod distributions;
 pub mod kmeans;
 pub mod level2;
+pub mod plot;
 pub mod shading;
 pub mod tree;
 
