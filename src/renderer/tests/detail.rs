@@ -98,13 +98,20 @@ fn camera(field: &HeightField) -> Camera {
     }
 }
 
-#[test]
-fn streamed_detail_renders_as_the_full_field_does() {
-    let path = write_test_pyramid(&rippled_field(), "render.hpyr");
+/// The rippled pyramid written to `name`: its path, the field loaded
+/// whole at full resolution, and level 3 resident with a 512² window.
+fn scenes(name: &str) -> (std::path::PathBuf, Scene, Scene) {
+    let path = write_test_pyramid(&rippled_field(), name);
     let pyramid = HeightPyramid::open(&path).unwrap();
     let full = Scene::new(pyramid.level_field(0).unwrap());
     let mut windowed = Scene::from_pyramid(&pyramid, 129).unwrap();
     windowed.set_detail_window(512, true).unwrap();
+    (path, full, windowed)
+}
+
+#[test]
+fn streamed_detail_renders_as_the_full_field_does() {
+    let (path, full, windowed) = scenes("render.hpyr");
     let mut without = windowed.clone();
     without.set_detail_window(0, true).unwrap();
     let camera = camera(&full.heights);
@@ -182,11 +189,7 @@ const TEXTURED_WINDOW_FLIP: f32 = 0.17;
 
 #[test]
 fn streamed_detail_textures_as_the_full_field_does() {
-    let path = write_test_pyramid(&rippled_field(), "textured.hpyr");
-    let pyramid = HeightPyramid::open(&path).unwrap();
-    let full = Scene::new(pyramid.level_field(0).unwrap());
-    let mut windowed = Scene::from_pyramid(&pyramid, 129).unwrap();
-    windowed.set_detail_window(512, true).unwrap();
+    let (path, full, windowed) = scenes("textured.hpyr");
     let camera = camera(&full.heights);
     let lighting = full.default_lighting();
     for (mode, name) in [(TexturingMode::Direct, "direct"), (TexturingMode::Atlas, "atlas")] {
