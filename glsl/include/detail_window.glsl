@@ -55,4 +55,22 @@ float detail_height(DetailWindow w, vec2 xy, float coarse, vec2 coarse_grad, out
     return mix(coarse, fine, weight);
 }
 
+// The ground terrain.warp draws at world xy before its procedural octaves:
+// the resident sketch atlas's B-spline (sampled handle `atlas`, `dims`
+// samples `spacing` metres apart) blended into the window's; `weight` the
+// window's share. Texturing reads the same surface (texturing.upsample,
+// direct texturing), so the layers' altitude and slope follow what is drawn.
+float detail_surface(DetailWindow w, uint atlas, uvec2 dims, vec2 spacing, vec2 xy, out vec2 grad, out float weight) {
+    vec2 coarse_grad;
+    float coarse = bspline_height(atlas, dims, spacing, xy, coarse_grad);
+    return detail_height(w, xy, coarse, coarse_grad, grad, weight);
+}
+
+// The procedural octave from which detail adds where the window has
+// weight `weight` (d0: the resident spacing): its samples replace the
+// octaves between d0 and their own spacing.
+float detail_window_octave(DetailWindow w, float weight, float d0) {
+    return weight > 0.0 ? weight * max(log2(d0 / min(w.spacing.x, w.spacing.y)), 0.0) : 0.0;
+}
+
 #endif

@@ -150,8 +150,12 @@ TerrainShaded shade_terrain(TerrainParams p, TerrainSample s) {
             // §8.2 evaluated per pixel: the reference of the atlas.
             uvec4 th = g_texturing[texturing].handles;
             vec4 sr = g_texturing[texturing].spacing_range;
+            // The base surface terrain.warp draws: the resident atlas
+            // blended into the streamed detail window where it is drawn.
             vec2 base_grad;
-            float h = bspline_height(th.y, g_texturing[texturing].grid.xy, sr.xy, s.world.xy, base_grad);
+            float window;
+            float h = detail_surface(g_texturing[texturing].window, th.y, g_texturing[texturing].grid.xy, sr.xy,
+                                     s.world.xy, base_grad, window);
             float footprint = max(depth, 1e-3) * p.forward.w;
             vec3 maps = input_maps(g_texturing[texturing].maps, s.world.xy / g_texturing[texturing].extent.xy);
             BaseField field = BaseField(th.y, g_texturing[texturing].grid.xy, sr.xy);

@@ -7,6 +7,7 @@
 #define ALPENGLOW_TEXTURE_ATLAS_GLSL
 
 #include "heap.glsl"
+#include "detail_window.glsl"
 
 #define MAX_PAGE_DEPTH 16
 #define PAGE_LEAF 0x80000000u
@@ -28,6 +29,7 @@ layout(set = 0, binding = 2, std430) readonly buffer TerrainTexturing {
     uvec4 color[MAX_ATLAS_TEXTURES / 4];   // sampled handles of the colour textures
     uvec4 normal[MAX_ATLAS_TEXTURES / 4];  // sampled handles of the normal textures
     uvec4 draw;           // terrain.draw: view (VIEW_*), detail on (0/1), grid side N, 0
+    DetailWindow window;  // the streamed detail window direct texturing reads (detail_window.glsl)
 } g_texturing[];
 
 layout(set = 0, binding = 2, std430) readonly buffer PageTable { uvec4 w[]; } g_page_tables[];

@@ -29,14 +29,20 @@ struct TexelState {
 layout(set = 0, binding = 2, std430) readonly buffer TileJobs { TileJob j[]; } g_tile_jobs[];
 layout(set = 0, binding = 2, std430) buffer TexelStates { TexelState t[]; } g_texel_states[];
 
-// Push constants of every texturing.* pass (TileGenerationPush).
+// Push constants of every texturing.* pass (TileGenerationPush); with
+// TEXTURE_TILES_DETAIL_WINDOW defined (texturing.upsample, UpsamplePush) the
+// detail window instead of the input maps and the extent.
 layout(push_constant) uniform Push {
     uvec4 handles;        // jobs (storage), scratch (storage), layers (storage), noise tile (sampled)
     uvec4 counts;         // job count, texel count, layer index, heights (sampled)
     uvec4 grid;           // height-field columns, rows, 0, 0
     vec4 spacing_range;   // sample spacing x, y (metres), lowest and highest height
+#ifdef TEXTURE_TILES_DETAIL_WINDOW
+    DetailWindow window;  // texturing.upsample: the streamed detail window (detail_window.glsl)
+#else
     uvec4 maps;           // input maps (sampled), w: present bits (surface_layers.glsl)
     vec4 extent;          // terrain rectangle x, y (metres), 0, 0
+#endif
 } pc;
 
 // The job holding scratch texel `texel` (jobs are sorted by first texel).

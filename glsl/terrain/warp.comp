@@ -73,17 +73,12 @@ void main() {
         ivec2 g = clamp(group + local, ivec2(0), ivec2(side - 1));
         vec3 p = phi(g);
         vec2 grad;
-        vec2 coarse_grad;
-        float coarse = bspline_height(pc.handles.x, pc.grid.zw, pc.spacing.xy, p.xy, coarse_grad);
         float window;
-        float h = detail_height(pc.window, p.xy, coarse, coarse_grad, grad, window);
+        float h = detail_surface(pc.window, pc.handles.x, pc.grid.zw, pc.spacing.xy, p.xy, grad, window);
         // Where the window's samples are drawn they replace the procedural
         // octaves coarser than their spacing (the ones between d0 and it):
         // geometry adds octaves from o_window, shading from the split up.
-        float o_window = 0.0;
-        if (window > 0.0) {
-            o_window = window * max(log2(d0 / min(pc.window.spacing.x, pc.window.spacing.y)), 0.0);
-        }
+        float o_window = detail_window_octave(pc.window, window, d0);
         // Largest distance to the four grid neighbours, heights from the
         // atlas gradient.
         float d2 = 0.0;

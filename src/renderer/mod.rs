@@ -458,7 +458,11 @@ impl Renderer {
         }
         if let Some(atlas) = &mut t.atlas {
             atlas.observe_profiles(self.graph.profiles());
-            frame.prepare_into(atlas, (), &mut uploads, stages)?;
+            // The atlas's base surface is the terrain's, window included.
+            let window = frame
+                .prepared::<TerrainFrame>()
+                .map_or(Default::default(), |t| t.detail.push);
+            frame.prepare_into(atlas, window, &mut uploads, stages)?;
         }
         if let Some(points) = &mut t.points {
             frame.prepare_into(points, (), &mut uploads, stages)?;

@@ -170,6 +170,49 @@ impl LayerTable {
     }
 }
 
+/// The streamed detail window (`crate::terrain::detail`) as
+/// `glsl/include/detail_window.glsl` reads it: in `terrain.warp`'s and
+/// `texturing.upsample`'s push constants and [`TexturingFrame`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct DetailPush {
+    /// Sampled handle of the window image, its side, the level's columns
+    /// and rows.
+    pub grid: [u32; 4],
+    /// Where the window's B-spline has its taps in the active rectangle,
+    /// level samples: lo x, lo y, hi x, hi y.
+    pub valid: [f32; 4],
+    /// Level spacing x, y (metres), blend band (samples), on (1) / off (0).
+    pub spacing: [f32; 4],
+}
+
+impl DetailPush {
+    /// These constants with the handle of the window image as `window`
+    /// binds it on the recording pass (None, no window: off).
+    pub fn bound(self, window: Option<Binding>, ctx: &PassContext<'_>) -> Result<DetailPush> {
+        let mut push = self;
+        push.grid[0] = window.map(|w| ctx.handle(w)).transpose()?.unwrap_or(0);
+        if window.is_none() {
+            push.spacing[3] = 0.0;
+        }
+        Ok(push)
+    }
+
+    /// The world rectangle `(min, max)` where the window is drawn (its
+    /// B-spline's taps in the active rectangle), if it is on.
+    pub fn drawn_rect(&self) -> Option<(glam::DVec2, glam::DVec2)> {
+        if self.spacing[3] < 0.5 {
+            return None;
+        }
+        let spacing = glam::DVec2::new(f64::from(self.spacing[0]), f64::from(self.spacing[1]));
+        let v = self.valid.map(f64::from);
+        Some((
+            glam::DVec2::new(v[0], v[1]) * spacing,
+            glam::DVec2::new(v[2], v[3]) * spacing,
+        ))
+    }
+}
+
 /// Per-frame constants of terrain texturing (`TerrainTexturing`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
@@ -194,4 +237,6 @@ pub struct TexturingFrame {
     /// terrain.draw: view ([`crate::terrain::geometry_image::TerrainView::code`]),
     /// detail on (0/1), grid side N, 0.
     pub draw: [u32; 4],
+    /// The streamed detail window direct texturing reads (off: zeros).
+    pub window: DetailPush,
 }

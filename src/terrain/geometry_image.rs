@@ -341,13 +341,8 @@ pub fn declare_warp_pass<S: Provides<TerrainFrame> + 'static>(
         // The view's warp upload is this frame's only when it was prepared.
         let prepared = frame.prepared::<crate::terrain::TerrainFrame>()?;
         prepared.view(pass.view)?;
-        let mut detail = prepared.detail.push;
-        detail.grid[0] = window.map(|w| ctx.handle(w)).transpose()?.unwrap_or(0);
-        if window.is_none() {
-            detail.spacing[3] = 0.0;
-        }
         let push = WarpPush {
-            window: detail,
+            window: prepared.detail.push.bound(window, ctx)?,
             handles: [
                 ctx.handle(atlas)?,
                 ctx.handle(upload)?,

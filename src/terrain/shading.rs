@@ -15,7 +15,7 @@ use crate::graph::{
     Binding, BufferAccess, BufferId, ImageId, PassBuilder, PassContext, RenderGraph, Stage, UploadRegion,
 };
 use crate::shaders;
-use crate::surface::gpu_layout::{LayerTable, TexturingFrame};
+use crate::surface::gpu_layout::{DetailPush, LayerTable, TexturingFrame};
 use crate::surface::input_maps::{InputMaps, MapBindings};
 use crate::terrain::geometry_image::VERTEX_STRIDE;
 use crate::terrain::TerrainFrame;
@@ -77,6 +77,9 @@ pub struct SurfaceInputs {
     pub texturing: TexturingFrame,
     /// The texture atlas and page table (atlas texturing only).
     pub atlas: Option<AtlasBindings>,
+    /// The streamed detail window (`crate::terrain::detail`), if the
+    /// terrain has one: direct texturing reads the ground it draws.
+    pub window: Option<ImageId>,
 }
 
 /// The bindings of [`SurfaceInputs`] on a shading pass.
@@ -87,6 +90,7 @@ pub struct SurfaceBindings {
     maps: MapBindings,
     constants: Binding,
     atlas: Option<AtlasSamples>,
+    window: Option<Binding>,
     lighting: LightingBindings,
 }
 
@@ -120,14 +124,20 @@ impl SurfaceInputs {
             maps: self.maps.sample_in(builder, stage),
             constants: builder.upload(self.constants, stage),
             atlas: (self.atlas.as_ref()).map(|atlas| AtlasSamples::declare(builder, atlas, stage)),
+            window: self.window.map(|w| builder.sample(w, stage)),
             lighting: targets.lighting.read_in(builder, stage),
         }
     }
 
     /// Writes the frame's layers table and texturing constants (with the
-    /// handles of `bindings`) while recording; returns what the shaders
-    /// take in their push constants.
-    pub fn write(&self, ctx: &mut PassContext<'_>, bindings: &SurfaceBindings) -> Result<SurfaceHandles> {
+    /// handles of `bindings` and the frame's detail window `window`) while
+    /// recording; returns what the shaders take in their push constants.
+    pub fn write(
+        &self,
+        ctx: &mut PassContext<'_>,
+        bindings: &SurfaceBindings,
+        window: DetailPush,
+    ) -> Result<SurfaceHandles> {
         let b = bindings;
         self.layers.write(ctx, b.table, &b.maps)?;
         let mut texturing = self.texturing;
@@ -136,6 +146,7 @@ impl SurfaceInputs {
         if let Some(atlas) = &b.atlas {
             atlas.set_handles(ctx, &mut texturing)?;
         }
+        texturing.window = window.bound(b.window, ctx)?;
         ctx.write_upload_pod(b.constants, &texturing)?;
         Ok(SurfaceHandles {
             lighting: ctx.handle(b.lighting.constants)?,
@@ -239,7 +250,8 @@ pub fn declare_draw_pass<S: Provides<TerrainFrame> + 'static>(
         .depth(targets.depth, Some(crate::view::depth::FAR_DEPTH))
         .record(move |ctx, frame| {
             let prepared = frame.prepared::<crate::terrain::TerrainFrame>()?.view(pass.view)?.draw;
-            let handles = pass.surface.write(ctx, &surface)?;
+            let window = frame.prepared::<crate::terrain::TerrainFrame>()?.detail.push;
+            let handles = pass.surface.write(ctx, &surface, window)?;
             let push = TerrainDrawPush {
                 lighting: [handles.lighting, 0, 0, 0],
                 noise_tile: handles.noise_tile,

@@ -240,6 +240,7 @@ impl Terrain {
             layers: self.layers.clone(),
             maps: self.maps,
             tree,
+            window: self.detail.as_ref().map(|(_, d)| d.image),
         }
     }
 
@@ -395,6 +396,7 @@ impl<S: Provides<TerrainFrame> + Provides<PreparedLighting> + 'static> Declare<S
             constants: state.constants,
             texturing,
             atlas: atlas.cloned(),
+            window: self.detail.as_ref().map(|(_, d)| d.image),
         };
         if let (Some(path), Some(constants)) = (&self.compute, state.compute) {
             let pass = ComputePass {

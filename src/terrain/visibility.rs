@@ -362,7 +362,8 @@ impl ComputeRaster {
         let ndc = ndc_depth.map(|image| shade.storage_image(image, ImageAccess::StorageWrite(compute)));
         let (inputs, (width, height), index) = (pass.surface.clone(), (targets.width, targets.height), pass.view);
         shade.record(move |ctx, frame| {
-            let handles = inputs.write(ctx, &surface)?;
+            let window = frame.prepared::<crate::terrain::TerrainFrame>()?.detail.push;
+            let handles = inputs.write(ctx, &surface, window)?;
             write_view_lighting(ctx, frame, index, surface.lighting())?;
             let image = |k: usize| ctx.handle(images[k]);
             let push = ShadePush {
@@ -413,7 +414,8 @@ impl ComputeRaster {
         let weight = shade.storage_image(weight, write);
         let (inputs, (width, height), index) = (pass.surface.clone(), (targets.width, targets.height), pass.view);
         shade.record(move |ctx, frame_data| {
-            let handles = inputs.write(ctx, &surface)?;
+            let window = frame_data.prepared::<crate::terrain::TerrainFrame>()?.detail.push;
+            let handles = inputs.write(ctx, &surface, window)?;
             write_view_lighting(ctx, frame_data, index, surface.lighting())?;
             let push = ShadeSplatsPush {
                 handles: [ctx.handle(sum)?, ctx.handle(frame)?, 0, ctx.handle(nearest)?],

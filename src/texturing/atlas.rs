@@ -48,6 +48,8 @@
 
 use std::collections::{HashMap, HashSet};
 
+use glam::DVec2;
+
 use crate::error::Result;
 pub use crate::texturing::atlas_settings::AtlasSettings;
 #[cfg(test)]
@@ -199,6 +201,27 @@ impl TileCache {
     pub fn clear(&mut self) {
         self.slots.iter_mut().for_each(|layer| layer.fill(None));
         self.index.clear();
+    }
+
+    /// Forgets the tiles whose texels (border included) reach into the
+    /// world rectangle `[lo, hi]` of a terrain of `extent`: what they show
+    /// there changed (the streamed detail window moved), so the frames
+    /// after generate them again.
+    pub fn forget_overlapping(&mut self, extent: DVec2, (lo, hi): (DVec2, DVec2)) {
+        let border = f64::from(self.settings.border);
+        for (k, slots) in self.slots.iter_mut().enumerate() {
+            let size = self.settings.tile_size(k as u32);
+            for slot in slots.iter_mut() {
+                let Some(r) = *slot else { continue };
+                let (a, b) = r.node.rect(extent);
+                let margin = (b - a) * border / f64::from(size - 2 * self.settings.border);
+                let (a, b) = (a - margin, b + margin);
+                if a.x <= hi.x && lo.x <= b.x && a.y <= hi.y && lo.y <= b.y {
+                    self.index.remove(&(r.node, size));
+                    *slot = None;
+                }
+            }
+        }
     }
 
     /// Plans one frame: `needed` from `select_tiles`; at most `cap` tiles
@@ -419,6 +442,35 @@ mod tests {
         assert!(!changed.is_empty() && changed == generated);
         assert_eq!(moved.stats.hits + changed.len(), b.len());
         assert!(moved.stats.hit_rate() > 0.5, "{:?}", moved.stats);
+    }
+
+    #[test]
+    fn forgetting_a_rectangle_regenerates_exactly_the_tiles_reaching_into_it() {
+        let mut cache = atlas(16384, 4, 16, 512).unwrap();
+        let a = needed_from(DVec3::new(1000.0, 1000.0, 300.0));
+        cache.plan_frame(1, &a, usize::MAX);
+        // A detail window's rectangle around the eye.
+        let rect = (DVec2::new(900.0, 950.0), DVec2::new(1150.0, 1100.0));
+        cache.forget_overlapping(EXTENT, rect);
+        let again = cache.plan_frame(2, &a, usize::MAX);
+        // The root, forgotten too, comes back as the fallback of last resort.
+        let generated: HashSet<NodeId> = (again.generate.iter().map(|&(n, _)| n))
+            .filter(|&n| n != NodeId::ROOT)
+            .collect();
+        let reaches = |t: &NeededTile| {
+            let (lo, hi) = t.node.rect(EXTENT);
+            // The border's 4 texels either side of the 8 fewer inner ones.
+            let margin = (hi - lo) * 4.0 / f64::from(cache.settings.fit(t.size) - 8);
+            let (lo, hi) = (lo - margin, hi + margin);
+            lo.x <= rect.1.x && rect.0.x <= hi.x && lo.y <= rect.1.y && rect.0.y <= hi.y
+        };
+        let expected: HashSet<NodeId> = (a.iter().filter(|t| reaches(t)).map(|t| t.node))
+            .filter(|&n| n != NodeId::ROOT)
+            .collect();
+        assert!(!expected.is_empty() && expected.len() < a.len());
+        assert_eq!(generated, expected);
+        let root_needed = a.iter().any(|t| t.node == NodeId::ROOT);
+        assert_eq!(again.stats.hits, a.len() - expected.len() - usize::from(root_needed));
     }
 
     #[test]

@@ -32,7 +32,7 @@ use crate::error::{Error, Result};
 use crate::graph::{BufferInfo, ImageId, RenderGraph, UploadRegion};
 use crate::io::heightmap::HeightField;
 use crate::profile::FrameProfile;
-use crate::surface::gpu_layout::LayerTable;
+use crate::surface::gpu_layout::{DetailPush, LayerTable};
 use crate::surface::input_maps::InputMaps;
 use crate::surface::layers::LayerTree;
 #[cfg(doc)]
@@ -129,6 +129,8 @@ pub struct TextureAtlas {
     /// Host copies of the colour textures, per texture and frame slot
     /// ([`TextureStreaming::readback`]).
     readback: Option<Vec<Vec<Arc<Buffer>>>>,
+    /// The detail window the resident tiles were generated with.
+    window: DetailPush,
 }
 
 /// What the generation passes read this frame (prepared by [`TextureAtlas`]).
@@ -140,6 +142,8 @@ pub struct TextureFrame {
     /// The dirty tiles' jobs, `images` holding the texture's index
     /// ([`TileJob::images`]).
     pub tile_jobs: Vec<TileJob>,
+    /// The terrain's detail window this frame (`texturing.upsample`).
+    pub window: DetailPush,
 }
 
 /// The atlas and page table the generation passes leave for `terrain.draw`.
@@ -166,6 +170,8 @@ pub struct GenerationInputs<'a> {
     /// The layers' extra input maps.
     pub maps: InputMaps,
     pub tree: &'a LayerTree,
+    /// The terrain's streamed detail window, if it has one.
+    pub window: Option<ImageId>,
 }
 
 /// An atlas texture and its graph resource.
@@ -235,7 +241,7 @@ impl TextureAtlas {
             scratch,
             base_push: base_push(&field),
         };
-        passes.declare_upsample(ctx, graph, inputs.heights)?;
+        passes.declare_upsample(ctx, graph, (inputs.heights, inputs.window))?;
         passes.declare_layers(ctx, graph, &inputs)?;
         passes.declare_finish(ctx, graph, &textures)?;
         let readback = match streaming.readback {
@@ -260,6 +266,7 @@ impl TextureAtlas {
             paced: true,
             readback,
             streaming,
+            window: DetailPush::default(),
         })
     }
 
@@ -358,6 +365,20 @@ impl TextureAtlas {
     }
 }
 
+impl TextureAtlas {
+    /// Forgets the tiles where the detail window's drawn rectangle was or
+    /// is when it changed: their base surface (`texturing.upsample`) did.
+    fn follow_window(&mut self, window: DetailPush) {
+        if window == self.window {
+            return;
+        }
+        for rect in [self.window.drawn_rect(), window.drawn_rect()].into_iter().flatten() {
+            self.cache.forget_overlapping(self.extent, rect);
+        }
+        self.window = window;
+    }
+}
+
 /// A frame's plan, before its uploads.
 struct PlannedFrame {
     plan: TilePlan,
@@ -370,7 +391,9 @@ struct PlannedFrame {
 
 impl Technique for TextureAtlas {
     type Prepared = TextureFrame;
-    type Needs<'a> = ();
+    /// The terrain's detail window this frame ([`crate::terrain::detail`];
+    /// default: none).
+    type Needs<'a> = DetailPush;
 
     fn name(&self) -> &'static str {
         "texturing"
@@ -380,8 +403,9 @@ impl Technique for TextureAtlas {
     /// documentation, step 1) and uploads its jobs and the page table every
     /// view samples. A frame whose plan cannot be generated forgets the
     /// cache, so that no tile stays marked resident without being generated.
-    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, (): ()) -> Result<TextureFrame> {
+    fn prepare(&mut self, frame: &mut FrameContext<'_, '_>, window: DetailPush) -> Result<TextureFrame> {
         let start = std::time::Instant::now();
+        self.follow_window(window);
         if !(1..=MAX_VIEWS).contains(&frame.views.len()) {
             return Err(Error::invalid(
                 "views",
@@ -427,6 +451,7 @@ impl Technique for TextureAtlas {
             jobs: p.jobs.len() as u32,
             texels: p.texels,
             tile_jobs: p.jobs,
+            window,
         })
     }
 }

@@ -15,6 +15,7 @@ use crate::graph::{
 };
 use crate::io::heightmap::HeightField;
 use crate::shaders;
+use crate::surface::gpu_layout::DetailPush;
 use crate::texturing::generation::{GenerationInputs, TextureFrame, TileJob, GROUP};
 use crate::view::{Frame, Provides};
 use crate::vulkan::{Buffer, BufferDesc, BufferUsageFlags, ComputePipeline, Context, MemoryLocation};
@@ -40,6 +41,19 @@ pub(crate) struct TileGenerationPush {
     extent: [f32; 4],
 }
 
+/// Push constants of `texturing.upsample` (`Push` in
+/// glsl/include/texture_tiles.glsl with `TEXTURE_TILES_DETAIL_WINDOW`): the
+/// detail window in place of the input maps and the extent.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct UpsamplePush {
+    handles: [u32; 4],
+    counts: [u32; 4],
+    grid: [u32; 4],
+    spacing_range: [f32; 4],
+    window: DetailPush,
+}
+
 /// The push constants every generation pass starts from.
 pub(crate) fn base_push(field: &HeightField) -> TileGenerationPush {
     let (lo, hi) = field.min_max();
@@ -63,27 +77,32 @@ pub(crate) struct GenerationPasses {
 }
 
 impl GenerationPasses {
-    /// `texturing.upsample`: the base surface at every dirty texel.
+    /// `texturing.upsample`: the base surface at every dirty texel, the
+    /// height field blended into the streamed detail window `window` (if
+    /// the terrain has one) as `terrain.warp` draws it.
     pub fn declare_upsample<S: Provides<TextureFrame> + 'static>(
         &self,
         ctx: &Context,
         graph: &mut RenderGraph<Frame<S>>,
-        heights: ImageId,
+        (heights, window): (ImageId, Option<ImageId>),
     ) -> Result<()> {
         let pipeline = ComputePipeline::new(ctx, shaders::TEXTURING_UPSAMPLE)?;
-        let base_push = self.base_push;
+        let base = self.base_push;
         let mut pass = graph.pass("texturing.upsample");
         let heights = pass.sample(heights, Stage::Compute);
+        let window = window.map(|w| pass.sample(w, Stage::Compute));
         let jobs = pass.upload(self.jobs, Stage::Compute);
         let scratch = pass.storage_buffer(self.scratch, BufferAccess::StorageWrite(Stage::Compute));
         pass.record(move |ctx, frame| {
             let tiles = frame.prepared::<TextureFrame>()?;
-            let push = TileGenerationPush {
+            let push = UpsamplePush {
                 handles: [ctx.handle(jobs)?, ctx.handle(scratch)?, 0, 0],
                 counts: [tiles.jobs, tiles.texels as u32, 0, ctx.handle(heights)?],
-                ..base_push
+                grid: base.grid,
+                spacing_range: base.spacing_range,
+                window: tiles.window.bound(window, ctx)?,
             };
-            dispatch(ctx, &pipeline, &push)
+            dispatch(ctx, &pipeline, &push, tiles.texels as u32)
         });
         Ok(())
     }
@@ -131,7 +150,7 @@ impl GenerationPasses {
                     maps: maps.handles(ctx)?,
                     ..base_push
                 };
-                dispatch(ctx, &pipeline, &push)
+                dispatch(ctx, &pipeline, &push, tiles.texels as u32)
             });
         }
         Ok(())
@@ -174,7 +193,7 @@ impl GenerationPasses {
                 counts: [tiles.jobs, tiles.texels as u32, 0, 0],
                 ..base_push
             };
-            dispatch(ctx, &pipeline, &push)
+            dispatch(ctx, &pipeline, &push, tiles.texels as u32)
         });
         Ok(())
     }
@@ -207,8 +226,8 @@ pub(crate) fn add_atlas_readback<S: Provides<TextureFrame> + 'static>(
 }
 
 /// One thread per dirty texel; nothing when no tile is dirty.
-fn dispatch(ctx: &mut PassContext<'_>, pipeline: &ComputePipeline, push: &TileGenerationPush) -> Result<()> {
-    let groups = u64::from(push.counts[1]).div_ceil(GROUP);
+fn dispatch<P: Pod>(ctx: &mut PassContext<'_>, pipeline: &ComputePipeline, push: &P, texels: u32) -> Result<()> {
+    let groups = u64::from(texels).div_ceil(GROUP);
     if groups == 0 {
         return Ok(());
     }

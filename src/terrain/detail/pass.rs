@@ -15,20 +15,7 @@ use crate::terrain::TerrainFrame;
 use crate::view::{Frame, Provides};
 use crate::vulkan::{ComputePipeline, Context, Format, Image, ImageDesc, ImageUsageFlags};
 
-/// The window as `detail_window.glsl` reads it (part of `terrain.warp`'s
-/// push constants).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct DetailPush {
-    /// Sampled handle of the window image, its side, the level's columns
-    /// and rows.
-    pub grid: [u32; 4],
-    /// Where the window's B-spline has its taps in the active rectangle,
-    /// level samples: lo x, lo y, hi x, hi y.
-    pub valid: [f32; 4],
-    /// Level spacing x, y (metres), blend band (samples), on (1) / off (0).
-    pub spacing: [f32; 4],
-}
+pub use crate::surface::gpu_layout::DetailPush;
 
 /// What `terrain.detail` copies this frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

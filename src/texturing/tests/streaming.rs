@@ -75,7 +75,7 @@ impl Rig {
         let mut uploads = self.graph.uploads(index);
         self.atlas.observe_profiles(self.graph.profiles());
         frame
-            .prepare_into(&mut self.atlas, (), &mut uploads, &mut stages)
+            .prepare_into(&mut self.atlas, Default::default(), &mut uploads, &mut stages)
             .expect("prepare");
         self.graph.execute(&mut self.frames, &frame, &stages).expect("execute")
     }
