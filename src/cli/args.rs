@@ -412,11 +412,12 @@ pub struct TerrainArgs {
     #[arg(long, default_value_t = 128, value_name = "TEXELS", value_parser = clap::builder::RangedI64ValueParser::<usize>::new().range(0..))]
     pub sketch: usize,
     /// Anchors the terrain's LOD plan to the world against swimming
-    /// (§7.4.3, §7.4.5): the plan's eye snaps to a grid of this many
-    /// sketch texels of the whole terrain and the mesh is planned again
-    /// only when it moves to another grid point (0, the default: planned
-    /// for the eye every frame, as in the text; 1 cuts the swimming 5–8×
-    /// but makes the mesh near the eye coarser). 0..=1024.
+    /// (§7.4.3, §7.4.5): the plan's eye snaps to a grid of at most this
+    /// many sketch texels of the whole terrain, halved until it is at most
+    /// the eye's height above the ground, and the mesh is planned again
+    /// only when the eye moves to another grid point (1, the default, cuts
+    /// a flying camera's swimming 5–8×; 0: planned for the eye every
+    /// frame, as in the text). 0..=1024.
     #[arg(long = "lod-snap", default_value_t = alpenglow::DEFAULT_LOD_SNAP, value_name = "TEXELS")]
     pub lod_snap: f64,
     /// Terrain colouring: the surface-layer tree cached in a texture atlas

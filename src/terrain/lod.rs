@@ -25,17 +25,32 @@
 //! every side and the frustum factor's planes move `reach` outwards, so
 //! everything the real camera sees stays covered. The distance term
 //! near the real eye is then off by up to `reach` (its `min_distance` of
-//! one sketch texel limits that): the price is accuracy, a mean depth
-//! error 1.2–2.1× the plain plan's (`docs/PERFORMANCE.md`), which is why
-//! it is off by default ([`DEFAULT_SNAP`]; `--lod-snap 1`,
-//! [`ANCHORED_SNAP`], turns it on). Only translation is anchored: a
-//! camera that turns, or changes its field of view, is planned again
-//! every frame.
+//! one sketch texel limits that).
+//!
+//! # Height-adaptive grid
+//!
+//! A grid of one whole-terrain sketch texel ([`ANCHORED_SNAP`]; 80 m on the
+//! default terrain, 250 m on the Jacksboro DEM) is right for a flying eye
+//! but not for one walking 2 m above the ground: planned for an eye up to
+//! `0.87 G` away (possibly under the ground, the eye's height is snapped
+//! too), the mesh under it is coarser and can rise above the real eye. So
+//! [`LodSettings::snap`] is the coarsest grid, halved until `G` is at most
+//! [`HEIGHT_FACTOR`] × the eye's height above the ground under it
+//! ([`LodSettings::anchor`]): a walking eye gets a grid of a few metres,
+//! almost the per-frame plan of the text (and about its swimming), a
+//! flying eye the anchored plan. The level of the grid keeps to the last
+//! frame's while the height allows it and is less than four times that
+//! grid (hysteresis: changing the level replans). Measured in
+//! `docs/PERFORMANCE.md` ("Swimming"); on by default ([`DEFAULT_SNAP`]),
+//! `--lod-snap 0` plans for every frame's eye. Only translation is
+//! anchored: a camera that turns, or changes its field of view, is planned
+//! again every frame.
 
 use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
 use crate::io::heightmap::HeightField;
+use crate::surface::bspline::sample_bspline;
 use crate::terrain::importance::{importance_map, smoothstep, Backface, Frustum, ImportanceParams};
 use crate::terrain::sketch_map::{SketchAlignment, SketchMap, DEFAULT_SKETCH_SIDE};
 use crate::terrain::warp::{bilinear, density_ratio, warp_into, PassOrder, WarpOptions, WarpResult};
@@ -91,23 +106,32 @@ pub struct LodSettings {
     pub mode: LodMode,
     pub factors: ImportanceFactors,
     pub alignment: SketchAlignment,
-    /// Spacing of the world grid the plan's eye is snapped to, in sketch
-    /// texels of a map over the whole terrain (`extent / (side − 1)`); 0:
-    /// the plan follows the eye every frame (the text). See the module
-    /// documentation.
+    /// Spacing of the coarsest world grid the plan's eye is snapped to, in
+    /// sketch texels of a map over the whole terrain (`extent / (side −
+    /// 1)`), halved for an eye near the ground; 0: the plan follows the eye
+    /// every frame (the text). See the module documentation.
     pub snap: f64,
 }
 
-/// Default [`LodSettings::snap`]: off (the text's per-frame plan). The
-/// anchored plan costs accuracy near the eye: as the default it put some
-/// of the 300 cameras 2 m above the ground of
-/// `src/terrain/tests/ground.rs` under the drawn ground and failed the
-/// distant-ridge test of `src/terrain/tests/reversed_depth.rs`. So it is
-/// asked for; [`ANCHORED_SNAP`] is the measured choice.
-pub const DEFAULT_SNAP: f64 = 0.0;
-/// The snap that cuts the swimming 5–8× and keeps the density of Fig. 7.12
-/// (`docs/PERFORMANCE.md`, "Swimming"): one whole-terrain sketch texel.
+/// Default [`LodSettings::snap`]: the anchored plan with a grid of one
+/// whole-terrain sketch texel at most, finer for an eye near the ground
+/// ([`HEIGHT_FACTOR`]; module documentation).
+pub const DEFAULT_SNAP: f64 = ANCHORED_SNAP;
+/// The coarsest snap that cuts the swimming 5–8× and keeps the density of
+/// Fig. 7.12 (`docs/PERFORMANCE.md`, "Swimming"): one whole-terrain
+/// sketch texel.
 pub const ANCHORED_SNAP: f64 = 1.0;
+/// The snap grid is at most this many times the eye's height above the
+/// ground ([`LodSettings::anchor`]): snapping moves the eye's height by at
+/// most `G / 2`, so the planned eye is no lower than the ground under the
+/// real one, and the near field of an eye near the ground is planned
+/// within about its height of the real eye (measured against 1 and 4 in
+/// `docs/PERFORMANCE.md`, "Swimming").
+pub const HEIGHT_FACTOR: f64 = 2.0;
+/// Most halvings of the coarsest snap grid for a low eye; an eye lower
+/// still is planned every frame (a grid of 1/2¹⁶ of a sketch texel, a few
+/// millimetres, anchors nothing).
+pub const MAX_SNAP_LEVEL: u32 = 16;
 /// Largest [`LodSettings::snap`] (a grid that coarse anchors the plan to
 /// one point of the terrain).
 pub const MAX_SNAP: f64 = 1024.0;
@@ -124,29 +148,81 @@ impl Default for LodSettings {
     }
 }
 
+/// The grid a plan's eye is snapped to ([`LodSettings::anchor`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Anchor {
+    /// The camera the plan is made for: the real one moved so that its eye
+    /// sits on the grid (the real one itself without snapping).
+    pub camera: Camera,
+    /// The grid's spacing `G` in metres (0: no snapping).
+    pub spacing: f64,
+    /// How many times the coarsest grid ([`LodSettings::snap`]) was halved
+    /// for the eye's height above the ground (None: no snapping).
+    pub level: Option<u32>,
+}
+
+impl Anchor {
+    /// Half the grid spacing: the real eye is in the cube of this half-size
+    /// around the planned one.
+    pub fn cell(&self) -> f64 {
+        0.5 * self.spacing
+    }
+}
+
 impl LodSettings {
-    /// The camera the plan is made for and the half-size of the grid cell
-    /// around its eye in which the real eye is: `camera` itself and 0
-    /// without snapping, else `camera` moved so that its eye sits on the
-    /// grid of [`LodSettings::snap`].
-    pub fn anchored_camera(&self, field: &HeightField, camera: &Camera) -> Result<(Camera, f64)> {
+    /// The grid the plan's eye snaps to for `camera` and the camera moved
+    /// onto it (module documentation, "Height-adaptive grid"): the coarsest
+    /// grid of [`LodSettings::snap`] sketch texels, halved until it is at
+    /// most [`HEIGHT_FACTOR`] × the eye's height above the B-spline ground
+    /// under it; `previous`, the level of the last frame's grid, is kept
+    /// while that grid is neither too coarse for the height nor four times
+    /// finer than it allows (hysteresis: a height that hovers about a
+    /// threshold does not replan every frame). No snapping with a snap of 0,
+    /// an eye at or under the ground, or a grid finer than
+    /// [`MAX_SNAP_LEVEL`] halvings.
+    pub fn anchor(&self, field: &HeightField, camera: &Camera, previous: Option<u32>) -> Result<Anchor> {
         if !(self.snap.is_finite() && (0.0..=MAX_SNAP).contains(&self.snap)) {
             return Err(Error::invalid(
                 "terrain.lod.snap",
                 format!("{} sketch texels (must be in 0..={MAX_SNAP})", self.snap),
             ));
         }
+        let unsnapped = Anchor {
+            camera: *camera,
+            spacing: 0.0,
+            level: None,
+        };
         if self.snap == 0.0 {
-            return Ok((*camera, 0.0));
+            return Ok(unsnapped);
         }
-        let spacing = self.snap * field.extent().max_element() / (self.sketch_side.max(2) - 1) as f64;
+        let coarsest = self.snap * field.extent().max_element() / (self.sketch_side.max(2) - 1) as f64;
+        let height = camera.eye.z - sample_bspline(field, camera.eye.x, camera.eye.y);
+        let allowed = HEIGHT_FACTOR * height;
+        if !(allowed > 0.0 && allowed.is_finite()) {
+            return Ok(unsnapped);
+        }
+        let grid = |level: u32| coarsest / f64::from(1u32 << level.min(31));
+        let keep =
+            previous.filter(|&p| p <= MAX_SNAP_LEVEL && grid(p) <= allowed && (p == 0 || grid(p) > 0.25 * allowed));
+        let level = match keep {
+            Some(p) => p,
+            None => (coarsest / allowed).log2().ceil().max(0.0) as u32,
+        };
+        if level > MAX_SNAP_LEVEL {
+            return Ok(unsnapped);
+        }
+        let spacing = grid(level);
         let eye = (camera.eye / spacing).round() * spacing;
         let moved = Camera {
             eye,
             target: camera.target + (eye - camera.eye),
             ..*camera
         };
-        Ok((moved, 0.5 * spacing))
+        Ok(Anchor {
+            camera: moved,
+            spacing,
+            level: Some(level),
+        })
     }
 }
 
@@ -154,6 +230,8 @@ impl LodSettings {
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct PlanKey {
     camera: Camera,
+    /// The snap grid's spacing (the region's margin depends on it).
+    spacing: f64,
     aspect: f64,
     settings: LodSettings,
     debug: DebugScalar,
@@ -172,6 +250,8 @@ pub struct LodFrame {
     pub upload: Vec<[f32; 4]>,
     /// What the current plan was made for (None: no plan yet).
     key: Option<PlanKey>,
+    /// The level of the last frame's snap grid ([`LodSettings::anchor`]).
+    snap_level: Option<u32>,
 }
 
 /// The per-type upper bound `I_s` of eq. 7.4. Surface type here is the
@@ -283,9 +363,12 @@ impl LodFrame {
         if !(4..=1024).contains(&n) {
             return Err(Error::invalid("sketch map size", format!("{n} (must be 4..=1024)")));
         }
-        let (anchored, cell) = settings.anchored_camera(field, camera)?;
+        let anchor = settings.anchor(field, camera, self.snap_level)?;
+        self.snap_level = anchor.level;
+        let (anchored, cell) = (anchor.camera, anchor.cell());
         let key = PlanKey {
             camera: anchored,
+            spacing: anchor.spacing,
             aspect,
             settings: *settings,
             debug,

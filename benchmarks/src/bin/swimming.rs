@@ -7,7 +7,8 @@
 //! DEM, forward and sideways; and the renderer's world-anchored plan
 //! (`LodSettings::snap`, `--lod-snap`, the §7.4.3/§7.4.5 remedy) against the
 //! plain per-frame warp. Besides the mean per-frame change it prints the
-//! worst single pair (the pop of a replan). The metric is defined in
+//! worst single pair (the pop of a replan), and per path the eye's height
+//! above the ground and the snap grids the height-adaptive plan used. The metric is defined in
 //! `src/terrain/swimming.rs` (`alpenglow::bench::measure_swimming`). No
 //! GPU needed.
 //!
@@ -17,7 +18,7 @@
 //! rows, in whole-terrain sketch texels; default 1, `--lod-snap 1`),
 //! `--warped-only` (leave out the uniform and world-static rows).
 
-use alpenglow::bench::{camera_path, measure_swimming, DebugScalar, LodFrame, Mesh, Swimming};
+use alpenglow::bench::{camera_path, measure_swimming, Anchor, DebugScalar, LodFrame, Mesh, Swimming};
 use alpenglow::{Camera, HeightField, LodMode, LodSettings, Scene};
 use alpenglow_bench::terrain::{jacksboro, low};
 use glam::{DVec2, DVec3};
@@ -150,6 +151,30 @@ fn main() -> alpenglow::Result<()> {
             ("sideways", DVec2::new(0.0, STEP * d0)),
         ] {
             let cameras = camera_path(start, step, frames);
+            // The eye's height above the ground along the path and the snap grids it gets.
+            let heights = cameras
+                .iter()
+                .map(|c| c.eye.z - alpenglow::bench::sample_bspline(&scene.heights, c.eye.x, c.eye.y));
+            let (low, high) = heights.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), h| (a.min(h), b.max(h)));
+            for &snap in &o.snaps {
+                let settings = LodSettings {
+                    snap,
+                    ..Default::default()
+                };
+                let mut grids: Vec<f64> = Vec::new();
+                let mut level = None;
+                for c in &cameras {
+                    let anchor: Anchor = settings.anchor(&scene.heights, c, level)?;
+                    level = anchor.level;
+                    if !grids.contains(&anchor.spacing) {
+                        grids.push(anchor.spacing);
+                    }
+                }
+                println!(
+                    "  {name} {path}: eye {low:.0}–{high:.0} m above the ground; snap {snap}: grids {:?} m",
+                    grids.iter().map(|g| format!("{g:.2}")).collect::<Vec<_>>()
+                );
+            }
             for (label, planner) in &planners {
                 let s = run(&scene.heights, &cameras, (width, height), *planner)?;
                 println!(

@@ -13,8 +13,11 @@ use glam::{DVec2, DVec3};
 
 use crate::io::heightmap::HeightField;
 use crate::random::SplitMix64;
+use crate::surface::bspline::sample_bspline;
 use crate::terrain::importance::Frustum;
-use crate::terrain::lod::{sketch_importance, DebugScalar, LodFrame, LodMode, LodSettings, ANCHORED_SNAP};
+use crate::terrain::lod::{
+    sketch_importance, DebugScalar, LodFrame, LodMode, LodSettings, ANCHORED_SNAP, DEFAULT_SNAP, HEIGHT_FACTOR,
+};
 use crate::terrain::procedural::ProceduralTerrain;
 use crate::terrain::swimming::{camera_path, measure, rasterize, shade, Mesh, Swimming};
 use crate::terrain::warp::{density_ratio, fraction_within};
@@ -277,6 +280,12 @@ fn anchored_plan_keeps_the_density_ratio() {
                 target: base.target + (eye - base.eye),
                 ..base
             };
+            let anchor = anchored.anchor(&field, &camera, None).expect("anchor");
+            println!(
+                "{name}: eye {:.0} m above the ground, grid {:.1} m",
+                eye.z - sample_bspline(&field, eye.x, eye.y),
+                anchor.spacing
+            );
             let fraction = |settings: &LodSettings| {
                 let mut frame = LodFrame::default();
                 frame
@@ -312,5 +321,71 @@ fn anchored_plan_keeps_the_density_ratio() {
             worst = worst.min(with);
         }
         assert!(worst >= 0.8, "{name}: only {:.1} % in [0.5, 1]", 100.0 * worst);
+    }
+}
+
+/// The snap grid adapts to the eye's height above the ground (module
+/// documentation of [`crate::terrain::lod`], "Height-adaptive grid"): an
+/// eye high above the ground gets the coarsest grid of the default snap,
+/// one 2 m above it a grid of at most `HEIGHT_FACTOR × 2 m` and a planned
+/// eye no lower than the ground under it, one under the ground (or with a snap of 0) none;
+/// a level is kept while the height allows it and is less than four times
+/// its grid, and a fresh plan picks the coarsest grid the height allows.
+#[test]
+fn snap_grid_follows_the_height_above_the_ground() {
+    let field = field();
+    let settings = LodSettings {
+        sketch_side: SKETCH,
+        snap: DEFAULT_SNAP,
+        ..Default::default()
+    };
+    let coarsest = DEFAULT_SNAP * field.extent().max_element() / (SKETCH - 1) as f64;
+    let at = |xy: DVec2, height: f64| {
+        let eye = xy.extend(sample_bspline(&field, xy.x, xy.y) + height);
+        Camera {
+            eye,
+            target: eye + DVec3::new(0.0, 1000.0, -80.0),
+            ..start(&field)
+        }
+    };
+    let mut random = SplitMix64(31);
+    for _ in 0..50 {
+        let xy = DVec2::new(random.next_f64(), random.next_f64()) * field.extent();
+        let high = settings.anchor(&field, &at(xy, 2.0 * coarsest), None).expect("anchor");
+        assert_eq!((high.spacing, high.level), (coarsest, Some(0)), "a flying eye");
+        let walking = at(xy, 2.0);
+        let low = settings.anchor(&field, &walking, None).expect("anchor");
+        assert!(
+            low.spacing <= HEIGHT_FACTOR * 2.0 && low.spacing > 0.5 * HEIGHT_FACTOR * 2.0,
+            "grid {} m for an eye 2 m up",
+            low.spacing
+        );
+        assert!(low.camera.eye.distance(walking.eye) <= 0.5 * 3f64.sqrt() * low.spacing + 1e-9);
+        let ground = sample_bspline(&field, xy.x, xy.y);
+        assert!(
+            low.camera.eye.z >= ground - 1e-9,
+            "the planned eye is no lower than the ground under the real one"
+        );
+        // Hysteresis: the last level kept while its grid is in [¼, 1] of what the height allows.
+        let level = low.level.expect("snapped");
+        let kept = settings.anchor(&field, &at(xy, 4.0), Some(level)).expect("anchor");
+        assert_eq!(kept.level, Some(level), "2 m's grid at 4 m");
+        let fresh = settings.anchor(&field, &at(xy, 4.0), None).expect("anchor");
+        assert!(
+            fresh.level.expect("snapped") < level,
+            "a fresh plan at 4 m takes a coarser grid"
+        );
+        let finer = settings.anchor(&field, &at(xy, 0.9), Some(level)).expect("anchor");
+        assert!(
+            finer.level.expect("snapped") > level,
+            "2 m's grid is too coarse at 0.9 m"
+        );
+        let under = at(xy, -1.0);
+        let unsnapped = |camera: &Camera, settings: &LodSettings| {
+            let anchor = settings.anchor(&field, camera, Some(level)).expect("anchor");
+            (anchor.spacing, anchor.level, anchor.camera) == (0.0, None, *camera)
+        };
+        assert!(unsnapped(&under, &settings), "an eye under the ground");
+        assert!(unsnapped(&walking, &LodSettings { snap: 0.0, ..settings }), "snap 0");
     }
 }
