@@ -260,12 +260,21 @@ fn pipeline_maps_of_the_default_view() {
     println!("detailed heights − atlas: rms {rms:.3} m, largest {worst:.3} m (bound {bound:.3} m)");
     assert!(worst <= bound + 1e-9, "detail {worst} m beyond its bound {bound} m");
 
-    let Some(dir) = std::env::var_os("ALPENGLOW_FIGURES").map(PathBuf::from) else {
-        return;
-    };
+    if let Some(dir) = std::env::var_os("ALPENGLOW_FIGURES").map(PathBuf::from) {
+        write_maps(&dir, &lod, &grid, &detailed);
+    }
+}
+
+/// Writes the maps of `lod` (sketch map, importance, Φ as colour), the
+/// warped `grid` (sketch grid coordinates) and the `detailed` geometry
+/// image into `dir`.
+fn write_maps(dir: &Path, lod: &LodFrame, grid: &[DVec2], detailed: &[DVec3]) {
+    let sketch = lod.sketch.as_ref().expect("sketch map");
+    let (n, importance, warped) = (sketch.n, &lod.importance, &lod.warp.positions);
+    let side = DETAILED_SIDE;
     let heights = range(&sketch.geometry, |p| p.z);
     write(
-        dir.as_path(),
+        dir,
         "sketch-map",
         &image(n, |k| [byte(unit(sketch.geometry[k].z, heights.0, heights.1)); 3]),
         n,
@@ -274,18 +283,18 @@ fn pipeline_maps_of_the_default_view() {
     let (lo, hi) = logs
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
-    write(&dir, "importance", &image(n, |k| heat(unit(logs[k], lo, hi))), n);
+    write(dir, "importance", &image(n, |k| heat(unit(logs[k], lo, hi))), n);
     write(
-        &dir,
+        dir,
         "sketch-geometry-image",
         &image(n, geometry_colours(warped, &sketch.geometry)),
         n,
     );
-    write(&dir, "warped-grid", &grid_lines(&grid, n, 512, 4), 512);
+    write(dir, "warped-grid", &grid_lines(grid, n, 512, 4), 512);
     write(
-        &dir,
+        dir,
         "detailed-geometry-image",
-        &image(side, geometry_colours(&detailed, &sketch.geometry)),
+        &image(side, geometry_colours(detailed, &sketch.geometry)),
         side,
     );
 }
