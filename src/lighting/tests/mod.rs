@@ -7,6 +7,7 @@ mod distant;
 mod figures;
 mod reference;
 mod sh_bands;
+mod sh_bands_figure;
 mod shadows;
 mod sky_cache;
 mod sky_hemisphere;

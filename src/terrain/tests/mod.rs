@@ -4,6 +4,7 @@
 mod compute_raster;
 mod detail_panels;
 mod ground;
+mod pipeline_figure;
 mod reversed_depth;
 mod swimming;
 mod terrain;
