@@ -80,8 +80,10 @@ pub const SPLAT_SINGLE_PASS_PREFIX: SpirV = spirv!("points/single_pass_prefix.co
 pub const SPLAT_SINGLE_PASS_RANGES: SpirV = spirv!("points/single_pass_ranges.comp");
 /// points.single_pass.radix<k>.count (§10.4), compute backend: each radix block's digit counts.
 pub const SPLAT_SINGLE_PASS_RADIX_COUNT: SpirV = spirv!("points/single_pass_radix_count.comp");
-/// points.single_pass.radix<k>.scan (§10.4), compute backend: each (digit, block)'s output position.
+/// points.single_pass.radix<k>.scan (§10.4), compute backend: each (block, digit)'s entries of the earlier blocks.
 pub const SPLAT_SINGLE_PASS_RADIX_SCAN: SpirV = spirv!("points/single_pass_radix_scan.comp");
+/// points.single_pass.radix<k>.starts (§10.4), compute backend: each digit's first output position.
+pub const SPLAT_SINGLE_PASS_RADIX_STARTS: SpirV = spirv!("points/single_pass_radix_starts.comp");
 /// points.single_pass.radix<k>.scatter (§10.4), compute backend: each block's entries, stably, to their positions.
 pub const SPLAT_SINGLE_PASS_RADIX_SCATTER: SpirV = spirv!("points/single_pass_radix_scatter.comp");
 /// points.single_pass.merge (§10.4), compute backend: per tile, its sorted slice merged front to back, shaded.

@@ -44,10 +44,12 @@
 //!    splat's entries (key, slot, the tile's 4×2-pixel blocks its bounding
 //!    box touches) written at positions fixed by the draws' order, none
 //!    past the entry buffer's capacity (their tiles marked cut, counted);
-//! 6. `points.single_pass.radix{k}.{count,scan,scatter}` ([`radix`]): a
-//!    stable LSD radix sort of the keys, 8 bits a pass (the tile index and
-//!    at least 12 bits of reach): equal keys keep draw order, so the sorted
-//!    entries are the same on every run;
+//! 6. `points.single_pass.radix{k}.{count,scan,starts,scatter}` ([`radix`]):
+//!    a stable LSD radix sort of the keys (the tile index and at least 12
+//!    bits of reach), digits of up to 12 bits (two passes at 512²), one
+//!    invocation per block of entries counting and scattering its own row:
+//!    equal keys keep draw order, so the sorted entries are the same on
+//!    every run;
 //! 7. `points.single_pass.ranges`: each tile's slice of the sorted entries
 //!    (where its tile index starts and ends) into its range words;
 //! 8. `points.single_pass.merge`: one workgroup per tile reads its slice of

@@ -132,7 +132,9 @@ pub(super) struct TileBins {
     groups: BufferId,
     /// A binned splat per slot: [`WORKGROUP_SIZE`] per workgroup of the binning passes.
     splats: BufferId,
-    /// Per (digit, radix block) of the capacity: a count, then a position.
+    /// Per radix block of the capacity a row of [`radix::DIGITS`] digit
+    /// counts (then the digit's entries of the earlier blocks), then each
+    /// digit's total (then its first output position).
     pub digits: BufferId,
     /// Tiles per row and per column.
     grid: [u32; 2],
@@ -206,7 +208,7 @@ pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
             "binned splats",
             BINNED_SPLAT_BYTES * u64::from(WORKGROUP_SIZE) * u64::from(group_capacity),
         ),
-        digits: buffer(graph, "splat tile digits", 4 * radix::DIGITS * blocks),
+        digits: buffer(graph, "splat tile digits", 4 * radix::DIGITS * (blocks + 1)),
         grid,
         capacity: entries,
         group_capacity,
