@@ -1,5 +1,5 @@
 #version 460
-// points.single_pass.radix<k>.count (dissertation §10.4;
+// points.single_pass.radix_serial<k>.count (dissertation §10.4;
 // glsl/include/single_pass_radix.glsl): one invocation per block of
 // RADIX_BLOCK consecutive entries (dispatched for the capacity; blocks past
 // the entries sorted return at once) counts the entries holding each value

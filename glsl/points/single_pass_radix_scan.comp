@@ -1,5 +1,5 @@
 #version 460
-// points.single_pass.radix<k>.scan (dissertation §10.4;
+// points.single_pass.radix_serial<k>.scan (dissertation §10.4;
 // glsl/include/single_pass_radix.glsl): one invocation per digit value
 // turns its column of the blocks' digit counts (block-major rows) into the
 // exclusive prefix over the blocks (the digit's entries of the earlier

@@ -1,5 +1,5 @@
 #version 460
-// points.single_pass.radix<k>.scatter (dissertation §10.4;
+// points.single_pass.radix_serial<k>.scatter (dissertation §10.4;
 // glsl/include/single_pass_radix.glsl): one invocation per block of
 // RADIX_BLOCK entries (dispatched for the capacity; blocks past the entries
 // sorted return at once) walks its entries in order and writes entry j of

@@ -1,5 +1,5 @@
 #version 460
-// points.single_pass.radix<k>.starts (dissertation §10.4;
+// points.single_pass.radix_serial<k>.starts (dissertation §10.4;
 // glsl/include/single_pass_radix.glsl): one workgroup turns the digits'
 // totals (after the blocks' rows) into each digit's first output position,
 // in place: each invocation sums a run of RADIX_DIGITS / 256 digits,
