@@ -333,6 +333,28 @@ mod tests {
         }
     }
 
+    /// The device picks its sort: lavapipe and llvmpipe (Mesa's CPU
+    /// drivers) the serial blocks, a GPU the shared runs; an override wins.
+    #[test]
+    fn the_device_type_picks_the_sort() {
+        let (ctx, _) = crate::test_support::validated_context();
+        let name = ctx.info().name.to_lowercase();
+        let mesa_cpu = name.contains("llvmpipe") || name.contains("lavapipe");
+        assert_eq!(ctx.is_cpu(), ctx.info().device_type == "CPU");
+        if mesa_cpu {
+            assert_eq!(RadixSort::for_device(&ctx), RadixSort::SerialBlocks, "{name}");
+        }
+        if !ctx.is_cpu() {
+            assert_eq!(RadixSort::for_device(&ctx), RadixSort::SharedRuns, "{name}");
+        }
+        let runs = with_radix_sort(RadixSort::SharedRuns, || RadixSort::for_device(&ctx));
+        assert_eq!(runs, RadixSort::SharedRuns);
+        assert_ne!(
+            RadixSort::SerialBlocks.pass_prefix(),
+            RadixSort::SharedRuns.pass_prefix()
+        );
+    }
+
     /// The digits buffer stays below the two entry buffers' 24 bytes per
     /// entry at every capacity up to the largest (2²⁴ entries): at 10⁷
     /// entries 80 MB for the serial blocks, 5 MB for the shared runs.
