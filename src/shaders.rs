@@ -78,12 +78,20 @@ pub const SPLAT_SINGLE_PASS_SCATTER: SpirV = spirv!("points/single_pass_scatter.
 pub const SPLAT_SINGLE_PASS_PREFIX: SpirV = spirv!("points/single_pass_prefix.comp");
 /// points.single_pass.ranges (§10.4), compute backend: each tile's slice of the sorted entries.
 pub const SPLAT_SINGLE_PASS_RANGES: SpirV = spirv!("points/single_pass_ranges.comp");
-/// points.single_pass.radix<k>.count (§10.4), compute backend: each radix block's digit counts.
+/// points.single_pass.radix_serial<k>.count (§10.4), compute backend, serial-blocks sort: each radix block's digit counts.
 pub const SPLAT_SINGLE_PASS_RADIX_COUNT: SpirV = spirv!("points/single_pass_radix_count.comp");
-/// points.single_pass.radix<k>.scan (§10.4), compute backend: each (digit, block)'s output position.
+/// points.single_pass.radix_serial<k>.scan (§10.4), compute backend: each (block, digit)'s entries of the earlier blocks.
 pub const SPLAT_SINGLE_PASS_RADIX_SCAN: SpirV = spirv!("points/single_pass_radix_scan.comp");
-/// points.single_pass.radix<k>.scatter (§10.4), compute backend: each block's entries, stably, to their positions.
+/// points.single_pass.radix_serial<k>.starts (§10.4), compute backend: each digit's first output position.
+pub const SPLAT_SINGLE_PASS_RADIX_STARTS: SpirV = spirv!("points/single_pass_radix_starts.comp");
+/// points.single_pass.radix_serial<k>.scatter (§10.4), compute backend: each block's entries, stably, to their positions.
 pub const SPLAT_SINGLE_PASS_RADIX_SCATTER: SpirV = spirv!("points/single_pass_radix_scatter.comp");
+/// points.single_pass.radix_runs<k>.count (§10.4), compute backend, shared-runs sort: each radix block's digit counts.
+pub const SPLAT_SINGLE_PASS_RADIX_RUNS_COUNT: SpirV = spirv!("points/single_pass_radix_runs_count.comp");
+/// points.single_pass.radix_runs<k>.scan (§10.4), compute backend, shared-runs sort: each (digit, block)'s output position.
+pub const SPLAT_SINGLE_PASS_RADIX_RUNS_SCAN: SpirV = spirv!("points/single_pass_radix_runs_scan.comp");
+/// points.single_pass.radix_runs<k>.scatter (§10.4), compute backend, shared-runs sort: each block's entries, stably, to their positions.
+pub const SPLAT_SINGLE_PASS_RADIX_RUNS_SCATTER: SpirV = spirv!("points/single_pass_radix_runs_scatter.comp");
 /// points.single_pass.merge (§10.4), compute backend: per tile, its sorted slice merged front to back, shaded.
 pub const SPLAT_SINGLE_PASS_TILE: SpirV = spirv!("points/single_pass_tile.comp");
 /// points.single_pass (§10.4): the interlock backend's fragment stage.

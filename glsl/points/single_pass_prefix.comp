@@ -22,7 +22,7 @@ layout(local_size_x = 256) in;
 
 layout(push_constant) uniform Push {
     uvec4 p;  // bins, tiles, capacity (entries), counter (0xffffffff: none)
-    uvec4 q;  // group buffer, groups of the frame's draws, splats of the draws not binned, key bits (whole radix digits)
+    uvec4 q;  // group buffer, groups of the frame's draws, splats of the draws not binned, key bits (whole bytes)
 } pc;
 
 shared uint s_sum[INVOCATIONS];

@@ -440,6 +440,12 @@ impl Context {
         &self.shared.info
     }
 
+    /// Whether the device is a CPU (`VK_PHYSICAL_DEVICE_TYPE_CPU`: lavapipe,
+    /// llvmpipe, SwiftShader), for techniques whose fastest form differs on one.
+    pub(crate) fn is_cpu(&self) -> bool {
+        self.shared.info.device_type == device_select::device_type_name(vk::PhysicalDeviceType::CPU)
+    }
+
     /// Alignment of a storage-buffer range's offset
     /// (`minStorageBufferOffsetAlignment`).
     pub fn storage_buffer_alignment(&self) -> u64 {

@@ -48,6 +48,8 @@ mod triangles;
 
 #[cfg(test)]
 pub(crate) use single_pass::with_entry_capacity;
+#[cfg(test)]
+pub(crate) use single_pass::{with_radix_sort, RadixSort};
 pub use stats::PointFrameStats;
 pub use technique::{PointRenderer, PointsFrame};
 

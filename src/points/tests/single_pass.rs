@@ -10,7 +10,8 @@
 //!   within [`BUNNY_FLIP`] (the modes blend the same kernels; they differ
 //!   only where surfaces meet within z_fuzzy);
 //! * the compute backend (tile-binned, §10.4) is deterministic: two renders
-//!   are byte-identical;
+//!   are byte-identical, and so are renders with either radix sort (a CPU
+//!   device's serial blocks, a GPU's shared runs);
 //! * a close-up with long tile lists (hundreds of entries per 8×8 tile,
 //!   many runs of the merge's walk) still matches the three-pass image;
 //! * an entry buffer too small for the frame drops whole tiles' lists,
@@ -211,16 +212,63 @@ fn single_pass_renders_are_byte_identical() {
     let [(a, stats), (b, _)] = [0, 1].map(|_| render_points(&scene, &camera, single_pass(), (160, 100)));
     eprintln!("{}", stats.summary());
     assert!(covered(&a) > 1000, "the bunny covers {} pixels", covered(&a));
+    assert_byte_identical(&a, &b, "two renders");
+}
+
+/// Asserts that `a` and `b` agree to the byte: colour, W, depth, normal, ids.
+fn assert_byte_identical(a: &FrameImages, b: &FrameImages, what: &str) {
     let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-    assert!(a.rgba8 == b.rgba8, "tone-mapped colour differs");
-    assert!(bits(&a.hdr) == bits(&b.hdr), "radiance differs");
+    assert!(a.rgba8 == b.rgba8, "{what}: tone-mapped colour differs");
+    assert!(bits(&a.hdr) == bits(&b.hdr), "{what}: radiance differs");
     assert!(
         bits(a.weight.as_ref().unwrap()) == bits(b.weight.as_ref().unwrap()),
-        "W differs"
+        "{what}: W differs"
     );
-    assert!(bits(&a.depth) == bits(&b.depth), "view depth differs");
-    assert!(bits(&a.normal) == bits(&b.normal), "normal differs");
-    assert!(a.class == b.class && a.instance == b.instance, "ids differ");
+    assert!(bits(&a.depth) == bits(&b.depth), "{what}: view depth differs");
+    assert!(bits(&a.normal) == bits(&b.normal), "{what}: normal differs");
+    assert!(a.class == b.class && a.instance == b.instance, "{what}: ids differ");
+}
+
+/// The two radix sorts (serial blocks with 12-bit digits, a CPU device's;
+/// shared runs with 8-bit digits, a GPU's) are stable sorts of the same
+/// keys, so every tile's list comes out in the same order and the images
+/// agree to the byte: the distant bunny, a close-up with long tile lists
+/// (several radix blocks; the operator is not commutative, so any
+/// reordering of equal keys would show), and an entry buffer that
+/// overflows (seven blocks; nearly every tile's list cut).
+#[test]
+fn both_radix_sorts_give_the_same_image() {
+    use crate::points::render::{with_entry_capacity, with_radix_sort, RadixSort};
+    let scene = bunny_scene();
+    let cases = [
+        ("distant", 0.5, (160, 100), None),
+        ("close-up", 0.3, (64, 64), None),
+        ("overflow", 0.5, (160, 100), Some(13_500)),
+    ];
+    for (what, distance, size, capacity) in cases {
+        let camera = bunny_camera(distance);
+        let render = |sort| {
+            with_radix_sort(sort, || match capacity {
+                Some(c) => with_entry_capacity(c, || render_points(&scene, &camera, single_pass(), size)),
+                None => render_points(&scene, &camera, single_pass(), size),
+            })
+        };
+        let (serial, serial_stats) = render(RadixSort::SerialBlocks);
+        let (runs, runs_stats) = render(RadixSort::SharedRuns);
+        eprintln!("{what}: {}", runs_stats.summary());
+        // The overflow keeps a few tiles (their lists fit below the capacity).
+        let least = if capacity.is_some() { 0 } else { 500 };
+        assert!(
+            covered(&runs) > least,
+            "{what}: the bunny covers {} pixels",
+            covered(&runs)
+        );
+        let counts = |s: &PointFrameStats| (s.drawn_splats, s.longest_tile_list, s.tile_entries_dropped);
+        assert_eq!(counts(&serial_stats), counts(&runs_stats), "{what}");
+        let dropped = runs_stats.tile_entries_dropped.expect("GPU counters");
+        assert_eq!(dropped > 0, capacity.is_some(), "{what}: {dropped} entries dropped");
+        assert_byte_identical(&serial, &runs, what);
+    }
 }
 
 /// A close-up at 64×64: long tile lists (over 512 entries in an 8×8 tile,

@@ -44,10 +44,15 @@
 //!    splat's entries (key, slot, the tile's 4×2-pixel blocks its bounding
 //!    box touches) written at positions fixed by the draws' order, none
 //!    past the entry buffer's capacity (their tiles marked cut, counted);
-//! 6. `points.single_pass.radix{k}.{count,scan,scatter}` ([`radix`]): a
-//!    stable LSD radix sort of the keys, 8 bits a pass (the tile index and
-//!    at least 12 bits of reach): equal keys keep draw order, so the sorted
-//!    entries are the same on every run;
+//! 6. `points.single_pass.radix_serial{k}.{count,scan,starts,scatter}` or
+//!    `points.single_pass.radix_runs{k}.{count,scan,scatter}` ([`radix`]):
+//!    a stable LSD radix sort of the keys (the tile index and at least 12
+//!    bits of reach); on a CPU device digits of up to 12 bits (two passes
+//!    at 512²), one invocation per block of entries counting and
+//!    scattering its own row, elsewhere 8-bit digits, a workgroup per
+//!    block ranking runs of entries in shared counters; the same sorted
+//!    entries either way: equal keys keep draw order, so they are the same
+//!    on every run and device;
 //! 7. `points.single_pass.ranges`: each tile's slice of the sorted entries
 //!    (where its tile index starts and ends) into its range words;
 //! 8. `points.single_pass.merge`: one workgroup per tile reads its slice of
@@ -73,6 +78,8 @@ mod tiles;
 
 use bytemuck::{Pod, Zeroable};
 
+#[cfg(test)]
+pub(crate) use radix::{with_radix_sort, RadixSort};
 #[cfg(test)]
 pub(crate) use tiles::with_entry_capacity;
 pub(super) use tiles::{entry_capacity, TileCapacity};
@@ -116,6 +123,20 @@ impl ResolvedPush {
         let (outputs, more) = targets.push(pass)?;
         Ok(ResolvedPush { outputs, more })
     }
+}
+
+/// Runs `f` with this thread's test override `key` set to `value`, then
+/// clears it (what the buffers and sorts of the views `f` declares take).
+#[cfg(test)]
+fn with_override<T: Copy + 'static, R>(
+    key: &'static std::thread::LocalKey<std::cell::Cell<Option<T>>>,
+    value: T,
+    f: impl FnOnce() -> R,
+) -> R {
+    key.with(|c| c.set(Some(value)));
+    let result = f();
+    key.with(|c| c.set(None));
+    result
 }
 
 /// Workgroups for `n` invocations of [`WORKGROUP_SIZE`]: (per row, rows).

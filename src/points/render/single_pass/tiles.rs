@@ -3,7 +3,8 @@
 //! deterministic. The passes are listed in the module doc of [`super`];
 //! the shaders are `glsl/points/single_pass_{bins_clear,bin,prefix,tile}.comp`
 //! with `glsl/include/single_pass_tiles.glsl` (layouts), and the radix sort's
-//! ([`radix`]) `glsl/points/single_pass_radix_{count,scan,scatter}.comp` with
+//! ([`radix`], one of two by device type: [`RadixSort`])
+//! `glsl/points/single_pass_radix{,_runs}_*.comp` with
 //! `glsl/include/single_pass_radix.glsl`.
 //!
 //! Capacity: the entry buffers hold [`entry_capacity`] entries, fixed when
@@ -30,7 +31,7 @@ use super::super::passes::{
     PASS_OPAQUE,
 };
 use super::super::PointsFrame;
-use super::radix::{self, RADIX_BLOCK};
+use super::radix::{self, RadixSort, RADIX_BLOCK};
 use super::{declare_clear, workgroups, ResolvedPush, SinglePassPush, ViewPasses, Written, WORKGROUP_SIZE};
 use crate::error::Result;
 use crate::graph::{Binding, BufferAccess, BufferId, BufferInfo, ImageAccess, PassContext, RenderGraph, Stage};
@@ -72,10 +73,7 @@ thread_local! {
 /// `capacity` entries (tests of the overflow).
 #[cfg(test)]
 pub(crate) fn with_entry_capacity<R>(capacity: u32, f: impl FnOnce() -> R) -> R {
-    CAPACITY_OVERRIDE.with(|c| c.set(Some(capacity)));
-    let result = f();
-    CAPACITY_OVERRIDE.with(|c| c.set(None));
-    result
+    super::with_override(&CAPACITY_OVERRIDE, capacity, f)
 }
 
 /// The tile entries of a view's entry buffers for a scene whose instances'
@@ -132,8 +130,11 @@ pub(super) struct TileBins {
     groups: BufferId,
     /// A binned splat per slot: [`WORKGROUP_SIZE`] per workgroup of the binning passes.
     splats: BufferId,
-    /// Per (digit, radix block) of the capacity: a count, then a position.
+    /// The radix sort's digit counts and positions
+    /// ([`RadixSort::digit_words`]; layouts in glsl/include/single_pass_radix.glsl).
     pub digits: BufferId,
+    /// Which radix sort orders the entries.
+    pub sort: RadixSort,
     /// Tiles per row and per column.
     grid: [u32; 2],
     pub capacity: u32,
@@ -192,6 +193,7 @@ pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
         graph.create_buffer(what, BufferInfo { size, location })
     };
     let blocks = u64::from(entries.div_ceil(RADIX_BLOCK));
+    let sort = RadixSort::for_device(ctx);
     let tiles = TileBins {
         bins: buffer(
             graph,
@@ -206,7 +208,8 @@ pub(super) fn declare<S: Provides<PointsFrame> + 'static>(
             "binned splats",
             BINNED_SPLAT_BYTES * u64::from(WORKGROUP_SIZE) * u64::from(group_capacity),
         ),
-        digits: buffer(graph, "splat tile digits", 4 * radix::DIGITS * blocks),
+        digits: buffer(graph, "splat tile digits", 4 * sort.digit_words(blocks)),
+        sort,
         grid,
         capacity: entries,
         group_capacity,
